@@ -1,0 +1,219 @@
+//! The f64 reference: every sampler, pdf and BRDF value the GPU kernels are judged against.
+//!
+//! Conventions: local frame with the normal on +z; ωi is the given incident direction and ωr
+//! the sampled one, both pointing away from the surface; every sampler takes its uniforms
+//! explicitly (u ∈ [0, 1], 1 included), so any sample can be reproduced one at a time.
+
+pub mod beckmann;
+pub mod discrete;
+pub mod ggx;
+pub mod microfacet;
+pub mod reflect;
+pub mod rng;
+pub mod ward;
+
+use beckmann::Beckmann;
+use ggx::Ggx;
+use glam::DVec3;
+use microfacet::{Microfacet, pdf_ndf, pdf_vndf};
+use serde::{Deserialize, Serialize};
+
+/// Which lobe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LobeKind {
+    Ward,
+    Beckmann,
+    Ggx,
+}
+
+/// How the half vector is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The lobe's own distribution: Ward's p(h), or D(h) cos θh for microfacets.
+    Ndf,
+    /// Visible normals: spherical caps for GGX, Heitz & d'Eon for Beckmann.
+    Vndf,
+    /// Bounded VNDF (Eto & Tokuyoshi 2023), GGX only.
+    Bounded,
+}
+
+impl LobeKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LobeKind::Ward => "ward",
+            LobeKind::Beckmann => "beckmann",
+            LobeKind::Ggx => "ggx",
+        }
+    }
+    /// Whether this lobe has a sampler for `method`.
+    pub fn supports(self, method: Method) -> bool {
+        match self {
+            LobeKind::Ward => method == Method::Ndf,
+            LobeKind::Beckmann => method != Method::Bounded,
+            LobeKind::Ggx => true,
+        }
+    }
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Ndf => "ndf",
+            Method::Vndf => "vndf",
+            Method::Bounded => "bounded",
+        }
+    }
+}
+
+/// Why a sample is not a usable reflected direction. Every invalid sample is counted under
+/// exactly one reason, checked in this order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Invalid {
+    /// ωr has a NaN or infinite component.
+    NonFiniteDirection,
+    /// ωr.z ≤ 0: the reflection left the upper hemisphere.
+    BelowHorizon,
+    /// p(ωr) is NaN or infinite.
+    NonFinitePdf,
+    /// p(ωr) ≤ 0.
+    ZeroPdf,
+}
+
+impl Invalid {
+    pub const ALL: [Invalid; 4] =
+        [Invalid::NonFiniteDirection, Invalid::BelowHorizon, Invalid::NonFinitePdf, Invalid::ZeroPdf];
+    pub fn name(self) -> &'static str {
+        match self {
+            Invalid::NonFiniteDirection => "non_finite_direction",
+            Invalid::BelowHorizon => "below_horizon",
+            Invalid::NonFinitePdf => "non_finite_pdf",
+            Invalid::ZeroPdf => "zero_pdf",
+        }
+    }
+    /// The code the GPU kernels use for this reason (`shaders/histogram.wgsl`).
+    pub fn code(self) -> u32 {
+        self as u32 + 1
+    }
+
+    /// Classifies a sampled direction and its density.
+    pub fn check(wr: DVec3, pdf_r: f64) -> Option<Invalid> {
+        if !wr.is_finite() {
+            Some(Invalid::NonFiniteDirection)
+        } else if wr.z <= 0.0 {
+            Some(Invalid::BelowHorizon)
+        } else if !pdf_r.is_finite() {
+            Some(Invalid::NonFinitePdf)
+        } else if pdf_r <= 0.0 {
+            Some(Invalid::ZeroPdf)
+        } else {
+            None
+        }
+    }
+}
+
+/// A reflectance lobe with its roughness and sampling method.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lobe {
+    pub kind: LobeKind,
+    pub method: Method,
+    pub alpha_x: f64,
+    pub alpha_y: f64,
+}
+
+/// One sample of a lobe.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LobeSample {
+    /// The half vector drawn.
+    pub h: DVec3,
+    /// The reflected direction ωr = 2(ωi·h)h − ωi.
+    pub omega_r: DVec3,
+    /// The density with which h was drawn, per unit solid angle.
+    pub pdf_h: f64,
+    /// p(ωr) = p(h) / (4 |ωr·h|), or the method's own reflected pdf (bounded VNDF).
+    pub pdf_r: f64,
+    /// `None` for a valid sample, else why it is not.
+    pub invalid: Option<Invalid>,
+}
+
+impl Lobe {
+    /// Draws a half vector and reflects ωi about it.
+    ///
+    /// ```
+    /// use lobes::reference::{Lobe, LobeKind, Method};
+    /// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3 };
+    /// let wi = lobes::reference::reflect::spherical(0.5, 0.0);
+    /// let s = lobe.sample(wi, [0.25, 0.5]);
+    /// assert!(s.invalid.is_none());
+    /// assert!((s.pdf_r - lobe.pdf_r(wi, s.omega_r)).abs() < 1e-9 * s.pdf_r);
+    /// ```
+    pub fn sample(&self, wi: DVec3, u: [f64; 2]) -> LobeSample {
+        let h = self.sample_h(wi, u);
+        let omega_r = reflect::reflect(wi, h);
+        let pdf_h = self.pdf_h(wi, h);
+        let pdf_r = match (self.kind, self.method) {
+            (LobeKind::Ggx, Method::Bounded) if omega_r.z > 0.0 => self.ggx().pdf_bounded_r(wi, h),
+            _ => reflect::pdf_reflected(pdf_h, omega_r, h),
+        };
+        LobeSample { h, omega_r, pdf_h, pdf_r, invalid: Invalid::check(omega_r, pdf_r) }
+    }
+
+    fn ggx(&self) -> Ggx {
+        Ggx { ax: self.alpha_x, ay: self.alpha_y }
+    }
+    fn beckmann(&self) -> Beckmann {
+        Beckmann { ax: self.alpha_x, ay: self.alpha_y }
+    }
+
+    /// The half vector for uniforms `u`.
+    pub fn sample_h(&self, wi: DVec3, u: [f64; 2]) -> DVec3 {
+        match (self.kind, self.method) {
+            (LobeKind::Ward, _) => ward::sample_h(self.alpha_x, self.alpha_y, u),
+            (LobeKind::Beckmann, Method::Ndf) => self.beckmann().sample_ndf(u),
+            (LobeKind::Beckmann, _) => self.beckmann().sample_vndf(wi, u),
+            (LobeKind::Ggx, Method::Ndf) => self.ggx().sample_ndf(u),
+            (LobeKind::Ggx, Method::Vndf) => self.ggx().sample_vndf(wi, u),
+            (LobeKind::Ggx, Method::Bounded) => self.ggx().sample_bounded(wi, u),
+        }
+    }
+
+    /// The density of h under this lobe's sampling method, per unit solid angle.
+    pub fn pdf_h(&self, wi: DVec3, h: DVec3) -> f64 {
+        match (self.kind, self.method) {
+            (LobeKind::Ward, _) => ward::pdf_h(self.alpha_x, self.alpha_y, h),
+            (LobeKind::Beckmann, Method::Ndf) => pdf_ndf(&self.beckmann(), h),
+            (LobeKind::Beckmann, _) => pdf_vndf(&self.beckmann(), wi, h),
+            (LobeKind::Ggx, Method::Ndf) => pdf_ndf(&self.ggx(), h),
+            (LobeKind::Ggx, Method::Vndf) => pdf_vndf(&self.ggx(), wi, h),
+            (LobeKind::Ggx, Method::Bounded) => {
+                let wr = reflect::reflect(wi, h);
+                if wr.z > 0.0 { self.ggx().pdf_bounded_r(wi, h) * 4.0 * wi.dot(h).abs() } else { 0.0 }
+            }
+        }
+    }
+
+    /// The density of a valid reflected direction ωr (above the horizon); 0 below it, where
+    /// samples are counted as invalid instead.
+    pub fn pdf_r(&self, wi: DVec3, wr: DVec3) -> f64 {
+        if wr.z <= 0.0 {
+            return 0.0;
+        }
+        let Some(h) = reflect::half_vector(wi, wr) else { return 0.0 };
+        match (self.kind, self.method) {
+            (LobeKind::Ggx, Method::Bounded) => self.ggx().pdf_bounded_r(wi, h),
+            _ => reflect::pdf_reflected(self.pdf_h(wi, h), wr, h),
+        }
+    }
+
+    /// The BRDF value f(ωi, ωr) without Fresnel: Ward's (ρs = 1), or the microfacet BRDF with
+    /// height-correlated Smith G2.
+    pub fn eval(&self, wi: DVec3, wr: DVec3) -> f64 {
+        match self.kind {
+            LobeKind::Ward => ward::eval(self.alpha_x, self.alpha_y, wi, wr),
+            LobeKind::Beckmann => microfacet::eval(&self.beckmann(), wi, wr),
+            LobeKind::Ggx => microfacet::eval(&self.ggx(), wi, wr),
+        }
+    }
+}
