@@ -8,3 +8,4 @@
 //!   `shaders/`.
 
 pub mod reference;
+pub mod report;
