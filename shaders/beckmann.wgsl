@@ -1,0 +1,153 @@
+// Beckmann; CPU twin: src/reference/beckmann.rs.
+// D(h) = exp(-(hx^2/ax^2 + hy^2/ay^2)/hz^2) / (pi ax ay hz^4)                 (Heitz 2014, eq. 71)
+// Lambda(w) = -erfc(a)/2 + exp(-a^2)/(2 a sqrt(pi)), a = wz/|(ax wx, ay wy)|  (Heitz 2014, eq. 72)
+// NDF sampling: tan th = a sqrt(-ln(1 - u1)), ph = 2 pi u2                      (Walter 2007, eqs. 28-29)
+// Visible normals: Heitz & d'Eon 2014 (slope-space CDF inversion), Newton steps as in Jakob 2014.
+
+const INV_SQRT_PI: f32 = 0.564189583547756;
+// A slope standing in for infinity (u at 0 or 1); from_tan_theta takes it to the horizon.
+const BIG_SLOPE: f32 = 1.0e15;
+
+// erfc with relative error < 1.2e-7 everywhere (Numerical Recipes, 2nd ed., section 6.2, "erfcc").
+fn erfc_approx(x: f32) -> f32 {
+    let z = abs(x);
+    let t = 1.0 / (1.0 + 0.5 * z);
+    var p = 0.17087277;
+    p = -0.82215223 + t * p;
+    p = 1.48851587 + t * p;
+    p = -1.13520398 + t * p;
+    p = 0.27886807 + t * p;
+    p = -0.18628806 + t * p;
+    p = 0.09678418 + t * p;
+    p = 0.37409196 + t * p;
+    p = 1.00002368 + t * p;
+    let r = t * exp(-z * z - 1.26551223 + t * p);
+    return select(2.0 - r, r, x >= 0.0);
+}
+
+// erfinv(2u - 1), Giles 2010 ("Approximating the erfinv function", single precision), with
+// (1 - x)(1 + x) formed as 4u(1 - u) so that no cancellation occurs near u = 0 or 1.
+fn erfinv_unit(u: f32) -> f32 {
+    if (u <= 0.0) {
+        return -BIG_SLOPE;
+    }
+    if (u >= 1.0) {
+        return BIG_SLOPE;
+    }
+    var w = -log(4.0 * u * (1.0 - u));
+    var p: f32;
+    if (w < 5.0) {
+        w = w - 2.5;
+        p = 2.81022636e-08;
+        p = 3.43273939e-07 + p * w;
+        p = -3.5233877e-06 + p * w;
+        p = -4.39150654e-06 + p * w;
+        p = 0.00021858087 + p * w;
+        p = -0.00125372503 + p * w;
+        p = -0.00417768164 + p * w;
+        p = 0.246640727 + p * w;
+        p = 1.50140941 + p * w;
+    } else {
+        w = sqrt(w) - 3.0;
+        p = -0.000200214257;
+        p = 0.000100950558 + p * w;
+        p = 0.00134934322 + p * w;
+        p = -0.00367342844 + p * w;
+        p = 0.00573950773 + p * w;
+        p = -0.0076224613 + p * w;
+        p = 0.00943887047 + p * w;
+        p = 1.00167406 + p * w;
+        p = 2.83297682 + p * w;
+    }
+    return p * (2.0 * u - 1.0);
+}
+
+fn beckmann_d(a: vec2<f32>, h: vec3<f32>) -> f32 {
+    if (h.z <= 0.0) {
+        return 0.0;
+    }
+    let q = h.xy / a;
+    let z2 = h.z * h.z;
+    return exp(-dot(q, q) / z2) / (PI * a.x * a.y * z2 * z2);
+}
+
+fn beckmann_g1(a: vec2<f32>, w: vec3<f32>) -> f32 {
+    let l = length(a * w.xy);
+    let c = abs(w.z);
+    if (c > 10.0 * l) {
+        return 1.0; // a > 10: Lambda < 1e-45
+    }
+    let x = c / l;
+    let lambda = -0.5 * erfc_approx(x) + exp(-x * x) * INV_SQRT_PI / (2.0 * x);
+    return 1.0 / (1.0 + lambda);
+}
+
+fn beckmann_sample_ndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
+    let phi = 2.0 * PI * u.y;
+    let d = a * vec2<f32>(cos(phi), sin(phi));
+    let len = length(d);
+    let h = from_tan_theta(sqrt(neg_ln(1.0 - u.x)) * len, d.x / len, d.y / len);
+    return reflect_sample(wi, h, beckmann_d(a, h) * h.z);
+}
+
+// Heitz & d'Eon 2014: unnormalised CDF of the visible slope, C(x) = erfc(-x)/2 + tan e^{-x^2}/(2 sqrt(pi)).
+fn beckmann_visible_cdf(x: f32, tan_t: f32) -> f32 {
+    return 0.5 * erfc_approx(-x) + 0.5 * tan_t * INV_SQRT_PI * exp(-x * x);
+}
+
+// The slope x with C(x) = u C(cot): Newton steps (C' = (1 - x tan) e^{-x^2}/sqrt(pi)) kept inside a
+// bisection bracket; [-6, 6] holds all but 1e-16 of the mass.
+fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
+    if (u <= 0.0) {
+        return -BIG_SLOPE;
+    }
+    var lo = -6.0;
+    var hi = 6.0;
+    if (tan_t > 1.0 / 6.0) {
+        hi = 1.0 / tan_t;
+    }
+    let goal = u * beckmann_visible_cdf(hi, tan_t);
+    var x = clamp(erfinv_unit(u), lo, hi);
+    for (var i = 0; i < 10; i++) {
+        let f = beckmann_visible_cdf(x, tan_t) - goal;
+        if (f > 0.0) {
+            hi = x;
+        } else {
+            lo = x;
+        }
+        let df = (1.0 - x * tan_t) * exp(-x * x) * INV_SQRT_PI;
+        var next = 0.5 * (lo + hi);
+        if (df > 1.0e-30) {
+            let newton = x - f / df;
+            if (newton > lo && newton < hi) {
+                next = newton;
+            }
+        }
+        x = next;
+    }
+    return x;
+}
+
+// Stretch, sample the alpha = 1 slopes, rotate by phi_i, unstretch; h = normalize(-slope, 1).
+fn beckmann_sample_vndf_h(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
+    let ws = stretch(a, wi);
+    let st = length(ws.xy);
+    var cs = vec2<f32>(1.0, 0.0);
+    if (st > 0.0) {
+        cs = ws.xy / st;
+    }
+    let x = beckmann_visible_slope(st / ws.z, u.x);
+    let y = erfinv_unit(u.y);
+    let sl = a * vec2<f32>(cs.x * x - cs.y * y, cs.y * x + cs.x * y);
+    let len = length(sl);
+    if (len == 0.0) {
+        return vec3<f32>(0.0, 0.0, 1.0);
+    }
+    return from_tan_theta(len, -sl.x / len, -sl.y / len);
+}
+
+// p(wr) = G1(wi) D(h) / (4 cos th_i).
+fn beckmann_sample_vndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
+    let h = beckmann_sample_vndf_h(a, wi, u);
+    return LobeSample(h, reflect_about(wi, h), beckmann_g1(a, wi) * beckmann_d(a, h) / (4.0 * wi.z));
+}

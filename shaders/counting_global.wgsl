@@ -1,0 +1,8 @@
+// Bin counting straight into the chunk's global counters, for histograms too large for the
+// adapter's workgroup storage.
+
+fn count_bin(bin: u32) {
+    atomicAdd(&counts[bin], 1u);
+}
+
+fn flush_bins(lid: u32) {}

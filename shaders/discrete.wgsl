@@ -1,0 +1,28 @@
+// Discrete 1D sampling; CPU twin: src/reference/discrete.rs.
+// The CDF (f64 prefix sums / total, rounded to f32 on the host) is inverted by binary search for the
+// first entry with cdf >= u and cdf > 0 (pbrt-v4 SampleDiscrete; the "> 0" keeps u = 0 off leading
+// zeros). The alias table is Walker's, built by Vose's method in f64 on the host.
+
+@group(0) @binding(3) var<storage, read> discrete_f: array<f32>; // CDF, or alias thresholds
+@group(0) @binding(4) var<storage, read> discrete_u: array<u32>; // alias indices
+
+fn discrete_sample_cdf(u: f32, n: u32, last_positive: u32) -> u32 {
+    var lo = 0u;
+    var hi = n;
+    while (lo < hi) {
+        let mid = lo + (hi - lo) / 2u;
+        let c = discrete_f[mid];
+        if (c >= u && c > 0.0) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return min(lo, last_positive);
+}
+
+// Column floor(u0 n) kept when u1 < threshold, else its alias.
+fn discrete_sample_alias(u: vec2<f32>, n: u32) -> u32 {
+    let column = min(u32(u.x * f32(n)), n - 1u);
+    return select(discrete_u[column], column, u.y < discrete_f[column]);
+}

@@ -1,0 +1,48 @@
+// Binning and exact counting; CPU twin: src/stats/histogram.rs.
+// The composing host prepends: ROWS, COLS, BINS (= ROWS * COLS, or the item count of a discrete
+// job), CELLS (= BINS + N_REASONS), and for the lobe kernels nothing else from here.
+// Cell layout: BINS bins, then one counter per invalid reason (codes 1..N_REASONS, in the order of
+// reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
+
+const N_REASONS: u32 = 4u;
+const REASON_NON_FINITE_DIRECTION: u32 = 1u;
+const REASON_BELOW_HORIZON: u32 = 2u;
+const REASON_NON_FINITE_PDF: u32 = 3u;
+const REASON_ZERO_PDF: u32 = 4u;
+const F32_MAX: f32 = 3.40282347e38;
+
+// x is neither NaN nor +-infinity (written without relying on IEEE comparisons of NaN being false).
+fn is_finite_f32(x: f32) -> bool {
+    let bits = bitcast<u32>(x);
+    return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
+// 0 for a valid sample, else the reason code; the order matches reference::Invalid::check.
+fn classify(wr: vec3<f32>, pdf: f32) -> u32 {
+    if (!(is_finite_f32(wr.x) && is_finite_f32(wr.y) && is_finite_f32(wr.z))) {
+        return REASON_NON_FINITE_DIRECTION;
+    }
+    if (wr.z <= 0.0) {
+        return REASON_BELOW_HORIZON;
+    }
+    if (!is_finite_f32(pdf)) {
+        return REASON_NON_FINITE_PDF;
+    }
+    if (pdf <= 0.0) {
+        return REASON_ZERO_PDF;
+    }
+    return 0u;
+}
+
+// Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over
+// [-pi, pi); phi = pi wraps to column 0, cos th = 1 falls in the top row.
+fn bin_of(w: vec3<f32>) -> u32 {
+    let z = clamp(w.z, -1.0, 1.0);
+    let row = min(u32((z + 1.0) * 0.5 * f32(ROWS)), ROWS - 1u);
+    let t = (atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
+    var col = u32(max(t, 0.0) * f32(COLS));
+    if (col >= COLS) {
+        col = 0u;
+    }
+    return row * COLS + col;
+}

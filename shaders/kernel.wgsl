@@ -1,0 +1,71 @@
+// The sampling-and-histogram kernels. The composing host (src/gpu/compose.rs) prepends the
+// constants (ROWS, COLS, BINS, CELLS, WG_WORDS, SAMPLES_PER_THREAD), the modules a job needs, and
+// `fn draw(index: vec2<u32>) -> u32`, which returns the bin of sample `index` or BINS + reason - 1.
+//
+// Counting is exact: per workgroup, bins are packed two to a u32 word of workgroup atomics
+// (16 bits each; a workgroup draws WG_SIZE * SAMPLES_PER_THREAD <= 65535 samples), flushed into
+// per-chunk u32 global counters (a chunk holds < 2^32 samples), which `fold` adds into 64-bit
+// totals (lo, hi pairs with carry) after every chunk.
+
+const WG_SIZE: u32 = 256u;
+
+struct Params {
+    seed: vec2<u32>,
+    base: vec2<u32>,
+    count: u32,
+    n_items: u32,
+    last_positive: u32,
+    _pad0: u32,
+    alpha: vec2<f32>,
+    _pad1: vec2<f32>,
+    wi: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read_write> counts: array<atomic<u32>>;
+@group(0) @binding(2) var<storage, read_write> totals: array<vec2<u32>>;
+@group(0) @binding(5) var<storage, read_write> directions_out: array<vec4<f32>>;
+
+fn flat_group(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return wg.x + wg.y * nwg.x;
+}
+
+@compute @workgroup_size(256)
+fn sample_histogram(
+    @builtin(local_invocation_index) lid: u32,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+) {
+    let first = flat_group(wg, nwg) * (WG_SIZE * SAMPLES_PER_THREAD);
+    var invalid = array<u32, N_REASONS>(0u, 0u, 0u, 0u);
+    for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
+        let local = first + k * WG_SIZE + lid;
+        if (local < params.count) {
+            let cell = draw(add64(params.base, local));
+            if (cell < BINS) {
+                count_bin(cell);
+            } else {
+                invalid[cell - BINS] += 1u;
+            }
+        }
+    }
+    flush_bins(lid);
+    for (var r = 0u; r < N_REASONS; r++) {
+        if (invalid[r] != 0u) {
+            atomicAdd(&counts[BINS + r], invalid[r]);
+        }
+    }
+}
+
+// totals[i] += counts[i] with carry into the high word; counts[i] = 0.
+@compute @workgroup_size(256)
+fn fold(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * WG_SIZE;
+    if (i >= CELLS) {
+        return;
+    }
+    let c = atomicExchange(&counts[i], 0u);
+    let t = totals[i];
+    let lo = t.x + c;
+    totals[i] = vec2<u32>(lo, t.y + select(0u, 1u, lo < t.x));
+}

@@ -1,0 +1,28 @@
+// Glue for a lobe job: SAMPLE_FN is replaced by the composing host with the sampler of the case's
+// lobe and method (ward_sample, ggx_sample_ndf, ggx_sample_vndf, ggx_sample_bounded,
+// beckmann_sample_ndf, beckmann_sample_vndf), all of signature (alpha, wi, u) -> LobeSample.
+
+fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
+    let u = rng_uniforms(params.seed, index);
+    return SAMPLE_FN(params.alpha, params.wi.xyz, u.xy);
+}
+
+fn draw(index: vec2<u32>) -> u32 {
+    let s = lobe_sample_at(index);
+    let reason = classify(s.wr, s.pdf_r);
+    if (reason != 0u) {
+        return BINS + reason - 1u;
+    }
+    return bin_of(s.wr);
+}
+
+// Writes (wr, reason code) of samples base .. base + count, for the per-sample check against f64.
+@compute @workgroup_size(256)
+fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.count) {
+        return;
+    }
+    let s = lobe_sample_at(add64(params.base, i));
+    directions_out[i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
+}

@@ -1,0 +1,59 @@
+// The half-vector -> reflected-direction change of variables; CPU twin: src/reference/reflect.rs.
+// wr = 2 (wi.h) h - wi and p(wr) = p(h) / (4 |wr.h|) (tutorial part 2; Walter et al. 2007, eq. 14).
+
+const PI: f32 = 3.14159265358979;
+
+struct LobeSample {
+    h: vec3<f32>,
+    wr: vec3<f32>,
+    pdf_r: f32,
+}
+
+fn reflect_about(wi: vec3<f32>, h: vec3<f32>) -> vec3<f32> {
+    return 2.0 * dot(wi, h) * h - wi;
+}
+
+// A LobeSample from a half vector and its density p(h): p(wr) = p(h) / (4 |wr.h|).
+fn reflect_sample(wi: vec3<f32>, h: vec3<f32>, pdf_h: f32) -> LobeSample {
+    let wr = reflect_about(wi, h);
+    return LobeSample(h, wr, pdf_h / (4.0 * abs(dot(wr, h))));
+}
+
+// Unit vector with polar tangent t and unit azimuth (c, s): cos = 1/sqrt(1+t^2), sin = t cos.
+// Past t = 1e18 (t^2 would overflow f32) cos = 1/t and sin = 1, the same limit without inf.
+fn from_tan_theta(t: f32, c: f32, s: f32) -> vec3<f32> {
+    var ct: f32;
+    var st: f32;
+    if (t > 1.0e18) {
+        ct = 1.0 / t;
+        st = 1.0;
+    } else {
+        ct = inverseSqrt(1.0 + t * t);
+        st = t * ct;
+    }
+    return vec3<f32>(st * c, st * s, ct);
+}
+
+// -ln u. For u > 1/2, ln u = 2 atanh(s) with s = (u - 1)/(u + 1), |s| <= 1/3, summed as its
+// series 2 s (1 + s^2/3 + s^4/5 + ...) to 9 terms: full f32 relative precision near u = 1,
+// where the builtin log only promises an absolute error of 2^-21. u = 0 gives 3e38 ("infinity").
+fn neg_ln(u: f32) -> f32 {
+    if (u <= 0.0) {
+        return 3.0e38;
+    }
+    if (u <= 0.5) {
+        return -log(u);
+    }
+    let s = (u - 1.0) / (u + 1.0);
+    let s2 = s * s;
+    var p = 1.0 / 17.0;
+    p = p * s2 + 1.0 / 15.0;
+    p = p * s2 + 1.0 / 13.0;
+    p = p * s2 + 1.0 / 11.0;
+    p = p * s2 + 1.0 / 9.0;
+    p = p * s2 + 1.0 / 7.0;
+    p = p * s2 + 1.0 / 5.0;
+    p = p * s2 + 1.0 / 3.0;
+    p = p * s2 + 1.0;
+    return -2.0 * s * p;
+}

@@ -1,0 +1,113 @@
+//! Composes the WGSL module of a job from the files in `shaders/`, holding only the code the
+//! job needs, and validates it with naga before any pipeline is made.
+
+use super::context::GpuError;
+use crate::job::{DiscreteMethod, Job};
+use crate::reference::{LobeKind, Method};
+
+/// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
+/// `src/stats`).
+pub mod sources {
+    pub const RNG: &str = include_str!("../../shaders/rng.wgsl");
+    pub const REFLECT: &str = include_str!("../../shaders/reflect.wgsl");
+    pub const WARD: &str = include_str!("../../shaders/ward.wgsl");
+    pub const MICROFACET: &str = include_str!("../../shaders/microfacet.wgsl");
+    pub const GGX: &str = include_str!("../../shaders/ggx.wgsl");
+    pub const BECKMANN: &str = include_str!("../../shaders/beckmann.wgsl");
+    pub const DISCRETE: &str = include_str!("../../shaders/discrete.wgsl");
+    pub const HISTOGRAM: &str = include_str!("../../shaders/histogram.wgsl");
+    pub const KERNEL: &str = include_str!("../../shaders/kernel.wgsl");
+    pub const COUNTING_WORKGROUP: &str = include_str!("../../shaders/counting_workgroup.wgsl");
+    pub const COUNTING_GLOBAL: &str = include_str!("../../shaders/counting_global.wgsl");
+    pub const LOBE_KERNEL: &str = include_str!("../../shaders/lobe_kernel.wgsl");
+}
+
+/// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
+/// under the 65535 that a 16-bit packed workgroup counter holds.
+pub const SAMPLES_PER_THREAD: u32 = 64;
+pub const WG_SIZE: u32 = 256;
+const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
+
+/// The WGSL sampler function of a lobe and method.
+pub fn sample_fn(kind: LobeKind, method: Method) -> &'static str {
+    match (kind, method) {
+        (LobeKind::Ward, _) => "ward_sample",
+        (LobeKind::Beckmann, Method::Ndf) => "beckmann_sample_ndf",
+        (LobeKind::Beckmann, _) => "beckmann_sample_vndf",
+        (LobeKind::Ggx, Method::Ndf) => "ggx_sample_ndf",
+        (LobeKind::Ggx, Method::Vndf) => "ggx_sample_vndf",
+        (LobeKind::Ggx, Method::Bounded) => "ggx_sample_bounded",
+    }
+}
+
+/// The modules a lobe needs, in order.
+fn lobe_modules(kind: LobeKind) -> &'static [&'static str] {
+    match kind {
+        LobeKind::Ward => &[sources::WARD],
+        LobeKind::Beckmann => &[sources::MICROFACET, sources::BECKMANN],
+        LobeKind::Ggx => &[sources::MICROFACET, sources::GGX],
+    }
+}
+
+/// The composed WGSL of `job`, counting in workgroup memory when `ceil(bins / 2)` words fit in
+/// `workgroup_words`, else in global memory.
+pub fn compose(job: &Job, workgroup_words: u32) -> String {
+    let bins = job.bins() as u32;
+    let (rows, cols) = match job {
+        Job::Lobe { grid, .. } => (grid.rows, grid.cols),
+        Job::Discrete { .. } => (1, bins),
+    };
+    let wg_words = bins.div_ceil(2);
+    let in_workgroup = wg_words <= workgroup_words;
+    let mut src = format!(
+        "// Composed by lobes for {}\n\
+         const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
+         const CELLS: u32 = BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
+         const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n\n",
+        describe(job)
+    );
+    let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
+    for part in [sources::RNG, sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting] {
+        src.push_str(part);
+        src.push('\n');
+    }
+    match job {
+        Job::Lobe { lobe, .. } => {
+            for part in lobe_modules(lobe.kind) {
+                src.push_str(part);
+                src.push('\n');
+            }
+            src.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", sample_fn(lobe.kind, lobe.method)));
+        }
+        Job::Discrete { method, .. } => {
+            src.push_str(sources::DISCRETE);
+            let call = match method {
+                DiscreteMethod::Cdf => "discrete_sample_cdf(u.x, params.n_items, params.last_positive)",
+                DiscreteMethod::Alias => "discrete_sample_alias(u.xy, params.n_items)",
+            };
+            src.push_str(&format!(
+                "\nfn draw(index: vec2<u32>) -> u32 {{\n    let u = rng_uniforms(params.seed, index);\n    return {call};\n}}\n"
+            ));
+        }
+    }
+    src
+}
+
+/// "ggx vndf", "discrete cdf (10 items)".
+pub fn describe(job: &Job) -> String {
+    match job {
+        Job::Lobe { lobe, .. } => format!("{} {}", lobe.kind.name(), lobe.method.name()),
+        Job::Discrete { dist, method } => format!("discrete {method:?} ({} items)", dist.len()).to_lowercase(),
+    }
+}
+
+/// Parses and validates a composed module with naga, so that a broken composition is a clear
+/// error rather than a wgpu panic.
+pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&module)
+        .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
+    Ok(module)
+}

@@ -1,0 +1,78 @@
+//! Adapter and device: the one place that talks to wgpu's instance.
+
+use thiserror::Error;
+
+/// Why no GPU could be used.
+#[derive(Debug, Error)]
+pub enum GpuError {
+    #[error(
+        "no GPU adapter found ({0}). On Debian/Ubuntu install Mesa's software Vulkan driver: \
+         `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe), or a vendor driver"
+    )]
+    NoAdapter(String),
+    #[error("the adapter '{adapter}' refused a device: {source}")]
+    Device { adapter: String, source: wgpu::RequestDeviceError },
+    #[error("shader for {what} failed naga validation: {message}")]
+    Shader { what: String, message: String },
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+    #[error("the GPU device was lost or ran out of memory: {0}")]
+    Lost(String),
+}
+
+/// A wgpu device and what its adapter offers.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+    pub features: wgpu::Features,
+}
+
+impl Gpu {
+    /// Opens the default adapter (honouring WGPU_BACKEND, WGPU_ADAPTER_NAME, WGPU_POWER_PREF),
+    /// asking for its full limits (lavapipe offers 32 KiB of workgroup storage where wgpu's
+    /// default is 16 KiB) and for timestamp queries where it has them.
+    pub fn new() -> Result<Self, GpuError> {
+        Self::with_limits(|adapter| adapter)
+    }
+
+    /// As [`Gpu::new`], with the adapter's limits passed through `shrink` first: tests use it to
+    /// impose small limits and prove that work is split to fit them.
+    pub fn with_limits(shrink: impl FnOnce(wgpu::Limits) -> wgpu::Limits) -> Result<Self, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        if std::env::var_os("WGPU_BACKEND").is_none() {
+            desc.backends = wgpu::Backends::PRIMARY;
+        }
+        let instance = wgpu::Instance::new(desc);
+        let options = wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::from_env().unwrap_or(wgpu::PowerPreference::HighPerformance),
+            ..Default::default()
+        };
+        let adapter = pollster::block_on(instance.request_adapter(&options))
+            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let info = adapter.get_info();
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let limits = shrink(adapter.limits());
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("lobes"),
+            required_features: features,
+            required_limits: limits.clone(),
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
+        Ok(Self { device, queue, info, limits, features })
+    }
+
+    /// "name (backend, driver)" for reports.
+    pub fn adapter_name(&self) -> String {
+        format!("{} ({:?}, {} {})", self.info.name, self.info.backend, self.info.driver, self.info.driver_info)
+            .trim()
+            .to_string()
+    }
+
+    pub fn has_timestamps(&self) -> bool {
+        self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+}

@@ -1,0 +1,8 @@
+//! The GPU engine: WGSL kernels (composed from `shaders/`) run through wgpu.
+
+pub mod compose;
+pub mod context;
+pub mod engine;
+
+pub use context::{Gpu, GpuError};
+pub use engine::{Chunking, GpuEngine, GpuRun};

@@ -1,0 +1,85 @@
+//! What a histogram run samples, and what it returns. Shared by the GPU engine ([`crate::gpu`])
+//! and the CPU reference engine ([`crate::cpu`]).
+
+use crate::reference::discrete::{AliasTable, Distribution};
+use crate::reference::{Invalid, Lobe};
+use crate::stats::histogram::SphereGrid;
+use glam::DVec3;
+
+/// How a discrete job samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DiscreteMethod {
+    Cdf,
+    Alias,
+}
+
+/// A sampling job: a lobe seen from one incident direction, or a discrete distribution.
+#[derive(Debug, Clone)]
+pub enum Job {
+    Lobe { lobe: Lobe, incident: DVec3, grid: SphereGrid },
+    Discrete { dist: Distribution, method: DiscreteMethod },
+}
+
+impl Job {
+    /// The number of bins: rows · cols, or the number of items.
+    pub fn bins(&self) -> usize {
+        match self {
+            Job::Lobe { grid, .. } => grid.bins(),
+            Job::Discrete { dist, .. } => dist.len(),
+        }
+    }
+
+    /// Draws sample `index` of the run keyed by `seed` in f64 and returns its cell: a bin, or
+    /// `bins + reason code − 1` for an invalid sample (the layout of the GPU counters).
+    pub fn cell_f64(&self, seed: u64, index: u64, alias: Option<&AliasTable>) -> usize {
+        let u = crate::reference::rng::uniforms(seed, index);
+        match self {
+            Job::Lobe { lobe, incident, grid } => {
+                let s = lobe.sample(*incident, [u[0], u[1]]);
+                match s.invalid {
+                    None => grid.bin_of(s.omega_r),
+                    Some(r) => self.bins() + r.code() as usize - 1,
+                }
+            }
+            Job::Discrete { dist, method: DiscreteMethod::Cdf } => dist.sample_cdf(u[0]).index,
+            Job::Discrete { method: DiscreteMethod::Alias, .. } => {
+                alias.expect("alias table built by the caller").sample(u[0], u[1]).index
+            }
+        }
+    }
+}
+
+/// The raw result of a run: exact 64-bit counts per bin and per invalid reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Counts {
+    pub bins: Vec<u64>,
+    /// Indexed like [`Invalid::ALL`].
+    pub invalid: [u64; 4],
+}
+
+impl Counts {
+    pub fn zeros(bins: usize) -> Self {
+        Self { bins: vec![0; bins], invalid: [0; 4] }
+    }
+    /// Splits a cell vector (bins followed by the reasons) as laid out by the kernels.
+    pub fn from_cells(cells: &[u64]) -> Self {
+        let n = cells.len() - 4;
+        Self { bins: cells[..n].to_vec(), invalid: [cells[n], cells[n + 1], cells[n + 2], cells[n + 3]] }
+    }
+    pub fn total(&self) -> u64 {
+        self.bins.iter().sum::<u64>() + self.invalid.iter().sum::<u64>()
+    }
+    pub fn invalid_count(&self, reason: Invalid) -> u64 {
+        self.invalid[reason.code() as usize - 1]
+    }
+    /// Adds another run's counts (shards of one run add exactly).
+    pub fn add(&mut self, other: &Counts) {
+        for (a, b) in self.bins.iter_mut().zip(&other.bins) {
+            *a += b;
+        }
+        for (a, b) in self.invalid.iter_mut().zip(&other.invalid) {
+            *a += b;
+        }
+    }
+}

@@ -1,0 +1,143 @@
+//! Pearson's χ² test of a histogram against expected counts, with the pooling of sparse cells
+//! used by Mitsuba 3's `ChiSquareTest` and pbrt-v4's BSDF tests.
+
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Cells whose expected count is below this are pooled (Mitsuba 3, pbrt-v4: 5).
+pub const MIN_EXPECTED: f64 = 5.0;
+
+/// The outcome of a χ² test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Chi2 {
+    pub statistic: f64,
+    pub dof: u64,
+    pub p_value: f64,
+    /// The per-case significance level the p-value was compared with.
+    pub significance: f64,
+    pub passed: bool,
+    /// Observed samples in cells whose expected count is exactly 0 (any rejects the sampler).
+    pub in_impossible_cells: u64,
+}
+
+/// Šidák's correction: the per-test level that keeps the family-wise level `alpha` over `tests`
+/// independent tests, 1 − (1 − α)^{1/m}.
+pub fn sidak(alpha: f64, tests: usize) -> f64 {
+    1.0 - (1.0 - alpha).powf(1.0 / tests.max(1) as f64)
+}
+
+/// The upper tail P(X ≥ x) of the χ² distribution with `dof` degrees of freedom.
+pub fn p_value(statistic: f64, dof: u64) -> f64 {
+    if dof == 0 {
+        return 1.0;
+    }
+    ChiSquared::new(dof as f64).expect("dof > 0").sf(statistic)
+}
+
+/// Pearson's test. Cells are sorted by expected count; those with expected < 5 are summed into
+/// a pool, and a pooled cell is emitted each time the pool's expected count reaches 5 (Mitsuba 3);
+/// a final pool below 5 is merged into the last emitted cell. Observed counts in cells with
+/// expected exactly 0 reject outright. dof = cells − 1 (the total is fixed).
+///
+/// ```
+/// let t = lobes::stats::chi2::test(&[10, 20, 30], &[10.0, 20.0, 30.0], 0.01);
+/// assert_eq!((t.statistic, t.dof, t.passed), (0.0, 2, true));
+/// ```
+pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
+    assert_eq!(observed.len(), expected.len());
+    let mut order: Vec<usize> = (0..expected.len()).collect();
+    order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
+    let mut cells: Vec<(f64, f64)> = Vec::new();
+    let (mut pool_o, mut pool_e) = (0.0, 0.0);
+    let mut impossible = 0;
+    for i in order {
+        let (o, e) = (observed[i] as f64, expected[i]);
+        if e <= 0.0 {
+            impossible += observed[i];
+        } else if e < MIN_EXPECTED {
+            pool_o += o;
+            pool_e += e;
+            if pool_e >= MIN_EXPECTED {
+                cells.push((pool_o, pool_e));
+                (pool_o, pool_e) = (0.0, 0.0);
+            }
+        } else {
+            cells.push((o, e));
+        }
+    }
+    if pool_e > 0.0 {
+        match cells.first_mut() {
+            // the cells are in increasing order of expectation; the smallest absorbs the rest
+            Some(c) => {
+                c.0 += pool_o;
+                c.1 += pool_e;
+            }
+            None => cells.push((pool_o, pool_e)),
+        }
+    }
+    let statistic: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
+    let dof = cells.len().saturating_sub(1) as u64;
+    let p = if impossible > 0 { 0.0 } else { p_value(statistic, dof) };
+    Chi2 { statistic, dof, p_value: p, significance, passed: p >= significance, in_impossible_cells: impossible }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed form for even dof 2k: P(X ≥ x) = e^{−x/2} Σ_{j<k} (x/2)^j / j!.
+    fn sf_even(x: f64, dof: u64) -> f64 {
+        let (h, mut term, mut sum) = (x / 2.0, 1.0, 0.0);
+        for j in 0..dof / 2 {
+            if j > 0 {
+                term *= h / j as f64;
+            }
+            sum += term;
+        }
+        (-h).exp() * sum
+    }
+
+    #[test]
+    fn p_values_match_closed_forms_and_tables() {
+        for dof in [2, 4, 10, 50, 200] {
+            for x in [0.5, 3.0, dof as f64, 2.0 * dof as f64 + 20.0] {
+                let (got, want) = (p_value(x, dof), sf_even(x, dof));
+                assert!((got - want).abs() <= 1e-10 * want.max(1e-300) + 1e-15, "dof {dof} x {x}: {got} vs {want}");
+            }
+        }
+        // Published critical values (Abramowitz & Stegun table 26.8): P = 0.05 and 0.01 points.
+        assert!((p_value(3.841458820694124, 1) - 0.05).abs() < 1e-12);
+        assert!((p_value(18.307038053275146, 10) - 0.05).abs() < 1e-12);
+        assert!((p_value(6.634896601021214, 1) - 0.01).abs() < 1e-12);
+        assert!((p_value(124.342, 100) - 0.05).abs() < 1e-4);
+        // the tail, not the CDF: large statistics give small p
+        assert!(p_value(1000.0, 10) < 1e-100);
+        assert!(p_value(0.0, 10) == 1.0);
+    }
+
+    #[test]
+    fn sidak_level() {
+        assert!((sidak(0.01, 1) - 0.01).abs() < 1e-15);
+        let a = sidak(0.01, 20);
+        assert!(((1.0 - a).powi(20) - 0.99).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pooling_and_impossible_cells() {
+        // three cells of expectation 2 pool into one of 6: dof = 2 with the two big cells
+        let t = test(&[2, 2, 2, 50, 50], &[2.0, 2.0, 2.0, 50.0, 50.0], 0.01);
+        assert_eq!(t.dof, 2);
+        assert_eq!(t.statistic, 0.0);
+        let t = test(&[1, 100], &[0.0, 101.0], 0.01);
+        assert_eq!((t.in_impossible_cells, t.passed), (1, false));
+    }
+
+    #[test]
+    fn rejects_a_shifted_histogram() {
+        let e = vec![1000.0; 20];
+        let mut o = vec![1000u64; 20];
+        o[0] = 1200;
+        o[1] = 800;
+        assert!(!test(&o, &e, 0.01).passed);
+    }
+}

@@ -1,0 +1,5 @@
+//! Statistics: binning, expected counts by quadrature, and the χ² test.
+
+pub mod chi2;
+pub mod expected;
+pub mod histogram;
