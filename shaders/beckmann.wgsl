@@ -119,7 +119,7 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
         var next = 0.5 * (lo + hi);
         if (df > 1.0e-30) {
             let newton = x - f / df;
-            if (newton > lo && newton < hi) {
+            if (newton >= lo && newton <= hi) {
                 next = newton;
             }
         }

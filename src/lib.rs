@@ -6,6 +6,8 @@
 //!
 //! - [`reference`]: the f64 math, one module per lobe, each the twin of a WGSL file in
 //!   `shaders/`.
+//! - [`cli`]: the `lobes` command line (argument parsing, validation, subcommands).
 
+pub mod cli;
 pub mod reference;
 pub mod report;

@@ -50,10 +50,13 @@ pub fn sample_visible_slope_x(tan_t: f64, u: f64) -> f64 {
     }
     for _ in 0..200 {
         let f = visible_slope_cdf(x, tan_t) - target;
+        if f == 0.0 {
+            return x;
+        }
         if f > 0.0 { hi = x } else { lo = x }
         let df = (1.0 - x * tan_t) * (-x * x).exp() * INV_SQRT_PI;
         let newton = x - f / df;
-        let next = if newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        let next = if newton >= lo && newton <= hi { newton } else { 0.5 * (lo + hi) };
         if next == x || hi - lo <= 4.0 * f64::EPSILON * x.abs().max(1e-300) {
             return next;
         }
@@ -92,17 +95,22 @@ impl Microfacet for Beckmann {
         let (cp, sp) = if sin_t > 0.0 { (ws.x / sin_t, ws.y / sin_t) } else { (1.0, 0.0) };
         let x = sample_visible_slope_x(tan_t, u[0]);
         let y = erf_inv((2.0 * u[1] - 1.0).clamp(-1.0, 1.0));
+        if !x.is_finite() || !y.is_finite() {
+            // x = −∞ (u1 = 0) and/or |y| = ∞ (u2 ∈ {0, 1}): the slope is infinite and the normal
+            // lies on the horizon, in the direction of the infinite components, rotated by φi and
+            // unstretched. Taken before the rotation below, where 0·∞ (φi on an axis, e.g. at
+            // normal incidence) or ∞ − ∞ (x and y both infinite) would give NaN.
+            let inf = |v: f64| if v.is_infinite() { v.signum() } else { 0.0 };
+            let (fx, fy) = (inf(x), inf(y));
+            let (dx, dy) = (self.ax * (cp * fx - sp * fy), self.ay * (sp * fx + cp * fy));
+            let l = dx.hypot(dy);
+            return DVec3::new(-dx / l, -dy / l, 0.0);
+        }
         // rotate by φi, unstretch; h ∝ (−slope_x, −slope_y, 1)
         let (sx, sy) = (self.ax * (cp * x - sp * y), self.ay * (sp * x + cp * y));
         let len = sx.hypot(sy);
         if len == 0.0 {
             return DVec3::Z;
-        }
-        if !len.is_finite() {
-            // x = −∞ (u1 = 0) or |y| = ∞ (u2 ∈ {0, 1}): the normal lies on the horizon.
-            let (fx, fy) = (if sx.is_infinite() { sx.signum() } else { 0.0 }, if sy.is_infinite() { sy.signum() } else { 0.0 });
-            let l = fx.hypot(fy);
-            return DVec3::new(-fx / l, -fy / l, 0.0);
         }
         from_tan_theta(len, -sx / len, -sy / len)
     }

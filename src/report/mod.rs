@@ -1,1 +1,4 @@
+//! Reports: per-case JSON and PNG heat maps, and the run table.
+
 pub mod heatmap;
+pub mod output;

@@ -1,5 +1,6 @@
 //! Statistics: binning, expected counts by quadrature, and the χ² test.
 
 pub mod chi2;
+pub mod compare;
 pub mod expected;
 pub mod histogram;

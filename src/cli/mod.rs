@@ -1,0 +1,317 @@
+//! The `lobes` command line: argument definitions, input validation and dispatch.
+//!
+//! Each subcommand is a variant of [`Command`] whose arguments are a clap `Args` struct and
+//! whose work is a function returning `anyhow::Result<()>`. Errors are of two kinds:
+//!
+//! - bad input, reported as a [`UsageError`] (or by clap itself while parsing), exit code
+//!   [`EXIT_USAGE`] = 2;
+//! - anything else (I/O, GPU, …), exit code [`EXIT_FAILURE`] = 1.
+//!
+//! [`exit_code`] tells the two apart. Syntax and per-value checks (a malformed list, u outside
+//! [0, 1], α ≤ 0) run as clap value parsers, so clap's message names the flag; checks that need
+//! the reference (weights, which methods a lobe supports) run in the subcommand and produce a
+//! [`UsageError`] whose message starts with the flag.
+
+pub mod tutorial;
+
+use crate::reference::{LobeKind, Method};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::DVec3;
+use std::fmt;
+use std::io::Write;
+
+/// Exit code for bad input: usage and validation errors (clap's own code for usage errors).
+pub const EXIT_USAGE: u8 = 2;
+/// Exit code for runtime failures.
+pub const EXIT_FAILURE: u8 = 1;
+
+/// The `lobes` command line.
+#[derive(Debug, Parser)]
+#[command(
+    name = "lobes",
+    version,
+    about = "Importance sampling of reflectance lobes and discrete distributions, checked against an f64 reference"
+)]
+pub struct Cli {
+    /// The subcommand to run.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Sample a discrete distribution by CDF inversion or an alias table (tutorial part 1).
+    Discrete(tutorial::DiscreteArgs),
+    /// Convert a half-vector pdf p(ωh) to the reflected pdf p(ωr), in plane (tutorial part 2).
+    PdfConvert(tutorial::PdfConvertArgs),
+    /// Draw one half vector from a lobe and reflect ωi about it (tutorial part 3).
+    Sample(tutorial::SampleArgs),
+}
+
+impl Cli {
+    /// Runs the parsed command.
+    pub fn run(self) -> anyhow::Result<()> {
+        match self.command {
+            Command::Discrete(args) => tutorial::discrete(&args),
+            Command::PdfConvert(args) => tutorial::pdf_convert(&args),
+            Command::Sample(args) => tutorial::sample(&args),
+        }
+    }
+}
+
+/// Bad input found after clap's parsing: the message names the flag and what is allowed.
+/// [`exit_code`] maps it to [`EXIT_USAGE`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct UsageError(pub String);
+
+impl fmt::Display for UsageError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+/// A [`UsageError`] as an `anyhow::Error`.
+pub fn usage(message: impl Into<String>) -> anyhow::Error {
+    UsageError(message.into()).into()
+}
+
+/// The process exit code for an error: [`EXIT_USAGE`] if a [`UsageError`] or a clap error is
+/// anywhere in its chain, else [`EXIT_FAILURE`].
+pub fn exit_code(err: &anyhow::Error) -> u8 {
+    let bad_input = err.chain().any(|e| e.is::<UsageError>() || e.is::<clap::Error>());
+    if bad_input { EXIT_USAGE } else { EXIT_FAILURE }
+}
+
+/// Output selection shared by the subcommands.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct OutputArgs {
+    /// Print exactly one JSON object on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Writes `text` to stdout; a failed write (closed pipe, full disk) is a runtime error.
+pub fn emit(text: &str) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes()).and_then(|()| out.flush()).map_err(|e| anyhow::anyhow!("writing to stdout: {e}"))
+}
+
+/// Writes `value` to stdout as one compact JSON object and a newline. Non-finite numbers
+/// become `null` (serde_json's rule).
+pub fn emit_json(value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let mut text = serde_json::to_string(value)?;
+    text.push('\n');
+    emit(&text)
+}
+
+/// A lobe, as named on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LobeChoice {
+    /// Ward's lobe with Walter's pdf (NDF sampling only).
+    Ward,
+    /// Beckmann microfacets.
+    Beckmann,
+    /// GGX (Trowbridge–Reitz) microfacets.
+    Ggx,
+}
+
+impl From<LobeChoice> for LobeKind {
+    fn from(c: LobeChoice) -> Self {
+        match c {
+            LobeChoice::Ward => LobeKind::Ward,
+            LobeChoice::Beckmann => LobeKind::Beckmann,
+            LobeChoice::Ggx => LobeKind::Ggx,
+        }
+    }
+}
+
+/// A half-vector sampling method, as named on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodChoice {
+    /// The lobe's own distribution (Ward's p(h), or D(h) cos θh).
+    Ndf,
+    /// Visible normals (Beckmann, GGX).
+    Vndf,
+    /// Bounded VNDF (GGX only).
+    Bounded,
+}
+
+impl From<MethodChoice> for Method {
+    fn from(c: MethodChoice) -> Self {
+        match c {
+            MethodChoice::Ndf => Method::Ndf,
+            MethodChoice::Vndf => Method::Vndf,
+            MethodChoice::Bounded => Method::Bounded,
+        }
+    }
+}
+
+/// Lobe, method and roughness: `--lobe L [--method M] (--alpha A | --alpha-x AX --alpha-y AY)`.
+#[derive(Debug, Clone, Args)]
+#[command(group = clap::ArgGroup::new("roughness").args(["alpha", "alpha_x", "alpha_y"]).required(true).multiple(true))]
+pub struct LobeArgs {
+    /// The lobe.
+    #[arg(long, value_enum)]
+    pub lobe: LobeChoice,
+    /// How the half vector is drawn; ward supports only ndf, bounded is GGX only.
+    #[arg(long, value_enum, default_value = "ndf")]
+    pub method: MethodChoice,
+    /// Isotropic roughness α: a finite number > 0.
+    #[arg(long, value_name = "A", value_parser = parse_alpha, allow_hyphen_values = true,
+          conflicts_with_all = ["alpha_x", "alpha_y"])]
+    pub alpha: Option<f64>,
+    /// Anisotropic roughness along x (with --alpha-y): a finite number > 0.
+    #[arg(long, value_name = "AX", value_parser = parse_alpha, allow_hyphen_values = true, requires = "alpha_y")]
+    pub alpha_x: Option<f64>,
+    /// Anisotropic roughness along y (with --alpha-x): a finite number > 0.
+    #[arg(long, value_name = "AY", value_parser = parse_alpha, allow_hyphen_values = true, requires = "alpha_x")]
+    pub alpha_y: Option<f64>,
+}
+
+impl LobeArgs {
+    /// The reference lobe, or a [`UsageError`] if the lobe has no sampler for the method.
+    pub fn lobe(&self) -> anyhow::Result<crate::reference::Lobe> {
+        let kind = LobeKind::from(self.lobe);
+        let method = Method::from(self.method);
+        if !kind.supports(method) {
+            let supported: Vec<&str> = [Method::Ndf, Method::Vndf, Method::Bounded]
+                .into_iter()
+                .filter(|&m| kind.supports(m))
+                .map(Method::name)
+                .collect();
+            return Err(usage(format!(
+                "--method {} is not available for --lobe {}; {} supports --method {}",
+                method.name(),
+                kind.name(),
+                kind.name(),
+                supported.join("|")
+            )));
+        }
+        let (alpha_x, alpha_y) = match (self.alpha, self.alpha_x, self.alpha_y) {
+            (Some(a), None, None) => (a, a),
+            (None, Some(ax), Some(ay)) => (ax, ay),
+            // clap's group, conflicts and requires rule these out; keep a clear message anyway.
+            _ => return Err(usage("give either --alpha A or both --alpha-x AX and --alpha-y AY")),
+        };
+        Ok(crate::reference::Lobe { kind, method, alpha_x, alpha_y })
+    }
+}
+
+/// The incident direction ωi in degrees: `--incident-theta` from the normal, `--incident-phi`
+/// azimuth from +x.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct IncidentArgs {
+    /// Polar angle of ωi from the normal, in degrees, in [0, 180] (above 90: from below).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = parse_polar_180, allow_hyphen_values = true)]
+    pub incident_theta: f64,
+    /// Azimuth of ωi from +x, in degrees, in [-360, 360].
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, value_parser = parse_azimuth, allow_hyphen_values = true)]
+    pub incident_phi: f64,
+}
+
+impl IncidentArgs {
+    /// ωi as a unit vector, normal on +z.
+    pub fn omega_i(&self) -> DVec3 {
+        crate::reference::reflect::spherical(self.incident_theta.to_radians(), self.incident_phi.to_radians())
+    }
+}
+
+/// A comma-separated list of numbers as given on the command line (syntax checked only).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NumberList(pub Vec<f64>);
+
+/// Parses one number; accepts what Rust's `f64` parser accepts (including `nan`, `inf`), so
+/// callers decide about non-finite values.
+pub fn parse_number(s: &str) -> Result<f64, String> {
+    let t = s.trim();
+    if t.is_empty() {
+        return Err("expected a number, got nothing".into());
+    }
+    t.parse::<f64>().map_err(|_| format!("'{t}' is not a number"))
+}
+
+/// Parses a comma-separated list such as `15,5,5.5`. An empty or blank string is the empty
+/// list; an empty item (`1,,2`, `1,`) or a non-number is an error naming its 0-based index.
+pub fn parse_number_list(s: &str) -> Result<NumberList, String> {
+    if s.trim().is_empty() {
+        return Ok(NumberList(Vec::new()));
+    }
+    s.split(',')
+        .enumerate()
+        .map(|(i, item)| {
+            parse_number(item).map_err(|e| {
+                format!("item at index {i} (counting from 0): {e}; expected comma-separated numbers such as 1,2.5,3")
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(NumberList)
+}
+
+/// Checks a uniform: u ∈ [0, 1] (NaN excluded).
+pub fn check_unit(u: f64) -> Result<f64, String> {
+    if (0.0..=1.0).contains(&u) {
+        Ok(u)
+    } else {
+        Err(format!("{u} is not in [0, 1]; each u must be a number in [0, 1]"))
+    }
+}
+
+/// Parses a non-empty list of uniforms in [0, 1].
+pub fn parse_unit_list(s: &str) -> Result<NumberList, String> {
+    let list = parse_number_list(s)?;
+    if list.0.is_empty() {
+        return Err("the list is empty; give at least one number in [0, 1], e.g. 0.5,0.25".into());
+    }
+    for (i, &u) in list.0.iter().enumerate() {
+        check_unit(u).map_err(|e| format!("item at index {i} (counting from 0): {e}"))?;
+    }
+    Ok(list)
+}
+
+/// Parses exactly two uniforms in [0, 1], `U1,U2`.
+pub fn parse_unit_pair(s: &str) -> Result<[f64; 2], String> {
+    let list = parse_unit_list(s)?.0;
+    match list[..] {
+        [u1, u2] => Ok([u1, u2]),
+        _ => Err(format!("expected exactly 2 numbers U1,U2 in [0, 1], got {}", list.len())),
+    }
+}
+
+/// Parses a roughness α: finite and > 0.
+pub fn parse_alpha(s: &str) -> Result<f64, String> {
+    let a = parse_number(s)?;
+    if a.is_finite() && a > 0.0 { Ok(a) } else { Err(format!("roughness must be a finite number > 0, got {a}")) }
+}
+
+/// Parses a finite number ≥ 0 (a density).
+pub fn parse_non_negative(s: &str) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    if x.is_finite() && x >= 0.0 { Ok(x) } else { Err(format!("must be a finite number ≥ 0, got {x}")) }
+}
+
+fn parse_degrees_in(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
+    let x = parse_number(s)?;
+    if (lo..=hi).contains(&x) {
+        Ok(x)
+    } else {
+        Err(format!("{x} is outside [{lo}, {hi}]; give an angle in degrees in [{lo}, {hi}]"))
+    }
+}
+
+/// Parses a polar angle of the upper hemisphere in degrees, [0, 90].
+pub fn parse_polar_90(s: &str) -> Result<f64, String> {
+    parse_degrees_in(s, 0.0, 90.0)
+}
+
+/// Parses a polar angle in degrees, [0, 180].
+pub fn parse_polar_180(s: &str) -> Result<f64, String> {
+    parse_degrees_in(s, 0.0, 180.0)
+}
+
+/// Parses an azimuth in degrees, [-360, 360].
+pub fn parse_azimuth(s: &str) -> Result<f64, String> {
+    parse_degrees_in(s, -360.0, 360.0)
+}
