@@ -240,6 +240,20 @@ impl GpuEngine {
         samples: u64,
         progress: &mut dyn FnMut(u64),
     ) -> Result<GpuRun, GpuError> {
+        self.histogram_onto(job, seed, first, samples, None, progress)
+    }
+
+    /// As [`GpuEngine::histogram`], adding onto `initial` counts on the device (the 64-bit
+    /// totals start from them): a run can continue an earlier one exactly.
+    pub fn histogram_onto(
+        &mut self,
+        job: &Job,
+        seed: u64,
+        first: u64,
+        samples: u64,
+        initial: Option<&Counts>,
+        progress: &mut dyn FnMut(u64),
+    ) -> Result<GpuRun, GpuError> {
         let kernel = self.kernel(job)?;
         let cells = job.bins() as u64 + 4;
         let max_binding = self.gpu.limits.max_storage_buffer_binding_size as u64;
@@ -259,6 +273,11 @@ impl GpuEngine {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let counts = self.buffer("chunk counts", cells * 4, storage);
         let totals = self.buffer("totals", cells * 8, storage);
+        if let Some(init) = initial {
+            let words: Vec<u32> = init.bins.iter().chain(&init.invalid).flat_map(|&c| [c as u32, (c >> 32) as u32]).collect();
+            assert_eq!(words.len() as u64, 2 * cells, "initial counts must match the job's cells");
+            self.gpu.queue.write_buffer(&totals, 0, bytemuck::cast_slice(&words));
+        }
         let params = self.buffer("params", stride * per_submit, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let dirs = self.buffer("directions (unused)", 16, wgpu::BufferUsages::STORAGE);
         let (tf, tu) = self.tables(job);

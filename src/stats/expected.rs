@@ -129,10 +129,16 @@ fn initial_split(bin: Rect, width: f64, q: &Quadrature) -> u32 {
 
 /// The probability of each bin of `grid` under `lobe`'s reflected density seen from `wi`.
 pub fn lobe_probabilities(lobe: &Lobe, wi: DVec3, grid: SphereGrid, q: &Quadrature) -> Expected {
+    let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
+    probabilities(&|w| lobe.pdf_r(wi, w), grid, width, q)
+}
+
+/// The probability of each upper-hemisphere bin of `grid` under the density `pdf` (per unit
+/// solid angle, zero below the horizon) whose narrowest feature is about `width` radians.
+pub fn probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature) -> Expected {
     let zs = grid.cos_theta_edges();
     let ps = grid.phi_edges();
-    let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
-    let f = |z: f64, phi: f64| lobe.pdf_r(wi, direction(z, phi));
+    let f = |z: f64, phi: f64| pdf(direction(z, phi));
     let rows: Vec<Vec<(f64, f64, f64)>> = (0..grid.rows as usize)
         .into_par_iter()
         .map(|r| {
