@@ -6,8 +6,17 @@
 //!
 //! - [`reference`]: the f64 math, one module per lobe, each the twin of a WGSL file in
 //!   `shaders/`.
+//! - [`gpu`]: the GPU engine: WGSL composed from `shaders/`, run through wgpu.
+//! - [`cpu`]: the same samples drawn in f64 on all cores.
+//! - [`stats`]: binning, expected counts by quadrature, the χ² test.
 //! - [`cli`]: the `lobes` command line (argument parsing, validation, subcommands).
 
 pub mod cli;
+pub mod cpu;
+pub mod gpu;
+pub mod job;
 pub mod reference;
 pub mod report;
+pub mod run;
+pub mod scene;
+pub mod stats;

@@ -12,6 +12,8 @@
 //! the reference (weights, which methods a lobe supports) run in the subcommand and produce a
 //! [`UsageError`] whose message starts with the flag.
 
+pub mod bench;
+pub mod run;
 pub mod tutorial;
 
 use crate::reference::{LobeKind, Method};
@@ -47,6 +49,12 @@ pub enum Command {
     PdfConvert(tutorial::PdfConvertArgs),
     /// Draw one half vector from a lobe and reflect ωi about it (tutorial part 3).
     Sample(tutorial::SampleArgs),
+    /// Run a scene: sample and histogram every case on the GPU, judge it with a χ² test
+    /// against the f64 reference, and write histogram.json and heat maps per case.
+    Run(run::RunArgs),
+    /// Measure samples per second (sampling + histogram on the device) per lobe, method and
+    /// backend: the GPU adapter and the f64 CPU reference on all cores.
+    Bench(bench::BenchArgs),
 }
 
 impl Cli {
@@ -56,6 +64,8 @@ impl Cli {
             Command::Discrete(args) => tutorial::discrete(&args),
             Command::PdfConvert(args) => tutorial::pdf_convert(&args),
             Command::Sample(args) => tutorial::sample(&args),
+            Command::Run(args) => run::run(&args),
+            Command::Bench(args) => bench::run(&args),
         }
     }
 }

@@ -1,0 +1,118 @@
+//! `lobes bench`: samples per second (sampling + histogram, data on the device) per lobe,
+//! method and backend. Medians of several runs.
+
+use super::{OutputArgs, emit, emit_json};
+use crate::cpu;
+use crate::gpu::GpuEngine;
+use crate::job::Job;
+use crate::reference::{Lobe, LobeKind, Method, reflect};
+use crate::stats::histogram::SphereGrid;
+use clap::Args;
+use serde::Serialize;
+use std::time::Instant;
+
+#[derive(Debug, Clone, Args)]
+pub struct BenchArgs {
+    /// Samples per GPU run (default 2^24).
+    #[arg(long, default_value_t = 1 << 24)]
+    pub samples: u64,
+    /// Samples per CPU-reference run (default 2^20; the f64 reference is much slower).
+    #[arg(long, default_value_t = 1 << 20)]
+    pub cpu_samples: u64,
+    /// Runs per measurement; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Roughness of every lobe.
+    #[arg(long, default_value_t = 0.3)]
+    pub alpha: f64,
+    /// Skip the CPU reference backend.
+    #[arg(long)]
+    pub gpu_only: bool,
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+/// One measurement.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchResult {
+    pub lobe: String,
+    pub method: String,
+    pub alpha: f64,
+    pub backend: String,
+    pub samples: u64,
+    /// Median over the runs: GPU time from timestamp queries where available, else wall time.
+    pub seconds: f64,
+    pub samples_per_second: f64,
+    pub timing: String,
+}
+
+/// The lobes and methods benchmarked, at 45° incidence on a 64 × 128 grid.
+pub fn bench_jobs(alpha: f64) -> Vec<Job> {
+    use LobeKind::*;
+    use Method::*;
+    [(Ward, Ndf), (Beckmann, Ndf), (Beckmann, Vndf), (Ggx, Ndf), (Ggx, Vndf), (Ggx, Bounded)]
+        .into_iter()
+        .map(|(kind, method)| Job::Lobe {
+            lobe: Lobe { kind, method, alpha_x: alpha, alpha_y: alpha },
+            incident: reflect::spherical(45f64.to_radians(), 0.0),
+            grid: SphereGrid { rows: 64, cols: 128 },
+        })
+        .collect()
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn result(job: &Job, backend: &str, samples: u64, seconds: f64, timing: &str, alpha: f64) -> BenchResult {
+    let Job::Lobe { lobe, .. } = job else { unreachable!("bench jobs are lobes") };
+    BenchResult {
+        lobe: lobe.kind.name().into(),
+        method: lobe.method.name().into(),
+        alpha,
+        backend: backend.into(),
+        samples,
+        seconds,
+        samples_per_second: samples as f64 / seconds,
+        timing: timing.into(),
+    }
+}
+
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    let runs = args.runs.max(1);
+    let mut engine = GpuEngine::open()?;
+    let adapter = engine.gpu.adapter_name();
+    let mut results = Vec::new();
+    for job in bench_jobs(args.alpha) {
+        engine.histogram(&job, 0, 0, 1 << 16, &mut |_| {})?; // compile and warm up
+        let mut times = Vec::new();
+        let mut timing = "wall";
+        for r in 0..runs {
+            let g = engine.histogram(&job, r as u64, 0, args.samples, &mut |_| {})?;
+            timing = if g.gpu_seconds.is_some() { "gpu timestamps" } else { "wall" };
+            times.push(g.gpu_seconds.unwrap_or(g.wall_seconds));
+        }
+        results.push(result(&job, "gpu", args.samples, median(times), timing, args.alpha));
+        if !args.gpu_only {
+            let times = (0..runs)
+                .map(|r| {
+                    let t = Instant::now();
+                    cpu::histogram(&job, r as u64, 0, args.cpu_samples);
+                    t.elapsed().as_secs_f64()
+                })
+                .collect();
+            let threads = format!("cpu-f64-{}-threads", rayon::current_num_threads());
+            results.push(result(&job, &threads, args.cpu_samples, median(times), "wall", args.alpha));
+        }
+    }
+    if args.output.json {
+        return emit_json(&serde_json::json!({"adapter": adapter, "runs": runs, "results": results}));
+    }
+    let mut text = format!("adapter: {adapter}\nmedian of {runs} runs, 64 x 128 bins, alpha {}, 45 deg incidence\n\n", args.alpha);
+    text += &format!("{:<10} {:<8} {:<22} {:>12} {:>10} {:>14}\n", "lobe", "method", "backend", "samples", "seconds", "samples/s");
+    for r in &results {
+        text += &format!("{:<10} {:<8} {:<22} {:>12} {:>10.4} {:>14.3e}\n", r.lobe, r.method, r.backend, r.samples, r.seconds, r.samples_per_second);
+    }
+    emit(&text)
+}
