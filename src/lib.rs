@@ -10,9 +10,12 @@
 //! - [`cpu`]: the same samples drawn in f64 on all cores.
 //! - [`stats`]: binning, expected counts by quadrature, the χ² test.
 //! - [`cli`]: the `lobes` command line (argument parsing, validation, subcommands).
+//! - [`embed`]: the WGSL samplers, densities and BRDFs for your own wgpu shaders, and helpers
+//!   that upload discrete distributions.
 
 pub mod cli;
 pub mod cpu;
+pub mod embed;
 pub mod gpu;
 pub mod job;
 pub mod reference;

@@ -1,0 +1,54 @@
+// Beckmann densities and BRDF for renderers that embed lobes' samplers (lobes::embed,
+// Module::Beckmann); CPU twins: src/reference/beckmann.rs and src/reference/microfacet.rs.
+// a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.
+// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon.
+
+// Smith's Lambda (Heitz 2014, eq. 72): -erfc(x)/2 + exp(-x^2) / (2 x sqrt(pi)),
+// x = |wz| / |(ax wx, ay wy)|; 0 past x = 10 (where it is below 1e-45).
+fn beckmann_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
+    let l = length(a * w.xy);
+    let c = abs(w.z);
+    if (c > 10.0 * l) {
+        return 0.0;
+    }
+    let x = c / l;
+    return -0.5 * erfc_approx(x) + exp(-x * x) * INV_SQRT_PI / (2.0 * x);
+}
+
+// Height-correlated Smith G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99).
+fn beckmann_g2(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    return 1.0 / (1.0 + beckmann_lambda(a, wi) + beckmann_lambda(a, wr));
+}
+
+// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (Walter et al. 2007, eq. 20).
+fn beckmann_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    if (wi.z <= 0.0 || wr.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wi + wr);
+    return beckmann_d(a, h) * beckmann_g2(a, wi, wr) / (4.0 * wi.z * wr.z);
+}
+
+// The density of wr under beckmann_sample_ndf: D(h) cos th_h / (4 |wr.h|).
+fn beckmann_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    return beckmann_d(a, h) * max(h.z, 0.0) / (4.0 * abs(dot(wr, h)));
+}
+
+// The density of wr under beckmann_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|).
+fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || wi.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    let cos_ih = dot(wi, h);
+    if (h.z <= 0.0 || cos_ih <= 0.0) {
+        return 0.0;
+    }
+    return beckmann_g1(a, wi) * cos_ih * beckmann_d(a, h) / wi.z / (4.0 * abs(dot(wr, h)));
+}

@@ -1,0 +1,76 @@
+// GGX densities and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ggx);
+// CPU twins: src/reference/ggx.rs and src/reference/microfacet.rs (Lobe::pdf_r, Lobe::eval).
+// a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.
+// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon.
+
+// Smith's Lambda (Heitz 2014, eq. 86): (|(ax wx, ay wy, wz)| / |wz| - 1) / 2.
+fn ggx_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
+    return 0.5 * (length(vec3<f32>(a * w.xy, w.z)) / abs(w.z) - 1.0);
+}
+
+// Height-correlated Smith G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99), formed
+// from G1 = 1 / (1 + Lambda) as G1i G1r / (G1i + G1r - G1i G1r), finite at grazing angles.
+fn ggx_g2(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let gi = ggx_g1(a, wi);
+    let gr = ggx_g1(a, wr);
+    if (gi <= 0.0 || gr <= 0.0) {
+        return 0.0;
+    }
+    return gi * gr / (gi + gr - gi * gr);
+}
+
+// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (Walter et al. 2007, eq. 20).
+fn ggx_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    if (wi.z <= 0.0 || wr.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wi + wr);
+    return ggx_d(a, h) * ggx_g2(a, wi, wr) / (4.0 * wi.z * wr.z);
+}
+
+// The density of wr under ggx_sample_ndf: D(h) cos th_h / (4 |wr.h|).
+fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    if (h.z <= 0.0) {
+        return 0.0;
+    }
+    return ggx_d(a, h) * h.z / (4.0 * abs(dot(wr, h)));
+}
+
+// The density of wr under ggx_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|)
+// (Heitz 2014, eq. 38, through the reflection Jacobian).
+fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || wi.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    let cos_ih = dot(wi, h);
+    if (h.z <= 0.0 || cos_ih <= 0.0) {
+        return 0.0;
+    }
+    return ggx_g1(a, wi) * cos_ih * ggx_d(a, h) / wi.z / (4.0 * abs(dot(wr, h)));
+}
+
+// The density of wr under ggx_sample_bounded (Eto & Tokuyoshi 2023, listing 2).
+fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    if (h.z <= 0.0) {
+        return 0.0;
+    }
+    let d = ggx_d(a, h);
+    let t = length(vec3<f32>(a * wi.xy, wi.z));
+    if (wi.z >= 0.0) {
+        return d / (2.0 * (ggx_bounded_k(a, wi) * wi.z + t));
+    }
+    let l = a * wi.xy;
+    return d * (t - wi.z) / (2.0 * dot(l, l));
+}

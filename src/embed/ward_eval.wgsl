@@ -1,0 +1,25 @@
+// Ward's density and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ward);
+// CPU twin: src/reference/ward.rs (pdf_h through the reflection Jacobian, eval).
+// a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.
+
+// Ward's BRDF with rho_s = 1 (Ward 1992, eq. 5a; Walter 2005, eq. 1):
+// exp(-(hx^2/ax^2 + hy^2/ay^2)/hz^2) / (4 pi ax ay sqrt(cos th_i cos th_r)).
+fn ward_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    if (wi.z <= 0.0 || wr.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wi + wr);
+    let q = h.xy / a;
+    return exp(-dot(q, q) / (h.z * h.z)) / (4.0 * PI * a.x * a.y * sqrt(wi.z * wr.z));
+}
+
+// The density of wr under ward_sample: p(h) / (4 |wr.h|) (Walter 2005, eq. 9), 0 at or below
+// the horizon.
+fn ward_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+        return 0.0;
+    }
+    let h = normalize(s);
+    return ward_pdf_h(a, h) / (4.0 * abs(dot(wr, h)));
+}
