@@ -67,6 +67,13 @@ impl Ggx {
         let z = (1.0 - u[1]) * (1.0 + b) - b;
         let sin_t = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
         let hs = DVec3::new(sin_t * cp, sin_t * sp, z) + ws;
+        if hs.length_squared() == 0.0 {
+            // u2 = 1 puts the point on the cap's rim z = −b; for the plain VNDF (b = ωs.z) at
+            // ωi = +z the whole rim is the single point −ωs, so hs = 0 and normalize() would
+            // give NaN. The limit u2 → 1 there is the horizon normal at azimuth 2πu1 (the rim
+            // maps to the normals with hs.z = 0), which is what is returned.
+            return DVec3::new(self.ax * cp, self.ay * sp, 0.0).normalize();
+        }
         DVec3::new(self.ax * hs.x, self.ay * hs.y, hs.z).normalize()
     }
 }
