@@ -13,6 +13,7 @@
 //! [`UsageError`] whose message starts with the flag.
 
 pub mod bench;
+pub mod merge;
 pub mod run;
 pub mod tutorial;
 
@@ -55,6 +56,9 @@ pub enum Command {
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
+    /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
+    /// test and write the same outputs as `lobes run`.
+    Merge(merge::MergeArgs),
 }
 
 impl Cli {
@@ -66,6 +70,7 @@ impl Cli {
             Command::Sample(args) => tutorial::sample(&args),
             Command::Run(args) => run::run(&args),
             Command::Bench(args) => bench::run(&args),
+            Command::Merge(args) => merge::run(&args),
         }
     }
 }

@@ -24,6 +24,10 @@ pub struct RunArgs {
     /// Use the CPU reference engine even if a GPU adapter exists.
     #[arg(long)]
     pub cpu: bool,
+    /// Run only shard I of N (0 ≤ I < N) of every case: its contiguous range of sample indices,
+    /// written as raw counts to OUT/<case>/shard-I-of-N.json for `lobes merge`.
+    #[arg(long, value_name = "I/N", value_parser = super::merge::parse_shard)]
+    pub shard: Option<super::merge::Shard>,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -55,6 +59,9 @@ fn progress_bar(samples: u64, name: &str) -> ProgressBar {
 }
 
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+    if let Some(shard) = args.shard {
+        return super::merge::run_shard(args, shard);
+    }
     let scene = load_scene(args.scene.as_ref())?;
     let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
     let adapter = backend.adapter();
