@@ -18,6 +18,8 @@ pub enum GpuError {
     Readback(String),
     #[error("the GPU device was lost or ran out of memory: {0}")]
     Lost(String),
+    #[error("too large for this GPU adapter: {0}")]
+    TooLarge(String),
 }
 
 /// A wgpu device and what its adapter offers.

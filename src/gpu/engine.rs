@@ -19,7 +19,9 @@ struct Params {
     count: u32,
     n_items: u32,
     last_positive: u32,
-    _pad0: u32,
+    /// First bin of the tile being counted (read only by a tiled kernel, see
+    /// [`GpuEngine::tiling`]; `_pad0` in the untiled kernel's WGSL).
+    tile_first: u32,
     alpha: [f32; 2],
     _pad1: [f32; 2],
     wi: [f32; 4],
@@ -58,6 +60,19 @@ pub struct GpuRun {
     pub wall_seconds: f64,
     /// Whether bins were counted in workgroup memory (else in global atomics).
     pub workgroup_counting: bool,
+    /// Passes over the samples: 1, or more where the histogram was split into tiles of bins to
+    /// fit the adapter's storage limits (see [`GpuEngine::tiling`]).
+    pub tiles: u64,
+}
+
+/// How a job's bins are split to fit the adapter: each pass draws every sample and counts the
+/// bins of one tile (all bins when `tiles` is 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Tiling {
+    /// Bins per tile (the last tile may hold fewer).
+    pub tile_bins: u64,
+    /// Number of tiles, each one pass over the samples.
+    pub tiles: u64,
 }
 
 /// Histograms jobs on a GPU; pipelines are cached by composed source, so cases of one shape
@@ -136,8 +151,59 @@ impl GpuEngine {
         compose::compose(job, self.workgroup_words())
     }
 
+    /// The largest storage buffer of counters this adapter binds, in bytes.
+    fn max_storage_bytes(&self) -> u64 {
+        self.gpu.limits.max_storage_buffer_binding_size.min(self.gpu.limits.max_buffer_size)
+    }
+
+    /// How `job`'s histogram is split to fit this adapter's limits: a tile's cells (its bins and
+    /// the four invalid reasons) must fit one storage binding as 64-bit totals, and the fold
+    /// kernel's grid (one invocation per cell) the per-dimension dispatch limit. An error if
+    /// the job cannot run here at all (a discrete table larger than a storage binding).
+    pub fn tiling(&self, job: &Job) -> Result<Tiling, GpuError> {
+        let limits = &self.gpu.limits;
+        let bytes = self.max_storage_bytes();
+        let dim = limits.max_compute_workgroups_per_dimension as u64;
+        let max_cells = (bytes / 8).min(dim * dim * WG_SIZE as u64).min(u32::MAX as u64);
+        let what = compose::describe(job);
+        let limit_names = format!(
+            "max_storage_buffer_binding_size {}, max_buffer_size {}",
+            limits.max_storage_buffer_binding_size, limits.max_buffer_size
+        );
+        if let Job::Discrete { dist, .. } = job {
+            let table = dist.len() as u64 * 4;
+            if table > bytes {
+                return Err(GpuError::TooLarge(format!(
+                    "{what}: its table needs {table} bytes in one storage buffer and this adapter binds at most {bytes} ({limit_names}); use at most {} weights",
+                    bytes / 4
+                )));
+            }
+        }
+        if max_cells < 5 {
+            return Err(GpuError::TooLarge(format!(
+                "{what}: this adapter's limits hold no histogram ({limit_names}, max_compute_workgroups_per_dimension {dim})"
+            )));
+        }
+        let bins = (job.bins() as u64).max(1);
+        let tile_bins = bins.min(max_cells - 4);
+        Ok(Tiling { tile_bins, tiles: bins.div_ceil(tile_bins) })
+    }
+
     fn kernel(&mut self, job: &Job) -> Result<Arc<Kernel>, GpuError> {
-        let source = self.source(job);
+        self.kernel_tiled(job, None)
+    }
+
+    /// The kernel of `job`, counting all bins (`tile` None) or the `tile` bins from
+    /// `params.tile_first` on.
+    fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<Kernel>, GpuError> {
+        let (source, in_workgroup) = match tile {
+            None => (self.source(job), job.bins().div_ceil(2) as u32 <= self.workgroup_words()),
+            Some(t) => {
+                let in_workgroup = t.div_ceil(2) <= self.workgroup_words();
+                let source = compose::compose(job, if in_workgroup { u32::MAX } else { 0 });
+                (tiled_source(&source, t)?, in_workgroup)
+            }
+        };
         if let Some(k) = self.cache.get(&source) {
             return Ok(k.clone());
         }
@@ -162,7 +228,7 @@ impl GpuEngine {
             sample: pipeline("sample_histogram"),
             fold: pipeline("fold"),
             directions: matches!(job, Job::Lobe { .. }).then(|| pipeline("directions")),
-            in_workgroup: job.bins().div_ceil(2) as u32 <= self.workgroup_words(),
+            in_workgroup,
         });
         self.check_errors()?;
         self.compiled += 1;
@@ -177,7 +243,7 @@ impl GpuEngine {
             count,
             n_items: 0,
             last_positive: 0,
-            _pad0: 0,
+            tile_first: 0,
             alpha: [0.0; 2],
             _pad1: [0.0; 2],
             wi: [0.0; 4],
@@ -254,14 +320,16 @@ impl GpuEngine {
         initial: Option<&Counts>,
         progress: &mut dyn FnMut(u64),
     ) -> Result<GpuRun, GpuError> {
-        let kernel = self.kernel(job)?;
-        let cells = job.bins() as u64 + 4;
-        let max_binding = self.gpu.limits.max_storage_buffer_binding_size as u64;
-        if cells * 8 > max_binding {
-            return Err(GpuError::Lost(format!(
-                "{} cells of 8 bytes exceed the adapter's storage binding limit of {max_binding} bytes",
-                cells
-            )));
+        let tiling = self.tiling(job)?;
+        let kernel = match tiling.tiles {
+            1 => self.kernel(job)?,
+            _ => self.kernel_tiled(job, Some(tiling.tile_bins as u32))?,
+        };
+        let bins = job.bins() as u64;
+        let tile_bins = tiling.tile_bins;
+        let cells = tile_bins + 4;
+        if let Some(init) = initial {
+            assert_eq!(init.bins.len() as u64, bins, "initial counts must match the job's bins");
         }
         let per_group = (WG_SIZE * SAMPLES_PER_THREAD) as u64;
         let max_groups = self.gpu.limits.max_compute_workgroups_per_dimension as u64 * self.gpu.limits.max_compute_workgroups_per_dimension as u64;
@@ -273,11 +341,6 @@ impl GpuEngine {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let counts = self.buffer("chunk counts", cells * 4, storage);
         let totals = self.buffer("totals", cells * 8, storage);
-        if let Some(init) = initial {
-            let words: Vec<u32> = init.bins.iter().chain(&init.invalid).flat_map(|&c| [c as u32, (c >> 32) as u32]).collect();
-            assert_eq!(words.len() as u64, 2 * cells, "initial counts must match the job's cells");
-            self.gpu.queue.write_buffer(&totals, 0, bytemuck::cast_slice(&words));
-        }
         let params = self.buffer("params", stride * per_submit, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let dirs = self.buffer("directions (unused)", 16, wgpu::BufferUsages::STORAGE);
         let (tf, tu) = self.tables(job);
@@ -286,56 +349,91 @@ impl GpuEngine {
 
         let start = Instant::now();
         let mut gpu_ticks = 0u64;
-        let mut done = 0u64;
-        while done < samples {
-            let n_chunks = (samples - done).div_ceil(chunk).min(per_submit);
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            for c in 0..n_chunks {
-                let base = done + c * chunk;
-                let count = chunk.min(samples - base);
-                let p = Self::params(job, seed, first + base, count as u32);
-                self.gpu.queue.write_buffer(&params, c * stride, bytemuck::bytes_of(&p));
-                let ts = queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(2 * c as u32),
-                    end_of_pass_write_index: Some(2 * c as u32 + 1),
-                });
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sample"), timestamp_writes: ts });
-                let offset = (c * stride) as u32;
-                pass.set_bind_group(0, &bind, &[offset]);
-                pass.set_pipeline(&kernel.sample);
-                let (gx, gy) = self.grid(count.div_ceil(per_group));
-                pass.dispatch_workgroups(gx, gy, 1);
-                pass.set_pipeline(&kernel.fold);
-                let (fx, fy) = self.grid(cells.div_ceil(WG_SIZE as u64));
-                pass.dispatch_workgroups(fx, fy, 1);
+        let mut result = Counts::zeros(bins as usize);
+        // Each tile is one pass over all the samples, counting the bins tile_first ..
+        // tile_first + tile_bins; every pass also counts the invalid reasons, which are taken
+        // from the first pass and must agree in the others.
+        for tile in 0..tiling.tiles {
+            let tile_first = tile * tile_bins;
+            let tile_len = tile_bins.min(bins - tile_first);
+            // The 64-bit totals start from the initial counts of the tile's cells, or zero.
+            if let Some(init) = initial {
+                let mut words = vec![0u32; 2 * cells as usize];
+                let tile_counts = &init.bins[tile_first as usize..(tile_first + tile_len) as usize];
+                for (i, &c) in tile_counts.iter().chain(std::iter::repeat_n(&0, (tile_bins - tile_len) as usize)).chain(&init.invalid).enumerate() {
+                    words[2 * i] = c as u32;
+                    words[2 * i + 1] = (c >> 32) as u32;
+                }
+                self.gpu.queue.write_buffer(&totals, 0, bytemuck::cast_slice(&words));
+            } else if tile > 0 {
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+                encoder.clear_buffer(&totals, 0, None);
+                self.gpu.queue.submit([encoder.finish()]);
             }
-            if let Some((set, resolve, read)) = &queries {
-                let n = 2 * n_chunks as u32;
-                encoder.resolve_query_set(set, 0..n, resolve, 0);
-                encoder.copy_buffer_to_buffer(resolve, 0, read, 0, n as u64 * 8);
+            let mut done = 0u64;
+            while done < samples {
+                let n_chunks = (samples - done).div_ceil(chunk).min(per_submit);
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+                for c in 0..n_chunks {
+                    let base = done + c * chunk;
+                    let count = chunk.min(samples - base);
+                    let mut p = Self::params(job, seed, first + base, count as u32);
+                    p.tile_first = tile_first as u32;
+                    self.gpu.queue.write_buffer(&params, c * stride, bytemuck::bytes_of(&p));
+                    let ts = queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(2 * c as u32),
+                        end_of_pass_write_index: Some(2 * c as u32 + 1),
+                    });
+                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("sample"), timestamp_writes: ts });
+                    let offset = (c * stride) as u32;
+                    pass.set_bind_group(0, &bind, &[offset]);
+                    pass.set_pipeline(&kernel.sample);
+                    let (gx, gy) = self.grid(count.div_ceil(per_group));
+                    pass.dispatch_workgroups(gx, gy, 1);
+                    pass.set_pipeline(&kernel.fold);
+                    let (fx, fy) = self.grid(cells.div_ceil(WG_SIZE as u64));
+                    pass.dispatch_workgroups(fx, fy, 1);
+                }
+                if let Some((set, resolve, read)) = &queries {
+                    let n = 2 * n_chunks as u32;
+                    encoder.resolve_query_set(set, 0..n, resolve, 0);
+                    encoder.copy_buffer_to_buffer(resolve, 0, read, 0, n as u64 * 8);
+                }
+                self.gpu.queue.submit([encoder.finish()]);
+                if let Some((_, _, read)) = &queries {
+                    let stamps: Vec<u64> = bytemuck::cast_slice(&self.read(read, 2 * n_chunks * 8)?).to_vec();
+                    gpu_ticks += stamps.chunks(2).map(|p| p[1].saturating_sub(p[0])).sum::<u64>();
+                } else {
+                    self.wait()?;
+                }
+                self.check_errors()?;
+                done += n_chunks * chunk.min(samples - done);
+                done = done.min(samples);
+                progress(((tile as u128 * samples as u128 + done as u128) / tiling.tiles as u128) as u64);
             }
-            self.gpu.queue.submit([encoder.finish()]);
-            if let Some((_, _, read)) = &queries {
-                let stamps: Vec<u64> = bytemuck::cast_slice(&self.read(read, 2 * n_chunks * 8)?).to_vec();
-                gpu_ticks += stamps.chunks(2).map(|p| p[1].saturating_sub(p[0])).sum::<u64>();
-            } else {
-                self.wait()?;
-            }
+            let raw: Vec<u32> = bytemuck::cast_slice(&self.read(&totals, cells * 8)?).to_vec();
             self.check_errors()?;
-            done += n_chunks * chunk.min(samples - done);
-            done = done.min(samples);
-            progress(done);
+            let cells64: Vec<u64> = raw.chunks(2).map(|p| p[0] as u64 | (p[1] as u64) << 32).collect();
+            result.bins[tile_first as usize..(tile_first + tile_len) as usize].copy_from_slice(&cells64[..tile_len as usize]);
+            let invalid: [u64; 4] = cells64[tile_bins as usize..].try_into().expect("four invalid reasons");
+            if tile == 0 {
+                result.invalid = invalid;
+            } else if invalid != result.invalid {
+                return Err(GpuError::Lost(format!(
+                    "tile {tile} of {} counted invalid samples {invalid:?} where tile 0 counted {:?}: the same samples drew differently",
+                    tiling.tiles, result.invalid
+                )));
+            }
         }
-        let raw: Vec<u32> = bytemuck::cast_slice(&self.read(&totals, cells * 8)?).to_vec();
-        let cells64: Vec<u64> = raw.chunks(2).map(|p| p[0] as u64 | (p[1] as u64) << 32).collect();
         let wall_seconds = start.elapsed().as_secs_f64();
         let period = self.gpu.queue.get_timestamp_period() as f64 * 1e-9;
         Ok(GpuRun {
-            counts: Counts::from_cells(&cells64),
+            counts: result,
             gpu_seconds: use_ts.then_some(gpu_ticks as f64 * period),
             wall_seconds,
             workgroup_counting: kernel.in_workgroup,
+            tiles: tiling.tiles,
         })
     }
 
@@ -433,4 +531,34 @@ impl GpuEngine {
         staging.unmap();
         Ok(data)
     }
+}
+
+/// The composed WGSL of an untiled job turned into a kernel that counts only the `tile_bins`
+/// bins from `params.tile_first` on (its cells: those bins, then the four invalid reasons).
+/// Samples outside the tile are drawn and dropped; invalid samples are counted in every pass.
+/// Each edit must apply exactly once, so a change to `shaders/kernel.wgsl` or to
+/// `compose::compose` that this does not know is an error, not a wrong histogram.
+fn tiled_source(source: &str, tile_bins: u32) -> Result<String, GpuError> {
+    let edits = [
+        ("const CELLS: u32 = BINS + 4u;", format!("const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;")),
+        ("count_bin(cell);", "if (cell - params.tile_first < TILE_BINS) { count_bin(cell - params.tile_first); }".to_string()),
+        ("atomicAdd(&counts[BINS + r], invalid[r]);", "atomicAdd(&counts[TILE_BINS + r], invalid[r]);".to_string()),
+        ("    _pad0: u32,", "    tile_first: u32,".to_string()),
+    ];
+    let broken = |from: &str| GpuError::Shader {
+        what: "tiled kernel".into(),
+        message: format!("the composed kernel does not hold `{from}` exactly once; update tiled_source in src/gpu/engine.rs"),
+    };
+    let mut s = source.to_string();
+    for (from, to) in edits {
+        if s.matches(from).count() != 1 {
+            return Err(broken(from));
+        }
+        s = s.replacen(from, &to, 1);
+    }
+    let key = "const WG_WORDS: u32 = ";
+    let at = s.find(key).ok_or_else(|| broken(key))? + key.len();
+    let end = at + s[at..].find(';').ok_or_else(|| broken(key))?;
+    s.replace_range(at..end, &format!("{}u", tile_bins.div_ceil(2)));
+    Ok(s)
 }
