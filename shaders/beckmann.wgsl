@@ -68,18 +68,23 @@ fn beckmann_d(a: vec2<f32>, h: vec3<f32>) -> f32 {
     }
     let q = h.xy / a;
     let z2 = h.z * h.z;
-    return exp(-dot(q, q) / z2) / (PI * a.x * a.y * z2 * z2);
+    let q2 = dot(q, q);
+    if (q2 > 87.0 * z2) {
+        return 0.0; // exp(-q2/hz^2) < 2^-126: underflows, and hz^4 may too (0/0)
+    }
+    return exp(-q2 / z2) / (PI * a.x * a.y * z2 * z2);
 }
 
-fn beckmann_g1(a: vec2<f32>, w: vec3<f32>) -> f32 {
-    let l = length(a * w.xy);
+// G1(w) / cos th = 1 / (cos th + cos th Lambda), cos th Lambda = -cos th erfc(a)/2 + a_w e^{-a^2}/(2 sqrt(pi)),
+// a_w = |(ax wx, ay wy)|, a = cos th / a_w: finite at cos th = 0 (grazing), where it is 2 sqrt(pi) / a_w.
+fn beckmann_g1_over_cos(a: vec2<f32>, w: vec3<f32>) -> f32 {
+    let aw = length(a * w.xy);
     let c = abs(w.z);
-    if (c > 10.0 * l) {
-        return 1.0; // a > 10: Lambda < 1e-45
+    if (c > 10.0 * aw) {
+        return 1.0 / c; // a > 10: Lambda < 1e-45
     }
-    let x = c / l;
-    let lambda = -0.5 * erfc_approx(x) + exp(-x * x) * INV_SQRT_PI / (2.0 * x);
-    return 1.0 / (1.0 + lambda);
+    let x = c / aw;
+    return 1.0 / (c - 0.5 * c * erfc_approx(x) + aw * exp(-x * x) * INV_SQRT_PI * 0.5);
 }
 
 fn beckmann_sample_ndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
@@ -101,13 +106,23 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
     if (u <= 0.0) {
         return -BIG_SLOPE;
     }
+    if (u >= 1.0) {
+        // the top of the support, x = cot th (where the visible density vanishes)
+        return select(BIG_SLOPE, 1.0 / tan_t, tan_t > 1.0 / BIG_SLOPE);
+    }
+    if (tan_t > 1.0e7) {
+        // th = 90 deg: the density tends to 2|x| e^{-x^2} on x <= 0, with CDF e^{-x^2}.
+        return -sqrt(neg_ln(u));
+    }
     var lo = -6.0;
     var hi = 6.0;
     if (tan_t > 1.0 / 6.0) {
         hi = 1.0 / tan_t;
     }
     let goal = u * beckmann_visible_cdf(hi, tan_t);
-    var x = clamp(erfinv_unit(u), lo, hi);
+    // First guess: the Gaussian quantile near normal incidence; near grazing, where
+    // C(x) ~ tan e^{-x^2}/(2 sqrt(pi)) dominates, the inverse of that limit, -sqrt(-ln u).
+    var x = clamp(select(erfinv_unit(u), -sqrt(neg_ln(u)), tan_t > 2.0), lo, hi);
     for (var i = 0; i < 10; i++) {
         let f = beckmann_visible_cdf(x, tan_t) - goal;
         if (f > 0.0) {
@@ -136,7 +151,7 @@ fn beckmann_sample_vndf_h(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> vec3<f32
     if (st > 0.0) {
         cs = ws.xy / st;
     }
-    let x = beckmann_visible_slope(st / ws.z, u.x);
+    let x = beckmann_visible_slope(select(st / ws.z, 1.0e30, ws.z <= 1.0e-30), u.x);
     let y = erfinv_unit(u.y);
     let sl = a * vec2<f32>(cs.x * x - cs.y * y, cs.y * x + cs.x * y);
     let len = length(sl);
@@ -146,8 +161,8 @@ fn beckmann_sample_vndf_h(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> vec3<f32
     return from_tan_theta(len, -sl.x / len, -sl.y / len);
 }
 
-// p(wr) = G1(wi) D(h) / (4 cos th_i).
+// p(wr) = G1(wi) D(h) / (4 cos th_i), zero for light from below the surface.
 fn beckmann_sample_vndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
     let h = beckmann_sample_vndf_h(a, wi, u);
-    return LobeSample(h, reflect_about(wi, h), beckmann_g1(a, wi) * beckmann_d(a, h) / (4.0 * wi.z));
+    return lobe_sample(wi, h, reflect_about(wi, h), beckmann_g1_over_cos(a, wi) * beckmann_d(a, h) * 0.25);
 }

@@ -26,3 +26,18 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = lobe_sample_at(add64(params.base, i));
     directions_out[i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
 }
+
+// Explicit uniforms for the stability suite: sample i uses explicit_u[i] (any u a caller can
+// pass, 0 and 1 included) and writes (wr, reason code), then (h, pdf_r).
+@group(0) @binding(3) var<storage, read> explicit_u: array<vec2<f32>>;
+
+@compute @workgroup_size(256)
+fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.count) {
+        return;
+    }
+    let s = SAMPLE_FN(params.alpha, params.wi.xyz, explicit_u[i]);
+    directions_out[2u * i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
+    directions_out[2u * i + 1u] = vec4<f32>(s.h, s.pdf_r);
+}

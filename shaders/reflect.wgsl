@@ -13,10 +13,16 @@ fn reflect_about(wi: vec3<f32>, h: vec3<f32>) -> vec3<f32> {
     return 2.0 * dot(wi, h) * h - wi;
 }
 
+// A LobeSample with its reflected density, which is 0 for light from below the surface
+// (wi.z < 0) and for reflections into it (wr.z <= 0), as in src/reference (Lobe::pdf_r).
+fn lobe_sample(wi: vec3<f32>, h: vec3<f32>, wr: vec3<f32>, pdf_r: f32) -> LobeSample {
+    return LobeSample(h, wr, select(pdf_r, 0.0, wi.z < 0.0 || wr.z <= 0.0));
+}
+
 // A LobeSample from a half vector and its density p(h): p(wr) = p(h) / (4 |wr.h|).
 fn reflect_sample(wi: vec3<f32>, h: vec3<f32>, pdf_h: f32) -> LobeSample {
     let wr = reflect_about(wi, h);
-    return LobeSample(h, wr, pdf_h / (4.0 * abs(dot(wr, h))));
+    return lobe_sample(wi, h, wr, pdf_h / (4.0 * abs(dot(wr, h))));
 }
 
 // Unit vector with polar tangent t and unit azimuth (c, s): cos = 1/sqrt(1+t^2), sin = t cos.

@@ -14,7 +14,11 @@ fn ward_pdf_h(a: vec2<f32>, h: vec3<f32>) -> f32 {
         return 0.0;
     }
     let q = h.xy / a;
-    return exp(-dot(q, q) / (h.z * h.z)) / (PI * a.x * a.y * h.z * h.z * h.z);
+    let q2 = dot(q, q);
+    if (q2 > 87.0 * h.z * h.z) {
+        return 0.0; // exp(-q2/hz^2) < 2^-126: underflows, and hz^3 may too (0/0)
+    }
+    return exp(-q2 / (h.z * h.z)) / (PI * a.x * a.y * h.z * h.z * h.z);
 }
 
 fn ward_sample(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {

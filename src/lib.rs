@@ -23,3 +23,4 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod stats;
+pub mod stress;

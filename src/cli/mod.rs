@@ -15,6 +15,7 @@
 pub mod bench;
 pub mod merge;
 pub mod run;
+pub mod stress;
 pub mod tutorial;
 
 use crate::reference::{LobeKind, Method};
@@ -56,6 +57,9 @@ pub enum Command {
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
+    /// Drive every sampler with the inputs where naive formulas break, on the GPU (f32) and
+    /// the CPU (f64); print case, kernel, worst errors and verdict.
+    Stress(stress::StressArgs),
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
     Merge(merge::MergeArgs),
@@ -70,6 +74,7 @@ impl Cli {
             Command::Sample(args) => tutorial::sample(&args),
             Command::Run(args) => run::run(&args),
             Command::Bench(args) => bench::run(&args),
+            Command::Stress(args) => stress::run(&args),
             Command::Merge(args) => merge::run(&args),
         }
     }

@@ -32,6 +32,7 @@ struct Kernel {
     sample: wgpu::ComputePipeline,
     fold: wgpu::ComputePipeline,
     directions: Option<wgpu::ComputePipeline>,
+    explicit: Option<wgpu::ComputePipeline>,
     in_workgroup: bool,
 }
 
@@ -228,6 +229,7 @@ impl GpuEngine {
             sample: pipeline("sample_histogram"),
             fold: pipeline("fold"),
             directions: matches!(job, Job::Lobe { .. }).then(|| pipeline("directions")),
+            explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("explicit_samples")),
             in_workgroup,
         });
         self.check_errors()?;
@@ -442,14 +444,43 @@ impl GpuEngine {
     pub fn directions(&mut self, job: &Job, seed: u64, first: u64, count: u32) -> Result<Vec<[f32; 4]>, GpuError> {
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.directions else { return Ok(Vec::new()) };
+        let (tf, _) = self.tables(job);
+        self.per_sample(pipeline, job, seed, first, count, &tf, 1)
+    }
+
+    /// The GPU's f32 samples for explicit uniforms: per sample `[ωr, reason]` and `[h, pdf_r]`.
+    pub fn explicit(&mut self, job: &Job, u: &[[f32; 2]]) -> Result<Vec<[[f32; 4]; 2]>, GpuError> {
+        let kernel = self.kernel(job)?;
+        let Some(pipeline) = &kernel.explicit else { return Ok(Vec::new()) };
+        let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("explicit u"),
+            contents: bytemuck::cast_slice(u),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let out = self.per_sample(pipeline, job, 0, 0, u.len() as u32, &input, 2)?;
+        Ok(out.chunks(2).map(|p| [p[0], p[1]]).collect())
+    }
+
+    /// Runs a one-thread-per-sample entry point writing `per` vec4s per sample.
+    #[allow(clippy::too_many_arguments)]
+    fn per_sample(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        job: &Job,
+        seed: u64,
+        first: u64,
+        count: u32,
+        input: &wgpu::Buffer,
+        per: u64,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let params = self.buffer("params", self.param_stride(), wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
-        let dirs = self.buffer("directions", count as u64 * 16, storage);
+        let dirs = self.buffer("per-sample output", count as u64 * 16 * per, storage);
         let dummy = self.buffer("unused", 16, wgpu::BufferUsages::STORAGE);
         let dummy2 = self.buffer("unused", 16, wgpu::BufferUsages::STORAGE);
-        let (tf, tu) = self.tables(job);
+        let dummy3 = self.buffer("unused", 16, wgpu::BufferUsages::STORAGE);
         self.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&Self::params(job, seed, first, count)));
-        let bind = self.bind_group(&params, &dummy, &dummy2, &tf, &tu, &dirs);
+        let bind = self.bind_group(&params, &dummy, &dummy2, input, &dummy3, &dirs);
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -460,7 +491,7 @@ impl GpuEngine {
             pass.dispatch_workgroups(gx, 1, 1);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = self.read(&dirs, count as u64 * 16)?;
+        let bytes = self.read(&dirs, count as u64 * 16 * per)?;
         self.check_errors()?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }

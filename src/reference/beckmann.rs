@@ -37,6 +37,13 @@ pub fn visible_slope_cdf(x: f64, tan_t: f64) -> f64 {
 /// The slope x̃ with C(x̃) = u · C(cot θ): Newton on C (C'(x) = (1 − x tan θ) e^{−x²}/√π)
 /// inside a shrinking bisection bracket [lo, hi], to the f64 resolution of x.
 pub fn sample_visible_slope_x(tan_t: f64, u: f64) -> f64 {
+    if u >= 1.0 {
+        return 1.0 / tan_t; // the top of the support, cot θ (+∞ at normal incidence)
+    }
+    if tan_t > 1e15 {
+        // θ = 90°: the density tends to 2|x| e^{−x²} on x ≤ 0, whose CDF e^{−x²} inverts exactly.
+        return -ward::neg_ln(u).sqrt();
+    }
     let cot = 1.0 / tan_t;
     let mut hi = cot.min(40.0);
     let target = u * visible_slope_cdf(hi, tan_t);
@@ -79,6 +86,18 @@ impl Microfacet for Beckmann {
             return 0.0;
         }
         -0.5 * erfc(a) + (-a * a).exp() * INV_SQRT_PI / (2.0 * a)
+    }
+
+    /// G1/cos θ = 1 / (cos θ + cos θ·Λ) with cos θ·Λ = −cos θ erfc(a)/2 + α_ω e^{−a²}/(2√π),
+    /// α_ω = |(αx ωx, αy ωy)|, a = cos θ/α_ω: finite at cos θ = 0, where it is 2√π/α_ω.
+    fn g1_over_cos(&self, w: DVec3) -> f64 {
+        let c = w.z.abs();
+        let aw = (self.ax * w.x).hypot(self.ay * w.y);
+        if aw == 0.0 {
+            return 1.0 / c;
+        }
+        let a = c / aw;
+        1.0 / (c - 0.5 * c * erfc(a) + aw * (-a * a).exp() * INV_SQRT_PI / 2.0)
     }
 
     fn sample_ndf(&self, u: [f64; 2]) -> DVec3 {

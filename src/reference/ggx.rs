@@ -16,6 +16,17 @@ use super::microfacet::{Microfacet, stretch};
 use glam::DVec3;
 use std::f64::consts::PI;
 
+/// 1 − ωs.z for ωs = normalize(αx ωx, αy ωy, ωz), as |v.xy|² / (|v| (|v| + v.z)) when v.z ≥ 0,
+/// which keeps its precision as ωs approaches the normal (near-specular α).
+pub fn one_minus_stretched_z(ax: f64, ay: f64, w: DVec3) -> f64 {
+    let v = DVec3::new(ax * w.x, ay * w.y, w.z);
+    let len = v.length();
+    if v.z < 0.0 {
+        return 1.0 - v.z / len;
+    }
+    (v.x * v.x + v.y * v.y) / (len * (len + v.z))
+}
+
 #[derive(Debug, Clone, Copy)]
 pub struct Ggx {
     pub ax: f64,
@@ -31,17 +42,28 @@ impl Ggx {
     /// Eto & Tokuyoshi 2023, listing 1: k, the factor that shrinks the spherical cap so that
     /// fewer reflected directions fall below the horizon.
     pub fn bounded_k(&self, wi: DVec3) -> f64 {
+        1.0 - self.bounded_one_minus_k(wi)
+    }
+
+    /// 1 − k = a² (s² + ωi.z²) / (s² + a² ωi.z²), exact algebra on listing 1's k that keeps its
+    /// precision as a → 0, where k → 1.
+    pub fn bounded_one_minus_k(&self, wi: DVec3) -> f64 {
         let a = self.ax.min(self.ay).clamp(0.0, 1.0);
         let s = 1.0 + wi.x.hypot(wi.y);
-        let (a2, s2) = (a * a, s * s);
-        (1.0 - a2) * s2 / (s2 + a2 * wi.z * wi.z)
+        let (a2, s2, z2) = (a * a, s * s, wi.z * wi.z);
+        a2 * (s2 + z2) / (s2 + a2 * z2)
     }
 
     /// Eto & Tokuyoshi 2023, listing 1: the cap's lower bound is −b instead of −ωs.z.
     pub fn sample_bounded(&self, wi: DVec3, u: [f64; 2]) -> DVec3 {
         let ws = stretch(self.ax, self.ay, wi);
-        let b = if wi.z > 0.0 { self.bounded_k(wi) * ws.z } else { ws.z };
-        self.cap_sample(ws, b, u)
+        let (b, ws_minus_b) = if wi.z > 0.0 {
+            let omk = self.bounded_one_minus_k(wi);
+            ((1.0 - omk) * ws.z, omk * ws.z)
+        } else {
+            (ws.z, 0.0)
+        };
+        self.cap_sample(wi, ws, b, ws_minus_b, u)
     }
 
     /// Eto & Tokuyoshi 2023, listing 2: the reflected density, for ωr above the horizon:
@@ -62,11 +84,16 @@ impl Ggx {
 
     /// A uniform point on the unit sphere's cap z ≥ −b, offset by ωs and unstretched
     /// (Dupuy & Benyoub 2023, listing 3; b = ωs.z there).
-    fn cap_sample(&self, ws: DVec3, b: f64, u: [f64; 2]) -> DVec3 {
+    fn cap_sample(&self, wi: DVec3, ws: DVec3, b: f64, ws_minus_b: f64, u: [f64; 2]) -> DVec3 {
         let (sp, cp) = (2.0 * PI * u[0]).sin_cos();
-        let z = (1.0 - u[1]) * (1.0 + b) - b;
-        let sin_t = (1.0 - z * z).clamp(0.0, 1.0).sqrt();
-        let hs = DVec3::new(sin_t * cp, sin_t * sp, z) + ws;
+        // z = s − b with s = (1 − u2)(1 + b). Near-specular α puts b and ωs.z near 1, where
+        // 1 − z², 1 − b and z + ωs.z all cancel; they are formed from differences computed
+        // without cancellation: 1 − z² = (s + (1 − b)) ((1 + b) − s), 1 − b = (1 − ωs.z) + (ωs.z − b),
+        // z + ωs.z = s + (ωs.z − b).
+        let s = (1.0 - u[1]) * (1.0 + b);
+        let one_minus_b = one_minus_stretched_z(self.ax, self.ay, wi) + ws_minus_b;
+        let sin_t = ((s + one_minus_b) * ((1.0 + b) - s)).clamp(0.0, 1.0).sqrt();
+        let hs = DVec3::new(sin_t * cp + ws.x, sin_t * sp + ws.y, s + ws_minus_b);
         if hs.length_squared() == 0.0 {
             // u2 = 1 puts the point on the cap's rim z = −b; for the plain VNDF (b = ωs.z) at
             // ωi = +z the whole rim is the single point −ωs, so hs = 0 and normalize() would
@@ -93,6 +120,11 @@ impl Microfacet for Ggx {
         2.0 * z / (z + self.stretched_len(w))
     }
 
+    /// G1/cos θ = 2 / (cos θ + t), t = |(αx ωx, αy ωy, ωz)|: finite at cos θ = 0.
+    fn g1_over_cos(&self, w: DVec3) -> f64 {
+        2.0 / (w.z.abs() + self.stretched_len(w))
+    }
+
     fn sample_ndf(&self, u: [f64; 2]) -> DVec3 {
         let (sp, cp) = (2.0 * PI * u[1]).sin_cos();
         let r = u[0].sqrt();
@@ -102,7 +134,7 @@ impl Microfacet for Ggx {
 
     fn sample_vndf(&self, wi: DVec3, u: [f64; 2]) -> DVec3 {
         let ws = stretch(self.ax, self.ay, wi);
-        self.cap_sample(ws, ws.z, u)
+        self.cap_sample(wi, ws, ws.z, 0.0, u)
     }
 }
 

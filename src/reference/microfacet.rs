@@ -19,6 +19,11 @@ pub trait Microfacet {
     fn g1(&self, w: DVec3) -> f64 {
         1.0 / (1.0 + self.lambda(w))
     }
+    /// G1(ω) / cos θ, in a form that stays finite as cos θ → 0 (grazing incidence), where
+    /// G1 → 0 and cos θ → 0 together.
+    fn g1_over_cos(&self, w: DVec3) -> f64 {
+        self.g1(w) / w.z
+    }
     /// A half vector with density D(h) cos θh.
     fn sample_ndf(&self, u: [f64; 2]) -> DVec3;
     /// A half vector with density D_ωi(h) (visible normals).
@@ -30,13 +35,14 @@ pub fn pdf_ndf(m: &impl Microfacet, h: DVec3) -> f64 {
     if h.z <= 0.0 { 0.0 } else { m.d(h) * h.z }
 }
 
-/// Density of visible-normal sampling (Heitz 2014, eq. 38): G1(ωi) max(0, ωi·h) D(h) / cos θi.
+/// Density of visible-normal sampling (Heitz 2014, eq. 38): G1(ωi) max(0, ωi·h) D(h) / cos θi,
+/// with G1/cos θi taken in its stable form (finite at θi = 90°). Zero for ωi below the horizon.
 pub fn pdf_vndf(m: &impl Microfacet, wi: DVec3, h: DVec3) -> f64 {
     let cos_ih = wi.dot(h);
-    if wi.z <= 0.0 || h.z <= 0.0 || cos_ih <= 0.0 {
+    if wi.z < 0.0 || h.z <= 0.0 || cos_ih <= 0.0 {
         return 0.0;
     }
-    m.g1(wi) * cos_ih * m.d(h) / wi.z
+    m.g1_over_cos(wi) * cos_ih * m.d(h)
 }
 
 /// Height-correlated Smith G2 (Heitz 2014, eq. 99): 1 / (1 + Λ(ωi) + Λ(ωr)).

@@ -154,6 +154,8 @@ impl Lobe {
         let omega_r = reflect::reflect(wi, h);
         let pdf_h = self.pdf_h(wi, h);
         let pdf_r = match (self.kind, self.method) {
+            // no reflection from below the surface, and none into it: p(ωr) = 0 there, as in pdf_r
+            _ if wi.z < 0.0 || omega_r.z <= 0.0 => 0.0,
             (LobeKind::Ggx, Method::Bounded) if omega_r.z > 0.0 => self.ggx().pdf_bounded_r(wi, h),
             _ => reflect::pdf_reflected(pdf_h, omega_r, h),
         };
@@ -197,7 +199,7 @@ impl Lobe {
     /// The density of a valid reflected direction ωr (above the horizon); 0 below it, where
     /// samples are counted as invalid instead.
     pub fn pdf_r(&self, wi: DVec3, wr: DVec3) -> f64 {
-        if wr.z <= 0.0 {
+        if wr.z <= 0.0 || wi.z < 0.0 {
             return 0.0;
         }
         let Some(h) = reflect::half_vector(wi, wr) else { return 0.0 };
