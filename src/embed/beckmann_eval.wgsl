@@ -1,7 +1,8 @@
 // Beckmann densities and BRDF for renderers that embed lobes' samplers (lobes::embed,
 // Module::Beckmann); CPU twins: src/reference/beckmann.rs and src/reference/microfacet.rs.
 // a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.
-// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon.
+// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon and for
+// wi below it (light from below the surface is not reflected).
 
 // Smith's Lambda (Heitz 2014, eq. 72): -erfc(x)/2 + exp(-x^2) / (2 x sqrt(pi)),
 // x = |wz| / |(ax wx, ay wy)|; 0 past x = 10 (where it is below 1e-45).
@@ -32,17 +33,19 @@ fn beckmann_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 // The density of wr under beckmann_sample_ndf: D(h) cos th_h / (4 |wr.h|).
 fn beckmann_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);
     return beckmann_d(a, h) * max(h.z, 0.0) / (4.0 * abs(dot(wr, h)));
 }
 
-// The density of wr under beckmann_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|).
+// The density of wr under beckmann_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|),
+// with G1 / cos th = 1 / (cos th + cos th Lambda), cos th Lambda = -cos th erfc(x)/2 + a_w e^{-x^2}/(2 sqrt(pi)),
+// a_w = |(ax wx, ay wy)|, x = cos th / a_w: finite at grazing incidence.
 fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);
@@ -50,5 +53,12 @@ fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     if (h.z <= 0.0 || cos_ih <= 0.0) {
         return 0.0;
     }
-    return beckmann_g1(a, wi) * cos_ih * beckmann_d(a, h) / wi.z / (4.0 * abs(dot(wr, h)));
+    let aw = length(a * wi.xy);
+    let c = wi.z;
+    var g1_over_cos = 1.0 / c;
+    if (c <= 10.0 * aw) {
+        let x = c / aw;
+        g1_over_cos = 1.0 / (c - 0.5 * c * erfc_approx(x) + 0.5 * aw * exp(-x * x) * INV_SQRT_PI);
+    }
+    return g1_over_cos * cos_ih * beckmann_d(a, h) / (4.0 * abs(dot(wr, h)));
 }

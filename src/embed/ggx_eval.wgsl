@@ -1,7 +1,8 @@
 // GGX densities and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ggx);
 // CPU twins: src/reference/ggx.rs and src/reference/microfacet.rs (Lobe::pdf_r, Lobe::eval).
 // a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.
-// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon.
+// Every density is per unit solid angle of wr and is 0 for wr at or below the horizon and for
+// wi below it (light from below the surface is not reflected).
 
 // Smith's Lambda (Heitz 2014, eq. 86): (|(ax wx, ay wy, wz)| / |wz| - 1) / 2.
 fn ggx_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
@@ -11,8 +12,8 @@ fn ggx_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
 // Height-correlated Smith G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99), formed
 // from G1 = 1 / (1 + Lambda) as G1i G1r / (G1i + G1r - G1i G1r), finite at grazing angles.
 fn ggx_g2(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let gi = ggx_g1(a, wi);
-    let gr = ggx_g1(a, wr);
+    let gi = 2.0 * abs(wi.z) / (abs(wi.z) + length(vec3<f32>(a * wi.xy, wi.z)));
+    let gr = 2.0 * abs(wr.z) / (abs(wr.z) + length(vec3<f32>(a * wr.xy, wr.z)));
     if (gi <= 0.0 || gr <= 0.0) {
         return 0.0;
     }
@@ -31,7 +32,7 @@ fn ggx_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 // The density of wr under ggx_sample_ndf: D(h) cos th_h / (4 |wr.h|).
 fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);
@@ -42,10 +43,11 @@ fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 }
 
 // The density of wr under ggx_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|)
-// (Heitz 2014, eq. 38, through the reflection Jacobian).
+// (Heitz 2014, eq. 38, through the reflection Jacobian), with G1(wi) / cos th_i = 2 / (cos th_i + t),
+// t = |(ax wi.x, ay wi.y, wi.z)|, which stays finite at grazing incidence.
 fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);
@@ -53,24 +55,26 @@ fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     if (h.z <= 0.0 || cos_ih <= 0.0) {
         return 0.0;
     }
-    return ggx_g1(a, wi) * cos_ih * ggx_d(a, h) / wi.z / (4.0 * abs(dot(wr, h)));
+    let g1_over_cos = 2.0 / (wi.z + length(vec3<f32>(a * wi.xy, wi.z)));
+    return g1_over_cos * cos_ih * ggx_d(a, h) / (4.0 * abs(dot(wr, h)));
 }
 
-// The density of wr under ggx_sample_bounded (Eto & Tokuyoshi 2023, listing 2).
+// The density of wr under ggx_sample_bounded (Eto & Tokuyoshi 2023, listing 2):
+// D(h) / (2 (k wi.z + t)).
 fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);
     if (h.z <= 0.0) {
         return 0.0;
     }
-    let d = ggx_d(a, h);
+    // Eto & Tokuyoshi 2023, listing 1: k = (1 - am^2) s^2 / (s^2 + am^2 wi.z^2), am = min(ax, ay)
+    // clamped to [0, 1], s = 1 + |wi.xy|.
+    let am = clamp(min(a.x, a.y), 0.0, 1.0);
+    let sl = 1.0 + length(wi.xy);
+    let k = (1.0 - am * am) * sl * sl / (sl * sl + am * am * wi.z * wi.z);
     let t = length(vec3<f32>(a * wi.xy, wi.z));
-    if (wi.z >= 0.0) {
-        return d / (2.0 * (ggx_bounded_k(a, wi) * wi.z + t));
-    }
-    let l = a * wi.xy;
-    return d * (t - wi.z) / (2.0 * dot(l, l));
+    return ggx_d(a, h) / (2.0 * (k * wi.z + t));
 }

@@ -13,11 +13,11 @@ fn ward_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     return exp(-dot(q, q) / (h.z * h.z)) / (4.0 * PI * a.x * a.y * sqrt(wi.z * wr.z));
 }
 
-// The density of wr under ward_sample: p(h) / (4 |wr.h|) (Walter 2005, eq. 9), 0 at or below
-// the horizon.
+// The density of wr under ward_sample: p(h) / (4 |wr.h|) (Walter 2005, eq. 9); 0 for wr at or
+// below the horizon and for wi below it.
 fn ward_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let s = wi + wr;
-    if (wr.z <= 0.0 || dot(s, s) == 0.0) {
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
         return 0.0;
     }
     let h = normalize(s);

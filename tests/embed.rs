@@ -1,0 +1,332 @@
+//! `lobes::embed` used the way a renderer uses it: the composed WGSL inside kernels of our own,
+//! checked on the GPU against the f64 reference; and the two examples, whose code is compiled
+//! into this test and run here. GPU tests: they need a wgpu adapter (lavapipe in CI) and fail
+//! without one.
+
+#[path = "../examples/dfg_lut.rs"]
+#[allow(dead_code)]
+mod dfg_lut;
+#[path = "../examples/end_to_end.rs"]
+#[allow(dead_code)]
+mod end_to_end;
+
+use glam::DVec3;
+use lobes::embed::{self, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteTable, Module};
+use lobes::gpu::{Gpu, GpuEngine};
+use lobes::job::{DiscreteMethod, Job};
+use lobes::reference::discrete::Distribution;
+use lobes::reference::{Lobe, LobeKind, Method, reflect, rng};
+use wgpu::util::DeviceExt;
+
+fn gpu() -> Gpu {
+    Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"))
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    }
+}
+
+/// Runs `entry` of `source` over `invocations` threads (workgroups of 64) with the given bind
+/// groups and returns the contents of `out`.
+fn dispatch(gpu: &Gpu, source: &str, entry: &str, layouts: &[&wgpu::BindGroupLayout], groups: &[&wgpu::BindGroup], invocations: u32, out: &wgpu::Buffer) -> Vec<u8> {
+    embed::validate(source).unwrap_or_else(|e| panic!("{e}"));
+    let d = &gpu.device;
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(entry), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+    let layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: None, bind_group_layouts: &layouts, immediate_size: 0 });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(entry),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let size = out.size();
+    let read = d.create_buffer(&wgpu::BufferDescriptor { label: None, size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+    let mut encoder = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        for (i, g) in groups.iter().enumerate() {
+            pass.set_bind_group(i as u32, *g, &[]);
+        }
+        pass.dispatch_workgroups(invocations.div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(out, 0, &read, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    read.map_async(wgpu::MapMode::Read, 0..size, move |r| tx.send(r).unwrap());
+    d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    rx.recv().unwrap().unwrap();
+    let bytes = read.get_mapped_range(0..size).unwrap().to_vec();
+    read.unmap();
+    bytes
+}
+
+const SAMPLERS: &str = r#"
+struct TestParams {
+    wi: vec4<f32>,
+    a: vec4<f32>,
+    seed: vec4<u32>,
+}
+@group(0) @binding(0) var<uniform> tp: TestParams;
+@group(0) @binding(1) var<storage, read_write> results: array<vec4<f32>>;
+
+// Per sample and sampler k: (wr, the sampler's pdf_r), then (the pdf function at wr, eval at wr).
+fn put(i: u32, k: u32, s: LobeSample, pdf: f32, f: f32) {
+    results[12u * i + 2u * k] = vec4<f32>(s.wr, s.pdf_r);
+    results[12u * i + 2u * k + 1u] = vec4<f32>(pdf, f, 0.0, 0.0);
+}
+
+@compute @workgroup_size(64)
+fn sample_all(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= arrayLength(&results) / 12u) {
+        return;
+    }
+    let u = rng_uniforms(tp.seed.xy, vec2<u32>(i, 0u)).xy;
+    let a = tp.a.xy;
+    let wi = tp.wi.xyz;
+    var s = ward_sample(a, wi, u);
+    put(i, 0u, s, ward_pdf(a, wi, s.wr), ward_eval(a, wi, s.wr));
+    s = beckmann_sample_ndf(a, wi, u);
+    put(i, 1u, s, beckmann_pdf_ndf(a, wi, s.wr), beckmann_eval(a, wi, s.wr));
+    s = beckmann_sample_vndf(a, wi, u);
+    put(i, 2u, s, beckmann_pdf_vndf(a, wi, s.wr), beckmann_eval(a, wi, s.wr));
+    s = ggx_sample_ndf(a, wi, u);
+    put(i, 3u, s, ggx_pdf_ndf(a, wi, s.wr), ggx_eval(a, wi, s.wr));
+    s = ggx_sample_vndf(a, wi, u);
+    put(i, 4u, s, ggx_pdf_vndf(a, wi, s.wr), ggx_eval(a, wi, s.wr));
+    s = ggx_sample_bounded(a, wi, u);
+    put(i, 5u, s, ggx_pdf_bounded(a, wi, s.wr), ggx_eval(a, wi, s.wr));
+}
+"#;
+
+/// Relative difference, with values below 1e-30 (f32 underflow) counted as equal.
+fn rel(gpu: f64, cpu: f64) -> f64 {
+    let d = (gpu - cpu).abs();
+    if d < 1e-30 { 0.0 } else { d / cpu.abs() }
+}
+
+/// Every embedded sampler, driven by the embedded RNG inside our own kernel, draws the f64
+/// reference's directions from the same uniforms, and the embedded pdf and BRDF functions
+/// agree with the sampler's own density and with the f64 reference at the GPU's directions
+/// (relative error below 1e-4; f32 gives about 1e-5).
+#[test]
+fn embedded_samplers_densities_and_brdfs_match_the_f64_reference() {
+    let gpu = gpu();
+    let source = embed::wgsl(&[Module::Rng, Module::Ward, Module::Beckmann, Module::Ggx]) + SAMPLERS;
+    let n: u32 = 4096;
+    let kernels = [
+        (LobeKind::Ward, Method::Ndf),
+        (LobeKind::Beckmann, Method::Ndf),
+        (LobeKind::Beckmann, Method::Vndf),
+        (LobeKind::Ggx, Method::Ndf),
+        (LobeKind::Ggx, Method::Vndf),
+        (LobeKind::Ggx, Method::Bounded),
+    ];
+    let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &[uniform_entry(0), storage_entry(1, false)],
+    });
+    let mut failures = Vec::new();
+    for (case, &(ax, ay, theta, phi)) in [(0.05, 0.05, 30.0, 0.0), (0.3, 0.3, 60.0, 0.0), (1.0, 1.0, 80.0, 0.0), (0.2, 0.6, 45.0, 30.0)].iter().enumerate() {
+        let wi: DVec3 = reflect::spherical(f64::to_radians(theta), f64::to_radians(phi));
+        let seed = 40 + case as u64;
+        let mut params = [0u32; 12];
+        for (k, x) in [wi.x as f32, wi.y as f32, wi.z as f32, 0.0, ax as f32, ay as f32, 0.0, 0.0].into_iter().enumerate() {
+            params[k] = x.to_bits();
+        }
+        params[8] = seed as u32;
+        params[9] = (seed >> 32) as u32;
+        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&params), usage: wgpu::BufferUsages::UNIFORM });
+        let out = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: n as u64 * 12 * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() }],
+        });
+        let bytes = dispatch(&gpu, &source, "sample_all", &[&layout], &[&group], n, &out);
+        let res: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        for (k, &(kind, method)) in kernels.iter().enumerate() {
+            let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+            let (mut compared, mut mismatches, mut max_angle, mut worst_pdf, mut worst_eval, mut worst_self) = (0, 0, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+            for i in 0..n as usize {
+                let [x, y, z, pdf_s] = res[12 * i + 2 * k];
+                let [pdf_fn, eval_fn, _, _] = res[12 * i + 2 * k + 1];
+                let u = rng::uniforms(seed, i as u64);
+                let reference = lobe.sample(wi, [u[0], u[1]]);
+                let wr = DVec3::new(x as f64, y as f64, z as f64);
+                let gpu_valid = wr.is_finite() && wr.z > 0.0 && pdf_s.is_finite() && pdf_s > 0.0;
+                if gpu_valid != reference.invalid.is_none() {
+                    mismatches += 1;
+                    continue;
+                }
+                if !gpu_valid {
+                    continue;
+                }
+                compared += 1;
+                max_angle = max_angle.max(lobes::stats::compare::angle_between(wr.normalize(), reference.omega_r));
+                // the pdf function against the sampler's own density, both on the GPU, and both
+                // functions against f64 at the GPU's direction
+                let wr64 = wr.normalize();
+                worst_self = worst_self.max(rel(pdf_fn as f64, pdf_s as f64));
+                worst_pdf = worst_pdf.max(rel(pdf_fn as f64, lobe.pdf_r(wi, wr64)));
+                worst_eval = worst_eval.max(rel(eval_fn as f64, lobe.eval(wi, wr64)));
+            }
+            let what = format!("{kind:?} {method:?} α=({ax},{ay}) θi={theta}°");
+            println!(
+                "{what}: {compared} compared, {mismatches} validity mismatches, max angle {max_angle:.2e} rad, \
+                 max relative error: pdf fn vs sampler {worst_self:.1e}, pdf vs f64 {worst_pdf:.1e}, eval vs f64 {worst_eval:.1e}"
+            );
+            if compared < n as usize / 4 || mismatches > 2 || max_angle > 1e-4 || worst_self > 1e-4 || worst_pdf > 1e-4 || worst_eval > 1e-4 {
+                failures.push(format!(
+                    "{what}: compared {compared}, mismatches {mismatches}, max angle {max_angle:.2e}, worst relative error: pdf fn vs sampler {worst_self:.2e}, pdf vs f64 {worst_pdf:.2e}, eval vs f64 {worst_eval:.2e}"
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+const DISCRETE_KERNEL: &str = r#"
+@group(0) @binding(0) var<storage, read_write> counts: array<atomic<u32>>;
+@group(0) @binding(1) var<uniform> info: DiscreteInfo;
+@group(0) @binding(2) var<uniform> run: vec4<u32>; // seed lo, seed hi, samples, method (0 cdf, 1 alias)
+
+@compute @workgroup_size(64)
+fn draw_discrete(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= run.z) {
+        return;
+    }
+    let u = rng_uniforms(run.xy, vec2<u32>(gid.x, 0u));
+    var k: u32;
+    if (run.w == 0u) {
+        k = discrete_sample_cdf(u.x, info.n_items, info.last_positive);
+    } else {
+        k = discrete_sample_alias(u.xy, info.n_items);
+    }
+    atomicAdd(&counts[k], 1u);
+}
+"#;
+
+/// A discrete distribution uploaded with `DiscreteBuffers` at bindings of our choosing, sampled
+/// in our own kernel, gives exactly the histogram of lobes' own χ²-tested kernel.
+#[test]
+fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
+    let gpu = gpu();
+    let mut engine = GpuEngine::open().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
+    let dist = Distribution::new(&[0.0, 15.0, 5.0, 0.0, 25.0, 5.0, 10.0, 15.0, 5.0, 5.0, 10.0, 0.0]).unwrap();
+    let bindings = DiscreteBindings { group: 1, table: 0, alias: 1 };
+    let source = embed::wgsl_with(&[Module::Rng, Module::Discrete], bindings) + DISCRETE_INFO_WGSL + DISCRETE_KERNEL;
+    assert!(source.contains("@group(1) @binding(1) var<storage, read> discrete_u"));
+    let samples: u32 = 1 << 20;
+    let seed: u64 = 0x1234_5678_9abc;
+    let d = &gpu.device;
+    let own = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &[storage_entry(0, false), uniform_entry(1), uniform_entry(2)],
+    });
+    let tables = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &DiscreteBuffers::layout_entries(bindings, wgpu::ShaderStages::COMPUTE),
+    });
+    for method in [DiscreteMethod::Cdf, DiscreteMethod::Alias] {
+        let buffers = match method {
+            DiscreteMethod::Cdf => DiscreteBuffers::cdf(d, &dist),
+            DiscreteMethod::Alias => DiscreteBuffers::alias(d, &dist),
+        };
+        assert_eq!(buffers.info, DiscreteTable::new(&dist, method).info);
+        let counts = d.create_buffer(&wgpu::BufferDescriptor {
+            label: None,
+            size: dist.len() as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let info = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::bytes_of(&buffers.info), usage: wgpu::BufferUsages::UNIFORM });
+        let run = [seed as u32, (seed >> 32) as u32, samples, (method == DiscreteMethod::Alias) as u32];
+        let run = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&run), usage: wgpu::BufferUsages::UNIFORM });
+        let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: None,
+            layout: &own,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: counts.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: info.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: run.as_entire_binding() },
+            ],
+        });
+        let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &tables, entries: &buffers.bind_group_entries(bindings) });
+        let bytes = dispatch(&gpu, &source, "draw_discrete", &[&own, &tables], &[&g0, &g1], samples, &counts);
+        let mine: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&bytes).iter().map(|&c| c as u64).collect();
+        let job = Job::Discrete { dist: dist.clone(), method };
+        let theirs = engine.histogram(&job, seed, 0, samples as u64, &mut |_| {}).unwrap().counts;
+        println!("{method:?}: {mine:?}");
+        assert_eq!(mine, theirs.bins, "{method:?}: embedded sampling differs from the engine's");
+        assert_eq!(mine.iter().sum::<u64>(), samples as u64);
+        for (i, w) in dist.weights().iter().enumerate() {
+            if *w == 0.0 {
+                assert_eq!(mine[i], 0, "{method:?}: zero-weight item {i} drawn");
+            }
+        }
+    }
+}
+
+/// examples/dfg_lut.rs: the DFG table from lobes' GGX sampler embedded in the example's own
+/// kernel agrees with the f64 quadrature within the example's documented tolerance, and its
+/// files have the documented layout.
+#[test]
+fn dfg_lut_example_matches_the_f64_quadrature() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("dfg");
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = dfg_lut::run(&dir).unwrap_or_else(|e| panic!("dfg_lut example (GPU tests need a wgpu adapter): {e:#}"));
+    println!("{}: max |GPU - f64| = {:.3e}", report.adapter, report.max_error);
+    assert!(report.max_error <= dfg_lut::TOLERANCE, "max error {} > {}", report.max_error, dfg_lut::TOLERANCE);
+    let raw = std::fs::read(dir.join("dfg.f32")).unwrap();
+    assert_eq!(raw.len(), 32 * 32 * 2 * 4);
+    let at = |j: usize, i: usize, c: usize| {
+        let k = 4 * (2 * (32 * j + i) + c);
+        f32::from_le_bytes(raw[k..k + 4].try_into().unwrap())
+    };
+    assert_eq!(at(5, 7, 1), report.lut[5 * 32 + 7][1]);
+    // a near-mirror at normal incidence reflects everything: A ≈ 1, B ≈ 0
+    assert!((at(0, 31, 0) - 1.0).abs() < 1e-3 && at(0, 31, 1) < 1e-3, "{} {}", at(0, 31, 0), at(0, 31, 1));
+    // energy: A + B is the single-scattering albedo, in (0, 1]
+    for t in &report.lut {
+        assert!(t[0] > 0.0 && t[1] >= 0.0 && t[0] + t[1] <= 1.0 + 1e-3, "{t:?}");
+    }
+    let png = image::open(dir.join("dfg.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (32, 32));
+}
+
+/// examples/end_to_end.rs: the library driven end to end passes its χ² tests.
+#[test]
+fn end_to_end_example_passes() {
+    let mut engine = GpuEngine::open().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
+    let verdicts = end_to_end::run(&mut engine, 1_000_000, 3).unwrap();
+    assert_eq!(verdicts.len(), 2);
+    for v in &verdicts {
+        println!("{}: chi2 {:.1}/{} p = {:.4}", v.name, v.chi2, v.dof, v.p_value);
+        assert!(v.passed, "{}: p = {}", v.name, v.p_value);
+    }
+    assert!(verdicts[0].max_angle_rad.unwrap() < 1e-4);
+}
