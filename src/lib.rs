@@ -4,7 +4,7 @@
 //! distributions: WGSL compute kernels draw and histogram millions of samples, and an f64
 //! CPU reference judges the histograms with a χ² test.
 //!
-//! - [`reference`]: the f64 math, one module per lobe, each the twin of a WGSL file in
+//! - [`reference`](mod@reference): the f64 math, one module per lobe, each the twin of a WGSL file in
 //!   `shaders/`.
 //! - [`gpu`]: the GPU engine: WGSL composed from `shaders/`, run through wgpu.
 //! - [`cpu`]: the same samples drawn in f64 on all cores.

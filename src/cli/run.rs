@@ -25,7 +25,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub cpu: bool,
     /// Run only shard I of N (0 ≤ I < N) of every case: its contiguous range of sample indices,
-    /// written as raw counts to OUT/<case>/shard-I-of-N.json for `lobes merge`.
+    /// written as raw counts to `OUT/<case>/shard-I-of-N.json` for `lobes merge`.
     #[arg(long, value_name = "I/N", value_parser = super::merge::parse_shard)]
     pub shard: Option<super::merge::Shard>,
     #[command(flatten)]
