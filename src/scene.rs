@@ -15,15 +15,21 @@
 //! incident_theta = 45.0 # degrees from the normal, [0, 90)
 //! incident_phi = 0.0    # degrees
 //! ```
+//!
+//! Every value is read as a TOML value first and checked here, so a wrong type, a value out
+//! of range, NaN or infinity, an unknown name or a key that does not apply to the case's lobe
+//! is a [`SceneError`] pointing at the value (a value set in `[defaults]` is reported where
+//! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
+//! fuzzes it).
 
 use crate::job::{DiscreteMethod, Job};
-use crate::reference::discrete::Distribution;
+use crate::reference::discrete::{Distribution, WeightsError};
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use serde::Deserialize;
-use std::collections::HashSet;
+use std::collections::HashMap;
 use std::ops::Range;
-use toml::Spanned;
+use toml::{Spanned, Value};
 
 /// The scene `lobes run` uses when no file is given: every lobe and method.
 pub const DEFAULT_SCENE: &str = include_str!("../scenes/all-lobes.toml");
@@ -32,9 +38,15 @@ pub const TUTORIAL_SCENE: &str = include_str!("../scenes/tutorial.toml");
 
 /// The largest sample count a case may ask for (2^40; counts are exact far beyond it).
 pub const MAX_SAMPLES: u64 = 1 << 40;
+/// The most bins (rows × cols, or discrete items) a case may have: 2^24. The GPU engine splits
+/// larger histograms into tiles that fit the adapter; this cap bounds the f64 quadrature, the
+/// heat maps and `histogram.json`.
+pub const MAX_BINS: u64 = 1 << 24;
+/// The longest case name (it names a folder).
+pub const MAX_NAME_LEN: usize = 100;
 
-/// A scene error with its location.
-#[derive(Debug, thiserror::Error)]
+/// A scene error with its location (1-based line and column, the column in characters).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}:{line}:{column}: {message}")]
 pub struct SceneError {
     pub file: String,
@@ -43,11 +55,12 @@ pub struct SceneError {
     pub message: String,
 }
 
+type Val = Spanned<Value>;
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawScene {
-    #[serde(default)]
-    defaults: RawDefaults,
+    defaults: Option<Spanned<RawDefaults>>,
     #[serde(default)]
     case: Vec<Spanned<RawCase>>,
 }
@@ -55,26 +68,50 @@ struct RawScene {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawDefaults {
-    samples: Option<Spanned<u64>>,
-    bins: Option<Spanned<[u32; 2]>>,
-    seed: Option<u64>,
+    samples: Option<Val>,
+    bins: Option<Val>,
+    seed: Option<Val>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawCase {
-    name: Spanned<String>,
-    lobe: Spanned<String>,
-    method: Option<Spanned<String>>,
-    alpha: Option<Spanned<f64>>,
-    alpha_x: Option<Spanned<f64>>,
-    alpha_y: Option<Spanned<f64>>,
-    incident_theta: Option<Spanned<f64>>,
-    incident_phi: Option<Spanned<f64>>,
-    weights: Option<Spanned<Vec<f64>>>,
-    samples: Option<Spanned<u64>>,
-    bins: Option<Spanned<[u32; 2]>>,
-    seed: Option<u64>,
+    name: Option<Val>,
+    lobe: Option<Val>,
+    method: Option<Val>,
+    alpha: Option<Val>,
+    alpha_x: Option<Val>,
+    alpha_y: Option<Val>,
+    incident_theta: Option<Val>,
+    incident_phi: Option<Val>,
+    weights: Option<Spanned<Weights>>,
+    samples: Option<Val>,
+    bins: Option<Val>,
+    seed: Option<Val>,
+}
+
+/// `weights = [...]`, each item with its own span (so an error points at the bad weight).
+#[derive(Debug)]
+struct Weights(Vec<Val>);
+
+impl<'de> Deserialize<'de> for Weights {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Weights;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of weights such as [15, 5, 25]")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Weights, A::Error> {
+                let mut items = Vec::new();
+                while let Some(item) = seq.next_element::<Val>()? {
+                    items.push(item);
+                }
+                Ok(Weights(items))
+            }
+        }
+        d.deserialize_seq(V)
+    }
 }
 
 /// One validated case.
@@ -92,6 +129,10 @@ pub struct Case {
 #[derive(Debug, Clone)]
 pub struct Scene {
     pub cases: Vec<Case>,
+    /// The file name used in messages.
+    pub file: String,
+    /// Line and column of each case's `[[case]]` table.
+    locations: Vec<(usize, usize)>,
 }
 
 struct Ctx<'a> {
@@ -99,13 +140,105 @@ struct Ctx<'a> {
     text: &'a str,
 }
 
+/// 1-based line and column (in characters) of byte offset `at` in `text`.
+fn line_column(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
 impl Ctx<'_> {
     fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
-        let before = &self.text[..span.start.min(self.text.len())];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        let (line, column) = line_column(self.text, span.start);
         SceneError { file: self.file.to_string(), line, column, message: message.into() }
     }
+}
+
+/// "a string", "an integer", … for messages.
+fn kind(v: &Value) -> &'static str {
+    match v {
+        Value::String(_) => "a string",
+        Value::Integer(_) => "an integer",
+        Value::Float(_) => "a floating-point number",
+        Value::Boolean(_) => "a boolean",
+        Value::Datetime(_) => "a date-time",
+        Value::Array(_) => "an array",
+        Value::Table(_) => "a table",
+    }
+}
+
+/// A number (TOML integer or float), finite and accepted by `ok`.
+fn number(ctx: &Ctx, v: &Val, key: &str, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<f64, SceneError> {
+    let x = match v.get_ref() {
+        Value::Integer(i) => *i as f64,
+        Value::Float(f) => *f,
+        other => return Err(ctx.err(v.span(), format!("{key} must be a number, got {}; {allowed}", kind(other)))),
+    };
+    if !x.is_finite() || !ok(x) {
+        return Err(ctx.err(v.span(), format!("{key} = {x} is not allowed; {allowed}")));
+    }
+    Ok(x)
+}
+
+/// A whole number in `lo ..= hi`.
+fn whole(ctx: &Ctx, v: &Val, key: &str, lo: u64, hi: u64, allowed: &str) -> Result<u64, SceneError> {
+    match v.get_ref() {
+        Value::Integer(i) if *i >= 0 && (lo..=hi).contains(&(*i as u64)) => Ok(*i as u64),
+        Value::Integer(i) => Err(ctx.err(v.span(), format!("{key} = {i} is not allowed; {allowed}"))),
+        Value::Float(f) => Err(ctx.err(v.span(), format!("{key} must be a whole number (an integer literal), got the floating-point number {f:?}; {allowed}"))),
+        other => Err(ctx.err(v.span(), format!("{key} must be a whole number, got {}; {allowed}", kind(other)))),
+    }
+}
+
+/// A string.
+fn string<'v>(ctx: &Ctx, v: &'v Val, key: &str, allowed: &str) -> Result<&'v str, SceneError> {
+    match v.get_ref() {
+        Value::String(s) => Ok(s),
+        other => Err(ctx.err(v.span(), format!("{key} must be a string, got {}; {allowed}", kind(other)))),
+    }
+}
+
+const SAMPLES_ALLOWED: &str = "give a whole number of samples from 1 to 2^40 (1099511627776), e.g. 10_000_000";
+const SEED_ALLOWED: &str = "give a whole number ≥ 0";
+const BINS_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows even (the horizon is a row edge), rows × cols ≤ 2^24 (16777216)";
+
+fn samples(ctx: &Ctx, v: &Val) -> Result<u64, SceneError> {
+    whole(ctx, v, "samples", 1, MAX_SAMPLES, SAMPLES_ALLOWED)
+}
+
+fn seed(ctx: &Ctx, v: &Val) -> Result<u64, SceneError> {
+    whole(ctx, v, "seed", 0, u64::MAX, SEED_ALLOWED)
+}
+
+fn bins(ctx: &Ctx, v: &Val) -> Result<SphereGrid, SceneError> {
+    let bad = |what: String| ctx.err(v.span(), format!("bins {what}; {BINS_ALLOWED}"));
+    let Value::Array(items) = v.get_ref() else { return Err(bad(format!("must be an array, got {}", kind(v.get_ref())))) };
+    let [rows, cols] = items.as_slice() else { return Err(bad(format!("has {} items, not 2", items.len()))) };
+    let dim = |x: &Value| match x {
+        Value::Integer(i) if *i >= 1 && *i <= u32::MAX as i64 => Ok(*i as u32),
+        Value::Integer(i) => Err(bad(format!("= [{rows}, {cols}] is not allowed ({i} is out of range)"))),
+        other => Err(bad(format!("must hold whole numbers, got {}", kind(other)))),
+    };
+    let (r, c) = (dim(rows)?, dim(cols)?);
+    if r % 2 == 1 {
+        return Err(bad(format!("= [{r}, {c}] is not allowed: {r} rows is odd")));
+    }
+    if r as u64 * c as u64 > MAX_BINS {
+        return Err(bad(format!("= [{r}, {c}] is not allowed: {} bins is more than 2^24", r as u64 * c as u64)));
+    }
+    Ok(SphereGrid { rows: r, cols: c })
+}
+
+/// `[defaults]`, each value validated where it is written.
+struct Defaults<'a> {
+    samples: Option<(u64, &'a Val)>,
+    bins: Option<SphereGrid>,
+    seed: Option<u64>,
 }
 
 impl Scene {
@@ -114,102 +247,227 @@ impl Scene {
         let ctx = Ctx { file, text };
         let raw: RawScene = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            ctx.err(span, e.message().trim().to_string())
+            let message = e
+                .message()
+                .trim()
+                .replace("struct RawScene", "[defaults] and [[case]] tables")
+                .replace("struct RawDefaults", "a [defaults] table")
+                .replace("struct RawCase", "a [[case]] table")
+                // `case` is the only plain sequence (weights say what they expect themselves)
+                .replace("expected a sequence", "expected [[case]] tables (write [[case]] for each case, not [case])");
+            ctx.err(span, message)
         })?;
+        let d = raw.defaults.as_ref().map(|d| d.get_ref());
+        let defaults = Defaults {
+            samples: d.and_then(|d| d.samples.as_ref()).map(|v| samples(&ctx, v).map(|n| (n, v))).transpose()?,
+            bins: d.and_then(|d| d.bins.as_ref()).map(|v| bins(&ctx, v)).transpose()?,
+            seed: d.and_then(|d| d.seed.as_ref()).map(|v| seed(&ctx, v)).transpose()?,
+        };
         if raw.case.is_empty() {
-            return Err(ctx.err(0..0, "the scene has no [[case]] tables; add at least one"));
+            return Err(ctx.err(0..0, "the scene has no [[case]] tables; add at least one (see scenes/all-lobes.toml)"));
         }
-        let mut names = HashSet::new();
+        // Names are compared ignoring case: they name folders, and some file systems ignore case.
+        let mut names: HashMap<String, (usize, usize)> = HashMap::new();
         let mut cases = Vec::new();
+        let mut locations = Vec::new();
         for c in &raw.case {
-            let case = validate_case(&ctx, c.get_ref(), &raw.defaults)?;
-            if !names.insert(case.name.clone()) {
-                return Err(ctx.err(c.get_ref().name.span(), format!("duplicate case name '{}'; names must be unique", case.name)));
+            let case = validate_case(&ctx, c, &defaults)?;
+            let here = line_column(text, c.span().start);
+            if let Some((line, column)) = names.insert(case.name.to_lowercase(), here) {
+                let span = c.get_ref().name.as_ref().map_or(c.span(), |n| n.span());
+                return Err(ctx.err(
+                    span,
+                    format!(
+                        "duplicate case name '{}' (the case at {line}:{column} has it too, ignoring case); names must be unique, they name the output folders",
+                        case.name
+                    ),
+                ));
             }
             cases.push(case);
+            locations.push(here);
         }
-        Ok(Scene { cases })
+        Ok(Scene { cases, file: file.to_string(), locations })
+    }
+
+    /// Parses a scene from raw bytes: text that is not UTF-8 is an error at the first bad byte.
+    pub fn from_bytes(file: &str, bytes: &[u8]) -> Result<Scene, SceneError> {
+        match std::str::from_utf8(bytes) {
+            Ok(text) => Scene::parse(file, text),
+            Err(e) => {
+                let good = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
+                let (line, column) = line_column(good, good.len());
+                Err(SceneError {
+                    file: file.to_string(),
+                    line,
+                    column,
+                    message: format!("the file is not UTF-8 text (byte {} is invalid); save it as UTF-8", e.valid_up_to()),
+                })
+            }
+        }
+    }
+
+    /// "file:line:column" of case `index`'s `[[case]]` table.
+    pub fn case_location(&self, index: usize) -> String {
+        let (line, column) = self.locations.get(index).copied().unwrap_or((1, 1));
+        format!("{}:{line}:{column}", self.file)
     }
 }
 
-fn finite_in(ctx: &Ctx, v: &Spanned<f64>, what: &str, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<f64, SceneError> {
-    let x = *v.get_ref();
-    if !x.is_finite() || !ok(x) {
-        return Err(ctx.err(v.span(), format!("{what} = {x} is not allowed; {allowed}")));
+fn check_name(ctx: &Ctx, c: &Spanned<RawCase>) -> Result<String, SceneError> {
+    let Some(v) = &c.get_ref().name else {
+        return Err(ctx.err(c.span(), "this [[case]] has no name; add name = \"...\" (letters, digits, '-', '_', '.')"));
+    };
+    let allowed = "a case name uses only letters, digits, '-', '_' and '.', at most 100 characters, not only dots (it names a folder)";
+    let name = string(ctx, v, "name", allowed)?;
+    let ok = !name.is_empty()
+        && name.len() <= MAX_NAME_LEN
+        && name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch))
+        && !name.chars().all(|ch| ch == '.');
+    if !ok {
+        return Err(ctx.err(v.span(), format!("case name {name:?} is not allowed; {allowed}")));
     }
-    Ok(x)
+    Ok(name.to_string())
 }
 
-fn validate_case(ctx: &Ctx, c: &RawCase, d: &RawDefaults) -> Result<Case, SceneError> {
-    let name = c.name.get_ref().clone();
-    if name.is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || "-_.".contains(ch)) {
-        return Err(ctx.err(c.name.span(), format!("case name '{name}' must be non-empty and use only letters, digits, '-', '_' and '.' (it names a folder)")));
+/// An error on the first of `keys` present: it does not apply to a case of this kind.
+fn reject_keys(ctx: &Ctx, keys: &[(&str, Option<&Val>)], why: &str) -> Result<(), SceneError> {
+    match keys.iter().find_map(|(k, v)| v.map(|v| (k, v))) {
+        Some((k, v)) => Err(ctx.err(v.span(), format!("{k} {why}"))),
+        None => Ok(()),
     }
-    let samples_s = c.samples.as_ref().or(d.samples.as_ref());
-    let samples = samples_s.map_or(10_000_000, |s| *s.get_ref());
-    if samples == 0 || samples > MAX_SAMPLES {
-        let span = samples_s.map_or(c.name.span(), |s| s.span());
-        return Err(ctx.err(span, format!("samples = {samples} is not allowed; give 1 to {MAX_SAMPLES}")));
-    }
-    let seed = c.seed.or(d.seed).unwrap_or(1);
-    let method_name = c.method.as_ref().map(|m| m.get_ref().as_str());
-    let method_span = c.method.as_ref().map_or(c.lobe.span(), |m| m.span());
-    let lobe_name = c.lobe.get_ref().as_str();
+}
+
+fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<Case, SceneError> {
+    let c = spanned.get_ref();
+    let name = check_name(ctx, spanned)?;
+    let samples = match &c.samples {
+        Some(v) => samples(ctx, v)?,
+        None => d.samples.map_or(10_000_000, |(n, _)| n),
+    };
+    let seed = match &c.seed {
+        Some(v) => seed(ctx, v)?,
+        None => d.seed.unwrap_or(1),
+    };
+    let lobes_allowed = "use ward, beckmann, ggx or discrete";
+    let Some(lobe_v) = &c.lobe else {
+        return Err(ctx.err(spanned.span(), format!("case '{name}' has no lobe; add lobe = \"...\" ({lobes_allowed})")));
+    };
+    let lobe_name = string(ctx, lobe_v, "lobe", lobes_allowed)?;
+    let method = c.method.as_ref().map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
+
     if lobe_name == "discrete" {
-        let method = match method_name.unwrap_or("cdf") {
-            "cdf" => DiscreteMethod::Cdf,
-            "alias" => DiscreteMethod::Alias,
-            other => return Err(ctx.err(method_span, format!("method '{other}' is not a discrete method; use cdf or alias"))),
+        let method = match method {
+            None | Some(("cdf", _)) => DiscreteMethod::Cdf,
+            Some(("alias", _)) => DiscreteMethod::Alias,
+            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias"))),
         };
+        reject_keys(
+            ctx,
+            &[
+                ("alpha", c.alpha.as_ref()),
+                ("alpha_x", c.alpha_x.as_ref()),
+                ("alpha_y", c.alpha_y.as_ref()),
+                ("incident_theta", c.incident_theta.as_ref()),
+                ("incident_phi", c.incident_phi.as_ref()),
+                ("bins", c.bins.as_ref()),
+            ],
+            "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
+        )?;
         let Some(w) = &c.weights else {
-            return Err(ctx.err(c.lobe.span(), "a discrete case needs weights = [w0, w1, ...]"));
+            return Err(ctx.err(lobe_v.span(), "a discrete case needs weights = [w0, w1, ...]: finite numbers ≥ 0, not all zero"));
         };
-        let dist = Distribution::new(w.get_ref()).map_err(|e| ctx.err(w.span(), format!("weights: {e}")))?;
+        let items = &w.get_ref().0;
+        if items.len() as u64 > MAX_BINS {
+            return Err(ctx.err(w.span(), format!("weights has {} items; at most 2^24 (16777216)", items.len())));
+        }
+        let values = items
+            .iter()
+            .enumerate()
+            .map(|(i, v)| number(ctx, v, &format!("weights[{i}]"), |x| x >= 0.0, "weights must be finite numbers ≥ 0"))
+            .collect::<Result<Vec<f64>, _>>()?;
+        let dist = Distribution::new(&values).map_err(|e| {
+            let span = match e {
+                WeightsError::Invalid { index, .. } => items.get(index).map_or(w.span(), |v| v.span()),
+                _ => w.span(),
+            };
+            ctx.err(span, format!("weights: {e}"))
+        })?;
         return Ok(Case { name, job: Job::Discrete { dist, method }, samples, seed, incident_deg: (0.0, 0.0) });
     }
+
     let kind = match lobe_name {
         "ward" => LobeKind::Ward,
         "beckmann" => LobeKind::Beckmann,
         "ggx" => LobeKind::Ggx,
-        other => return Err(ctx.err(c.lobe.span(), format!("lobe '{other}' is unknown; use ward, beckmann, ggx or discrete"))),
+        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}"))),
     };
-    let method = match method_name.unwrap_or("ndf") {
+    let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
+    let method = match method.map_or("ndf", |m| m.0) {
         "ndf" => Method::Ndf,
         "vndf" => Method::Vndf,
         "bounded" => Method::Bounded,
-        other => return Err(ctx.err(method_span, format!("method '{other}' is unknown; use ndf, vndf or bounded"))),
+        other => return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\")"))),
     };
     if !kind.supports(method) {
-        return Err(ctx.err(method_span, format!("{} has no '{}' sampler; ward: ndf; beckmann: ndf, vndf; ggx: ndf, vndf, bounded", kind.name(), method.name())));
+        return Err(ctx.err(
+            method_span,
+            format!("{} has no '{}' sampler; ward: ndf; beckmann: ndf, vndf; ggx: ndf, vndf, bounded", kind.name(), method.name()),
+        ));
     }
-    if c.weights.is_some() {
-        return Err(ctx.err(c.weights.as_ref().unwrap().span(), "weights only apply to lobe = \"discrete\""));
+    if let Some(w) = &c.weights {
+        return Err(ctx.err(w.span(), "weights only apply to lobe = \"discrete\"; remove them"));
     }
-    let positive = |v: &Spanned<f64>, what| finite_in(ctx, v, what, |x| x > 0.0, "roughness must be finite and > 0");
+    let rough = "roughness must be a finite number > 0";
+    let positive = |v: &Val, key| number(ctx, v, key, |x| x > 0.0, rough);
     let (ax, ay) = match (&c.alpha, &c.alpha_x, &c.alpha_y) {
         (Some(a), None, None) => {
             let a = positive(a, "alpha")?;
             (a, a)
         }
         (None, Some(x), Some(y)) => (positive(x, "alpha_x")?, positive(y, "alpha_y")?),
-        (Some(a), _, _) => return Err(ctx.err(a.span(), "give either alpha or both alpha_x and alpha_y, not both")),
-        _ => return Err(ctx.err(c.lobe.span(), "a lobe case needs alpha, or both alpha_x and alpha_y")),
+        (Some(_), Some(v), _) | (Some(_), None, Some(v)) => {
+            return Err(ctx.err(v.span(), "give either alpha or both alpha_x and alpha_y, not both"));
+        }
+        (None, Some(v), None) => return Err(ctx.err(v.span(), "alpha_x needs alpha_y too (or give alpha alone)")),
+        (None, None, Some(v)) => return Err(ctx.err(v.span(), "alpha_y needs alpha_x too (or give alpha alone)")),
+        (None, None, None) => {
+            return Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})")));
+        }
     };
     let theta = match &c.incident_theta {
-        Some(t) => finite_in(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
+        Some(t) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
         None => 0.0,
     };
     let phi = match &c.incident_phi {
-        Some(p) => finite_in(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 to 360")?,
+        Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360")?,
         None => 0.0,
     };
-    let bins_s = c.bins.as_ref().or(d.bins.as_ref());
-    let [rows, cols] = bins_s.map_or([64, 128], |b| *b.get_ref());
-    if rows == 0 || cols == 0 || rows % 2 == 1 || (rows as u64 * cols as u64) > (1 << 24) {
-        let span = bins_s.map_or(c.name.span(), |b| b.span());
-        return Err(ctx.err(span, format!("bins = [{rows}, {cols}] is not allowed; rows must be even (the horizon is a row edge), both ≥ 1, rows × cols ≤ 2^24")));
-    }
+    let grid = match &c.bins {
+        Some(v) => bins(ctx, v)?,
+        None => d.bins.unwrap_or(SphereGrid { rows: 64, cols: 128 }),
+    };
     let incident = reflect::spherical(theta.to_radians(), phi.to_radians());
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
-    Ok(Case { name, job: Job::Lobe { lobe, incident, grid: SphereGrid { rows, cols } }, samples, seed, incident_deg: (theta, phi) })
+    Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn embedded_scenes_parse() {
+        assert!(Scene::parse("all-lobes.toml", DEFAULT_SCENE).unwrap().cases.len() > 10);
+        assert_eq!(Scene::parse("tutorial.toml", TUTORIAL_SCENE).unwrap().cases.len(), 3);
+    }
+
+    #[test]
+    fn line_column_counts_characters_and_never_splits_one() {
+        let t = "aé\nθx";
+        assert_eq!(line_column(t, 0), (1, 1));
+        assert_eq!(line_column(t, 3), (1, 3));
+        assert_eq!(line_column(t, 4), (2, 1));
+        assert_eq!(line_column(t, 5), (2, 1)); // inside θ: rounded down to its start
+        assert_eq!(line_column(t, 99), (2, 3));
+    }
 }
