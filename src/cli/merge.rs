@@ -98,8 +98,10 @@ pub fn fnv1a64(text: &str) -> String {
     format!("{h:016x}")
 }
 
-/// Reads a scene's name and text (the embedded default for `None`) and validates it.
+/// Reads a scene's name and text (the embedded default for `None`) and validates it, with the
+/// errors of `lobes run` ([`super::run::load_scene`]).
 pub fn scene_text(path: Option<&PathBuf>) -> anyhow::Result<(String, String, Scene)> {
+    let scene = super::run::load_scene(path)?;
     let (name, text) = match path {
         Some(p) => {
             let text = std::fs::read_to_string(p).map_err(|e| usage(format!("cannot read scene file {}: {e}", p.display())))?;
@@ -107,8 +109,15 @@ pub fn scene_text(path: Option<&PathBuf>) -> anyhow::Result<(String, String, Sce
         }
         None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.to_string()),
     };
-    let scene = Scene::parse(&name, &text).map_err(|e| usage(e.to_string()))?;
     Ok((name, text, scene))
+}
+
+/// Creates the `--out` folder; a path that is not a folder or cannot be created is bad input.
+fn prepare_out(out: &Path) -> anyhow::Result<()> {
+    if out.exists() && !out.is_dir() {
+        return Err(usage(format!("--out {}: exists and is not a folder; give a folder (created if missing)", out.display())));
+    }
+    std::fs::create_dir_all(out).map_err(|e| usage(format!("--out {}: cannot create the output folder: {e}", out.display())))
 }
 
 fn reasons(values: &[u64; 4]) -> Value {
@@ -138,7 +147,7 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
     let hash = fnv1a64(&text);
     let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
     let adapter = backend.adapter();
-    std::fs::create_dir_all(&args.out).map_err(|e| anyhow::anyhow!("cannot create output folder {}: {e}", args.out.display()))?;
+    prepare_out(&args.out)?;
     let mut rows = Vec::new();
     for (case_index, case) in scene.cases.iter().enumerate() {
         let range = shard.range(case.samples);
@@ -467,7 +476,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         );
     }
     let level = sidak(args.significance, scene.cases.len());
-    std::fs::create_dir_all(&args.out).map_err(|e| anyhow::anyhow!("cannot create output folder {}: {e}", args.out.display()))?;
+    prepare_out(&args.out)?;
     let mut judge_backend = Backend::Cpu;
     let mut rows = Vec::new();
     let mut summary = Vec::new();
