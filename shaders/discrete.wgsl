@@ -21,6 +21,34 @@ fn discrete_sample_cdf(u: f32, n: u32, last_positive: u32) -> u32 {
     return min(lo, last_positive);
 }
 
+// Two-level inversion for tables of more than DISCRETE_BLOCK entries (one 24-bit uniform and an
+// f32 CDF cannot resolve them): discrete_f holds the CDF over blocks (n_blocks entries), then each
+// block's own CDF. u.x picks the block, u.y the entry within it.
+const DISCRETE_BLOCK: u32 = 4096u;
+
+fn discrete_search(u: f32, first: u32, n: u32) -> u32 {
+    var lo = 0u;
+    var hi = n;
+    while (lo < hi) {
+        let mid = lo + (hi - lo) / 2u;
+        let c = discrete_f[first + mid];
+        if (c >= u && c > 0.0) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return min(lo, n - 1u);
+}
+
+fn discrete_sample_cdf_blocks(u: vec2<f32>, n: u32, last_positive: u32) -> u32 {
+    let n_blocks = (n + DISCRETE_BLOCK - 1u) / DISCRETE_BLOCK;
+    let block = discrete_search(u.x, 0u, n_blocks);
+    let start = block * DISCRETE_BLOCK;
+    let len = min(DISCRETE_BLOCK, n - start);
+    return min(start + discrete_search(u.y, n_blocks + start, len), last_positive);
+}
+
 // Column floor(u0 n) kept when u1 < threshold, else its alias.
 fn discrete_sample_alias(u: vec2<f32>, n: u32) -> u32 {
     let column = min(u32(u.x * f32(n)), n - 1u);

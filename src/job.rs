@@ -42,7 +42,7 @@ impl Job {
                     Some(r) => self.bins() + r.code() as usize - 1,
                 }
             }
-            Job::Discrete { dist, method: DiscreteMethod::Cdf } => dist.sample_cdf(u[0]).index,
+            Job::Discrete { dist, method: DiscreteMethod::Cdf } => dist.sample_cdf_gpu_layout(u[0], u[1]).index,
             Job::Discrete { method: DiscreteMethod::Alias, .. } => {
                 alias.expect("alias table built by the caller").sample(u[0], u[1]).index
             }

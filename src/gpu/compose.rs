@@ -82,6 +82,9 @@ pub fn compose(job: &Job, workgroup_words: u32) -> String {
         Job::Discrete { method, .. } => {
             src.push_str(sources::DISCRETE);
             let call = match method {
+                DiscreteMethod::Cdf if job.bins() > crate::reference::discrete::BLOCK => {
+                    "discrete_sample_cdf_blocks(u.xy, params.n_items, params.last_positive)"
+                }
                 DiscreteMethod::Cdf => "discrete_sample_cdf(u.x, params.n_items, params.last_positive)",
                 DiscreteMethod::Alias => "discrete_sample_alias(u.xy, params.n_items)",
             };

@@ -3,7 +3,7 @@
 use super::compose::{self, SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use crate::job::{Counts, DiscreteMethod, Job};
-use crate::reference::discrete::AliasTable;
+use crate::reference::discrete::{self, AliasTable};
 use bytemuck::{Pod, Zeroable};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -266,6 +266,12 @@ impl GpuEngine {
     /// The discrete tables (binding 3: f32 CDF or thresholds, binding 4: u32 aliases).
     fn tables(&self, job: &Job) -> (wgpu::Buffer, wgpu::Buffer) {
         let (f, u): (Vec<f32>, Vec<u32>) = match job {
+            Job::Discrete { dist, method: DiscreteMethod::Cdf } if dist.len() > discrete::BLOCK => {
+                let cdf = dist.cdf();
+                let blocks = discrete::block_cdf(cdf);
+                let local = (0..blocks.len()).flat_map(|b| discrete::local_cdf(cdf, b));
+                (blocks.iter().copied().chain(local).map(|c| c as f32).collect(), vec![0])
+            }
             Job::Discrete { dist, method: DiscreteMethod::Cdf } => (dist.cdf().iter().map(|&c| c as f32).collect(), vec![0]),
             Job::Discrete { dist, method: DiscreteMethod::Alias } => {
                 let t = AliasTable::new(dist);

@@ -97,9 +97,43 @@ impl Distribution {
         DiscreteSample { index, probability: self.pmf[index] }
     }
 
+    /// Two-level CDF inversion for tables too long for one 24-bit uniform or an f32 CDF
+    /// (more than [`BLOCK`] entries): u0 picks a block of [`BLOCK`] entries by the CDF over
+    /// blocks, u1 picks the entry by the block's own CDF. P(i) = P(block) · P(i | block), each
+    /// level resolved to 2⁻²⁴ of its own range.
+    pub fn sample_blocks(&self, u0: f64, u1: f64) -> DiscreteSample {
+        let totals = block_cdf(&self.cdf);
+        let block = first_at_least(&totals, u0).min(totals.len() - 1);
+        let start = block * BLOCK;
+        let local = local_cdf(&self.cdf, block);
+        let index = (start + first_at_least(&local, u1).min(local.len() - 1)).min(self.last_positive());
+        DiscreteSample { index, probability: self.pmf[index] }
+    }
+
+    /// CDF inversion as the GPU does it: one uniform up to [`BLOCK`] entries, two-level above.
+    pub fn sample_cdf_gpu_layout(&self, u0: f64, u1: f64) -> DiscreteSample {
+        if self.len() <= BLOCK { self.sample_cdf(u0) } else { self.sample_blocks(u0, u1) }
+    }
+
     fn last_positive(&self) -> usize {
         self.pmf.iter().rposition(|&p| p > 0.0).expect("checked in new")
     }
+}
+
+/// Entries per block of the two-level CDF (and the largest table sampled with one uniform).
+pub const BLOCK: usize = 4096;
+
+/// The CDF over blocks of [`BLOCK`] entries: the global CDF at each block's last entry.
+pub fn block_cdf(cdf: &[f64]) -> Vec<f64> {
+    cdf.chunks(BLOCK).map(|c| *c.last().unwrap()).collect()
+}
+
+/// Block `b`'s own CDF: (CDF_i − CDF before the block) / (the block's mass), 0s for an empty block.
+pub fn local_cdf(cdf: &[f64], b: usize) -> Vec<f64> {
+    let before = if b == 0 { 0.0 } else { cdf[b * BLOCK - 1] };
+    let chunk = &cdf[b * BLOCK..((b + 1) * BLOCK).min(cdf.len())];
+    let mass = chunk.last().unwrap() - before;
+    chunk.iter().map(|c| if mass > 0.0 { ((c - before) / mass).min(1.0) } else { 0.0 }).collect()
 }
 
 /// Binary search for the first `i` with `cdf[i] ≥ u` and `cdf[i] > 0`; `cdf.len()` if none.
