@@ -57,6 +57,10 @@ impl Shard {
     }
 
     /// `shard-I-of-N.json`.
+    ///
+    /// ```
+    /// assert_eq!(lobes::cli::merge::Shard { index: 2, count: 8 }.file_name(), "shard-2-of-8.json");
+    /// ```
     pub fn file_name(&self) -> String {
         format!("shard-{}-of-{}.json", self.index, self.count)
     }
@@ -89,6 +93,11 @@ pub fn parse_shard(s: &str) -> Result<Shard, String> {
 }
 
 /// 64-bit FNV-1a of the scene text, to name a scene in errors and files.
+///
+/// ```
+/// assert_eq!(lobes::cli::merge::fnv1a64(""), "cbf29ce484222325");
+/// assert_eq!(lobes::cli::merge::fnv1a64("a"), "af63dc4c8601ec8c");
+/// ```
 pub fn fnv1a64(text: &str) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in text.bytes() {

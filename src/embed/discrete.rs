@@ -126,6 +126,9 @@ impl DiscreteTable {
 /// A distribution's tables in two wgpu storage buffers (usage `STORAGE | COPY_DST`), laid out
 /// as [`DiscreteTable`] describes, ready to bind where [`DiscreteBindings`] says.
 ///
+/// This example needs a device, so it is only compiled here; `tests/embed.rs`
+/// (`embedded_discrete_sampling_counts_exactly_like_the_engine`) runs the same calls on the GPU.
+///
 /// ```no_run
 /// # fn demo(device: &wgpu::Device) {
 /// use lobes::embed::{self, DiscreteBindings, DiscreteBuffers, Module};
