@@ -212,7 +212,7 @@ fn embedded_samplers_densities_and_brdfs_match_the_f64_reference() {
 const DISCRETE_KERNEL: &str = r#"
 @group(0) @binding(0) var<storage, read_write> counts: array<atomic<u32>>;
 @group(0) @binding(1) var<uniform> info: DiscreteInfo;
-@group(0) @binding(2) var<uniform> run: vec4<u32>; // seed lo, seed hi, samples, method (0 cdf, 1 alias)
+@group(0) @binding(2) var<uniform> run: vec4<u32>; // seed lo, seed hi, samples, method (0 cdf, 1 alias, 2 two-level cdf)
 
 @compute @workgroup_size(64)
 fn draw_discrete(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -223,8 +223,10 @@ fn draw_discrete(@builtin(global_invocation_id) gid: vec3<u32>) {
     var k: u32;
     if (run.w == 0u) {
         k = discrete_sample_cdf(u.x, info.n_items, info.last_positive);
-    } else {
+    } else if (run.w == 1u) {
         k = discrete_sample_alias(u.xy, info.n_items);
+    } else {
+        k = discrete_sample_cdf_blocks(u.xy, info.n_items, info.last_positive);
     }
     atomicAdd(&counts[k], 1u);
 }
@@ -236,7 +238,10 @@ fn draw_discrete(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
     let gpu = gpu();
     let mut engine = GpuEngine::open().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
-    let dist = Distribution::new(&[0.0, 15.0, 5.0, 0.0, 25.0, 5.0, 10.0, 15.0, 5.0, 5.0, 10.0, 0.0]).unwrap();
+    let short = Distribution::new(&[0.0, 15.0, 5.0, 0.0, 25.0, 5.0, 10.0, 15.0, 5.0, 5.0, 10.0, 0.0]).unwrap();
+    // longer than one block of the CDF: the two-level layout; weights 0..9, every 7th zero
+    let long_weights: Vec<f64> = (0..embed::BLOCK as u64 * 2 + 123).map(|i| if i % 7 == 3 { 0.0 } else { (rng::pcg4d([i as u32, 5, 0, 0])[0] % 10) as f64 }).collect();
+    let long = Distribution::new(&long_weights).unwrap();
     let bindings = DiscreteBindings { group: 1, table: 0, alias: 1 };
     let source = embed::wgsl_with(&[Module::Rng, Module::Discrete], bindings) + DISCRETE_INFO_WGSL + DISCRETE_KERNEL;
     assert!(source.contains("@group(1) @binding(1) var<storage, read> discrete_u"));
@@ -251,12 +256,14 @@ fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
         label: None,
         entries: &DiscreteBuffers::layout_entries(bindings, wgpu::ShaderStages::COMPUTE),
     });
-    for method in [DiscreteMethod::Cdf, DiscreteMethod::Alias] {
+    for (dist, method) in [(&short, DiscreteMethod::Cdf), (&short, DiscreteMethod::Alias), (&long, DiscreteMethod::Cdf), (&long, DiscreteMethod::Alias)] {
         let buffers = match method {
-            DiscreteMethod::Cdf => DiscreteBuffers::cdf(d, &dist),
-            DiscreteMethod::Alias => DiscreteBuffers::alias(d, &dist),
+            DiscreteMethod::Cdf => DiscreteBuffers::cdf(d, dist),
+            DiscreteMethod::Alias => DiscreteBuffers::alias(d, dist),
         };
-        assert_eq!(buffers.info, DiscreteTable::new(&dist, method).info);
+        let table = DiscreteTable::new(dist, method);
+        assert_eq!(buffers.info, table.info);
+        assert_eq!(table.two_level(), method == DiscreteMethod::Cdf && dist.len() > embed::BLOCK);
         let counts = d.create_buffer(&wgpu::BufferDescriptor {
             label: None,
             size: dist.len() as u64 * 4,
@@ -264,7 +271,12 @@ fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
             mapped_at_creation: false,
         });
         let info = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::bytes_of(&buffers.info), usage: wgpu::BufferUsages::UNIFORM });
-        let run = [seed as u32, (seed >> 32) as u32, samples, (method == DiscreteMethod::Alias) as u32];
+        let which = match method {
+            DiscreteMethod::Alias => 1,
+            DiscreteMethod::Cdf if table.two_level() => 2,
+            DiscreteMethod::Cdf => 0,
+        };
+        let run = [seed as u32, (seed >> 32) as u32, samples, which];
         let run = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&run), usage: wgpu::BufferUsages::UNIFORM });
         let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: None,
@@ -278,10 +290,10 @@ fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
         let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &tables, entries: &buffers.bind_group_entries(bindings) });
         let bytes = dispatch(&gpu, &source, "draw_discrete", &[&own, &tables], &[&g0, &g1], samples, &counts);
         let mine: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&bytes).iter().map(|&c| c as u64).collect();
-        let job = Job::Discrete { dist: dist.clone(), method };
+        let job = Job::Discrete { dist: (*dist).clone(), method };
         let theirs = engine.histogram(&job, seed, 0, samples as u64, &mut |_| {}).unwrap().counts;
-        println!("{method:?}: {mine:?}");
-        assert_eq!(mine, theirs.bins, "{method:?}: embedded sampling differs from the engine's");
+        println!("{method:?}, {} items: {:?}", dist.len(), &mine[..12]);
+        assert_eq!(mine, theirs.bins, "{method:?}, {} items: embedded sampling differs from the engine's", dist.len());
         assert_eq!(mine.iter().sum::<u64>(), samples as u64);
         for (i, w) in dist.weights().iter().enumerate() {
             if *w == 0.0 {

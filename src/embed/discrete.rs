@@ -1,7 +1,11 @@
 //! Uploading a discrete distribution for `shaders/discrete.wgsl`.
 
 use crate::job::DiscreteMethod;
-use crate::reference::discrete::{AliasTable, Distribution};
+use crate::reference::discrete::{self, AliasTable, Distribution};
+
+/// Items per block of the two-level CDF, and the most items sampled with one uniform
+/// (`crate::reference::discrete::BLOCK`; `DISCRETE_BLOCK` in the WGSL).
+pub const BLOCK: usize = discrete::BLOCK;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -62,8 +66,9 @@ pub const DISCRETE_INFO_WGSL: &str = "struct DiscreteInfo {\n    n_items: u32,\n
 ///
 /// - `table: Vec<f32>` → `discrete_f: array<f32>`, n entries. For the CDF method entry i is
 ///   (Σ_{j≤i} w_j) / Σ w, formed in f64 and rounded to f32 (so the last positive entry is
-///   exactly 1). For the alias method entry i is column i's threshold in [0, 1] (Vose's
-///   construction in f64, rounded to f32).
+///   exactly 1); beyond [`BLOCK`] items, the two-level layout of [`DiscreteTable::cdf`]. For
+///   the alias method entry i is column i's threshold in [0, 1] (Vose's construction in f64,
+///   rounded to f32).
 /// - `alias: Vec<u32>` → `discrete_u: array<u32>`: for the alias method n entries, column i's
 ///   alias; for the CDF method a single 0 (the binding must exist; a storage buffer may not be
 ///   empty).
@@ -101,10 +106,39 @@ impl DiscreteTable {
         DiscreteInfo { n_items: dist.len() as u32, last_positive, _pad: [0; 2] }
     }
 
-    /// The CDF tables, for `discrete_sample_cdf(u, info.n_items, info.last_positive)`.
+    /// The CDF tables. Up to [`BLOCK`] items the table is the CDF itself, for
+    /// `discrete_sample_cdf(u.x, info.n_items, info.last_positive)`. Longer tables are beyond
+    /// what one 24-bit uniform and an f32 CDF can resolve; they take the two-level layout of
+    /// `discrete_sample_cdf_blocks(u.xy, info.n_items, info.last_positive)`: first the CDF over
+    /// blocks of [`BLOCK`] items (⌈n / BLOCK⌉ entries: the global CDF at each block's last item),
+    /// then each block's own CDF (n entries in all), so `table.len()` = n + ⌈n / BLOCK⌉.
+    /// [`DiscreteTable::two_level`] says which.
+    ///
+    /// ```
+    /// use lobes::embed::{DiscreteTable, BLOCK};
+    /// use lobes::reference::discrete::Distribution;
+    /// let long = Distribution::new(&vec![1.0; BLOCK + 1]).unwrap();
+    /// let t = DiscreteTable::cdf(&long);
+    /// assert!(t.two_level());
+    /// assert_eq!(t.table.len(), BLOCK + 1 + 2);
+    /// assert_eq!(t.table[1], 1.0); // the CDF over the 2 blocks ends at 1
+    /// ```
     pub fn cdf(dist: &Distribution) -> Self {
-        let table = dist.cdf().iter().map(|&c| c as f32).collect();
+        let cdf = dist.cdf();
+        let table = if dist.len() > BLOCK {
+            let blocks = discrete::block_cdf(cdf);
+            let local = (0..blocks.len()).flat_map(|b| discrete::local_cdf(cdf, b));
+            blocks.iter().copied().chain(local).map(|c| c as f32).collect()
+        } else {
+            cdf.iter().map(|&c| c as f32).collect()
+        };
         Self { method: DiscreteMethod::Cdf, table, alias: vec![0], info: Self::info(dist) }
+    }
+
+    /// Whether the table has the two-level CDF layout (the CDF method with more than [`BLOCK`]
+    /// items), to be sampled with `discrete_sample_cdf_blocks`.
+    pub fn two_level(&self) -> bool {
+        self.method == DiscreteMethod::Cdf && self.info.n_items as usize > BLOCK
     }
 
     /// The alias tables, for `discrete_sample_alias(u2, info.n_items)`.

@@ -48,7 +48,7 @@
 
 mod discrete;
 
-pub use discrete::{DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable, DISCRETE_INFO_WGSL};
+pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable};
 
 use crate::gpu::compose::sources;
 use crate::gpu::GpuError;
@@ -112,7 +112,9 @@ pub enum Module {
     /// numbers and [`DiscreteTable`] for their contents).
     ///
     /// - `discrete_sample_cdf(u: f32, n: u32, last_positive: u32) -> u32`: the first index whose
-    ///   CDF ≥ u (binary search);
+    ///   CDF ≥ u (binary search), for up to [`BLOCK`] items;
+    /// - `discrete_sample_cdf_blocks(u: vec2<f32>, n: u32, last_positive: u32) -> u32`: the same
+    ///   for longer tables, in two levels (u.x picks a block of [`BLOCK`] items, u.y the item);
     /// - `discrete_sample_alias(u: vec2<f32>, n: u32) -> u32`: Walker's alias table, column
     ///   ⌊u.x·n⌋, kept when u.y < its threshold.
     Discrete,
@@ -370,7 +372,7 @@ mod tests {
                 &["ggx_sample_ndf", "ggx_sample_vndf", "ggx_sample_bounded", "ggx_pdf_ndf", "ggx_pdf_vndf", "ggx_pdf_bounded", "ggx_eval", "ggx_g2", "ggx_lambda"],
             ),
             (Module::Beckmann, &["beckmann_sample_ndf", "beckmann_sample_vndf", "beckmann_pdf_ndf", "beckmann_pdf_vndf", "beckmann_eval", "beckmann_g2"]),
-            (Module::Discrete, &["discrete_sample_cdf", "discrete_sample_alias", "discrete_f", "discrete_u"]),
+            (Module::Discrete, &["discrete_sample_cdf", "discrete_sample_cdf_blocks", "discrete_sample_alias", "discrete_f", "discrete_u"]),
         ];
         for (m, names) in wanted {
             let s = m.symbols();
