@@ -24,7 +24,7 @@ pub mod sources {
 
 /// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
 /// under the 65535 that a 16-bit packed workgroup counter holds.
-pub const SAMPLES_PER_THREAD: u32 = 64;
+pub const SAMPLES_PER_THREAD: u32 = 255;
 pub const WG_SIZE: u32 = 256;
 const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
 
