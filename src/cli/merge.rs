@@ -230,7 +230,7 @@ pub struct MergeArgs {
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Family-wise significance level, Šidák-corrected over the scene's cases.
-    #[arg(long, default_value_t = 0.01, value_parser = parse_level)]
+    #[arg(long, default_value_t = 0.01, value_parser = parse_level, allow_hyphen_values = true)]
     pub significance: f64,
     #[command(flatten)]
     pub output: OutputArgs,
