@@ -50,6 +50,22 @@ pub struct StressRow {
     pub passed: bool,
 }
 
+impl StressRow {
+    fn new(case: &str, kernel: &str, samples: usize) -> Self {
+        StressRow {
+            case: case.into(),
+            kernel: kernel.into(),
+            samples,
+            valid: 0,
+            worst_unit_error: 0.0,
+            bad_values: 0,
+            validity_mismatches: 0,
+            worst_angle_rad: 0.0,
+            passed: true,
+        }
+    }
+}
+
 const SAMPLERS: [(LobeKind, Method); 6] = [
     (LobeKind::Ward, Method::Ndf),
     (LobeKind::Beckmann, Method::Ndf),
@@ -117,17 +133,7 @@ pub fn run_case(case: &StressCase, gpu: Option<&mut GpuEngine>) -> anyhow::Resul
     let us = uniforms();
     let cpu: Vec<_> = us.iter().map(|&u| case.lobe.sample(case.incident, u)).collect();
     let mut rows = Vec::new();
-    let mut row = StressRow {
-        case: case.name.clone(),
-        kernel: "cpu f64".into(),
-        samples: us.len(),
-        valid: 0,
-        worst_unit_error: 0.0,
-        bad_values: 0,
-        validity_mismatches: 0,
-        worst_angle_rad: 0.0,
-        passed: true,
-    };
+    let mut row = StressRow::new(&case.name, "cpu f64", us.len());
     for s in &cpu {
         row.valid += usize::from(s.invalid.is_none());
         row.worst_unit_error = row.worst_unit_error.max(unit_error(s.h)).max(unit_error(s.omega_r));
@@ -140,17 +146,7 @@ pub fn run_case(case: &StressCase, gpu: Option<&mut GpuEngine>) -> anyhow::Resul
         let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 } };
         let u32s: Vec<[f32; 2]> = us.iter().map(|u| [u[0] as f32, u[1] as f32]).collect();
         let out = engine.explicit(&job, &u32s)?;
-        let mut row = StressRow {
-            case: case.name.clone(),
-            kernel: "gpu f32".into(),
-            samples: us.len(),
-            valid: 0,
-            worst_unit_error: 0.0,
-            bad_values: 0,
-            validity_mismatches: 0,
-            worst_angle_rad: 0.0,
-            passed: true,
-        };
+        let mut row = StressRow::new(&case.name, "gpu f32", us.len());
         for (g, c) in out.iter().zip(&cpu) {
             let wr = DVec3::new(g[0][0] as f64, g[0][1] as f64, g[0][2] as f64);
             let h = DVec3::new(g[1][0] as f64, g[1][1] as f64, g[1][2] as f64);
