@@ -100,8 +100,29 @@ fn beckmann_visible_cdf(x: f32, tan_t: f32) -> f32 {
     return 0.5 * erfc_approx(-x) + 0.5 * tan_t * INV_SQRT_PI * exp(-x * x);
 }
 
+// The complement D(x) = C(hi) - C(x), which keeps f32 precision as u -> 1 where C(x) -> C(hi).
+// Closed form (erfc(x) - erfc(hi))/2 - tan (e^{-x^2} - e^{-hi^2})/(2 sqrt(pi)); within 0.5 of
+// hi = cot th, where the two terms cancel, the integral of tan (hi - t) e^{-t^2}/sqrt(pi) over
+// [x, hi] (the density (1 - t tan) written without cancellation) by 4-point Gauss-Legendre.
+fn beckmann_visible_rest(x: f32, tan_t: f32, hi: f32, hi_is_cot: bool) -> f32 {
+    let d = hi - x;
+    if (hi_is_cot && d < 0.5) {
+        let gx = array<f32, 4>(0.0694318442, 0.3300094782, 0.6699905218, 0.9305681558);
+        let gw = array<f32, 4>(0.1739274226, 0.3260725774, 0.3260725774, 0.1739274226);
+        var integral = 0.0;
+        for (var k = 0; k < 4; k++) {
+            let s = d * gx[k];
+            let t = hi - s;
+            integral += gw[k] * s * exp(-t * t);
+        }
+        return integral * d * tan_t * INV_SQRT_PI;
+    }
+    return 0.5 * (erfc_approx(x) - erfc_approx(hi)) - 0.5 * tan_t * INV_SQRT_PI * (exp(-x * x) - exp(-hi * hi));
+}
+
 // The slope x with C(x) = u C(cot): Newton steps (C' = (1 - x tan) e^{-x^2}/sqrt(pi)) kept inside a
-// bisection bracket; [-6, 6] holds all but 1e-16 of the mass.
+// bisection bracket, until a step moves x by less than 1e-7 relative; [-6, 6] holds all but 1e-16
+// of the mass.
 fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
     if (u <= 0.0) {
         return -BIG_SLOPE;
@@ -119,12 +140,24 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
     if (tan_t > 1.0 / 6.0) {
         hi = 1.0 / tan_t;
     }
-    let goal = u * beckmann_visible_cdf(hi, tan_t);
+    let top = beckmann_visible_cdf(hi, tan_t);
+    let hi_is_cot = tan_t > 1.0 / 6.0;
+    // For u > 1/2 the complement is solved: D(x) = (1 - u) C(hi), (1 - u) exact on the 2^-24 grid.
+    let upper = u > 0.5;
+    let goal = select(u * top, (1.0 - u) * top, upper);
+    let top_hi = hi;
     // First guess: the Gaussian quantile near normal incidence; near grazing, where
     // C(x) ~ tan e^{-x^2}/(2 sqrt(pi)) dominates, the inverse of that limit, -sqrt(-ln u).
     var x = clamp(select(erfinv_unit(u), -sqrt(neg_ln(u)), tan_t > 2.0), lo, hi);
-    for (var i = 0; i < 10; i++) {
-        let f = beckmann_visible_cdf(x, tan_t) - goal;
+    // Usually 3-5 steps; up to 24 where C' -> 0 and Newton only halves the error.
+    for (var i = 0; i < 24; i++) {
+        // f increases with x in both forms: C(x) - goal, or goal - D(x)
+        var f: f32;
+        if (upper) {
+            f = goal - beckmann_visible_rest(x, tan_t, top_hi, hi_is_cot);
+        } else {
+            f = beckmann_visible_cdf(x, tan_t) - goal;
+        }
         if (f > 0.0) {
             hi = x;
         } else {
@@ -138,7 +171,11 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
                 next = newton;
             }
         }
+        let done = abs(next - x) <= 1.0e-7 * max(1.0, abs(x));
         x = next;
+        if (done) {
+            break;
+        }
     }
     return x;
 }

@@ -39,7 +39,11 @@ fn classify(wr: vec3<f32>, pdf: f32) -> u32 {
 fn bin_of(w: vec3<f32>) -> u32 {
     let z = clamp(w.z, -1.0, 1.0);
     let row = min(u32((z + 1.0) * 0.5 * f32(ROWS)), ROWS - 1u);
-    let t = (atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
+    // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
+    var t = 0.5;
+    if (w.x != 0.0 || w.y != 0.0) {
+        t = (atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
+    }
     var col = u32(max(t, 0.0) * f32(COLS));
     if (col >= COLS) {
         col = 0u;

@@ -41,3 +41,15 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     directions_out[2u * i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
     directions_out[2u * i + 1u] = vec4<f32>(s.h, s.pdf_r);
 }
+
+// Binning of explicit directions for the stability suite: direction i is packed in explicit_u
+// as (x, y) at 2i and (z, unused) at 2i + 1; its bin is written to directions_out[i].x.
+@compute @workgroup_size(256)
+fn bin_explicit(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.count) {
+        return;
+    }
+    let w = vec3<f32>(explicit_u[2u * i], explicit_u[2u * i + 1u].x);
+    directions_out[i] = vec4<f32>(f32(bin_of(w)), 0.0, 0.0, 0.0);
+}

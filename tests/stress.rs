@@ -74,3 +74,72 @@ fn tables_beyond_f32_resolution() {
         assert_eq!(counts.bins[n - 2], 0);
     }
 }
+
+/// Directions exactly on bin edges, at the poles and at φ = ±π: the GPU's f32 binning lands
+/// every one in a valid bin, agrees with the CPU's at the poles and at φ = ±π exactly, and
+/// elsewhere within one row or column (an edge is a tie that f32 and f64 may break apart).
+#[test]
+fn binning_at_edges_poles_and_the_seam() {
+    use lobes::reference::{Lobe, LobeKind, Method};
+    use lobes::stats::histogram::SphereGrid;
+    let mut e = engine();
+    let grid = SphereGrid { rows: 64, cols: 128 };
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
+    let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid };
+    let mut dirs: Vec<[f32; 3]> = Vec::new();
+    for z in grid.cos_theta_edges() {
+        for phi in grid.phi_edges() {
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            dirs.push([(s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32]);
+        }
+    }
+    let exact = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [-1.0, -0.0, 0.0], [-0.6, 0.0, 0.8], [-0.6, -0.0, -0.8]];
+    dirs.extend(exact);
+    let gpu = e.bins_of(&job, &dirs).unwrap();
+    let cols = grid.cols as i64;
+    for (d, &g) in dirs.iter().zip(&gpu) {
+        assert!((g as usize) < grid.bins(), "{d:?} → bin {g}");
+        let c = grid.bin_of(glam::DVec3::new(d[0] as f64, d[1] as f64, d[2] as f64)) as i64;
+        let (dr, dc) = ((g as i64 / cols - c / cols).abs(), (g as i64 % cols - c % cols).rem_euclid(cols));
+        assert!(dr <= 1 && (dc <= 1 || dc == cols - 1), "{d:?}: gpu bin {g}, cpu bin {c}");
+    }
+    let n = dirs.len();
+    let tail: Vec<u32> = gpu[n - exact.len()..].to_vec();
+    // +z: top row, φ = 0 → column 64; −z: row 0; φ = ±π (either sign of zero) → column 0
+    assert_eq!(tail, vec![63 * 128 + 64, 64, 32 * 128, 32 * 128, 57 * 128, 6 * 128]);
+}
+
+/// A seeded random search beyond the listed cases: roughness log-uniform in [1e-6, 10] with
+/// anisotropy up to 1000:1, incidence from 0° to 90°, every sampler; the same assertions as
+/// the suite.
+#[test]
+fn random_search_beyond_the_listed_cases() {
+    use lobes::reference::{Lobe, LobeKind, Method, reflect, rng};
+    use lobes::stress::{StressCase, run_case};
+    let mut e = engine();
+    let samplers = [
+        (LobeKind::Ward, Method::Ndf),
+        (LobeKind::Beckmann, Method::Ndf),
+        (LobeKind::Beckmann, Method::Vndf),
+        (LobeKind::Ggx, Method::Ndf),
+        (LobeKind::Ggx, Method::Vndf),
+        (LobeKind::Ggx, Method::Bounded),
+    ];
+    let mut failed = Vec::new();
+    for i in 0..120u64 {
+        let r = rng::uniforms(2024, i);
+        let (kind, method) = samplers[i as usize % samplers.len()];
+        let ax = 10f64.powf(-6.0 + 7.0 * r[0]);
+        // anisotropy up to 1000:1 either way (beyond it, at grazing incidence, the f32 cap rim
+        // near the antipode of ωs loses the direction: seen at 25000:1, not handled yet)
+        let ay = if i % 3 == 0 { ax } else { (ax * 10f64.powf(3.0 * (2.0 * r[1] - 1.0))).clamp(1e-6, 10.0) };
+        let wi = reflect::spherical((90.0 * r[2]).to_radians(), 360f64.to_radians() * r[3]);
+        let case = StressCase { name: format!("random {i}: {kind:?} {method:?} α ({ax:.3e}, {ay:.3e}) ωi {wi:?}"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay }, incident: wi };
+        for row in run_case(&case, Some(&mut e)).unwrap() {
+            if !row.passed {
+                failed.push(format!("{} [{}]: {:?}", row.case, row.kernel, row));
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{failed:#?}");
+}

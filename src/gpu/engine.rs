@@ -33,6 +33,7 @@ struct Kernel {
     fold: wgpu::ComputePipeline,
     directions: Option<wgpu::ComputePipeline>,
     explicit: Option<wgpu::ComputePipeline>,
+    bin_explicit: Option<wgpu::ComputePipeline>,
     in_workgroup: bool,
 }
 
@@ -230,6 +231,7 @@ impl GpuEngine {
             fold: pipeline("fold"),
             directions: matches!(job, Job::Lobe { .. }).then(|| pipeline("directions")),
             explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("explicit_samples")),
+            bin_explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("bin_explicit")),
             in_workgroup,
         });
         self.check_errors()?;
@@ -465,6 +467,20 @@ impl GpuEngine {
         });
         let out = self.per_sample(pipeline, job, 0, 0, u.len() as u32, &input, 2)?;
         Ok(out.chunks(2).map(|p| [p[0], p[1]]).collect())
+    }
+
+    /// The GPU's bins (`shaders/histogram.wgsl`'s `bin_of`, on `job`'s grid) of f32 directions.
+    pub fn bins_of(&mut self, job: &Job, dirs: &[[f32; 3]]) -> Result<Vec<u32>, GpuError> {
+        let kernel = self.kernel(job)?;
+        let Some(pipeline) = &kernel.bin_explicit else { return Ok(Vec::new()) };
+        let packed: Vec<[f32; 2]> = dirs.iter().flat_map(|d| [[d[0], d[1]], [d[2], 0.0]]).collect();
+        let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("explicit directions"),
+            contents: bytemuck::cast_slice(&packed),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let out = self.per_sample(pipeline, job, 0, 0, dirs.len() as u32, &input, 1)?;
+        Ok(out.iter().map(|v| v[0] as u32).collect())
     }
 
     /// Runs a one-thread-per-sample entry point writing `per` vec4s per sample.

@@ -20,11 +20,12 @@ impl SphereGrid {
     }
 
     /// The bin of a unit direction: row ⌊(z+1)/2 · rows⌋ (z = 1 in the top row), column
-    /// ⌊(φ+π)/2π · cols⌋ with φ = π wrapped to column 0.
+    /// ⌊(φ+π)/2π · cols⌋ with φ = π wrapped to column 0 and φ = 0 at the poles.
     pub fn bin_of(&self, w: DVec3) -> usize {
         let z = w.z.clamp(-1.0, 1.0);
         let row = (((z + 1.0) * 0.5 * self.rows as f64) as u32).min(self.rows - 1);
-        let t = (w.y.atan2(w.x) + PI) / (2.0 * PI);
+        // at the poles φ is undefined (atan2 of two zeros depends on their signs): use φ = 0
+        let t = if w.x == 0.0 && w.y == 0.0 { 0.5 } else { (w.y.atan2(w.x) + PI) / (2.0 * PI) };
         let mut col = (t.max(0.0) * self.cols as f64) as u32;
         if col >= self.cols {
             col = 0;
