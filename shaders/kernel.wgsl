@@ -1,5 +1,5 @@
 // The sampling-and-histogram kernels. The composing host (src/gpu/compose.rs) prepends the
-// constants (ROWS, COLS, BINS, CELLS, WG_WORDS, SAMPLES_PER_THREAD), the modules a job needs, and
+// constants (ROWS, COLS, BINS, TILE_BINS, CELLS, WG_WORDS, SAMPLES_PER_THREAD), the modules a job needs, and
 // `fn draw(index: vec2<u32>) -> u32`, which returns the bin of sample `index` or BINS + reason - 1.
 //
 // Counting is exact: per workgroup, bins are packed two to a u32 word of workgroup atomics
@@ -15,7 +15,7 @@ struct Params {
     count: u32,
     n_items: u32,
     last_positive: u32,
-    _pad0: u32,
+    tile_first: u32,
     alpha: vec2<f32>,
     _pad1: vec2<f32>,
     wi: vec4<f32>,
@@ -47,7 +47,11 @@ fn sample_histogram(
         if (local < count) {
             let cell = draw(add64(base, local));
             if (cell < BINS) {
-                count_bin(cell);
+                // a pass counts the bins tile_first .. tile_first + TILE_BINS (all, untiled)
+                let in_tile = cell - params.tile_first;
+                if (in_tile < TILE_BINS) {
+                    count_bin(in_tile);
+                }
             } else {
                 invalid += select(vec4<u32>(0u), vec4<u32>(1u), vec4<u32>(cell - BINS) == vec4<u32>(0u, 1u, 2u, 3u));
             }
@@ -56,7 +60,7 @@ fn sample_histogram(
     flush_bins(lid);
     for (var r = 0u; r < N_REASONS; r++) {
         if (invalid[r] != 0u) {
-            atomicAdd(&counts[BINS + r], invalid[r]);
+            atomicAdd(&counts[TILE_BINS + r], invalid[r]);
         }
     }
 }

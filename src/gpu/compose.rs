@@ -49,20 +49,27 @@ fn lobe_modules(kind: LobeKind) -> &'static [&'static str] {
     }
 }
 
-/// The composed WGSL of `job`, counting in workgroup memory when `ceil(bins / 2)` words fit in
-/// `workgroup_words`, else in global memory.
+/// The composed WGSL of `job`, counting all its bins.
 pub fn compose(job: &Job, workgroup_words: u32) -> String {
+    compose_tile(job, workgroup_words, job.bins() as u32)
+}
+
+/// The composed WGSL of `job` counting `tile_bins` bins from `params.tile_first` on (a
+/// histogram too large for one storage buffer is counted tile by tile, one pass each), in
+/// workgroup memory when `ceil(tile_bins / 2)` words fit in `workgroup_words`, else in global
+/// memory.
+pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
         Job::Discrete { .. } => (1, bins),
     };
-    let wg_words = bins.div_ceil(2);
+    let wg_words = tile_bins.div_ceil(2);
     let in_workgroup = wg_words <= workgroup_words;
     let mut src = format!(
         "// Composed by lobes for {}\n\
          const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const CELLS: u32 = BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
          const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n\n",
         describe(job)
     );

@@ -19,8 +19,7 @@ struct Params {
     count: u32,
     n_items: u32,
     last_positive: u32,
-    /// First bin of the tile being counted (read only by a tiled kernel, see
-    /// [`GpuEngine::tiling`]; `_pad0` in the untiled kernel's WGSL).
+    /// First bin of the tile being counted (see [`GpuEngine::tiling`]; 0 when untiled).
     tile_first: u32,
     alpha: [f32; 2],
     _pad1: [f32; 2],
@@ -200,11 +199,7 @@ impl GpuEngine {
     fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<Kernel>, GpuError> {
         let (source, in_workgroup) = match tile {
             None => (self.source(job), job.bins().div_ceil(2) as u32 <= self.workgroup_words()),
-            Some(t) => {
-                let in_workgroup = t.div_ceil(2) <= self.workgroup_words();
-                let source = compose::compose(job, if in_workgroup { u32::MAX } else { 0 });
-                (tiled_source(&source, t)?, in_workgroup)
-            }
+            Some(t) => (compose::compose_tile(job, self.workgroup_words(), t), t.div_ceil(2) <= self.workgroup_words()),
         };
         if let Some(k) = self.cache.get(&source) {
             return Ok(k.clone());
@@ -584,34 +579,4 @@ impl GpuEngine {
         staging.unmap();
         Ok(data)
     }
-}
-
-/// The composed WGSL of an untiled job turned into a kernel that counts only the `tile_bins`
-/// bins from `params.tile_first` on (its cells: those bins, then the four invalid reasons).
-/// Samples outside the tile are drawn and dropped; invalid samples are counted in every pass.
-/// Each edit must apply exactly once, so a change to `shaders/kernel.wgsl` or to
-/// `compose::compose` that this does not know is an error, not a wrong histogram.
-fn tiled_source(source: &str, tile_bins: u32) -> Result<String, GpuError> {
-    let edits = [
-        ("const CELLS: u32 = BINS + 4u;", format!("const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;")),
-        ("count_bin(cell);", "if (cell - params.tile_first < TILE_BINS) { count_bin(cell - params.tile_first); }".to_string()),
-        ("atomicAdd(&counts[BINS + r], invalid[r]);", "atomicAdd(&counts[TILE_BINS + r], invalid[r]);".to_string()),
-        ("    _pad0: u32,", "    tile_first: u32,".to_string()),
-    ];
-    let broken = |from: &str| GpuError::Shader {
-        what: "tiled kernel".into(),
-        message: format!("the composed kernel does not hold `{from}` exactly once; update tiled_source in src/gpu/engine.rs"),
-    };
-    let mut s = source.to_string();
-    for (from, to) in edits {
-        if s.matches(from).count() != 1 {
-            return Err(broken(from));
-        }
-        s = s.replacen(from, &to, 1);
-    }
-    let key = "const WG_WORDS: u32 = ";
-    let at = s.find(key).ok_or_else(|| broken(key))? + key.len();
-    let end = at + s[at..].find(';').ok_or_else(|| broken(key))?;
-    s.replace_range(at..end, &format!("{}u", tile_bins.div_ceil(2)));
-    Ok(s)
 }
