@@ -66,7 +66,8 @@ impl StressRow {
     }
 }
 
-const SAMPLERS: [(LobeKind, Method); 6] = [
+/// Every sampler: each lobe with each method it supports.
+pub const SAMPLERS: [(LobeKind, Method); 6] = [
     (LobeKind::Ward, Method::Ndf),
     (LobeKind::Beckmann, Method::Ndf),
     (LobeKind::Beckmann, Method::Vndf),

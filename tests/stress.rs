@@ -114,17 +114,9 @@ fn binning_at_edges_poles_and_the_seam() {
 /// the suite.
 #[test]
 fn random_search_beyond_the_listed_cases() {
-    use lobes::reference::{Lobe, LobeKind, Method, reflect, rng};
-    use lobes::stress::{StressCase, run_case};
+    use lobes::reference::{Lobe, reflect, rng};
+    use lobes::stress::{SAMPLERS as samplers, StressCase, run_case};
     let mut e = engine();
-    let samplers = [
-        (LobeKind::Ward, Method::Ndf),
-        (LobeKind::Beckmann, Method::Ndf),
-        (LobeKind::Beckmann, Method::Vndf),
-        (LobeKind::Ggx, Method::Ndf),
-        (LobeKind::Ggx, Method::Vndf),
-        (LobeKind::Ggx, Method::Bounded),
-    ];
     let mut failed = Vec::new();
     for i in 0..120u64 {
         let r = rng::uniforms(2024, i);
