@@ -230,17 +230,10 @@ pub struct MergeArgs {
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Family-wise significance level, Šidák-corrected over the scene's cases.
-    #[arg(long, default_value_t = 0.01, value_parser = parse_level, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.01, value_parser = super::run::parse_level, allow_hyphen_values = true)]
     pub significance: f64,
     #[command(flatten)]
     pub output: OutputArgs,
-}
-
-fn parse_level(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x > 0.0 && x < 1.0 => Ok(x),
-        _ => Err(format!("'{s}' is not a significance level; give a number strictly between 0 and 1")),
-    }
 }
 
 /// One shard file, read back.

@@ -33,7 +33,8 @@ pub struct RunArgs {
     pub output: OutputArgs,
 }
 
-fn parse_level(s: &str) -> Result<f64, String> {
+/// A significance level strictly between 0 and 1 (`--significance` of run and merge).
+pub(super) fn parse_level(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x > 0.0 && x < 1.0 => Ok(x),
         _ => Err(format!("'{s}' is not a significance level; give a number strictly between 0 and 1")),

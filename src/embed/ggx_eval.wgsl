@@ -70,11 +70,8 @@ fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    // Eto & Tokuyoshi 2023, listing 1: k = (1 - am^2) s^2 / (s^2 + am^2 wi.z^2), am = min(ax, ay)
-    // clamped to [0, 1], s = 1 + |wi.xy|.
-    let am = clamp(min(a.x, a.y), 0.0, 1.0);
-    let sl = 1.0 + length(wi.xy);
-    let k = (1.0 - am * am) * sl * sl / (sl * sl + am * am * wi.z * wi.z);
+    // k as the sampler forms it (shaders/ggx.wgsl, Eto & Tokuyoshi 2023 listing 1)
+    let k = 1.0 - ggx_bounded_one_minus_k(a, wi);
     let t = length(vec3<f32>(a * wi.xy, wi.z));
     return ggx_d(a, h) / (2.0 * (k * wi.z + t));
 }
