@@ -3,6 +3,8 @@
 //! backend of the benchmark.
 
 use crate::job::{Counts, DiscreteMethod, Job};
+use crate::reference::effects::Effects;
+use crate::stats::weighted::WeightedSums;
 use crate::reference::discrete::AliasTable;
 use rayon::prelude::*;
 
@@ -41,4 +43,41 @@ pub fn histogram(job: &Job, seed: u64, first: u64, samples: u64) -> Counts {
             a
         });
     Counts::from_cells(&cells)
+}
+
+/// The weighted histogram of samples `first .. first + samples` of a lobe job with `effects`,
+/// in f64: the same fixed-point sums as `shaders/weighted.wgsl`, and per bin the largest
+/// relative difference between the weight and eval · cos θr / pdf.
+pub fn weighted(job: &Job, effects: &Effects, seed: u64, first: u64, samples: u64) -> WeightedSums {
+    let Job::Lobe { lobe, incident, grid } = job else { panic!("weighted histograms are for lobe jobs") };
+    let bins = job.bins();
+    const BLOCK: u64 = 1 << 16;
+    (0..samples.div_ceil(BLOCK))
+        .into_par_iter()
+        .fold(
+            || WeightedSums::zeros(bins),
+            |mut sums, b| {
+                let start = first + b * BLOCK;
+                for i in start..(start + BLOCK).min(first + samples) {
+                    let u = crate::reference::rng::uniforms(seed, i);
+                    let s = lobe.sample(*incident, [u[0], u[1]]);
+                    let w = effects.weight(lobe, *incident, &s);
+                    match s.invalid {
+                        None => {
+                            let bin = grid.bin_of(s.omega_r);
+                            sums.record(bin, w);
+                            let check = effects.eval(lobe, *incident, s.omega_r) * s.omega_r.z / lobe.pdf_r(*incident, s.omega_r);
+                            let e = if w == check { 0.0 } else { ((w - check).abs() / check) as f32 };
+                            sums.max_error[bin] = sums.max_error[bin].max(if e.is_nan() { f32::INFINITY } else { e });
+                        }
+                        Some(r) => sums.record(bins + r.code() as usize - 1, w),
+                    }
+                }
+                sums
+            },
+        )
+        .reduce(|| WeightedSums::zeros(bins), |mut a, b| {
+            a.add(&b);
+            a
+        })
 }

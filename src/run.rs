@@ -8,6 +8,8 @@ use crate::scene::Case;
 use crate::stats::chi2::Chi2;
 use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::Quadrature;
+use crate::stats::weighted::{self, AlbedoCheck, WeightedSums};
+use crate::gpu::effects::Specialisation;
 use std::time::Instant;
 
 /// Samples regenerated on the CPU for the per-sample check.
@@ -59,6 +61,48 @@ pub struct CaseResult {
     pub quadrature_seconds: f64,
     pub angle: Option<AngleCheck>,
     pub workgroup_counting: Option<bool>,
+    /// The weighted histogram and its verdict, for a case with effects.
+    pub weighted: Option<WeightedResult>,
+}
+
+/// A case's weighted histogram: the sums, their verdict, and the time of the weighted pass.
+#[derive(Debug, Clone)]
+pub struct WeightedResult {
+    pub sums: WeightedSums,
+    pub check: AlbedoCheck,
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+}
+
+impl CaseResult {
+    /// The case's verdict: the χ² test, and the albedo checks where the case is weighted.
+    pub fn passed(&self) -> bool {
+        self.chi2.passed && self.weighted.as_ref().is_none_or(|w| w.check.passed)
+    }
+}
+
+/// The weighted sums of samples `first .. first + samples` of a case with effects, with the
+/// specialised module on the GPU: (sums, GPU seconds, wall seconds).
+pub fn weighted_sums(backend: &mut Backend, case: &Case, first: u64, samples: u64) -> anyhow::Result<(WeightedSums, Option<f64>, f64)> {
+    let effects = case.effects.as_ref().expect("a weighted case");
+    Ok(match backend {
+        Backend::Gpu(engine) => {
+            let r = engine.weighted(&case.job, effects, case.seed, first, samples, Specialisation::Specialised)?;
+            (r.sums, r.gpu_seconds, r.wall_seconds)
+        }
+        Backend::Cpu => {
+            let t = Instant::now();
+            let sums = cpu::weighted(&case.job, effects, case.seed, first, samples);
+            (sums, None, t.elapsed().as_secs_f64())
+        }
+    })
+}
+
+/// Judges the weighted sums of a whole case.
+pub fn judge_weighted(case: &Case, sums: WeightedSums, gpu_seconds: Option<f64>, wall_seconds: f64, significance: f64) -> WeightedResult {
+    let effects = case.effects.as_ref().expect("a weighted case");
+    let check = weighted::albedo_check(&case.job, effects, &sums, case.samples, significance, &Quadrature::default());
+    WeightedResult { sums, check, gpu_seconds, wall_seconds }
 }
 
 /// Histograms samples `first .. first + samples` of a case on `backend`.
@@ -111,5 +155,12 @@ pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress:
         case.samples
     );
     let (expected, chi2, quadrature_seconds, angle) = judge(backend, case, counts.clone(), significance)?;
-    Ok(CaseResult { case: case.clone(), counts, expected, chi2, gpu_seconds, histogram_seconds, quadrature_seconds, angle, workgroup_counting })
+    let weighted = match &case.effects {
+        Some(_) => {
+            let (sums, gpu, wall) = weighted_sums(backend, case, 0, case.samples)?;
+            Some(judge_weighted(case, sums, gpu, wall, significance))
+        }
+        None => None,
+    };
+    Ok(CaseResult { case: case.clone(), counts, expected, chi2, gpu_seconds, histogram_seconds, quadrature_seconds, angle, workgroup_counting, weighted })
 }

@@ -24,6 +24,9 @@
 
 use crate::job::{DiscreteMethod, Job};
 use crate::reference::discrete::{Distribution, WeightsError};
+use crate::reference::effects::Effects;
+use crate::reference::fresnel::Fresnel;
+use crate::reference::masking::Masking;
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use serde::Deserialize;
@@ -42,6 +45,9 @@ pub const MAX_SAMPLES: u64 = 1 << 40;
 /// larger histograms into tiles that fit the adapter; this cap bounds the f64 quadrature, the
 /// heat maps and `histogram.json`.
 pub const MAX_BINS: u64 = 1 << 24;
+/// The largest sample count of a weighted case (its 64-bit fixed-point sums hold 2^32 samples
+/// of mean weight up to 4096).
+pub const MAX_WEIGHTED_SAMPLES: u64 = 1 << 32;
 /// The longest case name (it names a folder).
 pub const MAX_NAME_LEN: usize = 100;
 
@@ -88,6 +94,12 @@ struct RawCase {
     samples: Option<Val>,
     bins: Option<Val>,
     seed: Option<Val>,
+    weighted: Option<Val>,
+    fresnel: Option<Val>,
+    f0: Option<Val>,
+    eta: Option<Val>,
+    k: Option<Val>,
+    masking: Option<Val>,
 }
 
 /// `weights = [...]`, each item with its own span (so an error points at the bad weight).
@@ -123,6 +135,9 @@ pub struct Case {
     pub seed: u64,
     /// Incident angles in degrees (lobes).
     pub incident_deg: (f64, f64),
+    /// For a weighted histogram (`weighted = true`, or any of `fresnel`, `masking`): the
+    /// effects whose estimator weights are summed per bin. `None`: counts only.
+    pub effects: Option<Effects>,
 }
 
 /// A validated scene.
@@ -160,7 +175,7 @@ impl Ctx<'_> {
 }
 
 /// "a string", "an integer", … for messages.
-fn kind(v: &Value) -> &'static str {
+fn kind_of(v: &Value) -> &'static str {
     match v {
         Value::String(_) => "a string",
         Value::Integer(_) => "an integer",
@@ -177,7 +192,7 @@ fn number(ctx: &Ctx, v: &Val, key: &str, ok: impl Fn(f64) -> bool, allowed: &str
     let x = match v.get_ref() {
         Value::Integer(i) => *i as f64,
         Value::Float(f) => *f,
-        other => return Err(ctx.err(v.span(), format!("{key} must be a number, got {}; {allowed}", kind(other)))),
+        other => return Err(ctx.err(v.span(), format!("{key} must be a number, got {}; {allowed}", kind_of(other)))),
     };
     if !x.is_finite() || !ok(x) {
         return Err(ctx.err(v.span(), format!("{key} = {x} is not allowed; {allowed}")));
@@ -191,7 +206,7 @@ fn whole(ctx: &Ctx, v: &Val, key: &str, lo: u64, hi: u64, allowed: &str) -> Resu
         Value::Integer(i) if *i >= 0 && (lo..=hi).contains(&(*i as u64)) => Ok(*i as u64),
         Value::Integer(i) => Err(ctx.err(v.span(), format!("{key} = {i} is not allowed; {allowed}"))),
         Value::Float(f) => Err(ctx.err(v.span(), format!("{key} must be a whole number (an integer literal), got the floating-point number {f:?}; {allowed}"))),
-        other => Err(ctx.err(v.span(), format!("{key} must be a whole number, got {}; {allowed}", kind(other)))),
+        other => Err(ctx.err(v.span(), format!("{key} must be a whole number, got {}; {allowed}", kind_of(other)))),
     }
 }
 
@@ -199,7 +214,7 @@ fn whole(ctx: &Ctx, v: &Val, key: &str, lo: u64, hi: u64, allowed: &str) -> Resu
 fn string<'v>(ctx: &Ctx, v: &'v Val, key: &str, allowed: &str) -> Result<&'v str, SceneError> {
     match v.get_ref() {
         Value::String(s) => Ok(s),
-        other => Err(ctx.err(v.span(), format!("{key} must be a string, got {}; {allowed}", kind(other)))),
+        other => Err(ctx.err(v.span(), format!("{key} must be a string, got {}; {allowed}", kind_of(other)))),
     }
 }
 
@@ -217,12 +232,12 @@ fn seed(ctx: &Ctx, v: &Val) -> Result<u64, SceneError> {
 
 fn bins(ctx: &Ctx, v: &Val) -> Result<SphereGrid, SceneError> {
     let bad = |what: String| ctx.err(v.span(), format!("bins {what}; {BINS_ALLOWED}"));
-    let Value::Array(items) = v.get_ref() else { return Err(bad(format!("must be an array, got {}", kind(v.get_ref())))) };
+    let Value::Array(items) = v.get_ref() else { return Err(bad(format!("must be an array, got {}", kind_of(v.get_ref())))) };
     let [rows, cols] = items.as_slice() else { return Err(bad(format!("has {} items, not 2", items.len()))) };
     let dim = |x: &Value| match x {
         Value::Integer(i) if *i >= 1 && *i <= u32::MAX as i64 => Ok(*i as u32),
         Value::Integer(i) => Err(bad(format!("= [{rows}, {cols}] is not allowed ({i} is out of range)"))),
-        other => Err(bad(format!("must hold whole numbers, got {}", kind(other)))),
+        other => Err(bad(format!("must hold whole numbers, got {}", kind_of(other)))),
     };
     let (r, c) = (dim(rows)?, dim(cols)?);
     if r % 2 == 1 {
@@ -373,6 +388,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
             ],
             "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
         )?;
+        reject_keys(ctx, &effect_keys(c), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
         let Some(w) = &c.weights else {
             return Err(ctx.err(lobe_v.span(), "a discrete case needs weights = [w0, w1, ...]: finite numbers ≥ 0, not all zero"));
         };
@@ -392,7 +408,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
             };
             ctx.err(span, format!("weights: {e}"))
         })?;
-        return Ok(Case { name, job: Job::Discrete { dist, method }, samples, seed, incident_deg: (0.0, 0.0) });
+        return Ok(Case { name, job: Job::Discrete { dist, method }, samples, seed, incident_deg: (0.0, 0.0), effects: None });
     }
 
     let kind = match lobe_name {
@@ -448,7 +464,94 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
     };
     let incident = reflect::spherical(theta.to_radians(), phi.to_radians());
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
-    Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi) })
+    let effects = effects(ctx, c, kind)?;
+    if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
+        let span = c.samples.as_ref().or(d.samples.map(|(_, v)| v)).map_or(spanned.span(), |v| v.span());
+        return Err(ctx.err(span, format!("samples = {samples} is too many for a weighted case; at most 2^32 (4294967296)")));
+    }
+    Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi), effects })
+}
+
+fn effect_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 6] {
+    [
+        ("weighted", c.weighted.as_ref()),
+        ("fresnel", c.fresnel.as_ref()),
+        ("f0", c.f0.as_ref()),
+        ("eta", c.eta.as_ref()),
+        ("k", c.k.as_ref()),
+        ("masking", c.masking.as_ref()),
+    ]
+}
+
+/// The effects of a lobe case: `None` unless it asks for a weighted histogram.
+fn effects(ctx: &Ctx, c: &RawCase, kind: LobeKind) -> Result<Option<Effects>, SceneError> {
+    let fresnel_allowed = "use none, schlick (with f0), conductor (with eta and k) or dielectric (with eta)";
+    let fresnel = match &c.fresnel {
+        None => Fresnel::None,
+        Some(v) => match string(ctx, v, "fresnel", fresnel_allowed)? {
+            "none" => Fresnel::None,
+            "schlick" => Fresnel::Schlick {
+                f0: required(ctx, v, c.f0.as_ref(), "f0", |x| (0.0..=1.0).contains(&x), "f0 is the reflectance at normal incidence, 0 ≤ f0 ≤ 1")?,
+            },
+            "conductor" => Fresnel::Conductor {
+                eta: required(ctx, v, c.eta.as_ref(), "eta", |x| x > 0.0, "eta is the real part of the index of refraction, > 0")?,
+                k: required(ctx, v, c.k.as_ref(), "k", |x| x >= 0.0, "k is the absorption (imaginary part of the index), ≥ 0")?,
+            },
+            "dielectric" => Fresnel::Dielectric {
+                eta: required(ctx, v, c.eta.as_ref(), "eta", |x| x > 0.0, "eta is the relative index of refraction n_t / n_i, > 0")?,
+            },
+            other => return Err(ctx.err(v.span(), format!("fresnel '{other}' is unknown; {fresnel_allowed}"))),
+        },
+    };
+    // Parameters that the chosen form does not read.
+    let unused = |key: &str, v: Option<&Val>, used: bool| match v {
+        Some(v) if !used => Err(ctx.err(v.span(), format!("{key} does not apply to fresnel = \"{}\"; remove it ({fresnel_allowed})", fresnel.name()))),
+        _ => Ok(()),
+    };
+    unused("f0", c.f0.as_ref(), matches!(fresnel, Fresnel::Schlick { .. }))?;
+    unused("eta", c.eta.as_ref(), matches!(fresnel, Fresnel::Conductor { .. } | Fresnel::Dielectric { .. }))?;
+    unused("k", c.k.as_ref(), matches!(fresnel, Fresnel::Conductor { .. }))?;
+    let masking_allowed = "use none, g1, separable or height-correlated";
+    let masking = match &c.masking {
+        None => Masking::None,
+        Some(v) => {
+            let m = match string(ctx, v, "masking", masking_allowed)? {
+                "none" => Masking::None,
+                "g1" => Masking::G1,
+                "separable" => Masking::Separable,
+                "height-correlated" => Masking::HeightCorrelated,
+                other => return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}"))),
+            };
+            if kind == LobeKind::Ward && m != Masking::None {
+                return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));
+            }
+            m
+        }
+    };
+    let weighted = match &c.weighted {
+        None => None,
+        Some(v) => match v.get_ref() {
+            Value::Boolean(b) => Some((*b, v)),
+            other => return Err(ctx.err(v.span(), format!("weighted must be true or false, got {}", kind_of(other)))),
+        },
+    };
+    let asked = c.fresnel.as_ref().or(c.masking.as_ref());
+    match (weighted, asked) {
+        (Some((false, _)), Some(v)) => Err(ctx.err(
+            v.span(),
+            "Fresnel and masking only change the estimator weights, which a case with weighted = false does not sum; set weighted = true or remove them",
+        )),
+        (Some((true, _)), _) | (None, Some(_)) => Ok(Some(Effects { fresnel, masking })),
+        _ => Ok(None),
+    }
+}
+
+/// The number `key` that `fresnel` (at `form`) needs.
+fn required(ctx: &Ctx, form: &Val, v: Option<&Val>, key: &str, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<f64, SceneError> {
+    match v {
+        Some(v) => number(ctx, v, key, ok, allowed),
+        None => Err(ctx.err(form.span(), format!("this Fresnel form needs {key}; add {key} = ... ({allowed})"))),
+    }
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ use crate::run::{self, ANGLE_CHECK_SAMPLES, Backend, CaseResult};
 use crate::scene::{Case, DEFAULT_SCENE, Scene};
 use crate::stats::chi2::sidak;
 use crate::stats::compare::{self, AngleCheck};
+use crate::stats::weighted::WeightedSums;
 use clap::Args;
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
@@ -171,6 +172,10 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
             }
             _ => None,
         };
+        let weighted = match case.effects {
+            Some(_) => Some(run::weighted_sums(&mut backend, case, range.start, n)?),
+            None => None,
+        };
         let (lobe, method, params, r, c) = describe_case(case);
         let doc = json!({
             "format": SHARD_FORMAT, "version": SHARD_VERSION, "lobes_version": env!("CARGO_PKG_VERSION"),
@@ -185,6 +190,8 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
             "timing": {"gpu_seconds": gpu_seconds, "histogram_wall_seconds": wall_seconds},
             "workgroup_counting": workgroup_counting,
             "per_sample_check": angle,
+            "weighted": weighted.as_ref().map(|w| &w.0),
+            "weighted_timing": weighted.as_ref().map(|w| json!({"gpu_seconds": w.1, "wall_seconds": w.2})),
             // serde_json reads floats back to within an ulp only: the exact bits, for the merge.
             "per_sample_check_f64_bits": angle.as_ref().map(|a| json!({
                 "max_angle_rad": a.max_angle_rad.to_bits(), "mean_angle_rad": a.mean_angle_rad.to_bits()})),
@@ -265,6 +272,8 @@ pub struct ShardFile {
     pub workgroup_counting: Option<bool>,
     /// The per-sample check (only in the shard starting at sample 0, on the GPU).
     pub angle: Option<AngleCheck>,
+    /// The weighted sums of a case with effects, with the GPU and wall seconds of their pass.
+    pub weighted: Option<(WeightedSums, Option<f64>, f64)>,
     /// The scene's file name when the shard was run.
     pub scene_name: String,
     /// The scene's full text.
@@ -349,7 +358,19 @@ pub fn read_shard(path: &Path) -> anyhow::Result<ShardFile> {
             })
         }
     };
+    let weighted = match &v["weighted"] {
+        Value::Null => None,
+        w => {
+            let sums: WeightedSums = serde_json::from_value(w.clone()).map_err(|e| bad(format!("invalid field 'weighted': {e}")))?;
+            if sums.bins.len() != bins.len() || sums.max_error.len() != bins.len() {
+                return Err(bad(format!("field 'weighted' has {} bins where 'counts' has {}", sums.bins.len(), bins.len())));
+            }
+            let t = &v["weighted_timing"];
+            Some((sums, t["gpu_seconds"].as_f64(), t["wall_seconds"].as_f64().unwrap_or(0.0)))
+        }
+    };
     let shard = ShardFile {
+        weighted,
         path: path.to_path_buf(),
         case: str_of("case")?,
         seed: u64_of("seed")?,
@@ -491,6 +512,26 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         anyhow::ensure!(counts.total() == case.samples, "case '{}': shards add up to {} samples, not {}", case.name, counts.total(), case.samples);
         let (expected, chi2, quadrature_seconds, _) = run::judge(&mut judge_backend, case, counts.clone(), level)?;
         let gpu_seconds = parts.iter().map(|s| s.gpu_seconds).sum::<Option<f64>>();
+        let weighted = match &case.effects {
+            None => None,
+            Some(_) => {
+                let mut sums = WeightedSums::zeros(case.job.bins());
+                let (mut gpu, mut wall) = (Some(0.0), 0.0);
+                for s in parts {
+                    let Some((w, g, t)) = &s.weighted else {
+                        return Err(usage(format!(
+                            "{}: case '{}' is weighted in the scene but this shard has no weighted sums; run the shard again with this lobes",
+                            s.path.display(),
+                            case.name
+                        )));
+                    };
+                    sums.add(w);
+                    gpu = gpu.zip(*g).map(|(a, b)| a + b);
+                    wall += t;
+                }
+                Some(run::judge_weighted(case, sums, gpu, wall, level))
+            }
+        };
         let wcs: Vec<Option<bool>> = parts.iter().map(|s| s.workgroup_counting).collect();
         let result = CaseResult {
             case: case.clone(),
@@ -502,12 +543,14 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
             quadrature_seconds,
             angle: parts.iter().find(|s| s.first == 0).and_then(|s| s.angle.clone()),
             workgroup_counting: if wcs.iter().all(|w| *w == wcs[0]) { wcs[0] } else { None },
+            weighted,
         };
         output::write_case(&args.out, &result, &adapter, &backends)?;
-        failed += usize::from(!result.chi2.passed);
+        failed += usize::from(!result.passed());
         rows.push(output::table_row(&result));
         summary.push(json!({
             "case": case.name, "samples": case.samples, "shards": parts.len(),
+            "albedo": result.weighted.as_ref().map(|w| json!({"albedo": w.check.albedo, "reference": w.check.reference, "passed": w.check.passed})),
             "gpu_seconds": result.gpu_seconds, "wall_seconds": result.histogram_seconds,
             "chi2": result.chi2.statistic, "dof": result.chi2.dof, "p_value": result.chi2.p_value,
             "passed": result.chi2.passed, "max_angle_rad": result.angle.as_ref().map(|a| a.max_angle_rad),

@@ -155,12 +155,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                     backend = Backend::Cpu;
                 }
                 let dash = || "-".to_string();
-                rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash()]);
+                rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
                 summary.push(json!({"case": case.name, "samples": case.samples, "passed": false, "error": format!("{e:#}"), "output": null}));
                 continue;
             }
         };
-        failed += usize::from(!result.chi2.passed);
+        failed += usize::from(!result.passed());
         if result.gpu_seconds.is_none() {
             if backend.name() == "cpu" { cpu_rows = true } else { wall_rows = true }
         }
@@ -168,7 +168,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         summary.push(json!({
             "case": case.name, "samples": case.samples, "backend": backend.name(), "gpu_seconds": result.gpu_seconds,
             "wall_seconds": result.histogram_seconds, "chi2": result.chi2.statistic, "dof": result.chi2.dof,
-            "p_value": result.chi2.p_value, "passed": result.chi2.passed,
+            "p_value": result.chi2.p_value, "passed": result.passed(),
+            "albedo": result.weighted.as_ref().map(|w| json!({"albedo": w.check.albedo, "reference": w.check.reference,
+                "relative_error": w.check.relative_error, "p_value": w.check.p_value, "max_weight_error": w.check.max_weight_error,
+                "passed": w.check.passed})),
             "max_angle_rad": result.angle.as_ref().map(|a| a.max_angle_rad),
             "output": args.out.join(&case.name),
         }));
@@ -190,8 +193,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     }
     match (errors, failed) {
         (0, 0) => Ok(()),
-        (0, f) => anyhow::bail!("{f} of {n} cases failed the χ² test"),
+        (0, f) => anyhow::bail!("{f} of {n} cases failed the χ² test or the albedo checks"),
         (e, 0) => anyhow::bail!("{e} of {n} cases could not run (see the errors above)"),
-        (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test"),
+        (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test or the albedo checks"),
     }
 }

@@ -32,7 +32,7 @@
 //! collide with each other, and declarations at WGSL module scope may come in any order, so a
 //! composed string is all that is needed. It is also exactly the code the χ² tests judge:
 //! [`Module::source`] returns the same `shaders/*.wgsl` text that the test kernels are built
-//! from (`crate::gpu::compose::sources`), plus the pdf and BRDF functions of `src/embed/*.wgsl`,
+//! from (`crate::gpu::compose::sources`), plus the pdf, BRDF and estimator-weight functions of `shaders/*_eval.wgsl`,
 //! which `tests/embed.rs` checks against the f64 reference on the GPU.
 //!
 //! The composed code defines, at module scope, the names listed on each [`Module`] (and a few
@@ -53,13 +53,6 @@ pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers,
 use crate::gpu::compose::sources;
 use crate::gpu::GpuError;
 
-/// The pdf and BRDF functions that renderers need besides the samplers (MIS weights, light
-/// sampling); the χ² kernels do not use them.
-mod extra {
-    pub const GGX: &str = include_str!("ggx_eval.wgsl");
-    pub const BECKMANN: &str = include_str!("beckmann_eval.wgsl");
-    pub const WARD: &str = include_str!("ward_eval.wgsl");
-}
 
 /// A WGSL module of lobes, as embedded by [`wgsl`]. The listed functions are the ones meant for
 /// callers; [`Module::symbols`] lists every name the module defines.
@@ -84,13 +77,13 @@ pub enum Module {
     Reflect,
     /// `shaders/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz).
     Microfacet,
-    /// `shaders/ward.wgsl` and `src/embed/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
+    /// `shaders/ward.wgsl` and `shaders/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
     ///
     /// - `ward_sample(a, wi, u: vec2<f32>) -> LobeSample`;
     /// - `ward_pdf(a, wi, wr) -> f32` (the density of `ward_sample`), `ward_eval(a, wi, wr) -> f32`
     ///   (Ward's BRDF, ρs = 1), `ward_pdf_h(a, h)`, `ward_sample_h(a, u)`.
     Ward,
-    /// `shaders/ggx.wgsl` and `src/embed/ggx_eval.wgsl`: GGX (Trowbridge–Reitz).
+    /// `shaders/ggx.wgsl` and `shaders/ggx_eval.wgsl`: GGX (Trowbridge–Reitz).
     ///
     /// - samplers `ggx_sample_ndf`, `ggx_sample_vndf` (spherical caps, Dupuy & Benyoub 2023),
     ///   `ggx_sample_bounded` (Eto & Tokuyoshi 2023), all `(a, wi, u: vec2<f32>) -> LobeSample`;
@@ -99,7 +92,7 @@ pub enum Module {
     /// - `ggx_eval(a, wi, wr)`: D G2 / (4 cos θi cos θr) with height-correlated Smith G2;
     ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`.
     Ggx,
-    /// `shaders/beckmann.wgsl` and `src/embed/beckmann_eval.wgsl`: Beckmann.
+    /// `shaders/beckmann.wgsl` and `shaders/beckmann_eval.wgsl`: Beckmann.
     ///
     /// - samplers `beckmann_sample_ndf`, `beckmann_sample_vndf` (Heitz & d'Eon 2014),
     ///   `(a, wi, u: vec2<f32>) -> LobeSample`;
@@ -163,9 +156,9 @@ impl Module {
             Module::Rng => &[sources::RNG],
             Module::Reflect => &[sources::REFLECT],
             Module::Microfacet => &[sources::MICROFACET],
-            Module::Ward => &[sources::WARD, extra::WARD],
-            Module::Ggx => &[sources::GGX, extra::GGX],
-            Module::Beckmann => &[sources::BECKMANN, extra::BECKMANN],
+            Module::Ward => &[sources::WARD, sources::WARD_EVAL],
+            Module::Ggx => &[sources::GGX, sources::GGX_EVAL],
+            Module::Beckmann => &[sources::BECKMANN, sources::BECKMANN_EVAL],
             Module::Discrete => &[sources::DISCRETE],
         }
     }

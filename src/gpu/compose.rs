@@ -20,6 +20,12 @@ pub mod sources {
     pub const COUNTING_WORKGROUP: &str = include_str!("../../shaders/counting_workgroup.wgsl");
     pub const COUNTING_GLOBAL: &str = include_str!("../../shaders/counting_global.wgsl");
     pub const LOBE_KERNEL: &str = include_str!("../../shaders/lobe_kernel.wgsl");
+    pub const WARD_EVAL: &str = include_str!("../../shaders/ward_eval.wgsl");
+    pub const GGX_EVAL: &str = include_str!("../../shaders/ggx_eval.wgsl");
+    pub const BECKMANN_EVAL: &str = include_str!("../../shaders/beckmann_eval.wgsl");
+    pub const FRESNEL: &str = include_str!("../../shaders/fresnel.wgsl");
+    pub const MASKING: &str = include_str!("../../shaders/masking.wgsl");
+    pub const WEIGHTED: &str = include_str!("../../shaders/weighted.wgsl");
 }
 
 /// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
@@ -59,31 +65,10 @@ pub fn compose(job: &Job, workgroup_words: u32) -> String {
 /// workgroup memory when `ceil(tile_bins / 2)` words fit in `workgroup_words`, else in global
 /// memory.
 pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
-    let bins = job.bins() as u32;
-    let (rows, cols) = match job {
-        Job::Lobe { grid, .. } => (grid.rows, grid.cols),
-        Job::Discrete { .. } => (1, bins),
-    };
-    let wg_words = tile_bins.div_ceil(2);
-    let in_workgroup = wg_words <= workgroup_words;
-    let mut src = format!(
-        "// Composed by lobes for {}\n\
-         const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
-         const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n\n",
-        describe(job)
-    );
-    let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
-    for part in [sources::RNG, sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting] {
-        src.push_str(part);
-        src.push('\n');
-    }
+    let mut src = header(job, workgroup_words, tile_bins);
     match job {
         Job::Lobe { lobe, .. } => {
-            for part in lobe_modules(lobe.kind) {
-                src.push_str(part);
-                src.push('\n');
-            }
+            push_all(&mut src, lobe_modules(lobe.kind));
             src.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", sample_fn(lobe.kind, lobe.method)));
         }
         Job::Discrete { method, .. } => {
@@ -101,6 +86,34 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
         }
     }
     src
+}
+
+/// The constants, the RNG, binning and counting kernels every job's module starts with.
+fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
+    let bins = job.bins() as u32;
+    let (rows, cols) = match job {
+        Job::Lobe { grid, .. } => (grid.rows, grid.cols),
+        Job::Discrete { .. } => (1, bins),
+    };
+    let wg_words = tile_bins.div_ceil(2);
+    let in_workgroup = wg_words <= workgroup_words;
+    let mut src = format!(
+        "// Composed by lobes for {}\n\
+         const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
+         const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n\n",
+        describe(job)
+    );
+    let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
+    push_all(&mut src, &[sources::RNG, sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
+    src
+}
+
+fn push_all(src: &mut String, parts: &[&str]) {
+    for part in parts {
+        src.push_str(part);
+        src.push('\n');
+    }
 }
 
 /// "ggx vndf", "discrete cdf (10 items)".

@@ -13,7 +13,7 @@ use wgpu::util::DeviceExt;
 /// The kernel's uniform block (`Params` in `shaders/kernel.wgsl`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
-struct Params {
+pub(super) struct Params {
     seed: [u32; 2],
     base: [u32; 2],
     count: u32,
@@ -87,9 +87,11 @@ pub struct GpuEngine {
     pub chunking: Chunking,
     /// Number of modules compiled so far (for tests of the cache).
     pub compiled: usize,
+    /// Pipelines of weighted histograms (`src/gpu/weighted.rs`).
+    pub(super) weighted: super::weighted::WeightedPipelines,
 }
 
-fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+pub(super) fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
@@ -128,7 +130,8 @@ impl GpuEngine {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), errors, chunking: Chunking::default(), compiled: 0 }
+        let weighted = super::weighted::WeightedPipelines::new(&gpu);
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), errors, chunking: Chunking::default(), compiled: 0, weighted }
     }
 
     /// Opens the default adapter.
@@ -136,14 +139,14 @@ impl GpuEngine {
         Ok(Self::new(Gpu::new()?))
     }
 
-    fn check_errors(&self) -> Result<(), GpuError> {
+    pub(super) fn check_errors(&self) -> Result<(), GpuError> {
         match self.errors.lock().unwrap().take() {
             Some(e) => Err(GpuError::Lost(e)),
             None => Ok(()),
         }
     }
 
-    fn workgroup_words(&self) -> u32 {
+    pub(super) fn workgroup_words(&self) -> u32 {
         self.gpu.limits.max_compute_workgroup_storage_size / 4
     }
 
@@ -235,7 +238,7 @@ impl GpuEngine {
         Ok(kernel)
     }
 
-    fn params(job: &Job, seed: u64, base: u64, count: u32) -> Params {
+    pub(super) fn params(job: &Job, seed: u64, base: u64, count: u32) -> Params {
         let mut p = Params {
             seed: [seed as u32, (seed >> 32) as u32],
             base: [base as u32, (base >> 32) as u32],
@@ -286,16 +289,16 @@ impl GpuEngine {
         (make("discrete f32", bytemuck::cast_slice(&f)), make("discrete u32", bytemuck::cast_slice(&u)))
     }
 
-    fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    pub(super) fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
         self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
     }
 
-    fn param_stride(&self) -> u64 {
+    pub(super) fn param_stride(&self) -> u64 {
         (self.gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Params>() as u64)
     }
 
     /// Workgroup grid for `groups` workgroups within the per-dimension limit.
-    fn grid(&self, groups: u64) -> (u32, u32) {
+    pub(super) fn grid(&self, groups: u64) -> (u32, u32) {
         let max = self.gpu.limits.max_compute_workgroups_per_dimension as u64;
         let x = groups.clamp(1, max);
         (x as u32, groups.div_ceil(x).max(1) as u32)
@@ -546,20 +549,20 @@ impl GpuEngine {
         })
     }
 
-    fn timestamp_buffers(&self, n: u32) -> (wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer) {
+    pub(super) fn timestamp_buffers(&self, n: u32) -> (wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer) {
         let set = self.gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("timestamps"), ty: wgpu::QueryType::Timestamp, count: n });
         let resolve = self.buffer("timestamps", n as u64 * 8, wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
         let read = self.buffer("timestamps read", n as u64 * 8, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
         (set, resolve, read)
     }
 
-    fn wait(&self) -> Result<(), GpuError> {
+    pub(super) fn wait(&self) -> Result<(), GpuError> {
         self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Lost(e.to_string()))?;
         Ok(())
     }
 
     /// Copies the first `size` bytes of `src` to the host.
-    fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+    pub(super) fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
         let staging = if src.usage().contains(wgpu::BufferUsages::MAP_READ) {
             src.clone()
         } else {

@@ -6,7 +6,10 @@
 
 pub mod beckmann;
 pub mod discrete;
+pub mod effects;
+pub mod fresnel;
 pub mod ggx;
+pub mod masking;
 pub mod microfacet;
 pub mod reflect;
 pub mod rng;

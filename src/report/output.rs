@@ -81,10 +81,27 @@ pub fn histogram_json(r: &CaseResult, adapter: &str, backend: &str) -> Value {
         "per_sample_check": r.angle,
         "quadrature": quadrature,
         "workgroup_counting": r.workgroup_counting,
+        "weighted": r.weighted.as_ref().map(|w| weighted_json(r, w, cols)),
     })
 }
 
-/// Writes the three heat maps and then `histogram.json` into `dir/<case>/`.
+/// The `weighted` section: the effects, the verdict, and per bin the albedo estimate, its f64
+/// quadrature and the largest weight difference.
+fn weighted_json(r: &CaseResult, w: &crate::run::WeightedResult, cols: usize) -> Value {
+    let n = r.case.samples;
+    let estimate: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, n)).collect();
+    json!({
+        "effects": r.case.effects,
+        "check": w.check,
+        "timing": {"gpu_seconds": w.gpu_seconds, "wall_seconds": w.wall_seconds},
+        "bin_albedo": nested(&estimate, cols),
+        "bin_albedo_reference": nested(&w.check.reference_bins, cols),
+        "bin_max_weight_error": nested(&w.sums.max_error, cols),
+        "sums": w.sums,
+    })
+}
+
+/// Writes the heat maps and then `histogram.json` into `dir/<case>/`.
 pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
@@ -108,13 +125,19 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> a
         let map = Heatmap { title: &title, rows, cols, values, scale, row_label, col_label, row_range, col_range };
         heatmap::write_png(&map, &folder.join(file))?;
     }
+    if let Some(w) = &r.weighted {
+        let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
+        let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
+        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label, col_label, row_range, col_range };
+        heatmap::write_png(&map, &folder.join("albedo.png"))?;
+    }
     let doc = histogram_json(r, adapter, backend);
     write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
     Ok(())
 }
 
 /// One line of the run table.
-pub fn table_row(r: &CaseResult) -> [String; 8] {
+pub fn table_row(r: &CaseResult) -> [String; 9] {
     let time = match r.gpu_seconds {
         Some(g) => format!("{g:.3} s"),
         None => format!("{:.3} s*", r.histogram_seconds),
@@ -127,15 +150,16 @@ pub fn table_row(r: &CaseResult) -> [String; 8] {
         format!("{:.1}", r.chi2.statistic),
         r.chi2.dof.to_string(),
         format!("{:.4}", r.chi2.p_value),
-        if r.chi2.passed { "pass".into() } else { "FAIL".into() },
+        if r.passed() { "pass".into() } else { "FAIL".into() },
         angle,
+        r.weighted.as_ref().map_or("-".into(), |w| format!("{:.5} ({:+.1e})", w.check.albedo, w.check.relative_error)),
     ]
 }
 
-pub const TABLE_HEADER: [&str; 8] = ["case", "samples", "GPU time", "chi2", "dof", "p-value", "verdict", "max angle err"];
+pub const TABLE_HEADER: [&str; 9] = ["case", "samples", "GPU time", "chi2", "dof", "p-value", "verdict", "max angle err", "albedo (rel err)"];
 
 /// A plain-text table with aligned columns.
-pub fn format_table(rows: &[[String; 8]]) -> String {
+pub fn format_table(rows: &[[String; 9]]) -> String {
     let mut widths = TABLE_HEADER.map(|h| h.chars().count());
     for r in rows {
         for (w, c) in widths.iter_mut().zip(r) {

@@ -4,3 +4,4 @@ pub mod chi2;
 pub mod compare;
 pub mod expected;
 pub mod histogram;
+pub mod weighted;

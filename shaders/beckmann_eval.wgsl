@@ -62,3 +62,14 @@ fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     }
     return g1_over_cos * cos_ih * beckmann_d(a, h) / (4.0 * abs(dot(wr, h)));
 }
+
+// Smith's G1(w) = cos th (G1 / cos th), in the form that stays finite at grazing angles.
+fn beckmann_g1(a: vec2<f32>, w: vec3<f32>) -> f32 {
+    return abs(w.z) * beckmann_g1_over_cos(a, w);
+}
+
+// The estimator weight f cos th_r / p(wr) of beckmann_sample_vndf for f = D / (4 cos th_i cos th_r)
+// (no Fresnel, no masking): with p(wr) = G1(wi) D / (4 cos th_i) it is 1 / G1(wi).
+fn beckmann_vndf_weight(a: vec2<f32>, wi: vec3<f32>) -> f32 {
+    return 1.0 / beckmann_g1(a, wi);
+}

@@ -75,3 +75,19 @@ fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let t = length(vec3<f32>(a * wi.xy, wi.z));
     return ggx_d(a, h) / (2.0 * (k * wi.z + t));
 }
+
+// The estimator weight f cos th_r / p(wr) of ggx_sample_vndf for f = D / (4 cos th_i cos th_r)
+// (no Fresnel, no masking): with p(wr) = D / (2 (cos th_i + t)) it is (cos th_i + t) / (2 cos th_i)
+// = 1 / G1(wi), whatever the sample.
+fn ggx_vndf_weight(a: vec2<f32>, wi: vec3<f32>) -> f32 {
+    let t = length(vec3<f32>(a * wi.xy, wi.z));
+    return (wi.z + t) / (2.0 * wi.z);
+}
+
+// The same for ggx_sample_bounded, p(wr) = D / (2 (k cos th_i + t)) (Eto & Tokuyoshi 2023,
+// listing 2): (k cos th_i + t) / (2 cos th_i).
+fn ggx_bounded_weight(a: vec2<f32>, wi: vec3<f32>) -> f32 {
+    let k = 1.0 - ggx_bounded_one_minus_k(a, wi);
+    let t = length(vec3<f32>(a * wi.xy, wi.z));
+    return (k * wi.z + t) / (2.0 * wi.z);
+}

@@ -23,3 +23,10 @@ fn ward_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let h = normalize(s);
     return ward_pdf_h(a, h) / (4.0 * abs(dot(wr, h)));
 }
+
+// The estimator weight f cos th_r / p(wr) of ward_sample (rho_s = 1; Walter 2005, eq. 10):
+// (h.wr) cos^3 th_h sqrt(cos th_r / cos th_i), |cos th_r| past the horizon; 0 for a back-facing
+// h (wi.h <= 0), which the BRDF (h = normalize(wi + wr)) never produces.
+fn ward_weight(wi: vec3<f32>, h: vec3<f32>, wr: vec3<f32>) -> f32 {
+    return max(dot(wi, h), 0.0) * h.z * h.z * h.z * sqrt(abs(wr.z) / wi.z);
+}

@@ -1,0 +1,61 @@
+// Fresnel reflectance of the microfacet (or Ward half-vector) at cos th = wi.h; CPU twin:
+// src/reference/fresnel.rs. Every form returns a reflectance in [0, 1].
+
+// Schlick 1994, eq. 24: F0 + (1 - F0) (1 - cos th)^5.
+fn fresnel_schlick(c: f32, f0: f32) -> f32 {
+    let m = clamp(1.0 - c, 0.0, 1.0);
+    let m2 = m * m;
+    return f0 + (1.0 - f0) * (m2 * m2 * m);
+}
+
+// A dielectric seen from outside, relative index eta = n_t / n_i (pbrt-v4 FrDielectric, eq. 9.5):
+// 1 past the critical angle (total internal reflection, eta < 1).
+fn fresnel_dielectric(c: f32, eta: f32) -> f32 {
+    let ci = clamp(c, 0.0, 1.0);
+    let sin2_t = (1.0 - ci * ci) / (eta * eta);
+    if (sin2_t >= 1.0) {
+        return 1.0;
+    }
+    let ct = sqrt(1.0 - sin2_t);
+    let r_parl = (eta * ci - ct) / (eta * ci + ct);
+    let r_perp = (ci - eta * ct) / (ci + eta * ct);
+    return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+// Complex numbers as vec2 (re, im).
+fn complex_mul(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+fn complex_div(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    return complex_mul(a, vec2<f32>(b.x, -b.y)) / dot(b, b);
+}
+
+// The principal square root without cancellation (pbrt-v4 pstd::sqrt of complex).
+fn complex_sqrt(z: vec2<f32>) -> vec2<f32> {
+    let n = length(z);
+    if (n == 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let t1 = sqrt(0.5 * (n + abs(z.x)));
+    let t2 = 0.5 * z.y / t1;
+    if (z.x >= 0.0) {
+        return vec2<f32>(t1, t2);
+    }
+    return vec2<f32>(abs(t2), select(-t1, t1, z.y >= 0.0));
+}
+
+// A conductor with complex index eta + i k (pbrt-v4 FrComplex, eq. 9.6 with complex eta):
+// cos th_t = sqrt(1 - sin^2 th / eta^2), r_parl = (eta c - cos th_t) / (eta c + cos th_t),
+// r_perp = (c - eta cos th_t) / (c + eta cos th_t), F = (|r_parl|^2 + |r_perp|^2) / 2.
+fn fresnel_conductor(c: f32, eta: f32, k: f32) -> f32 {
+    let ci = clamp(c, 0.0, 1.0);
+    let e = vec2<f32>(eta, k);
+    let sin2_t = complex_div(vec2<f32>(1.0 - ci * ci, 0.0), complex_mul(e, e));
+    let ct = complex_sqrt(vec2<f32>(1.0, 0.0) - sin2_t);
+    let ec = e * ci;
+    let r_parl = complex_div(ec - ct, ec + ct);
+    let ect = complex_mul(e, ct);
+    let r_perp = complex_div(vec2<f32>(ci, 0.0) - ect, vec2<f32>(ci, 0.0) + ect);
+    return 0.5 * (dot(r_parl, r_parl) + dot(r_perp, r_perp));
+}

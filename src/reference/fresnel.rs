@@ -1,0 +1,151 @@
+//! Fresnel reflectance at the angle cos θ = ωi·h between the incident direction and the
+//! microfacet (or Ward half vector); the f64 twin of `shaders/fresnel.wgsl`.
+
+use serde::Serialize;
+
+/// Which Fresnel term multiplies the BRDF.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Fresnel {
+    /// F = 1: a lossless mirror-like microsurface.
+    None,
+    /// Schlick's approximation with normal-incidence reflectance `f0` ∈ [0, 1].
+    Schlick { f0: f64 },
+    /// A conductor with complex index of refraction η + i k.
+    Conductor { eta: f64, k: f64 },
+    /// A dielectric with relative index η = n_t / n_i (reflection only).
+    Dielectric { eta: f64 },
+}
+
+impl Fresnel {
+    /// The reflectance at cos θ (clamped to [0, 1]).
+    pub fn reflectance(&self, cos_theta: f64) -> f64 {
+        match *self {
+            Fresnel::None => 1.0,
+            Fresnel::Schlick { f0 } => schlick(cos_theta, f0),
+            Fresnel::Conductor { eta, k } => conductor(cos_theta, eta, k),
+            Fresnel::Dielectric { eta } => dielectric(cos_theta, eta),
+        }
+    }
+    /// The kernels' code for this form (`FRESNEL` in the composed WGSL).
+    pub fn mode(&self) -> u32 {
+        match self {
+            Fresnel::None => 0,
+            Fresnel::Schlick { .. } => 1,
+            Fresnel::Conductor { .. } => 2,
+            Fresnel::Dielectric { .. } => 3,
+        }
+    }
+    /// The kernels' parameters: (f0) or (η, k).
+    pub fn params(&self) -> [f32; 4] {
+        match *self {
+            Fresnel::None => [0.0; 4],
+            Fresnel::Schlick { f0 } => [f0 as f32, 0.0, 0.0, 0.0],
+            Fresnel::Conductor { eta, k } => [eta as f32, k as f32, 0.0, 0.0],
+            Fresnel::Dielectric { eta } => [eta as f32, 0.0, 0.0, 0.0],
+        }
+    }
+    pub fn name(&self) -> &'static str {
+        match self {
+            Fresnel::None => "none",
+            Fresnel::Schlick { .. } => "schlick",
+            Fresnel::Conductor { .. } => "conductor",
+            Fresnel::Dielectric { .. } => "dielectric",
+        }
+    }
+}
+
+/// Schlick 1994, eq. 24: F0 + (1 − F0)(1 − cos θ)⁵.
+pub fn schlick(c: f64, f0: f64) -> f64 {
+    f0 + (1.0 - f0) * (1.0 - c.clamp(0.0, 1.0)).powi(5)
+}
+
+/// A dielectric seen from outside (pbrt-v4 `FrDielectric`, eq. 9.5); 1 past the critical angle.
+pub fn dielectric(c: f64, eta: f64) -> f64 {
+    let ci = c.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - ci * ci) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let ct = (1.0 - sin2_t).sqrt();
+    let r_parl = (eta * ci - ct) / (eta * ci + ct);
+    let r_perp = (ci - eta * ct) / (ci + eta * ct);
+    0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
+
+/// Complex numbers as (re, im), just what the conductor's Fresnel equations need.
+#[derive(Clone, Copy)]
+struct C(f64, f64);
+
+impl C {
+    fn mul(self, b: C) -> C {
+        C(self.0 * b.0 - self.1 * b.1, self.0 * b.1 + self.1 * b.0)
+    }
+    fn div(self, b: C) -> C {
+        let d = b.0 * b.0 + b.1 * b.1;
+        C((self.0 * b.0 + self.1 * b.1) / d, (self.1 * b.0 - self.0 * b.1) / d)
+    }
+    fn add(self, b: C) -> C {
+        C(self.0 + b.0, self.1 + b.1)
+    }
+    fn sub(self, b: C) -> C {
+        C(self.0 - b.0, self.1 - b.1)
+    }
+    fn norm2(self) -> f64 {
+        self.0 * self.0 + self.1 * self.1
+    }
+    /// The principal square root, without cancellation (pbrt-v4 `pstd::sqrt`).
+    fn sqrt(self) -> C {
+        let n = self.0.hypot(self.1);
+        if n == 0.0 {
+            return C(0.0, 0.0);
+        }
+        let t1 = (0.5 * (n + self.0.abs())).sqrt();
+        let t2 = 0.5 * self.1 / t1;
+        if self.0 >= 0.0 { C(t1, t2) } else { C(t2.abs(), t1.copysign(self.1)) }
+    }
+}
+
+/// A conductor with complex index η + i k (pbrt-v4 `FrComplex`): eq. 9.6 with complex η.
+pub fn conductor(c: f64, eta: f64, k: f64) -> f64 {
+    let ci = c.clamp(0.0, 1.0);
+    let e = C(eta, k);
+    let sin2_t = C(1.0 - ci * ci, 0.0).div(e.mul(e));
+    let ct = C(1.0, 0.0).sub(sin2_t).sqrt();
+    let ec = C(eta * ci, k * ci);
+    let r_parl = ec.sub(ct).div(ec.add(ct));
+    let ect = e.mul(ct);
+    let r_perp = C(ci, 0.0).sub(ect).div(C(ci, 0.0).add(ect));
+    0.5 * (r_parl.norm2() + r_perp.norm2())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normal_incidence_matches_the_closed_forms() {
+        // At normal incidence both polarisations give ((η − 1)² + k²) / ((η + 1)² + k²).
+        let (eta, k) = (0.2, 3.9);
+        let f0 = ((eta - 1.0f64).powi(2) + k * k) / ((eta + 1.0f64).powi(2) + k * k);
+        assert!((conductor(1.0, eta, k) - f0).abs() < 1e-14);
+        assert!((dielectric(1.0, 1.5) - 0.04).abs() < 1e-15);
+        assert!((schlick(1.0, 0.04) - 0.04).abs() < 1e-15);
+    }
+
+    #[test]
+    fn conductor_with_no_absorption_is_the_dielectric() {
+        for c in [0.05, 0.3, 0.7, 1.0] {
+            assert!((conductor(c, 1.5, 0.0) - dielectric(c, 1.5)).abs() < 1e-14, "cos {c}");
+        }
+    }
+
+    #[test]
+    fn grazing_incidence_reflects_everything() {
+        assert_eq!(dielectric(0.0, 1.5), 1.0);
+        assert!((conductor(0.0, 0.2, 3.9) - 1.0).abs() < 1e-12);
+        assert_eq!(schlick(0.0, 0.04), 1.0);
+        // total internal reflection from the denser side, past asin(1/1.5)'s complement
+        assert_eq!(dielectric(0.5, 1.0 / 1.5), 1.0);
+    }
+}
