@@ -437,3 +437,20 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn effects() {
+    scene_error(&ggx("alpha = 0.2\nfresnel = ⟦\"fresnell\"\n"), &["fresnel 'fresnell' is unknown", "schlick", "conductor", "dielectric"]);
+    scene_error(&ggx("alpha = 0.2\nfresnel = ⟦\"schlick\"\n"), &["needs f0", "0 ≤ f0 ≤ 1"]);
+    scene_error(&ggx("alpha = 0.2\nfresnel = \"schlick\"\nf0 = ⟦1.5\n"), &["f0 = 1.5 is not allowed", "0 ≤ f0 ≤ 1"]);
+    scene_error(&ggx("alpha = 0.2\nfresnel = ⟦\"conductor\"\neta = 0.2\n"), &["needs k"]);
+    scene_error(&ggx("alpha = 0.2\nfresnel = \"conductor\"\neta = ⟦-1\nk = 3\n"), &["eta = -1 is not allowed", "> 0"]);
+    scene_error(&ggx("alpha = 0.2\nfresnel = \"dielectric\"\neta = 1.5\nk = ⟦2\n"), &["k does not apply to fresnel = \"dielectric\""]);
+    scene_error(&ggx("alpha = 0.2\nf0 = ⟦0.04\n"), &["f0 does not apply to fresnel = \"none\""]);
+    scene_error(&ggx("alpha = 0.2\nmasking = ⟦\"smith\"\n"), &["masking 'smith' is unknown", "height-correlated"]);
+    scene_error("[[case]]\nname = \"w\"\nlobe = \"ward\"\nalpha = 0.2\nmasking = ⟦\"g1\"\n", &["Ward's BRDF has no Smith masking"]);
+    scene_error(&ggx("alpha = 0.2\nweighted = false\nfresnel = ⟦\"schlick\"\nf0 = 0.1\n"), &["set weighted = true or remove them"]);
+    scene_error(&ggx("alpha = 0.2\nweighted = ⟦1\n"), &["weighted must be true or false"]);
+    scene_error(&discrete("weights = [1, 2]\nmasking = ⟦\"g1\"\n"), &["masking does not apply to lobe = \"discrete\""]);
+    scene_error(&ggx("alpha = 0.2\nweighted = true\nsamples = ⟦8_000_000_000\n"), &["too many for a weighted case", "2^32"]);
+}

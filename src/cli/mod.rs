@@ -15,6 +15,7 @@
 pub mod bench;
 pub mod merge;
 pub mod run;
+pub mod shader;
 pub mod stress;
 pub mod tutorial;
 
@@ -60,6 +61,9 @@ pub enum Command {
     /// Drive every sampler with the inputs where naive formulas break, on the GPU (f32) and
     /// the CPU (f64); print case, kernel, worst errors and verdict.
     Stress(stress::StressArgs),
+    /// Print the composed WGSL that `lobes run` compiles for a scene's cases (each distinct
+    /// module once), with the override constants its pipelines are made with.
+    Shader(shader::ShaderArgs),
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
     Merge(merge::MergeArgs),
@@ -76,6 +80,7 @@ impl Cli {
             Command::Bench(args) => bench::run(&args),
             Command::Stress(args) => stress::run(&args),
             Command::Merge(args) => merge::run(&args),
+            Command::Shader(args) => shader::run(&args),
         }
     }
 }

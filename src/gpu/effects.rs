@@ -246,6 +246,15 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
     }
 }
 
+/// The module a case runs: its weighted module (which holds its counting kernels too) with
+/// effects, else its counting module (`tile_bins` bins per pass where the histogram is tiled).
+pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, tile_bins: u32) -> Composed {
+    match (effects, job) {
+        (Some(e), Job::Lobe { .. }) => compose_effects(job, e, workgroup_words, Specialisation::Specialised),
+        _ => Composed { source: compose::compose_tile(job, workgroup_words, tile_bins), constants: Vec::new() },
+    }
+}
+
 /// How many of `lobe_files(kind)` the counting module already holds (the samplers).
 fn lobe_modules_len(kind: LobeKind) -> usize {
     if kind == LobeKind::Ward { 1 } else { 2 }

@@ -96,6 +96,11 @@ impl GpuEngine {
         Ok(pipeline)
     }
 
+    /// Number of weighted pipelines compiled so far (one per distinct module and constants).
+    pub fn weighted_pipelines_built(&self) -> usize {
+        self.weighted.compiled
+    }
+
     /// Sums the weights of samples `first .. first + samples` of `job` (a lobe) with `effects`,
     /// with the specialised module or the uber-kernel.
     pub fn weighted(
@@ -106,6 +111,22 @@ impl GpuEngine {
         first: u64,
         samples: u64,
         how: Specialisation,
+    ) -> Result<WeightedRun, GpuError> {
+        let composed = self.weighted_module(job, effects, how);
+        self.weighted_with(job, effects, &composed, seed, first, samples)
+    }
+
+    /// As [`GpuEngine::weighted`] with a module of the caller's (from
+    /// [`GpuEngine::weighted_module`], possibly altered: the tests break a weight on purpose
+    /// and check that the verdict catches it).
+    pub fn weighted_with(
+        &mut self,
+        job: &Job,
+        effects: &Effects,
+        composed: &Composed,
+        seed: u64,
+        first: u64,
+        samples: u64,
     ) -> Result<WeightedRun, GpuError> {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
@@ -118,8 +139,7 @@ impl GpuEngine {
                 self.gpu.limits.max_storage_buffer_binding_size
             )));
         }
-        let composed = self.weighted_module(job, effects, how);
-        let pipeline = self.weighted_pipeline(job, &composed)?;
+        let pipeline = self.weighted_pipeline(job, composed)?;
 
         let per_group = (WG_SIZE * SAMPLES_PER_THREAD) as u64;
         let dim = self.gpu.limits.max_compute_workgroups_per_dimension as u64;

@@ -113,9 +113,11 @@ impl Effects {
     /// The weak white furnace test (Heitz 2014, "Understanding the masking-shadowing function"): with F = 1 the integral of
     /// f |cos θr| over the whole sphere is 1 for G = G1(ωi), and 1 / G1(ωi) = 1 + Λ(ωi) for
     /// G = 1 (the projected area of the visible microfacets over that of the surface). `None`
-    /// for the other effects, which have no closed form.
+    /// for the other effects, which have no closed form, and for bounded VNDF sampling, whose
+    /// shrunk cap never draws some of the normals that reflect below the horizon (its sphere
+    /// total falls short of the furnace by design; its hemisphere albedo does not).
     pub fn furnace(&self, l: &Lobe, wi: DVec3) -> Option<f64> {
-        if self.fresnel != Fresnel::None || l.kind == LobeKind::Ward {
+        if self.fresnel != Fresnel::None || l.kind == LobeKind::Ward || l.method == Method::Bounded {
             return None;
         }
         let lambda = || match l.kind {

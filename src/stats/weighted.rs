@@ -137,7 +137,7 @@ mod tests {
 }
 
 /// The verdict on a weighted histogram.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Clone, Serialize)]
 pub struct AlbedoCheck {
     /// Σ w / N over the bins.
     pub albedo: f64,
@@ -168,11 +168,37 @@ pub struct AlbedoCheck {
     pub reference_bins: Vec<f64>,
 }
 
+impl std::fmt::Debug for AlbedoCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "albedo {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); sphere {:.6} ± {:.1e} vs furnace {:?} (p {:?}); weight error {:.1e}; overflow {}; {}",
+            self.albedo,
+            self.std_error,
+            self.reference,
+            self.relative_error,
+            self.p_value,
+            self.sphere_total,
+            self.sphere_std_error,
+            self.furnace,
+            self.furnace_p_value,
+            self.max_weight_error,
+            self.overflow,
+            if self.passed { "pass" } else { "FAIL" }
+        )
+    }
+}
+
 /// The largest per-bin weight difference accepted in f32 (issue 5: 1e-3).
 pub const WEIGHT_ERROR_LIMIT: f32 = 1e-3;
 
-/// Two-sided p-value of a standard normal z (1 where the error is exactly zero).
-fn two_sided(diff: f64, sigma: f64) -> (f64, f64) {
+/// The relative accuracy of an f32 weight summed in fixed point: the z-tests add it to the
+/// statistical error, so that a constant weight (zero variance) is not failed for rounding.
+pub const F32_FLOOR: f64 = 1e-6;
+
+/// z = diff / σ and its two-sided p-value, with σ² = std_error² + (F32_FLOOR · value)².
+fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
+    let sigma = std_error.hypot(F32_FLOOR * value.abs());
     if diff == 0.0 {
         return (0.0, 1.0);
     }
@@ -199,11 +225,11 @@ pub fn albedo_check(
     let reference: f64 = reference_bins.iter().sum();
     let albedo = sums.albedo(n);
     let std_error = sums.std_error(n, true);
-    let (z, p_value) = two_sided(albedo - reference, std_error);
+    let (z, p_value) = two_sided(albedo - reference, std_error, reference);
     let sphere_total = sums.sphere_total(n);
     let sphere_std_error = sums.std_error(n, false);
     let furnace = effects.furnace(lobe, wi);
-    let furnace_p_value = furnace.map(|f| two_sided(sphere_total - f, sphere_std_error).1);
+    let furnace_p_value = furnace.map(|f| two_sided(sphere_total - f, sphere_std_error, f).1);
     let max_weight_error = sums.max_weight_error();
     let passed = p_value >= significance
         && furnace_p_value.is_none_or(|p| p >= significance)

@@ -1,0 +1,59 @@
+//! `lobes shader SCENE [--case NAME]`: the composed WGSL that `lobes run` compiles for each
+//! case, once per distinct module, with the override constants its pipelines are made with.
+
+use super::{emit, usage};
+use crate::gpu::GpuEngine;
+use crate::gpu::effects::{self, Composed};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, Args)]
+pub struct ShaderArgs {
+    /// Scene file (TOML); without it, the embedded scenes/all-lobes.toml.
+    pub scene: Option<PathBuf>,
+    /// Print only this case's module.
+    #[arg(long)]
+    pub case: Option<String>,
+}
+
+pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
+    let scene = super::run::load_scene(args.scene.as_ref())?;
+    let cases: Vec<_> = match &args.case {
+        None => scene.cases.iter().collect(),
+        Some(name) => {
+            let found: Vec<_> = scene.cases.iter().filter(|c| &c.name == name).collect();
+            if found.is_empty() {
+                let names: Vec<&str> = scene.cases.iter().map(|c| c.name.as_str()).collect();
+                return Err(usage(format!("--case {name}: no such case in {}; its cases are: {}", scene.file, names.join(", "))));
+            }
+            found
+        }
+    };
+    // The module depends on the adapter's limits (workgroup storage, storage binding size):
+    // use the adapter `lobes run` would use, or wgpu's default limits without one.
+    let engine = GpuEngine::open().map_err(|e| eprintln!("note: {e}\nnote: composing for wgpu's default limits")).ok();
+    let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
+    for case in cases {
+        let (words, tile) = match &engine {
+            Some(e) => (e.gpu.limits.max_compute_workgroup_storage_size / 4, e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins)),
+            None => (wgpu::Limits::default().max_compute_workgroup_storage_size / 4, case.job.bins() as u64),
+        };
+        let m = effects::case_module(&case.job, case.effects.as_ref(), words, tile as u32);
+        match modules.iter_mut().find(|(k, _)| *k == m) {
+            Some((_, names)) => names.push(&case.name),
+            None => modules.push((m, vec![&case.name])),
+        }
+    }
+    let mut text = String::new();
+    for (m, names) in &modules {
+        let constants: Vec<String> = m.constants.iter().map(|(k, v)| format!("{k} = {v}")).collect();
+        text += &format!(
+            "// ==== lobes module for case(s) {}; pipeline constants: {}\n",
+            names.join(", "),
+            if constants.is_empty() { "none".to_string() } else { constants.join(", ") }
+        );
+        text += &m.source;
+        text += "\n";
+    }
+    emit(&text)
+}
