@@ -28,6 +28,11 @@ pub struct BenchArgs {
     /// Skip the CPU reference backend.
     #[arg(long)]
     pub gpu_only: bool,
+    /// Instead of the lobe table: what generality costs. For each weighted case of this scene
+    /// (e.g. scenes/effects.toml), the weighted pass with the case's specialised module against
+    /// the uber-kernel with every lobe and effect switched at run time, alternating in one run.
+    #[arg(long, value_name = "SCENE")]
+    pub effects: Option<std::path::PathBuf>,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -79,7 +84,71 @@ fn result(job: &Job, backend: &str, samples: u64, seconds: f64, timing: &str, al
     }
 }
 
+/// The specialised module against the uber-kernel on one case.
+#[derive(Debug, Clone, Serialize)]
+pub struct EffectsResult {
+    pub case: String,
+    pub samples: u64,
+    pub specialised_seconds: f64,
+    pub uber_seconds: f64,
+    /// uber / specialised: how many times longer generality takes.
+    pub ratio: f64,
+}
+
+fn run_effects(args: &BenchArgs, scene: &std::path::PathBuf) -> anyhow::Result<()> {
+    use crate::gpu::effects::Specialisation::{Specialised, Uber};
+    let scene = super::run::load_scene(Some(scene))?;
+    let runs = args.runs.max(1);
+    let mut engine = GpuEngine::open()?;
+    let adapter = engine.gpu.adapter_name();
+    let mut results = Vec::new();
+    for case in scene.cases.iter().filter(|c| c.effects.is_some()) {
+        let effects = case.effects.as_ref().expect("filtered");
+        let mut time = |how, seed: u64, n: u64| -> anyhow::Result<f64> {
+            let r = engine.weighted(&case.job, effects, seed, 0, n, how)?;
+            Ok(r.gpu_seconds.unwrap_or(r.wall_seconds))
+        };
+        time(Specialised, 0, 1 << 16)?; // compile and warm up both
+        time(Uber, 0, 1 << 16)?;
+        let (mut spec, mut uber) = (Vec::new(), Vec::new());
+        for r in 0..runs as u64 {
+            spec.push(time(Specialised, r, args.samples)?);
+            uber.push(time(Uber, r, args.samples)?);
+        }
+        let ratios: Vec<f64> = uber.iter().zip(&spec).map(|(u, s)| u / s).collect();
+        results.push(EffectsResult {
+            case: case.name.clone(),
+            samples: args.samples,
+            specialised_seconds: median(spec),
+            uber_seconds: median(uber),
+            ratio: median(ratios),
+        });
+    }
+    anyhow::ensure!(!results.is_empty(), "{}: the scene has no weighted cases (set weighted = true, fresnel or masking)", scene.file);
+    if args.output.json {
+        return emit_json(&serde_json::json!({"adapter": adapter, "runs": runs, "effects": results}));
+    }
+    let mut text = format!("adapter: {adapter}
+weighted pass, median of {runs} runs; ratio = uber-kernel time / specialised time (median of per-run ratios)
+
+");
+    text += &format!("{:<28} {:>10} {:>14} {:>14} {:>7}
+", "case", "samples", "specialised s", "uber s", "ratio");
+    for r in &results {
+        text += &format!("{:<28} {:>10} {:>14.4} {:>14.4} {:>7.2}
+", r.case, r.samples, r.specialised_seconds, r.uber_seconds, r.ratio);
+    }
+    let geo = (results.iter().map(|r| r.ratio.ln()).sum::<f64>() / results.len() as f64).exp();
+    text += &format!("
+geometric mean of the ratios: {geo:.2}
+");
+    emit(&text)
+}
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    if let Some(scene) = &args.effects {
+        return run_effects(args, scene);
+    }
     let runs = args.runs.max(1);
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();
