@@ -14,6 +14,11 @@
 //! alpha = 0.2           # or alpha_x and alpha_y
 //! incident_theta = 45.0 # degrees from the normal, [0, 90)
 //! incident_phi = 0.0    # degrees
+//! # effects (any of them makes the case weighted: Σ f cos θ / pdf per bin)
+//! fresnel = "schlick"   # none | schlick (f0) | conductor (eta, k) | dielectric (eta)
+//! f0 = 0.04
+//! masking = "g1"        # none | g1 | separable | height-correlated (not for ward)
+//! # weighted = true     # a weighted histogram without Fresnel or masking
 //! ```
 //!
 //! Every value is read as a TOML value first and checked here, so a wrong type, a value out
