@@ -9,7 +9,7 @@
 
 use crate::gpu::GpuEngine;
 use crate::job::Job;
-use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
+use crate::reference::{Invalid, Lobe, reflect, rng};
 use crate::stats::compare::angle_between;
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
@@ -66,15 +66,7 @@ impl StressRow {
     }
 }
 
-/// Every sampler: each lobe with each method it supports.
-pub const SAMPLERS: [(LobeKind, Method); 6] = [
-    (LobeKind::Ward, Method::Ndf),
-    (LobeKind::Beckmann, Method::Ndf),
-    (LobeKind::Beckmann, Method::Vndf),
-    (LobeKind::Ggx, Method::Ndf),
-    (LobeKind::Ggx, Method::Vndf),
-    (LobeKind::Ggx, Method::Bounded),
-];
+pub use crate::reference::SAMPLERS;
 
 /// The hard cases: each sampler at each hard roughness and incidence.
 pub fn cases() -> Vec<StressCase> {

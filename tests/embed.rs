@@ -15,7 +15,7 @@ use lobes::embed::{self, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, 
 use lobes::gpu::{Gpu, GpuEngine};
 use lobes::job::{DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
-use lobes::reference::{Lobe, LobeKind, Method, reflect, rng};
+use lobes::reference::{Lobe, reflect, rng};
 use wgpu::util::DeviceExt;
 
 fn gpu() -> Gpu {
@@ -132,14 +132,7 @@ fn embedded_samplers_densities_and_brdfs_match_the_f64_reference() {
     let gpu = gpu();
     let source = embed::wgsl(&[Module::Rng, Module::Ward, Module::Beckmann, Module::Ggx]) + SAMPLERS;
     let n: u32 = 4096;
-    let kernels = [
-        (LobeKind::Ward, Method::Ndf),
-        (LobeKind::Beckmann, Method::Ndf),
-        (LobeKind::Beckmann, Method::Vndf),
-        (LobeKind::Ggx, Method::Ndf),
-        (LobeKind::Ggx, Method::Vndf),
-        (LobeKind::Ggx, Method::Bounded),
-    ];
+    let kernels = lobes::reference::SAMPLERS;
     let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: None,
         entries: &[uniform_entry(0), storage_entry(1, false)],

@@ -100,14 +100,7 @@ fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64) -> Lobe {
 /// anisotropic (0.15, 0.4) at θi = 30°, φi = 40°.
 const CONFIGS: [(f64, f64, f64, f64); 2] = [(0.3, 0.3, 60.0, 0.0), (0.15, 0.4, 30.0, 40.0)];
 
-const SAMPLERS: [(LobeKind, Method); 6] = [
-    (LobeKind::Ward, Method::Ndf),
-    (LobeKind::Beckmann, Method::Ndf),
-    (LobeKind::Beckmann, Method::Vndf),
-    (LobeKind::Ggx, Method::Ndf),
-    (LobeKind::Ggx, Method::Vndf),
-    (LobeKind::Ggx, Method::Bounded),
-];
+const SAMPLERS: [(LobeKind, Method); 6] = lobes::reference::SAMPLERS;
 
 const H_THETA: usize = 20;
 const H_PHI: usize = 8;

@@ -11,14 +11,7 @@ use proptest::prelude::*;
 use statrs::function::erf::erf;
 use std::f64::consts::PI;
 
-const KINDS: [(LobeKind, Method); 6] = [
-    (LobeKind::Ward, Method::Ndf),
-    (LobeKind::Beckmann, Method::Ndf),
-    (LobeKind::Beckmann, Method::Vndf),
-    (LobeKind::Ggx, Method::Ndf),
-    (LobeKind::Ggx, Method::Vndf),
-    (LobeKind::Ggx, Method::Bounded),
-];
+const KINDS: [(LobeKind, Method); 6] = lobes::reference::SAMPLERS;
 
 /// A uniform in [0, 1], exactly 0 or exactly 1 one time in five.
 fn unit() -> impl Strategy<Value = f64> {

@@ -615,6 +615,7 @@ mod tests {
             wall_seconds: 0.0,
             workgroup_counting: None,
             angle: None,
+            weighted: None,
             scene_name: "s".into(),
             scene: "".into(),
         }

@@ -42,15 +42,7 @@ impl Composed {
     }
 }
 
-/// Every sampler, in the order of the uber-kernel's sampler ids.
-pub const SAMPLERS: [(LobeKind, Method); 6] = [
-    (LobeKind::Ward, Method::Ndf),
-    (LobeKind::Beckmann, Method::Ndf),
-    (LobeKind::Beckmann, Method::Vndf),
-    (LobeKind::Ggx, Method::Ndf),
-    (LobeKind::Ggx, Method::Vndf),
-    (LobeKind::Ggx, Method::Bounded),
-];
+pub use crate::reference::SAMPLERS;
 
 /// The uber-kernel's id of a sampler.
 pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {

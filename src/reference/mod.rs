@@ -70,6 +70,17 @@ impl Method {
     }
 }
 
+/// Every sampler: each lobe with each method it supports (the uber-kernel's sampler ids are
+/// indices into this list).
+pub const SAMPLERS: [(LobeKind, Method); 6] = [
+    (LobeKind::Ward, Method::Ndf),
+    (LobeKind::Beckmann, Method::Ndf),
+    (LobeKind::Beckmann, Method::Vndf),
+    (LobeKind::Ggx, Method::Ndf),
+    (LobeKind::Ggx, Method::Vndf),
+    (LobeKind::Ggx, Method::Bounded),
+];
+
 /// Why a sample is not a usable reflected direction. Every invalid sample is counted under
 /// exactly one reason, checked in this order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
