@@ -56,6 +56,9 @@ lobe = "beckmann"
 alpha = 0.5
 incident_theta = 70.0
 samples = 999_999
+fresnel = "dielectric"
+eta = 1.5
+masking = "height-correlated"
 
 [[case]]
 name = "alias"
@@ -102,7 +105,13 @@ fn three_shards_merge_to_exactly_the_unsharded_run() {
         for png in ["measured.png", "expected.png", "residual.png"] {
             assert!(dir.join("merged").join(case).join(png).is_file(), "{case}/{png}");
         }
+        // the weighted case's fixed-point sums add up exactly too
+        assert_eq!(a["weighted"].is_null(), case != "beckmann-ndf", "{case}");
+        for key in ["sums", "check", "bin_albedo", "bin_max_weight_error", "effects"] {
+            assert_eq!(a["weighted"][key], b["weighted"][key], "{case}: weighted '{key}' differs");
+        }
     }
+    assert!(dir.join("merged/beckmann-ndf/albedo.png").is_file());
     // the same table as `lobes run`
     let text = lobes(&dir, &["merge", "part0", "part1", "part2", "--out", "merged-again"]);
     let table = String::from_utf8_lossy(&text.stdout);
