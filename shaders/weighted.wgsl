@@ -34,28 +34,26 @@ const SQUARES_BINS: u32 = CELLS;
 const SQUARES_ALL: u32 = CELLS + 1u;
 const WEIGHT_OVERFLOW: u32 = CELLS + 2u;
 
-// Adds round(v * scale) (below 2^64) into the 64-bit fixed-point cell at words 2 cell, 2 cell + 1.
-fn add_fixed(cell: u32, v: f32, scale: f32) {
+// round(v * scale) as a 64-bit integer (lo, hi), for v * scale below 2^64: the rounded value has
+// 24 significant bits, so hi and lo split it exactly.
+fn fixed_parts(v: f32, scale: f32) -> vec2<u32> {
     let x = round(v * scale);
-    // x has 24 significant bits: hi and lo split it exactly.
     let hi = floor(x * (1.0 / 4294967296.0));
-    let lo = u32(x - hi * 4294967296.0);
-    let old = atomicAdd(&weight_sums[2u * cell], lo);
-    let up = u32(hi) + select(0u, 1u, old + lo < old);
-    if (up != 0u) {
-        atomicAdd(&weight_sums[2u * cell + 1u], up);
-    }
+    return vec2<u32>(u32(x - hi * 4294967296.0), u32(hi));
 }
 
-fn record_weight(cell: u32, w: f32) {
-    if (w >= 0.0 && w < WEIGHT_LIMIT) {
-        add_fixed(cell, w, WEIGHT_SCALE);
-        add_fixed(SQUARES_ALL, w * w, SQUARE_SCALE);
-        if (cell < BINS) {
-            add_fixed(SQUARES_BINS, w * w, SQUARE_SCALE);
-        }
-    } else {
-        add_fixed(WEIGHT_OVERFLOW, 1.0, 1.0);
+// a + b in 64 bits (private accumulators).
+fn add_parts(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.x + b.x;
+    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
+}
+
+// Adds the 64-bit p into cell `cell` (words 2 cell, 2 cell + 1), the carry from atomicAdd's old value.
+fn add_fixed(cell: u32, p: vec2<u32>) {
+    let old = atomicAdd(&weight_sums[2u * cell], p.x);
+    let up = p.y + select(0u, 1u, old + p.x < old);
+    if (up != 0u) {
+        atomicAdd(&weight_sums[2u * cell + 1u], up);
     }
 }
 
@@ -78,6 +76,11 @@ fn weighted_histogram(
     @builtin(num_workgroups) nwg: vec3<u32>,
 ) {
     let first = flat_group(wg, nwg) * (WG_SIZE * SAMPLES_PER_THREAD);
+    // The sums of squares and the overflow count stay in registers until the end: one atomic
+    // per invocation instead of one per sample.
+    var squares_bins = vec2<u32>(0u);
+    var squares_all = vec2<u32>(0u);
+    var overflow = 0u;
     for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
         let local = first + k * WG_SIZE + lid;
         if (local >= params.count) {
@@ -87,12 +90,22 @@ fn weighted_histogram(
         let s = effect_sample(u.xy);
         let reason = classify(s.wr, s.pdf_r);
         let w = effect_weight(s);
+        if (!(w >= 0.0 && w < WEIGHT_LIMIT)) {
+            overflow += 1u;
+            continue;
+        }
+        let sq = fixed_parts(w * w, SQUARE_SCALE);
+        squares_all = add_parts(squares_all, sq);
         if (reason == 0u) {
             let bin = bin_of(s.wr);
-            record_weight(bin, w);
+            add_fixed(bin, fixed_parts(w, WEIGHT_SCALE));
+            squares_bins = add_parts(squares_bins, sq);
             atomicMax(&weight_error[bin], relative_error_bits(w, effect_check(s.wr)));
         } else {
-            record_weight(BINS + reason - 1u, w);
+            add_fixed(BINS + reason - 1u, fixed_parts(w, WEIGHT_SCALE));
         }
     }
+    add_fixed(SQUARES_BINS, squares_bins);
+    add_fixed(SQUARES_ALL, squares_all);
+    add_fixed(WEIGHT_OVERFLOW, vec2<u32>(overflow, 0u));
 }
