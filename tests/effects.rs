@@ -184,3 +184,23 @@ fn gpu_and_cpu_weighted_sums_agree() {
     let uber = e.weighted(&j, &effects, 3, 0, n, Specialisation::Uber).unwrap().sums;
     assert!((uber.albedo(n) - a).abs() < 1e-6 * a, "uber {} vs specialised {a}", uber.albedo(n));
 }
+
+/// `lobes shader` through the binary: the module of one case, with its pipeline constants; an
+/// unknown case is bad input (exit 2) naming the cases there are.
+#[test]
+fn shader_command_prints_the_composed_module() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/effects.toml");
+    let run = |args: &[&str]| std::process::Command::new(env!("CARGO_BIN_EXE_lobes")).args(args).output().expect("run lobes");
+    let out = run(&["shader", scene, "--case", "ward-schlick"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("// ==== lobes module for case(s) ward-schlick; pipeline constants: ANISOTROPIC = 1, FRESNEL = 1"), "{}", &text[..200.min(text.len())]);
+    let source = text.split_once('\n').unwrap().1;
+    let names = functions(source);
+    assert!(names.iter().any(|n| n == "effect_weight") && !names.iter().any(|n| n.starts_with("ggx_")));
+    let all = run(&["shader", scene]);
+    assert_eq!(String::from_utf8_lossy(&all.stdout).matches("// ==== lobes module").count(), 6, "six cases, six effect sets");
+    let bad = run(&["shader", scene, "--case", "nope"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("its cases are: ggx-vndf-furnace"));
+}
