@@ -89,7 +89,7 @@ impl WeightedSums {
         self.albedo(n) + below as f64 / WEIGHT_SCALE / n as f64
     }
 
-    /// The standard error √((E[w²] − E[w]²) / N) of the albedo (`hemisphere`: samples below
+    /// The standard error √((E(w²) − E(w)²) / N) of the albedo (`hemisphere`: samples below
     /// the horizon weigh 0) or of the sphere total.
     pub fn std_error(&self, n: u64, hemisphere: bool) -> f64 {
         let (mean, squares) = if hemisphere { (self.albedo(n), self.squares_bins) } else { (self.sphere_total(n), self.squares_all) };
