@@ -22,6 +22,18 @@ use glam::DVec3;
 use serde::Serialize;
 
 /// The effects of a case: its Fresnel term and its masking-shadowing term.
+///
+/// ```
+/// use lobes::reference::effects::Effects;
+/// use lobes::reference::{Lobe, LobeKind, Method, fresnel::Fresnel, masking::Masking, reflect::spherical};
+/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3 };
+/// let wi = spherical(0.6, 0.0);
+/// let e = Effects { fresnel: Fresnel::Schlick { f0: 0.04 }, masking: Masking::HeightCorrelated };
+/// let s = lobe.sample(wi, [0.3, 0.7]);
+/// // the sampler's closed-form weight is f cos θr / p(ωr)
+/// let direct = e.eval(&lobe, wi, s.omega_r) * s.omega_r.z / lobe.pdf_r(wi, s.omega_r);
+/// assert!((e.weight(&lobe, wi, &s) - direct).abs() < 1e-12);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Effects {
     pub fresnel: Fresnel,
