@@ -24,3 +24,4 @@ pub mod run;
 pub mod scene;
 pub mod stats;
 pub mod stress;
+pub mod tradeoff;

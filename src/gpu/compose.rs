@@ -129,7 +129,9 @@ pub fn describe(job: &Job) -> String {
 pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+    // FLOAT64 for lobes::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.
+    let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
         .validate(&module)
         .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
     Ok(module)

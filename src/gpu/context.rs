@@ -54,7 +54,8 @@ impl Gpu {
         let adapter = pollster::block_on(instance.request_adapter(&options))
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
-        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
+        let features = adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::SHADER_F64);
         let limits = shrink(adapter.limits());
         let desc = wgpu::DeviceDescriptor {
             label: Some("lobes"),
@@ -76,5 +77,10 @@ impl Gpu {
 
     pub fn has_timestamps(&self) -> bool {
         self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Whether the device runs WGSL `f64` (the adapter has SHADER_F64).
+    pub fn has_f64(&self) -> bool {
+        self.features.contains(wgpu::Features::SHADER_F64)
     }
 }

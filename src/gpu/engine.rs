@@ -89,7 +89,13 @@ pub struct GpuEngine {
     pub compiled: usize,
     /// Pipelines of weighted histograms (`src/gpu/weighted.rs`).
     pub(super) weighted: super::weighted::WeightedPipelines,
+    /// Rewrites each composed module before it is compiled (`None`: as composed); pipelines
+    /// are cached by the rewritten text. `lobes::tradeoff` sets it for its precision variants.
+    pub rewrite: Option<Rewrite>,
 }
+
+/// A rewrite of a job's composed WGSL (see [`GpuEngine::rewrite`]).
+pub type Rewrite = Arc<dyn Fn(&Job, String) -> String + Send + Sync>;
 
 pub(super) fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -131,7 +137,7 @@ impl GpuEngine {
             immediate_size: 0,
         });
         let weighted = super::weighted::WeightedPipelines::new(&gpu);
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), errors, chunking: Chunking::default(), compiled: 0, weighted }
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), errors, chunking: Chunking::default(), compiled: 0, weighted, rewrite: None }
     }
 
     /// Opens the default adapter.
@@ -203,6 +209,10 @@ impl GpuEngine {
         let (source, in_workgroup) = match tile {
             None => (self.source(job), job.bins().div_ceil(2) as u32 <= self.workgroup_words()),
             Some(t) => (compose::compose_tile(job, self.workgroup_words(), t), t.div_ceil(2) <= self.workgroup_words()),
+        };
+        let source = match &self.rewrite {
+            Some(rewrite) => rewrite(job, source),
+            None => source,
         };
         if let Some(k) = self.cache.get(&source) {
             return Ok(k.clone());

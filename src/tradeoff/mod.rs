@@ -1,0 +1,518 @@
+//! `lobes tradeoff`: accuracy against cost. For each lobe it sweeps the sample count and the
+//! kernel's precision ([`Precision`]: f32 with fast approximations, f32 with the builtin
+//! functions, f64) and reports per point the time, the χ² test, the L1 distance of the
+//! normalised histogram from the expected one and the largest per-sample angle against the f64
+//! reference; it compares GGX's two visible-normal samplers (spherical caps and bounded VNDF) by
+//! time per sample and by the variance of the albedo estimator; and it measures the expected
+//! histogram's quadrature at fixed resolutions on the CPU (f64) and the GPU (f32) against the
+//! adaptive f64 quadrature that `lobes run` uses.
+
+pub mod quadrature;
+pub mod variants;
+
+pub use variants::Precision;
+
+use crate::gpu::GpuEngine;
+use crate::job::{Counts, Job};
+use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
+use crate::stats::chi2;
+use crate::stats::compare::{self, ExpectedCounts, angle_between};
+use crate::stats::expected::{self, Quadrature, REFERENCE_SAMPLES};
+use crate::stats::histogram::SphereGrid;
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::Serialize;
+use statrs::function::gamma::ln_gamma;
+use std::time::Instant;
+
+/// The histogram grid of every sweep: 64 rows over cos θ × 128 columns over φ (as `lobes bench`).
+pub const GRID: SphereGrid = SphereGrid { rows: 64, cols: 128 };
+
+/// A sampler: lobe and method, named `ggx-vndf`, `ward-ndf`, ….
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sampler {
+    pub kind: LobeKind,
+    pub method: Method,
+}
+
+impl Sampler {
+    pub const ALL: [Sampler; 6] = [
+        Sampler { kind: LobeKind::Ward, method: Method::Ndf },
+        Sampler { kind: LobeKind::Beckmann, method: Method::Ndf },
+        Sampler { kind: LobeKind::Beckmann, method: Method::Vndf },
+        Sampler { kind: LobeKind::Ggx, method: Method::Ndf },
+        Sampler { kind: LobeKind::Ggx, method: Method::Vndf },
+        Sampler { kind: LobeKind::Ggx, method: Method::Bounded },
+    ];
+
+    pub fn name(&self) -> String {
+        format!("{}-{}", self.kind.name(), self.method.name())
+    }
+
+    pub fn parse(s: &str) -> Option<Sampler> {
+        Sampler::ALL.into_iter().find(|x| x.name() == s.trim())
+    }
+
+    pub fn lobe(&self, alpha: f64) -> Lobe {
+        Lobe { kind: self.kind, method: self.method, alpha_x: alpha, alpha_y: alpha }
+    }
+}
+
+/// What the sample-count × precision sweep runs.
+#[derive(Debug, Clone)]
+pub struct SweepSettings {
+    pub samplers: Vec<Sampler>,
+    pub precisions: Vec<Precision>,
+    pub alpha: f64,
+    pub incident_theta_deg: f64,
+    /// Sample counts 2^k for k = min, min + step, … ≤ max.
+    pub log2_min: u32,
+    pub log2_max: u32,
+    pub log2_step: u32,
+    /// One sampler swept further, to 2^`long_log2_max`.
+    pub long: Option<Sampler>,
+    pub long_log2_max: u32,
+    pub seed: u64,
+    /// Samples regenerated on the CPU in f64 for the per-sample angle (the first ones of the run).
+    pub angle_samples: u32,
+}
+
+impl Default for SweepSettings {
+    fn default() -> Self {
+        Self {
+            samplers: vec![
+                Sampler { kind: LobeKind::Ward, method: Method::Ndf },
+                Sampler { kind: LobeKind::Beckmann, method: Method::Ndf },
+                Sampler { kind: LobeKind::Ggx, method: Method::Ndf },
+                Sampler { kind: LobeKind::Ggx, method: Method::Vndf },
+                Sampler { kind: LobeKind::Ggx, method: Method::Bounded },
+            ],
+            precisions: Precision::ALL.to_vec(),
+            alpha: 0.3,
+            incident_theta_deg: 45.0,
+            log2_min: 16,
+            log2_max: 24,
+            log2_step: 2,
+            long: Some(Sampler { kind: LobeKind::Ggx, method: Method::Vndf }),
+            long_log2_max: 28,
+            seed: 1,
+            angle_samples: 1 << 18,
+        }
+    }
+}
+
+impl SweepSettings {
+    /// The sample counts of a sampler.
+    pub fn counts(&self, s: Sampler) -> Vec<u64> {
+        let max = if self.long == Some(s) { self.long_log2_max.max(self.log2_max) } else { self.log2_max };
+        (self.log2_min..=max).step_by(self.log2_step.max(1) as usize).map(|k| 1u64 << k).collect()
+    }
+}
+
+/// The per-sample angle of a precision's kernel against the f64 reference.
+#[derive(Debug, Clone, Serialize)]
+pub struct AngleError {
+    pub compared: u64,
+    pub validity_mismatches: u64,
+    pub max_angle_rad: f64,
+    pub mean_angle_rad: f64,
+}
+
+/// One point of the sweep.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepPoint {
+    pub sampler: String,
+    pub precision: Precision,
+    pub samples: u64,
+    pub wall_seconds: f64,
+    /// From timestamp queries, where the adapter has them.
+    pub gpu_seconds: Option<f64>,
+    pub chi2: f64,
+    pub dof: u64,
+    pub p_value: f64,
+    /// Σ over cells (bins and invalid reasons) of |count/N − expected/N|.
+    pub l1: f64,
+    /// What L1 would be on average for an exact sampler at this N: Σ E|X − λ|/N with
+    /// X ~ Poisson(λ = N p) per cell.
+    pub l1_noise: f64,
+    /// The per-sample check (the same for every N of a sampler and precision).
+    pub angle: AngleError,
+}
+
+impl SweepPoint {
+    /// The time used for plots and per-sample costs: GPU time where measured, else wall time.
+    pub fn seconds(&self) -> f64 {
+        self.gpu_seconds.unwrap_or(self.wall_seconds)
+    }
+}
+
+/// A precision that could not run for a sampler, and why.
+#[derive(Debug, Clone, Serialize)]
+pub struct Unavailable {
+    pub sampler: String,
+    pub precision: Precision,
+    pub reason: String,
+}
+
+/// The expected-count facts of one sampler, shared by its points.
+#[derive(Debug, Clone, Serialize)]
+pub struct SweepLobe {
+    pub sampler: String,
+    pub alpha: f64,
+    pub incident_theta_deg: f64,
+    /// Σ sqrt(2 p / π) over cells: L1 ≈ this / √N for an exact sampler once counts are large.
+    pub l1_noise_coefficient: f64,
+    pub quadrature_max_error_sigma_at_1e8: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct Sweep {
+    pub lobes: Vec<SweepLobe>,
+    pub points: Vec<SweepPoint>,
+    pub unavailable: Vec<Unavailable>,
+}
+
+/// Cell probabilities (bins, then the invalid reasons) of a lobe job.
+fn cell_probabilities(e: &ExpectedCounts) -> Vec<f64> {
+    e.bins.iter().chain(&e.invalid).copied().collect()
+}
+
+/// E|X − λ| for X ~ Poisson(λ): 2 e^{−λ} λ^{⌊λ⌋+1} / ⌊λ⌋! (the mean absolute deviation of the
+/// Poisson distribution; Johnson, Kemp & Kotz, "Univariate Discrete Distributions", 3rd ed., §4.3).
+pub fn poisson_mean_abs_dev(lambda: f64) -> f64 {
+    if lambda <= 0.0 {
+        return 0.0;
+    }
+    let k = lambda.floor();
+    (2f64.ln() - lambda + (k + 1.0) * lambda.ln() - ln_gamma(k + 1.0)).exp()
+}
+
+/// The L1 distance Σ |c/N − p| of counts from cell probabilities.
+pub fn l1_distance(counts: &Counts, p: &[f64]) -> f64 {
+    let n = counts.total() as f64;
+    counts.bins.iter().chain(&counts.invalid).zip(p).map(|(&c, &q)| (c as f64 / n - q).abs()).sum()
+}
+
+/// Why `precision` cannot run `sampler` on this engine, if it cannot.
+pub fn unavailable(engine: &GpuEngine, sampler: Sampler, precision: Precision) -> Option<String> {
+    if precision != Precision::F64 {
+        return None;
+    }
+    if !engine.gpu.has_f64() {
+        return Some(format!("the adapter '{}' has no SHADER_F64", engine.gpu.info.name));
+    }
+    if variants::sampler64(&sampler.lobe(1.0)).is_none() {
+        return Some(format!("no f64 kernel for {} (it would need f64 erfc and erfinv)", sampler.name()));
+    }
+    None
+}
+
+/// The GPU directions of samples 0 .. n of `job` under the engine's current precision against
+/// the f64 reference. For the f64 kernel the directions come back as f32 hi + lo pairs.
+pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precision: Precision) -> anyhow::Result<AngleError> {
+    let Job::Lobe { lobe, incident, .. } = job else { anyhow::bail!("angle_error: a lobe job") };
+    let u: Vec<[f32; 2]> = (0..n as u64)
+        .map(|i| {
+            let r = rng::uniforms(seed, i);
+            [r[0] as f32, r[1] as f32]
+        })
+        .collect();
+    let gpu = engine.explicit(job, &u)?;
+    let per: Vec<(bool, f64)> = gpu
+        .par_iter()
+        .zip(u.par_iter())
+        .map(|(g, u)| {
+            let s = lobe.sample(*incident, [u[0] as f64, u[1] as f64]);
+            let gpu_valid = g[0][3] == 0.0;
+            if gpu_valid != s.invalid.is_none() {
+                return (false, f64::NAN);
+            }
+            if !gpu_valid {
+                return (true, f64::NAN);
+            }
+            let hi = DVec3::new(g[0][0] as f64, g[0][1] as f64, g[0][2] as f64);
+            let w = if precision == Precision::F64 { hi + DVec3::new(g[1][0] as f64, g[1][1] as f64, g[1][2] as f64) } else { hi };
+            (true, angle_between(w.normalize(), s.omega_r))
+        })
+        .collect();
+    let mismatches = per.iter().filter(|p| !p.0).count() as u64;
+    let angles: Vec<f64> = per.iter().filter(|p| p.0 && !p.1.is_nan()).map(|p| p.1).collect();
+    let compared = angles.len() as u64;
+    Ok(AngleError {
+        compared,
+        validity_mismatches: mismatches,
+        max_angle_rad: angles.iter().copied().fold(0.0, f64::max),
+        mean_angle_rad: if compared > 0 { angles.iter().sum::<f64>() / compared as f64 } else { 0.0 },
+    })
+}
+
+/// The job of a sampler at the sweep's α and θi.
+pub fn sweep_job(s: Sampler, alpha: f64, theta_deg: f64) -> Job {
+    Job::Lobe { lobe: s.lobe(alpha), incident: reflect::spherical(theta_deg.to_radians(), 0.0), grid: GRID }
+}
+
+/// Runs the sample-count × precision sweep; `log` receives progress lines.
+pub fn sweep(engine: &mut GpuEngine, set: &SweepSettings, log: &mut dyn FnMut(&str)) -> anyhow::Result<Sweep> {
+    let mut out = Sweep::default();
+    for &s in &set.samplers {
+        let job = sweep_job(s, set.alpha, set.incident_theta_deg);
+        let unit = compare::expected_counts(&job, 1, &Quadrature::default());
+        let p = cell_probabilities(&unit);
+        out.lobes.push(SweepLobe {
+            sampler: s.name(),
+            alpha: set.alpha,
+            incident_theta_deg: set.incident_theta_deg,
+            l1_noise_coefficient: p.iter().map(|&q| (2.0 * q / std::f64::consts::PI).sqrt()).sum(),
+            quadrature_max_error_sigma_at_1e8: unit.quadrature.as_ref().map_or(0.0, |q| q.max_error_sigma),
+        });
+        for &prec in &set.precisions {
+            if let Some(reason) = unavailable(engine, s, prec) {
+                log(&format!("{} {}: unavailable ({reason})", s.name(), prec.name()));
+                out.unavailable.push(Unavailable { sampler: s.name(), precision: prec, reason });
+                continue;
+            }
+            engine.rewrite = prec.rewrite();
+            let result = sweep_one(engine, set, s, &job, &p, prec, log);
+            engine.rewrite = None;
+            out.points.extend(result?);
+        }
+    }
+    Ok(out)
+}
+
+fn sweep_one(
+    engine: &mut GpuEngine,
+    set: &SweepSettings,
+    s: Sampler,
+    job: &Job,
+    p: &[f64],
+    prec: Precision,
+    log: &mut dyn FnMut(&str),
+) -> anyhow::Result<Vec<SweepPoint>> {
+    engine.histogram(job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?; // compile and warm up
+    let angle = angle_error(engine, job, set.seed, set.angle_samples, prec)?;
+    let mut points = Vec::new();
+    for n in set.counts(s) {
+        let r = engine.histogram(job, set.seed, 0, n, &mut |_| {})?;
+        anyhow::ensure!(r.counts.total() == n, "{} {}: {} samples counted for {n}", s.name(), prec.name(), r.counts.total());
+        let expected: Vec<f64> = p.iter().map(|q| q * n as f64).collect();
+        let observed: Vec<u64> = r.counts.bins.iter().chain(&r.counts.invalid).copied().collect();
+        let test = chi2::test(&observed, &expected, 0.01);
+        let point = SweepPoint {
+            sampler: s.name(),
+            precision: prec,
+            samples: n,
+            wall_seconds: r.wall_seconds,
+            gpu_seconds: r.gpu_seconds,
+            chi2: test.statistic,
+            dof: test.dof,
+            p_value: test.p_value,
+            l1: l1_distance(&r.counts, p),
+            l1_noise: p.iter().map(|&q| poisson_mean_abs_dev(q * n as f64)).sum::<f64>() / n as f64,
+            angle: angle.clone(),
+        };
+        log(&format!(
+            "{} {} 2^{}: {:.3} s, chi2/dof {:.3}, p {:.3}, L1 {:.2e} (noise {:.2e}), max angle {:.1e} rad",
+            s.name(),
+            prec.name(),
+            n.trailing_zeros(),
+            point.seconds(),
+            point.chi2 / point.dof.max(1) as f64,
+            point.p_value,
+            point.l1,
+            point.l1_noise,
+            angle.max_angle_rad
+        ));
+        points.push(point);
+    }
+    Ok(points)
+}
+
+/// Spherical caps against bounded VNDF at one roughness and incidence.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodPoint {
+    pub alpha: f64,
+    pub incident_theta_deg: f64,
+    pub method: String,
+    /// GPU histogram run (f32-accurate kernel) for the time per sample.
+    pub gpu_samples: u64,
+    pub seconds: f64,
+    pub timing: &'static str,
+    pub ns_per_sample: f64,
+    /// Samples of the albedo estimator (f64 reference samples of the same uniforms).
+    pub estimator_samples: u64,
+    /// Share of samples reflected below the horizon (weight 0).
+    pub below_horizon: f64,
+    /// Mean of w = f(ωi, ωr) cos θr / p(ωr) (0 for invalid samples): the albedo estimate.
+    pub mean: f64,
+    /// Per-sample variance of w.
+    pub variance: f64,
+    /// ∫ f cos θr dωr by adaptive f64 quadrature, for comparison with `mean`.
+    pub albedo_quadrature: f64,
+    /// 1 / (variance × seconds per sample): higher is better.
+    pub efficiency: f64,
+}
+
+/// Settings of the caps-vs-bounded comparison.
+#[derive(Debug, Clone)]
+pub struct MethodSettings {
+    pub alphas: Vec<f64>,
+    pub thetas_deg: Vec<f64>,
+    pub gpu_samples: u64,
+    pub estimator_samples: u64,
+    pub seed: u64,
+}
+
+impl Default for MethodSettings {
+    fn default() -> Self {
+        Self { alphas: vec![0.1, 0.5, 1.0], thetas_deg: vec![30.0, 60.0, 85.0], gpu_samples: 1 << 24, estimator_samples: 1 << 20, seed: 2 }
+    }
+}
+
+/// Mean and variance of the albedo estimator over samples 0 .. n (f64 reference), and the
+/// share below the horizon.
+pub fn albedo_estimator(lobe: &Lobe, wi: DVec3, seed: u64, n: u64) -> (f64, f64, f64) {
+    let (sum, sum2, below) = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let u = rng::uniforms(seed, i);
+            let s = lobe.sample(wi, [u[0], u[1]]);
+            match s.invalid {
+                None => {
+                    let w = lobe.eval(wi, s.omega_r) * s.omega_r.z / s.pdf_r;
+                    (w, w * w, 0u64)
+                }
+                Some(Invalid::BelowHorizon) => (0.0, 0.0, 1),
+                Some(_) => (0.0, 0.0, 0),
+            }
+        })
+        .reduce(|| (0.0, 0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1, a.2 + b.2));
+    let nf = n as f64;
+    let mean = sum / nf;
+    (mean, (sum2 / nf - mean * mean) * nf / (nf - 1.0), below as f64 / nf)
+}
+
+/// Time per sample and albedo-estimator variance of GGX spherical caps and bounded VNDF.
+pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<MethodPoint>> {
+    engine.rewrite = None;
+    let mut out = Vec::new();
+    for &alpha in &set.alphas {
+        for &theta in &set.thetas_deg {
+            let wi = reflect::spherical(theta.to_radians(), 0.0);
+            let lobe0 = Sampler { kind: LobeKind::Ggx, method: Method::Vndf }.lobe(alpha);
+            let albedo: f64 = expected::probabilities(&|w| lobe0.eval(wi, w) * w.z, GRID, alpha.min(1.0), &Quadrature::default())
+                .probabilities
+                .iter()
+                .sum();
+            for method in [Method::Vndf, Method::Bounded] {
+                let lobe = Sampler { kind: LobeKind::Ggx, method }.lobe(alpha);
+                let job = Job::Lobe { lobe, incident: wi, grid: GRID };
+                engine.histogram(&job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?;
+                let r = engine.histogram(&job, set.seed, 0, set.gpu_samples, &mut |_| {})?;
+                let seconds = r.gpu_seconds.unwrap_or(r.wall_seconds);
+                let (mean, variance, below) = albedo_estimator(&lobe, wi, set.seed, set.estimator_samples);
+                let point = MethodPoint {
+                    alpha,
+                    incident_theta_deg: theta,
+                    method: if method == Method::Vndf { "spherical caps (vndf)".into() } else { "bounded vndf".into() },
+                    gpu_samples: set.gpu_samples,
+                    seconds,
+                    timing: if r.gpu_seconds.is_some() { "gpu timestamps" } else { "wall" },
+                    ns_per_sample: seconds / set.gpu_samples as f64 * 1e9,
+                    estimator_samples: set.estimator_samples,
+                    below_horizon: below,
+                    mean,
+                    variance,
+                    albedo_quadrature: albedo,
+                    efficiency: 1.0 / (variance * seconds / set.gpu_samples as f64),
+                };
+                log(&format!(
+                    "ggx {} alpha {alpha} theta {theta}: {:.2} ns/sample, below horizon {:.4}, mean w {:.5} (quadrature {:.5}), var {:.3e}",
+                    method.name(),
+                    point.ns_per_sample,
+                    below,
+                    mean,
+                    albedo,
+                    variance
+                ));
+                out.push(point);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// One quadrature rule for one lobe.
+#[derive(Debug, Clone, Serialize)]
+pub struct QuadraturePoint {
+    pub sampler: String,
+    pub alpha: f64,
+    pub incident_theta_deg: f64,
+    /// "adaptive" or "gl-N" (N × N Gauss–Legendre per bin).
+    pub rule: String,
+    pub cpu_seconds: f64,
+    /// max over cells with expected count ≥ 5 at 10⁸ samples of |p − p_adaptive| / √(p_adaptive/10⁸).
+    pub cpu_max_sigma_at_1e8: f64,
+    pub gpu_seconds: Option<f64>,
+    pub gpu_wall_seconds: Option<f64>,
+    pub gpu_max_sigma_at_1e8: Option<f64>,
+    /// max over the same cells of |p_gpu − p_cpu| / p_cpu (GPU f32 against CPU f64, same rule).
+    pub gpu_vs_cpu_max_rel: Option<f64>,
+    /// Σ |p_gpu − p_cpu| / Σ p_cpu over all bins.
+    pub gpu_vs_cpu_l1_rel: Option<f64>,
+}
+
+/// max |p − q| / √(q/10⁸) over cells with 10⁸ q ≥ 5.
+pub fn max_sigma(p: &[f64], reference: &[f64]) -> f64 {
+    p.iter()
+        .zip(reference)
+        .filter(|&(_, &q)| q * REFERENCE_SAMPLES >= chi2::MIN_EXPECTED)
+        .map(|(&a, &q)| (a - q).abs() / (q / REFERENCE_SAMPLES).sqrt())
+        .fold(0.0, f64::max)
+}
+
+/// The quadrature comparison for one lobe: the adaptive f64 rule and fixed n × n rules.
+pub fn compare_quadrature(engine: &GpuEngine, s: Sampler, alpha: f64, theta_deg: f64, rules: &[usize]) -> anyhow::Result<Vec<QuadraturePoint>> {
+    let lobe = s.lobe(alpha);
+    let wi = reflect::spherical(theta_deg.to_radians(), 0.0);
+    let t = Instant::now();
+    let adaptive = expected::lobe_probabilities(&lobe, wi, GRID, &Quadrature::default());
+    let adaptive_seconds = t.elapsed().as_secs_f64();
+    let reference = &adaptive.probabilities;
+    let base = |rule: String, cpu_seconds, cpu_sigma| QuadraturePoint {
+        sampler: s.name(),
+        alpha,
+        incident_theta_deg: theta_deg,
+        rule,
+        cpu_seconds,
+        cpu_max_sigma_at_1e8: cpu_sigma,
+        gpu_seconds: None,
+        gpu_wall_seconds: None,
+        gpu_max_sigma_at_1e8: None,
+        gpu_vs_cpu_max_rel: None,
+        gpu_vs_cpu_l1_rel: None,
+    };
+    let mut out = vec![base("adaptive".into(), adaptive_seconds, adaptive.max_error_sigma)];
+    for &n in rules {
+        let t = Instant::now();
+        let cpu = quadrature::fixed_probabilities(&|w| lobe.pdf_r(wi, w), GRID, n);
+        let cpu_seconds = t.elapsed().as_secs_f64();
+        let mut point = base(format!("gl-{n}"), cpu_seconds, max_sigma(&cpu, reference));
+        quadrature::gpu_probabilities(engine, &lobe, wi, GRID, n)?; // compile and warm up
+        let g = quadrature::gpu_probabilities(engine, &lobe, wi, GRID, n)?;
+        let gpu: Vec<f64> = g.probabilities.iter().map(|&x| x as f64).collect();
+        point.gpu_seconds = g.gpu_seconds;
+        point.gpu_wall_seconds = Some(g.wall_seconds);
+        point.gpu_max_sigma_at_1e8 = Some(max_sigma(&gpu, reference));
+        point.gpu_vs_cpu_max_rel = Some(
+            gpu.iter()
+                .zip(&cpu)
+                .filter(|&(_, &c)| c * REFERENCE_SAMPLES >= chi2::MIN_EXPECTED)
+                .map(|(&g, &c)| (g - c).abs() / c)
+                .fold(0.0, f64::max),
+        );
+        point.gpu_vs_cpu_l1_rel = Some(gpu.iter().zip(&cpu).map(|(g, c)| (g - c).abs()).sum::<f64>() / cpu.iter().sum::<f64>());
+        out.push(point);
+    }
+    Ok(out)
+}

@@ -1,0 +1,163 @@
+//! The kernel precisions that `lobes tradeoff` compares, as rewrites of the composed WGSL
+//! (installed with [`GpuEngine::rewrite`](crate::gpu::GpuEngine::rewrite)). The rewriting
+//! happens here and nowhere else:
+//!
+//! - `f32-accurate`: the kernels as composed (`shaders/*.wgsl`), unchanged;
+//! - `f32-fast`: every call of `log`, `exp`, `sin`, `cos`, `atan2` and `neg_ln` in the composed
+//!   module is renamed to its `fast_*` twin of `shaders/fastmath.wgsl` (bit tricks and low-order
+//!   polynomials, errors 1e-4 to 1.5e-3), which is appended;
+//! - `f64`: `shaders/f64.wgsl` (f64 samplers, f64 binning, its own f64 sin/cos/atan2/exp/ln) is
+//!   appended and replaces the composed `draw` and `explicit_samples`, with the job's α and ωi
+//!   baked in as f64 constants (the kernel's uniform block carries them in f32 only).
+
+use crate::gpu::engine::Rewrite;
+use crate::job::Job;
+use crate::reference::{Lobe, LobeKind, Method};
+use serde::Serialize;
+use std::sync::Arc;
+
+pub const FASTMATH: &str = include_str!("../../shaders/fastmath.wgsl");
+pub const F64: &str = include_str!("../../shaders/f64.wgsl");
+
+/// The arithmetic of a sampling kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum Precision {
+    /// f32 with cheap approximations of ln, exp, sin, cos and atan2.
+    F32Fast,
+    /// f32 with the builtin functions (the kernels `lobes run` judges).
+    F32Accurate,
+    /// f64 throughout (needs SHADER_F64).
+    F64,
+}
+
+impl Precision {
+    pub const ALL: [Precision; 3] = [Precision::F32Fast, Precision::F32Accurate, Precision::F64];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32Fast => "f32-fast",
+            Precision::F32Accurate => "f32-accurate",
+            Precision::F64 => "f64",
+        }
+    }
+
+    /// Parses `f32-fast`, `f32-accurate` or `f64`.
+    pub fn parse(s: &str) -> Option<Precision> {
+        Precision::ALL.into_iter().find(|p| p.name() == s.trim())
+    }
+
+    /// The engine rewrite for this precision (`None` for f32-accurate).
+    pub fn rewrite(self) -> Option<Rewrite> {
+        match self {
+            Precision::F32Accurate => None,
+            Precision::F32Fast => Some(Arc::new(|_job: &Job, src: String| fast(&src))),
+            Precision::F64 => Some(Arc::new(|job: &Job, src: String| f64_kernel(job, &src))),
+        }
+    }
+}
+
+/// The f64 sampler of `shaders/f64.wgsl` for a lobe and method, where one is written
+/// (Beckmann's visible normals would need f64 erfc and erfinv: not written).
+pub fn sampler64(lobe: &Lobe) -> Option<&'static str> {
+    match (lobe.kind, lobe.method) {
+        (LobeKind::Ward, _) => Some("ward_sample64"),
+        (LobeKind::Beckmann, Method::Ndf) => Some("beckmann_sample_ndf64"),
+        (LobeKind::Beckmann, _) => None,
+        (LobeKind::Ggx, Method::Ndf) => Some("ggx_sample_ndf64"),
+        (LobeKind::Ggx, Method::Vndf) => Some("ggx_sample_vndf64"),
+        (LobeKind::Ggx, Method::Bounded) => Some("ggx_sample_bounded64"),
+    }
+}
+
+/// The builtins that `f32-fast` replaces (`neg_ln` is lobes' own accurate −ln u).
+pub const FAST_REPLACED: [&str; 6] = ["log", "exp", "sin", "cos", "atan2", "neg_ln"];
+
+fn is_ident(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_'
+}
+
+/// Renames each call `name(` (a whole identifier followed by `(`, not a definition `fn name(`)
+/// to `to(`.
+pub fn rename_calls(src: &str, name: &str, to: &str) -> String {
+    let bytes = src.as_bytes();
+    let pat = format!("{name}(");
+    let mut out = String::with_capacity(src.len() + 256);
+    let mut last = 0;
+    for (i, _) in src.match_indices(&pat) {
+        let whole = i == 0 || !is_ident(bytes[i - 1]);
+        let definition = src[..i].trim_end().ends_with("fn") && src[..i].trim_end().len() < src[..i].len();
+        if whole && !definition {
+            out.push_str(&src[last..i]);
+            out.push_str(to);
+            out.push('(');
+            last = i + pat.len();
+        }
+    }
+    out.push_str(&src[last..]);
+    out
+}
+
+/// The `f32-fast` module: calls renamed to `fast_*`, `shaders/fastmath.wgsl` appended.
+pub fn fast(src: &str) -> String {
+    let mut s = src.to_string();
+    for name in FAST_REPLACED {
+        s = rename_calls(&s, name, &format!("fast_{name}"));
+    }
+    s.push('\n');
+    s.push_str(FASTMATH);
+    s
+}
+
+/// An f64 literal that round-trips (17 significant digits).
+fn lit(x: f64) -> String {
+    format!("{x:.16e}lf")
+}
+
+/// The `f64` module of a lobe job: the composed `draw` and `explicit_samples` renamed out of
+/// the way (`*_f32`), `shaders/f64.wgsl` appended with the job's sampler, α and ωi in f64.
+///
+/// Panics for a job without an f64 sampler ([`sampler64`]); callers check first.
+pub fn f64_kernel(job: &Job, src: &str) -> String {
+    let Job::Lobe { lobe, incident, .. } = job else { panic!("lobes tradeoff: f64 kernels exist for lobes only") };
+    let sampler = sampler64(lobe).unwrap_or_else(|| {
+        panic!("lobes tradeoff: no f64 sampler for {} {}", lobe.kind.name(), lobe.method.name())
+    });
+    // definitions start a line (comments may mention them too)
+    let mut s = src.replacen("\nfn draw(", "\nfn draw_f32(", 1).replacen("\nfn explicit_samples(", "\nfn explicit_samples_f32(", 1);
+    assert!(s.contains("\nfn draw_f32(") && s.contains("\nfn explicit_samples_f32("), "composed lobe kernel lacks draw/explicit_samples");
+    s.push_str(&format!(
+        "\n// f64 variant (lobes tradeoff): the job's alpha and incident direction in f64\n\
+         const A64: vec2<f64> = vec2<f64>({}, {});\nconst WI64: vec3<f64> = vec3<f64>({}, {}, {});\n",
+        lit(lobe.alpha_x),
+        lit(lobe.alpha_y),
+        lit(incident.x),
+        lit(incident.y),
+        lit(incident.z)
+    ));
+    s.push_str(&F64.replace("SAMPLE64(", &format!("{sampler}(")));
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn renames_calls_only() {
+        let src = "fn neg_ln(u: f32) -> f32 { return -log(u); }\nlet a = neg_ln(x) + exp(y) + fast_exp(z) + exp2(w) + my_log(v);";
+        let out = fast(src);
+        let head = &out[..out.find("// Cheap").unwrap()];
+        assert!(head.contains("fn neg_ln(u: f32)"), "{head}");
+        assert!(head.contains("-fast_log(u)"));
+        assert!(head.contains("fast_neg_ln(x) + fast_exp(y) + fast_exp(z) + exp2(w) + my_log(v)"), "{head}");
+    }
+
+    #[test]
+    fn literals_round_trip() {
+        for x in [0.3, 1.0 / 3.0, 0.7071067811865476, 1e-7, 5e-324f64.max(1e-300)] {
+            let s = lit(x);
+            assert_eq!(s[..s.len() - 2].parse::<f64>().unwrap(), x);
+        }
+    }
+}
