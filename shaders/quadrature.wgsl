@@ -25,18 +25,17 @@ fn quadrature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     }
     let row = bin / COLS;
     let col = bin % COLS;
-    let z0 = -1.0 + 2.0 * f32(row) / f32(ROWS);
-    let z1 = -1.0 + 2.0 * f32(row + 1u) / f32(ROWS);
-    if (z1 <= 0.0) {
+    // Centres and half-widths straight from the bin index (z edges are exact in f32 for even
+    // ROWS; phi edges formed as -pi + 2 pi c / COLS would carry an error of ~1 ulp of pi, 5e-6 of
+    // a 128-column bin's width, into its mass).
+    let hz = 1.0 / f32(ROWS);
+    let cz = -1.0 + (2.0 * f32(row) + 1.0) * hz;
+    if (cz + hz <= 0.0) {
         probabilities[bin] = 0.0; // p(wr) = 0 below the horizon
         return;
     }
-    let p0 = -PI + 2.0 * PI * f32(col) / f32(COLS);
-    let p1 = -PI + 2.0 * PI * f32(col + 1u) / f32(COLS);
-    let hz = 0.5 * (z1 - z0);
-    let cz = 0.5 * (z1 + z0);
-    let hp = 0.5 * (p1 - p0);
-    let cp = 0.5 * (p1 + p0);
+    let hp = PI / f32(COLS);
+    let cp = -PI + (2.0 * f32(col) + 1.0) * hp;
     var sum = 0.0;
     for (var i = 0u; i < N_NODES; i++) {
         let z = cz + hz * gl_nodes[i].x;

@@ -3,10 +3,12 @@
 //! fails these tests with the fix in the message.
 
 use lobes::gpu::GpuEngine;
-use lobes::reference::{LobeKind, Method};
+use lobes::reference::{LobeKind, Method, reflect};
+use lobes::stats::chi2;
 use lobes::stats::compare;
 use lobes::stats::expected::Quadrature;
 use lobes::tradeoff::{self, Precision, Sampler, quadrature};
+use std::process::Command;
 
 fn engine() -> GpuEngine {
     GpuEngine::open().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"))
@@ -37,5 +39,143 @@ fn f64_kernels_match_the_f64_reference() {
         assert_eq!(a.validity_mismatches, 0, "{}", s.name());
         assert!(a.compared > 30_000, "{}: {a:?}", s.name());
         assert!(a.max_angle_rad < 1e-9, "{}: {a:?}", s.name());
+    }
+}
+
+const WARD: Sampler = Sampler { kind: LobeKind::Ward, method: Method::Ndf };
+
+/// The fast approximations (sin/cos ~1e-3, atan2 1.5e-3, ln/exp ~1e-4) cost accuracy: every
+/// f32-fast kernel's worst angle is above f32-accurate's, and below 5e-3 rad.
+#[test]
+fn fast_kernels_are_less_accurate_but_bounded() {
+    let mut e = engine();
+    for s in [WARD, Sampler { kind: LobeKind::Ggx, method: Method::Ndf }, GGX_VNDF, Sampler { kind: LobeKind::Beckmann, method: Method::Vndf }] {
+        let fast = angle(&mut e, s, Precision::F32Fast, 1 << 16);
+        let accurate = angle(&mut e, s, Precision::F32Accurate, 1 << 16);
+        eprintln!("{}: fast {:.2e}, accurate {:.2e} rad", s.name(), fast.max_angle_rad, accurate.max_angle_rad);
+        assert!(fast.max_angle_rad > 10.0 * accurate.max_angle_rad, "{}: fast {fast:?} accurate {accurate:?}", s.name());
+        assert!(fast.max_angle_rad < 5e-3, "{}: {fast:?}", s.name());
+        assert!(fast.validity_mismatches < 10, "{}: {fast:?}", s.name());
+    }
+}
+
+fn chi2_at(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u64) -> (chi2::Chi2, f64, f64) {
+    let job = tradeoff::sweep_job(s, 0.3, 45.0);
+    let exp = compare::expected_counts(&job, n, &Quadrature::default());
+    e.rewrite = prec.rewrite();
+    let r = e.histogram(&job, 1, 0, n, &mut |_| {}).expect("histogram");
+    e.rewrite = None;
+    let p: Vec<f64> = exp.bins.iter().chain(&exp.invalid).map(|x| x / n as f64).collect();
+    let noise: f64 = p.iter().map(|&q| tradeoff::poisson_mean_abs_dev(q * n as f64)).sum::<f64>() / n as f64;
+    (compare::chi2_test(&r.counts, &exp, 0.01), tradeoff::l1_distance(&r.counts, &p), noise)
+}
+
+/// GGX's fast kernel still passes χ² at 2^20 ≈ 1e6 samples; Ward's does not hide its bias at
+/// 2^22 (its fast −ln u is off by ~1e-4 absolute near u = 1, i.e. near the lobe's peak).
+#[test]
+fn fast_kernels_pass_chi2_at_a_million_and_show_their_bias_later() {
+    let mut e = engine();
+    let (t, _, _) = chi2_at(&mut e, GGX_VNDF, Precision::F32Fast, 1 << 20);
+    assert!(t.passed, "ggx-vndf f32-fast at 2^20: {t:?}");
+    let (t, l1, noise) = chi2_at(&mut e, WARD, Precision::F32Fast, 1 << 22);
+    assert!(t.p_value < 1e-6 && l1 > 1.1 * noise, "ward-ndf f32-fast at 2^22: {t:?}, L1 {l1} vs noise {noise}");
+    let (t, l1, noise) = chi2_at(&mut e, WARD, Precision::F32Accurate, 1 << 22);
+    assert!(t.passed && l1 < 1.05 * noise, "ward-ndf f32-accurate at 2^22: {t:?}, L1 {l1} vs noise {noise}");
+}
+
+/// An exact sampler's L1 distance falls like 1/√N: the least-squares slope of log L1 against
+/// log N over 2^16 .. 2^24 is −1/2 within 0.05, and L1 stays within 10% of its Poisson
+/// expectation at every N.
+#[test]
+fn l1_falls_like_one_over_sqrt_n() {
+    let mut e = engine();
+    let mut pts = Vec::new();
+    for k in (16..=24).step_by(2) {
+        let (_, l1, noise) = chi2_at(&mut e, GGX_VNDF, Precision::F32Accurate, 1 << k);
+        eprintln!("2^{k}: L1 {l1:.4e}, noise {noise:.4e}");
+        assert!((l1 / noise - 1.0).abs() < 0.1, "2^{k}: L1 {l1} noise {noise}");
+        pts.push(((k as f64) * 2f64.ln(), l1.ln()));
+    }
+    let n = pts.len() as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    assert!((slope + 0.5).abs() < 0.05, "slope {slope}");
+}
+
+/// The GPU's f32 fixed-rule quadrature agrees with the same rule in f64 on the CPU: summed
+/// over bins to 1e-6 of the mass, and bin by bin to 2e-5 where the expected count at 1e8
+/// samples is ≥ 5.
+#[test]
+fn gpu_quadrature_matches_cpu_f64_same_rule() {
+    let e = engine();
+    for (s, alpha) in [(GGX_VNDF, 0.3), (WARD, 0.2), (Sampler { kind: LobeKind::Ggx, method: Method::Bounded }, 0.6)] {
+        let lobe = s.lobe(alpha);
+        let wi = reflect::spherical(40f64.to_radians(), 0.3);
+        for n in [1, 4, 8] {
+            let cpu = quadrature::fixed_probabilities(&|w| lobe.pdf_r(wi, w), tradeoff::GRID, n);
+            let gpu = quadrature::gpu_probabilities(&e, &lobe, wi, tradeoff::GRID, n).expect("GPU quadrature");
+            let l1: f64 = gpu.probabilities.iter().zip(&cpu).map(|(&g, c)| (g as f64 - c).abs()).sum::<f64>() / cpu.iter().sum::<f64>();
+            let max_rel = gpu
+                .probabilities
+                .iter()
+                .zip(&cpu)
+                .filter(|&(_, &c)| c * 1e8 >= 5.0)
+                .map(|(&g, &c)| (g as f64 - c).abs() / c)
+                .fold(0.0, f64::max);
+            eprintln!("{} alpha {alpha} gl-{n}: L1 rel {l1:.2e}, max rel {max_rel:.2e}", s.name());
+            assert!(l1 < 1e-6, "{} gl-{n}: L1 rel {l1}", s.name());
+            assert!(max_rel < 2e-5, "{} gl-{n}: max rel {max_rel}", s.name());
+        }
+    }
+}
+
+fn lobes_bin(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_lobes")).args(args).output().expect("run the lobes binary")
+}
+
+/// A small run through the binary writes the three outputs; f64 for a sampler without an f64
+/// kernel is reported as unavailable, not dropped; bad input exits with 2 naming the flag.
+#[test]
+fn cli_writes_outputs_and_rejects_bad_input() {
+    let dir = std::env::temp_dir().join(format!("lobes-tradeoff-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = lobes_bin(&[
+        "tradeoff", "--samplers", "ggx-ndf,beckmann-vndf", "--precisions", "f32-accurate,f64", "--min-log2", "16", "--max-log2", "18",
+        "--long", "none", "--parts", "sweep", "--angle-samples", "4096", "--json", "--out", dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let points = v["sweep"]["points"].as_array().unwrap();
+    // ggx-ndf: 2 precisions x 2 counts; beckmann-vndf: f32-accurate x 2 counts
+    assert_eq!(points.len(), 6, "{v}");
+    let missing = v["sweep"]["unavailable"].as_array().unwrap();
+    assert_eq!(missing.len(), 1);
+    assert_eq!(missing[0]["sampler"], "beckmann-vndf");
+    assert_eq!(missing[0]["precision"], "f64");
+    let md = std::fs::read_to_string(dir.join("tradeoff.md")).unwrap();
+    assert!(md.contains("| beckmann-vndf | f64 | – | unavailable: no f64 kernel"), "{md}");
+    assert!(md.contains("| ggx-ndf | f64 | 2^18 |"), "{md}");
+    let png = std::fs::read(dir.join("tradeoff.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("tradeoff.json")).unwrap()).unwrap();
+    assert_eq!(json["sweep"]["points"], v["sweep"]["points"]);
+    let _ = std::fs::remove_dir_all(&dir);
+
+    for (args, needle) in [
+        (&["tradeoff", "--samplers", "phong"][..], "--samplers: 'phong' is unknown"),
+        (&["tradeoff", "--precisions", "f16"][..], "--precisions: 'f16' is unknown"),
+        (&["tradeoff", "--min-log2", "20", "--max-log2", "18"][..], "--min-log2 20 is above --max-log2 18"),
+        (&["tradeoff", "--max-log2", "40"][..], "--max-log2"),
+        (&["tradeoff", "--alpha", "0"][..], "roughness must be a finite number > 0"),
+        (&["tradeoff", "--incident-theta", "90"][..], "outside [0, 90)"),
+        (&["tradeoff", "--long", "ggx"][..], "--long: 'ggx' is unknown"),
+        (&["tradeoff", "--parts", "all"][..], "--parts: 'all' is unknown"),
+        (&["tradeoff", "--out", "Cargo.toml"][..], "exists and is not a folder"),
+    ] {
+        let out = lobes_bin(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
     }
 }

@@ -17,6 +17,7 @@ pub mod merge;
 pub mod run;
 pub mod shader;
 pub mod stress;
+pub mod tradeoff;
 pub mod tutorial;
 
 use crate::reference::{LobeKind, Method};
@@ -67,6 +68,10 @@ pub enum Command {
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
     Merge(merge::MergeArgs),
+    /// Accuracy against cost: sample count × kernel precision (f32 fast / f32 / f64), spherical
+    /// caps against bounded VNDF, and the expected histogram's quadrature; writes tradeoff.md,
+    /// tradeoff.png and tradeoff.json with --out.
+    Tradeoff(tradeoff::TradeoffArgs),
 }
 
 impl Cli {
@@ -81,6 +86,7 @@ impl Cli {
             Command::Stress(args) => stress::run(&args),
             Command::Merge(args) => merge::run(&args),
             Command::Shader(args) => shader::run(&args),
+            Command::Tradeoff(args) => tradeoff::run(&args),
         }
     }
 }

@@ -445,7 +445,7 @@ fn draw_axis_labels(img: &mut RgbImage, h: &Heatmap, lay: &Layout) {
 }
 
 /// Fills a rectangle, clipped to the image.
-fn fill_rect(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, rgb: Rgb<u8>) {
+pub(crate) fn fill_rect(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, rgb: Rgb<u8>) {
     let (x1, y1) = (
         x.saturating_add(w).min(img.width()),
         y.saturating_add(h).min(img.height()),
@@ -521,13 +521,13 @@ fn trim_zeros(s: &str) -> &str {
 }
 
 /// Width in pixels of `s` drawn by [`draw_text`].
-fn text_width(s: &str) -> u32 {
+pub(crate) fn text_width(s: &str) -> u32 {
     let n = s.chars().count() as u32;
     (n * (GLYPH_W + 1) * TEXT_SCALE).saturating_sub(TEXT_SCALE)
 }
 
 /// Draws `s` with its top-left corner at (x, y), clipped to the image.
-fn draw_text(img: &mut RgbImage, x: i64, y: i64, s: &str, rgb: Rgb<u8>) {
+pub(crate) fn draw_text(img: &mut RgbImage, x: i64, y: i64, s: &str, rgb: Rgb<u8>) {
     let advance = ((GLYPH_W + 1) * TEXT_SCALE) as i64;
     for (i, ch) in s.chars().enumerate() {
         draw_glyph(img, x + i as i64 * advance, y, glyph(ch), rgb);

@@ -91,7 +91,7 @@ impl Default for SweepSettings {
             alpha: 0.3,
             incident_theta_deg: 45.0,
             log2_min: 16,
-            log2_max: 24,
+            log2_max: 26,
             log2_step: 2,
             long: Some(Sampler { kind: LobeKind::Ggx, method: Method::Vndf }),
             long_log2_max: 28,
@@ -515,4 +515,33 @@ pub fn compare_quadrature(engine: &GpuEngine, s: Sampler, alpha: f64, theta_deg:
         out.push(point);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn poisson_mean_absolute_deviation() {
+        // λ = 1: E|X − 1| = P(0)·1 + Σ_{k≥2} (k − 1) P(k) = 2/e; λ = 2.5 by direct summation
+        assert!((poisson_mean_abs_dev(1.0) - 2.0 / std::f64::consts::E).abs() < 1e-15);
+        let lambda: f64 = 2.5;
+        let direct: f64 = (0..60)
+            .map(|k| (k as f64 - lambda).abs() * (-lambda + k as f64 * lambda.ln() - ln_gamma(k as f64 + 1.0)).exp())
+            .sum();
+        assert!((poisson_mean_abs_dev(lambda) - direct).abs() < 1e-13, "{direct}");
+        // large λ: the normal limit √(2λ/π)
+        let l = 1e6;
+        assert!((poisson_mean_abs_dev(l) / (2.0 * l / std::f64::consts::PI).sqrt() - 1.0).abs() < 1e-5);
+        assert_eq!(poisson_mean_abs_dev(0.0), 0.0);
+    }
+
+    #[test]
+    fn sample_counts_of_the_sweep() {
+        let s = SweepSettings::default();
+        let vndf = Sampler::parse("ggx-vndf").unwrap();
+        assert_eq!(s.counts(Sampler::parse("ward-ndf").unwrap()), [1 << 16, 1 << 18, 1 << 20, 1 << 22, 1 << 24, 1 << 26]);
+        assert_eq!(*s.counts(vndf).last().unwrap(), 1 << 28);
+        assert!(Sampler::parse("ggx-fancy").is_none());
+    }
 }
