@@ -178,4 +178,16 @@ fn cli_writes_outputs_and_rejects_bad_input() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
     }
+
+    // no adapter: a runtime failure (1) that names the package to install
+    let out = Command::new(env!("CARGO_BIN_EXE_lobes"))
+        .args(["tradeoff", "--parts", "quadrature"])
+        .env("VK_DRIVER_FILES", "/nonexistent.json")
+        .env("VK_ICD_FILENAMES", "/nonexistent.json")
+        .env_remove("WGPU_BACKEND")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
 }
