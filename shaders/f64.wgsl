@@ -302,9 +302,10 @@ fn ggx_sample_bounded64(a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>) -> LobeSample
     return LobeSample64(h, wr, pdf);
 }
 
-// Reason codes of shaders/histogram.wgsl, in the order of reference::Invalid::check. The f64
-// values are finite here (no operation above makes inf or NaN from finite inputs but 0/0 at
-// degenerate inputs, caught by the self-comparison).
+// Reason codes of shaders/histogram.wgsl, in the order of reference::Invalid::check. Nothing
+// above makes an infinity (u = 0 is mapped to INF_SLOPE64), and a NaN from a degenerate input
+// fails the self-comparison where the driver keeps IEEE comparisons (not guaranteed: the f32
+// kernels test bit patterns instead; no NaN occurred in tests/tradeoff.rs).
 fn classify64(wr: vec3<f64>, pdf: f64) -> u32 {
     if (!(all(wr == wr) && all(abs(wr) <= vec3<f64>(1.0e300lf)))) {
         return REASON_NON_FINITE_DIRECTION;

@@ -51,6 +51,9 @@ pub struct TradeoffArgs {
     /// Samples per sampler and precision compared one by one with the f64 reference (1 ..= 2^24).
     #[arg(long, default_value_t = 1 << 18, value_parser = clap::value_parser!(u32).range(1..=1 << 24))]
     pub angle_samples: u32,
+    /// Timed runs per measurement; medians are reported (1 ..= 99).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=99))]
+    pub runs: u32,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -106,11 +109,12 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         long_log2_max: args.long_max_log2,
         seed: args.seed,
         angle_samples: args.angle_samples,
+        runs: args.runs as usize,
     };
     let has = |p: &str| parts.iter().any(|x| x == p);
     let sweep = if has("sweep") { tradeoff::sweep(&mut engine, &sweep_settings, &mut log)? } else { Default::default() };
     let methods = if has("methods") {
-        tradeoff::compare_methods(&mut engine, &MethodSettings { seed: args.seed + 1, ..Default::default() }, &mut log)?
+        tradeoff::compare_methods(&mut engine, &MethodSettings { seed: args.seed + 1, runs: args.runs as usize, ..Default::default() }, &mut log)?
     } else {
         Vec::new()
     };
@@ -119,7 +123,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         let ggx_vndf = Sampler::parse("ggx-vndf").expect("a sampler");
         for alpha in [args.alpha, 0.05] {
             log(&format!("quadrature: ggx-vndf alpha {alpha}"));
-            quadrature.extend(tradeoff::compare_quadrature(&engine, ggx_vndf, alpha, args.incident_theta, &[1, 2, 4, 8])?);
+            quadrature.extend(tradeoff::compare_quadrature(&engine, ggx_vndf, alpha, args.incident_theta, &[1, 2, 4, 8], args.runs as usize)?);
         }
     }
     let command = std::iter::once("lobes".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
@@ -129,6 +133,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         grid: [tradeoff::GRID.rows, tradeoff::GRID.cols],
         seed: args.seed,
         angle_samples: args.angle_samples,
+        runs: args.runs,
         sweep,
         methods,
         quadrature,

@@ -18,6 +18,8 @@ pub struct Report {
     pub grid: [u32; 2],
     pub seed: u64,
     pub angle_samples: u32,
+    /// Timed runs per measurement (medians reported).
+    pub runs: u32,
     pub sweep: Sweep,
     pub methods: Vec<MethodPoint>,
     pub quadrature: Vec<QuadraturePoint>,
@@ -137,9 +139,9 @@ pub fn quadrature_table(q: &[QuadraturePoint]) -> String {
 /// The whole markdown document.
 pub fn markdown(r: &Report) -> String {
     let mut s = format!(
-        "# lobes tradeoff\n\n`{}`\n\nAdapter: {}. Grid {} × {} (cos θ × φ), seed {}. Times: GPU timestamps where the adapter has them \
-         (on lavapipe they measure CPU time), else wall time.\n\n",
-        r.command, r.adapter, r.grid[0], r.grid[1], r.seed
+        "# lobes tradeoff\n\n`{}`\n\nAdapter: {}. Grid {} × {} (cos θ × φ), seed {}. Times: median of {} run(s); GPU timestamps where the \
+         adapter has them (on lavapipe they measure CPU time), else wall time.\n\n",
+        r.command, r.adapter, r.grid[0], r.grid[1], r.seed, r.runs
     );
     let lobe_line = r.sweep.lobes.first().map_or(String::new(), |l| format!("α = {}, θi = {}°", l.alpha, l.incident_theta_deg));
     s += &format!(

@@ -75,6 +75,8 @@ pub struct SweepSettings {
     pub seed: u64,
     /// Samples regenerated on the CPU in f64 for the per-sample angle (the first ones of the run).
     pub angle_samples: u32,
+    /// Timed runs per point; the median time is reported (the counts of every run must agree).
+    pub runs: usize,
 }
 
 impl Default for SweepSettings {
@@ -97,6 +99,7 @@ impl Default for SweepSettings {
             long_log2_max: 28,
             seed: 1,
             angle_samples: 1 << 18,
+            runs: 1,
         }
     }
 }
@@ -293,7 +296,7 @@ fn sweep_one(
     let angle = angle_error(engine, job, set.seed, set.angle_samples, prec)?;
     let mut points = Vec::new();
     for n in set.counts(s) {
-        let r = engine.histogram(job, set.seed, 0, n, &mut |_| {})?;
+        let (r, wall_seconds, gpu_seconds) = timed_histogram(engine, job, set.seed, n, set.runs)?;
         anyhow::ensure!(r.counts.total() == n, "{} {}: {} samples counted for {n}", s.name(), prec.name(), r.counts.total());
         let expected: Vec<f64> = p.iter().map(|q| q * n as f64).collect();
         let observed: Vec<u64> = r.counts.bins.iter().chain(&r.counts.invalid).copied().collect();
@@ -302,8 +305,8 @@ fn sweep_one(
             sampler: s.name(),
             precision: prec,
             samples: n,
-            wall_seconds: r.wall_seconds,
-            gpu_seconds: r.gpu_seconds,
+            wall_seconds,
+            gpu_seconds,
             chi2: test.statistic,
             dof: test.dof,
             p_value: test.p_value,
@@ -326,6 +329,28 @@ fn sweep_one(
         points.push(point);
     }
     Ok(points)
+}
+
+/// The median of `v` (upper median for an even count).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// `runs` histograms of samples 0 .. n: the first run's result with the median wall and GPU
+/// times; every run must count exactly the same.
+fn timed_histogram(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64, runs: usize) -> anyhow::Result<(crate::gpu::GpuRun, f64, Option<f64>)> {
+    let first = engine.histogram(job, seed, 0, n, &mut |_| {})?;
+    let (mut wall, mut gpu) = (vec![first.wall_seconds], first.gpu_seconds.map(|g| vec![g]));
+    for _ in 1..runs.max(1) {
+        let r = engine.histogram(job, seed, 0, n, &mut |_| {})?;
+        anyhow::ensure!(r.counts == first.counts, "two runs of the same samples counted differently");
+        wall.push(r.wall_seconds);
+        if let (Some(g), Some(v)) = (r.gpu_seconds, gpu.as_mut()) {
+            v.push(g);
+        }
+    }
+    Ok((first, median(wall), gpu.map(median)))
 }
 
 /// Spherical caps against bounded VNDF at one roughness and incidence.
@@ -361,11 +386,13 @@ pub struct MethodSettings {
     pub gpu_samples: u64,
     pub estimator_samples: u64,
     pub seed: u64,
+    /// Timed GPU runs per point; the median is reported.
+    pub runs: usize,
 }
 
 impl Default for MethodSettings {
     fn default() -> Self {
-        Self { alphas: vec![0.1, 0.5, 1.0], thetas_deg: vec![30.0, 60.0, 85.0], gpu_samples: 1 << 24, estimator_samples: 1 << 20, seed: 2 }
+        Self { alphas: vec![0.1, 0.5, 1.0], thetas_deg: vec![30.0, 60.0, 85.0], gpu_samples: 1 << 24, estimator_samples: 1 << 20, seed: 2, runs: 1 }
     }
 }
 
@@ -408,8 +435,8 @@ pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut d
                 let lobe = Sampler { kind: LobeKind::Ggx, method }.lobe(alpha);
                 let job = Job::Lobe { lobe, incident: wi, grid: GRID };
                 engine.histogram(&job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?;
-                let r = engine.histogram(&job, set.seed, 0, set.gpu_samples, &mut |_| {})?;
-                let seconds = r.gpu_seconds.unwrap_or(r.wall_seconds);
+                let (_, wall, gpu) = timed_histogram(engine, &job, set.seed, set.gpu_samples, set.runs)?;
+                let seconds = gpu.unwrap_or(wall);
                 let (mean, variance, below) = albedo_estimator(&lobe, wi, set.seed, set.estimator_samples);
                 let point = MethodPoint {
                     alpha,
@@ -417,7 +444,7 @@ pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut d
                     method: if method == Method::Vndf { "spherical caps (vndf)".into() } else { "bounded vndf".into() },
                     gpu_samples: set.gpu_samples,
                     seconds,
-                    timing: if r.gpu_seconds.is_some() { "gpu timestamps" } else { "wall" },
+                    timing: if gpu.is_some() { "gpu timestamps" } else { "wall" },
                     ns_per_sample: seconds / set.gpu_samples as f64 * 1e9,
                     estimator_samples: set.estimator_samples,
                     below_horizon: below,
@@ -472,12 +499,18 @@ pub fn max_sigma(p: &[f64], reference: &[f64]) -> f64 {
 }
 
 /// The quadrature comparison for one lobe: the adaptive f64 rule and fixed n × n rules.
-pub fn compare_quadrature(engine: &GpuEngine, s: Sampler, alpha: f64, theta_deg: f64, rules: &[usize]) -> anyhow::Result<Vec<QuadraturePoint>> {
+pub fn compare_quadrature(engine: &GpuEngine, s: Sampler, alpha: f64, theta_deg: f64, rules: &[usize], runs: usize) -> anyhow::Result<Vec<QuadraturePoint>> {
     let lobe = s.lobe(alpha);
     let wi = reflect::spherical(theta_deg.to_radians(), 0.0);
-    let t = Instant::now();
-    let adaptive = expected::lobe_probabilities(&lobe, wi, GRID, &Quadrature::default());
-    let adaptive_seconds = t.elapsed().as_secs_f64();
+    let mut times = Vec::new();
+    let mut adaptive = None;
+    for _ in 0..runs.max(1) {
+        let t = Instant::now();
+        adaptive = Some(expected::lobe_probabilities(&lobe, wi, GRID, &Quadrature::default()));
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let adaptive = adaptive.expect("one run");
+    let adaptive_seconds = median(times);
     let reference = &adaptive.probabilities;
     let base = |rule: String, cpu_seconds, cpu_sigma| QuadraturePoint {
         sampler: s.name(),
@@ -494,15 +527,21 @@ pub fn compare_quadrature(engine: &GpuEngine, s: Sampler, alpha: f64, theta_deg:
     };
     let mut out = vec![base("adaptive".into(), adaptive_seconds, adaptive.max_error_sigma)];
     for &n in rules {
-        let t = Instant::now();
-        let cpu = quadrature::fixed_probabilities(&|w| lobe.pdf_r(wi, w), GRID, n);
-        let cpu_seconds = t.elapsed().as_secs_f64();
-        let mut point = base(format!("gl-{n}"), cpu_seconds, max_sigma(&cpu, reference));
+        let mut times = Vec::new();
+        let mut cpu = Vec::new();
+        for _ in 0..runs.max(1) {
+            let t = Instant::now();
+            cpu = quadrature::fixed_probabilities(&|w| lobe.pdf_r(wi, w), GRID, n);
+            times.push(t.elapsed().as_secs_f64());
+        }
+        let mut point = base(format!("gl-{n}"), median(times), max_sigma(&cpu, reference));
         quadrature::gpu_probabilities(engine, &lobe, wi, GRID, n)?; // compile and warm up
-        let g = quadrature::gpu_probabilities(engine, &lobe, wi, GRID, n)?;
+        let gs: Vec<quadrature::GpuQuadrature> =
+            (0..runs.max(1)).map(|_| quadrature::gpu_probabilities(engine, &lobe, wi, GRID, n)).collect::<Result<_, _>>()?;
+        let g = &gs[0];
         let gpu: Vec<f64> = g.probabilities.iter().map(|&x| x as f64).collect();
-        point.gpu_seconds = g.gpu_seconds;
-        point.gpu_wall_seconds = Some(g.wall_seconds);
+        point.gpu_seconds = gs.iter().map(|g| g.gpu_seconds).collect::<Option<Vec<f64>>>().map(median);
+        point.gpu_wall_seconds = Some(median(gs.iter().map(|g| g.wall_seconds).collect()));
         point.gpu_max_sigma_at_1e8 = Some(max_sigma(&gpu, reference));
         point.gpu_vs_cpu_max_rel = Some(
             gpu.iter()
