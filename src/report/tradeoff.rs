@@ -265,7 +265,7 @@ pub fn plot(sweep: &Sweep) -> RgbImage {
         line(&mut img, (l, t), (l, b), INK, false);
         line(&mut img, (r, t), (r, b), INK, false);
         // reference: L1 = c / sqrt(N), N = seconds / (seconds per sample of f32-accurate at its largest N)
-        if let Some(a) = pts.iter().filter(|p| p.precision == Precision::F32Accurate).last() {
+        if let Some(a) = pts.iter().rfind(|p| p.precision == Precision::F32Accurate) {
             let sps = a.seconds() / a.samples as f64;
             // log L1 = log c − (log t − log sps)/2: the part inside the panel's y range
             let (lc, ls) = (lobe.l1_noise_coefficient.log10(), sps.log10());
