@@ -16,7 +16,7 @@ pub struct TradeoffArgs {
     pub out: Option<PathBuf>,
     /// Samplers to sweep, comma-separated: ward-ndf, beckmann-ndf, beckmann-vndf, ggx-ndf,
     /// ggx-vndf, ggx-bounded.
-    #[arg(long, value_name = "LIST", default_value = "ward-ndf,beckmann-ndf,ggx-ndf,ggx-vndf,ggx-bounded")]
+    #[arg(long, value_name = "LIST", default_value = "ward-ndf,beckmann-ndf,beckmann-vndf,ggx-ndf,ggx-vndf,ggx-bounded")]
     pub samplers: String,
     /// Kernel precisions, comma-separated: f32-fast, f32-accurate, f64.
     #[arg(long, value_name = "LIST", default_value = "f32-fast,f32-accurate,f64")]

@@ -39,24 +39,33 @@ pub fn sweep_table(sweep: &Sweep) -> String {
         "| sampler | precision | samples | GPU s | wall s | ns/sample | χ²/dof | p | L1 | L1 / noise | max angle vs f64 (rad) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for p in &sweep.points {
-        t += &format!(
-            "| {} | {} | {} | {} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.2} | {} |\n",
-            p.sampler,
-            p.precision.name(),
-            pow2(p.samples),
-            p.gpu_seconds.map_or("–".into(), |g| format!("{g:.3}")),
-            p.wall_seconds,
-            p.seconds() / p.samples as f64 * 1e9,
-            p.chi2 / p.dof.max(1) as f64,
-            p.p_value,
-            sci(p.l1),
-            p.l1 / p.l1_noise,
-            sci(p.angle.max_angle_rad),
-        );
+    // each sampler's points, then its unavailable precisions, in sweep order
+    let mut names: Vec<&str> = sweep.lobes.iter().map(|l| l.sampler.as_str()).collect();
+    for x in sweep.points.iter().map(|p| p.sampler.as_str()).chain(sweep.unavailable.iter().map(|u| u.sampler.as_str())) {
+        if !names.contains(&x) {
+            names.push(x);
+        }
     }
-    for u in &sweep.unavailable {
-        t += &format!("| {} | {} | – | unavailable: {} | | | | | | | |\n", u.sampler, u.precision.name(), u.reason);
+    for name in names {
+        for p in sweep.points.iter().filter(|p| p.sampler == name) {
+            t += &format!(
+                "| {} | {} | {} | {} | {:.3} | {:.1} | {:.3} | {:.3} | {} | {:.2} | {} |\n",
+                p.sampler,
+                p.precision.name(),
+                pow2(p.samples),
+                p.gpu_seconds.map_or("–".into(), |g| format!("{g:.3}")),
+                p.wall_seconds,
+                p.seconds() / p.samples as f64 * 1e9,
+                p.chi2 / p.dof.max(1) as f64,
+                p.p_value,
+                sci(p.l1),
+                p.l1 / p.l1_noise,
+                sci(p.angle.max_angle_rad),
+            );
+        }
+        for u in sweep.unavailable.iter().filter(|u| u.sampler == name) {
+            t += &format!("| {} | {} | – | unavailable: {} | | | | | | | |\n", u.sampler, u.precision.name(), u.reason);
+        }
     }
     t
 }
@@ -71,7 +80,12 @@ pub fn summary_table(sweep: &Sweep) -> String {
     for l in &sweep.lobes {
         for prec in Precision::ALL {
             let pts: Vec<&SweepPoint> = sweep.points.iter().filter(|p| p.sampler == l.sampler && p.precision == prec).collect();
-            let Some(last) = pts.last() else { continue };
+            let Some(last) = pts.last() else {
+                if let Some(u) = sweep.unavailable.iter().find(|u| u.sampler == l.sampler && u.precision == prec) {
+                    t += &format!("| {} | {} | unavailable: {} | | | | |\n", l.sampler, prec.name(), u.reason);
+                }
+                continue;
+            };
             let first_fail = pts.iter().find(|p| p.p_value < 0.01);
             let passes = pts.iter().take_while(|p| p.p_value >= 0.01).last();
             t += &format!(

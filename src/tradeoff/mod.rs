@@ -85,6 +85,7 @@ impl Default for SweepSettings {
             samplers: vec![
                 Sampler { kind: LobeKind::Ward, method: Method::Ndf },
                 Sampler { kind: LobeKind::Beckmann, method: Method::Ndf },
+                Sampler { kind: LobeKind::Beckmann, method: Method::Vndf },
                 Sampler { kind: LobeKind::Ggx, method: Method::Ndf },
                 Sampler { kind: LobeKind::Ggx, method: Method::Vndf },
                 Sampler { kind: LobeKind::Ggx, method: Method::Bounded },
