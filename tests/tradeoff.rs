@@ -171,6 +171,7 @@ fn cli_writes_outputs_and_rejects_bad_input() {
         (&["tradeoff", "--incident-theta", "90"][..], "outside [0, 90)"),
         (&["tradeoff", "--long", "ggx"][..], "--long: 'ggx' is unknown"),
         (&["tradeoff", "--parts", "all"][..], "--parts: 'all' is unknown"),
+        (&["tradeoff", "--angle-samples", "16777216"][..], "--angle-samples"),
         (&["tradeoff", "--out", "Cargo.toml"][..], "exists and is not a folder"),
     ] {
         let out = lobes_bin(args);
