@@ -119,7 +119,8 @@ mod tests {
             b.record(i % 2, w);
         }
         assert_eq!(a, b);
-        assert_eq!(a.bins[1], to_fixed(1.5, WEIGHT_SCALE) + to_fixed(7.0, WEIGHT_SCALE));
+        assert_eq!(a.bins[1], to_fixed(1.5, WEIGHT_SCALE) + to_fixed(1e-7, WEIGHT_SCALE));
+        assert_eq!(a.bins[0], to_fixed(0.25, WEIGHT_SCALE) + to_fixed(3.0e6, WEIGHT_SCALE) + to_fixed(7.0, WEIGHT_SCALE));
         a.record(0, f64::NAN);
         a.record(0, 1e9);
         assert_eq!(a.overflow, 2);
