@@ -1,5 +1,5 @@
-// f64 twins of the samplers that `lobes tradeoff` sweeps (Ward, Beckmann NDF, GGX NDF, spherical
-// caps and bounded VNDF), each line by line the same algebra as src/reference (ward.rs,
+// f64 twins of the samplers that `lobes tradeoff` sweeps (Ward, Beckmann NDF and visible normals,
+// GGX NDF, spherical caps and bounded VNDF), each line by line the same algebra as src/reference (ward.rs,
 // beckmann.rs sample_ndf, ggx.rs, microfacet.rs, reflect.rs), plus f64 binning
 // (src/stats/histogram.rs). Appended by src/tradeoff/variants.rs to a composed f32 kernel, whose
 // `draw` and `explicit_samples` it replaces (the host prepends A64, WI64 and SAMPLE64).
@@ -111,7 +111,7 @@ fn exp_neg64(x: f64) -> f64 {
     if (x < -745.0lf) {
         return 0.0lf;
     }
-    let k = floor(x / LN2_HI64 + 0.5lf);
+    let k = floor(x * 1.4426950408889634lf + 0.5lf); // x / ln 2 (only picks k)
     let r = (x - k * LN2_HI64) - k * LN2_LO64;
     var p = 1.0lf / 87178291200.0lf;              // 1/14!
     p = p * r + 1.0lf / 6227020800.0lf;

@@ -52,11 +52,20 @@ pub struct TradeoffArgs {
     /// one dispatch, its output within a 128 MiB storage binding).
     #[arg(long, default_value_t = 1 << 18, value_parser = clap::value_parser!(u32).range(1..=1 << 22))]
     pub angle_samples: u32,
+    /// Longest predicted time of one sweep point, in seconds (the previous point's time per
+    /// sample × N); longer points are skipped and listed as such.
+    #[arg(long, value_name = "S", default_value_t = 20.0, value_parser = parse_seconds)]
+    pub max_seconds: f64,
     /// Timed runs per measurement; medians are reported (1 ..= 99).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=99))]
     pub runs: u32,
     #[command(flatten)]
     pub output: OutputArgs,
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    let x = super::parse_number(s)?;
+    if x.is_finite() && x > 0.0 { Ok(x) } else { Err(format!("{x} is not a time limit; give a number of seconds > 0")) }
 }
 
 fn parse_theta(s: &str) -> Result<f64, String> {
@@ -111,6 +120,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         seed: args.seed,
         angle_samples: args.angle_samples,
         runs: args.runs as usize,
+        max_point_seconds: args.max_seconds,
     };
     let has = |p: &str| parts.iter().any(|x| x == p);
     let sweep = if has("sweep") { tradeoff::sweep(&mut engine, &sweep_settings, &mut log)? } else { Default::default() };

@@ -63,6 +63,15 @@ pub fn sweep_table(sweep: &Sweep) -> String {
                 sci(p.angle.max_angle_rad),
             );
         }
+        for k in sweep.skipped.iter().filter(|k| k.sampler == name) {
+            t += &format!(
+                "| {} | {} | {} | skipped: ~{:.0} s predicted, over --max-seconds | | | | | | | |\n",
+                k.sampler,
+                k.precision.name(),
+                pow2(k.samples),
+                k.predicted_seconds
+            );
+        }
         for u in sweep.unavailable.iter().filter(|u| u.sampler == name) {
             t += &format!("| {} | {} | – | unavailable: {} | | | | | | | |\n", u.sampler, u.precision.name(), u.reason);
         }

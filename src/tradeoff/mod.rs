@@ -77,6 +77,9 @@ pub struct SweepSettings {
     pub angle_samples: u32,
     /// Timed runs per point; the median time is reported (the counts of every run must agree).
     pub runs: usize,
+    /// A point whose predicted time (the previous point's seconds per sample × N) exceeds this
+    /// is not run but reported as skipped.
+    pub max_point_seconds: f64,
 }
 
 impl Default for SweepSettings {
@@ -101,6 +104,7 @@ impl Default for SweepSettings {
             seed: 1,
             angle_samples: 1 << 18,
             runs: 1,
+            max_point_seconds: 20.0,
         }
     }
 }
@@ -169,11 +173,22 @@ pub struct SweepLobe {
     pub quadrature_max_error_sigma_at_1e8: f64,
 }
 
+/// A point not run because it would take longer than the limit.
+#[derive(Debug, Clone, Serialize)]
+pub struct Skipped {
+    pub sampler: String,
+    pub precision: Precision,
+    pub samples: u64,
+    /// The previous point's seconds per sample × this N (one run).
+    pub predicted_seconds: f64,
+}
+
 #[derive(Debug, Clone, Serialize, Default)]
 pub struct Sweep {
     pub lobes: Vec<SweepLobe>,
     pub points: Vec<SweepPoint>,
     pub unavailable: Vec<Unavailable>,
+    pub skipped: Vec<Skipped>,
 }
 
 /// Cell probabilities (bins, then the invalid reasons) of a lobe job.
@@ -278,7 +293,9 @@ pub fn sweep(engine: &mut GpuEngine, set: &SweepSettings, log: &mut dyn FnMut(&s
             engine.rewrite = prec.rewrite();
             let result = sweep_one(engine, set, s, &job, &p, prec, log);
             engine.rewrite = None;
-            out.points.extend(result?);
+            let (points, skipped) = result?;
+            out.points.extend(points);
+            out.skipped.extend(skipped);
         }
     }
     Ok(out)
@@ -292,11 +309,20 @@ fn sweep_one(
     p: &[f64],
     prec: Precision,
     log: &mut dyn FnMut(&str),
-) -> anyhow::Result<Vec<SweepPoint>> {
+) -> anyhow::Result<(Vec<SweepPoint>, Vec<Skipped>)> {
     engine.histogram(job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?; // compile and warm up
     let angle = angle_error(engine, job, set.seed, set.angle_samples, prec)?;
-    let mut points = Vec::new();
+    let mut points: Vec<SweepPoint> = Vec::new();
+    let mut skipped = Vec::new();
     for n in set.counts(s) {
+        if let Some(last) = points.last() {
+            let predicted = last.seconds() / last.samples as f64 * n as f64;
+            if predicted > set.max_point_seconds {
+                log(&format!("{} {} 2^{}: skipped, ~{predicted:.0} s predicted (limit {} s)", s.name(), prec.name(), n.trailing_zeros(), set.max_point_seconds));
+                skipped.push(Skipped { sampler: s.name(), precision: prec, samples: n, predicted_seconds: predicted });
+                continue;
+            }
+        }
         let (r, wall_seconds, gpu_seconds) = timed_histogram(engine, job, set.seed, n, set.runs)?;
         anyhow::ensure!(r.counts.total() == n, "{} {}: {} samples counted for {n}", s.name(), prec.name(), r.counts.total());
         let expected: Vec<f64> = p.iter().map(|q| q * n as f64).collect();
@@ -329,7 +355,7 @@ fn sweep_one(
         ));
         points.push(point);
     }
-    Ok(points)
+    Ok((points, skipped))
 }
 
 /// The median of `v` (upper median for an even count).
