@@ -1,7 +1,7 @@
 //! `lobes shader SCENE [--case NAME]`: the composed WGSL that `lobes run` compiles for each
 //! case, once per distinct module, with the override constants its pipelines are made with.
 
-use super::{emit, usage};
+use super::{OutputArgs, emit, emit_json, usage};
 use crate::gpu::GpuEngine;
 use crate::gpu::effects::{self, Composed};
 use clap::Args;
@@ -14,6 +14,8 @@ pub struct ShaderArgs {
     /// Print only this case's module.
     #[arg(long)]
     pub case: Option<String>,
+    #[command(flatten)]
+    pub output: OutputArgs,
 }
 
 pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
@@ -43,6 +45,16 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
             Some((_, names)) => names.push(&case.name),
             None => modules.push((m, vec![&case.name])),
         }
+    }
+    if args.output.json {
+        let list: Vec<serde_json::Value> = modules
+            .iter()
+            .map(|(m, names)| {
+                let constants: serde_json::Map<String, serde_json::Value> = m.constants.iter().map(|(k, v)| (k.to_string(), (*v).into())).collect();
+                serde_json::json!({"cases": names, "constants": constants, "source": m.source})
+            })
+            .collect();
+        return emit_json(&serde_json::json!({"scene": scene.file, "modules": list}));
     }
     let mut text = String::new();
     for (m, names) in &modules {
