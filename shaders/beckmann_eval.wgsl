@@ -32,35 +32,25 @@ fn beckmann_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 
 // The density of wr under beckmann_sample_ndf: D(h) cos th_h / (4 |wr.h|).
 fn beckmann_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
+    let h = reflection_half_vector(wi, wr);
+    if (h.z <= 0.0) {
         return 0.0;
     }
-    let h = normalize(s);
-    return beckmann_d(a, h) * max(h.z, 0.0) / (4.0 * abs(dot(wr, h)));
+    return beckmann_d(a, h) * h.z / (4.0 * abs(dot(wr, h)));
 }
 
 // The density of wr under beckmann_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|),
-// with G1 / cos th = 1 / (cos th + cos th Lambda), cos th Lambda = -cos th erfc(x)/2 + a_w e^{-x^2}/(2 sqrt(pi)),
-// a_w = |(ax wx, ay wy)|, x = cos th / a_w: finite at grazing incidence.
+// with G1 / cos th_i in its grazing-stable form (beckmann_g1_over_cos).
 fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
+    let h = reflection_half_vector(wi, wr);
+    if (h.z <= 0.0) {
         return 0.0;
     }
-    let h = normalize(s);
     let cos_ih = dot(wi, h);
-    if (h.z <= 0.0 || cos_ih <= 0.0) {
+    if (cos_ih <= 0.0) {
         return 0.0;
     }
-    let aw = length(a * wi.xy);
-    let c = wi.z;
-    var g1_over_cos = 1.0 / c;
-    if (c <= 10.0 * aw) {
-        let x = c / aw;
-        g1_over_cos = 1.0 / (c - 0.5 * c * erfc_approx(x) + 0.5 * aw * exp(-x * x) * INV_SQRT_PI);
-    }
-    return g1_over_cos * cos_ih * beckmann_d(a, h) / (4.0 * abs(dot(wr, h)));
+    return beckmann_g1_over_cos(a, wi) * cos_ih * beckmann_d(a, h) / (4.0 * abs(dot(wr, h)));
 }
 
 // Smith's G1(w) = cos th (G1 / cos th), in the form that stays finite at grazing angles.

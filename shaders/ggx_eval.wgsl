@@ -31,11 +31,7 @@ fn ggx_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 
 // The density of wr under ggx_sample_ndf: D(h) cos th_h / (4 |wr.h|).
 fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
-        return 0.0;
-    }
-    let h = normalize(s);
+    let h = reflection_half_vector(wi, wr);
     if (h.z <= 0.0) {
         return 0.0;
     }
@@ -46,13 +42,12 @@ fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 // (Heitz 2014, eq. 38, through the reflection Jacobian), with G1(wi) / cos th_i = 2 / (cos th_i + t),
 // t = |(ax wi.x, ay wi.y, wi.z)|, which stays finite at grazing incidence.
 fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
+    let h = reflection_half_vector(wi, wr);
+    if (h.z <= 0.0) {
         return 0.0;
     }
-    let h = normalize(s);
     let cos_ih = dot(wi, h);
-    if (h.z <= 0.0 || cos_ih <= 0.0) {
+    if (cos_ih <= 0.0) {
         return 0.0;
     }
     let g1_over_cos = 2.0 / (wi.z + length(vec3<f32>(a * wi.xy, wi.z)));
@@ -62,11 +57,7 @@ fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 // The density of wr under ggx_sample_bounded (Eto & Tokuyoshi 2023, listing 2):
 // D(h) / (2 (k wi.z + t)).
 fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
-        return 0.0;
-    }
-    let h = normalize(s);
+    let h = reflection_half_vector(wi, wr);
     if (h.z <= 0.0) {
         return 0.0;
     }

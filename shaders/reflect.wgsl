@@ -25,6 +25,18 @@ fn reflect_sample(wi: vec3<f32>, h: vec3<f32>, pdf_h: f32) -> LobeSample {
     return lobe_sample(wi, h, wr, pdf_h / (4.0 * abs(dot(wr, h))));
 }
 
+// The half vector of the reflection wi -> wr where both are counted (wi.z >= 0, wr.z > 0,
+// wr != -wi, h above the horizon), else vec3(0): every density of wr is 0 there, as in
+// src/reference (Lobe::pdf_r and reflect::half_vector).
+fn reflection_half_vector(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+    let s = wi + wr;
+    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let h = normalize(s);
+    return select(vec3<f32>(0.0), h, h.z > 0.0);
+}
+
 // Unit vector with polar tangent t and unit azimuth (c, s): cos = 1/sqrt(1+t^2), sin = t cos.
 // Past t = 1e18 (t^2 would overflow f32) cos = 1/t and sin = 1, the same limit without inf.
 fn from_tan_theta(t: f32, c: f32, s: f32) -> vec3<f32> {

@@ -16,11 +16,10 @@ fn ward_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
 // The density of wr under ward_sample: p(h) / (4 |wr.h|) (Walter 2005, eq. 9); 0 for wr at or
 // below the horizon and for wi below it.
 fn ward_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    let s = wi + wr;
-    if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
+    let h = reflection_half_vector(wi, wr);
+    if (h.z <= 0.0) {
         return 0.0;
     }
-    let h = normalize(s);
     return ward_pdf_h(a, h) / (4.0 * abs(dot(wr, h)));
 }
 

@@ -46,8 +46,8 @@ pub fn sample_fn(kind: LobeKind, method: Method) -> &'static str {
     }
 }
 
-/// The modules a lobe needs, in order.
-fn lobe_modules(kind: LobeKind) -> &'static [&'static str] {
+/// The modules a lobe's samplers need, in order.
+pub(crate) fn lobe_modules(kind: LobeKind) -> &'static [&'static str] {
     match kind {
         LobeKind::Ward => &[sources::WARD],
         LobeKind::Beckmann => &[sources::MICROFACET, sources::BECKMANN],
@@ -89,7 +89,7 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
 }
 
 /// The constants, the RNG, binning and counting kernels every job's module starts with.
-fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
+pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
@@ -109,7 +109,7 @@ fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     src
 }
 
-fn push_all(src: &mut String, parts: &[&str]) {
+pub(crate) fn push_all(src: &mut String, parts: &[&str]) {
     for part in parts {
         src.push_str(part);
         src.push('\n');

@@ -89,12 +89,13 @@ fn sampler_glue(kind: LobeKind, method: Method) -> SamplerGlue {
     SamplerGlue { weight, eval, g1, pdf }
 }
 
-/// The shader files of a lobe's samplers and of its eval/pdf/weight functions.
-fn lobe_files(kind: LobeKind) -> &'static [&'static str] {
+/// The file of a lobe's BRDF, pdf and weight functions (its samplers' files are
+/// [`compose::lobe_modules`], already in the counting module).
+fn eval_file(kind: LobeKind) -> &'static str {
     match kind {
-        LobeKind::Ward => &[sources::WARD, sources::WARD_EVAL],
-        LobeKind::Beckmann => &[sources::MICROFACET, sources::BECKMANN, sources::BECKMANN_EVAL],
-        LobeKind::Ggx => &[sources::MICROFACET, sources::GGX, sources::GGX_EVAL],
+        LobeKind::Ward => sources::WARD_EVAL,
+        LobeKind::Beckmann => sources::BECKMANN_EVAL,
+        LobeKind::Ggx => sources::GGX_EVAL,
     }
 }
 
@@ -209,10 +210,8 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
         Specialisation::Specialised => {
             let mut source = compose::compose(job, workgroup_words);
             source.push('\n');
-            for part in &lobe_files(lobe.kind)[lobe_modules_len(lobe.kind)..] {
-                source.push_str(part);
-                source.push('\n');
-            }
+            source.push_str(eval_file(lobe.kind));
+            source.push('\n');
             let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
             source.push_str("override ANISOTROPIC: bool = true;\n");
             let fresnel = effects.fresnel != Fresnel::None;
@@ -247,36 +246,13 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
     }
 }
 
-/// How many of `lobe_files(kind)` the counting module already holds (the samplers).
-fn lobe_modules_len(kind: LobeKind) -> usize {
-    if kind == LobeKind::Ward { 1 } else { 2 }
-}
-
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
-    let Job::Lobe { grid, .. } = job else { panic!("effects apply to lobe jobs only") };
-    // The counting module of any lobe job on this grid, with the sampler switched at run time.
-    let mut source = compose::compose(job, workgroup_words);
-    let cut = source.find("// Glue for a lobe job").expect("the lobe kernel's glue");
-    source.truncate(cut);
-    source = source.replacen(&format!("// Composed by lobes for {}", compose::describe(job)), &format!("// Composed by lobes: the uber-kernel on a {}x{} grid", grid.rows, grid.cols), 1);
-    for part in [
-        sources::WARD,
-        sources::WARD_EVAL,
-        sources::MICROFACET,
-        sources::GGX,
-        sources::GGX_EVAL,
-        sources::BECKMANN,
-        sources::BECKMANN_EVAL,
-        sources::FRESNEL,
-        sources::MASKING,
-    ] {
-        if !source.contains(part) {
-            source.push_str(part);
-            source.push('\n');
-        }
-    }
+    let mut source = compose::header(job, workgroup_words, job.bins() as u32);
+    source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
+    compose::push_all(&mut source, &[sources::MICROFACET, sources::WARD, sources::GGX, sources::BECKMANN]);
+    compose::push_all(&mut source, &[sources::WARD_EVAL, sources::GGX_EVAL, sources::BECKMANN_EVAL, sources::FRESNEL, sources::MASKING]);
     source.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", "sampler_sample"));
     source.push_str(&samplers_glue(&SAMPLERS, true));
     source.push_str(&fresnel_glue(Some("effect.modes.y")));

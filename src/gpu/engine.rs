@@ -299,7 +299,8 @@ impl GpuEngine {
         (make("discrete f32", bytemuck::cast_slice(&f)), make("discrete u32", bytemuck::cast_slice(&u)))
     }
 
-    pub(super) fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    /// A buffer of at least `size` bytes (16 at the least), not mapped.
+    pub(crate) fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
         self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
     }
 
@@ -559,7 +560,8 @@ impl GpuEngine {
         })
     }
 
-    pub(super) fn timestamp_buffers(&self, n: u32) -> (wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer) {
+    /// A timestamp query set of `n` queries with its resolve and read-back buffers.
+    pub(crate) fn timestamp_buffers(&self, n: u32) -> (wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer) {
         let set = self.gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("timestamps"), ty: wgpu::QueryType::Timestamp, count: n });
         let resolve = self.buffer("timestamps", n as u64 * 8, wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
         let read = self.buffer("timestamps read", n as u64 * 8, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
@@ -572,7 +574,7 @@ impl GpuEngine {
     }
 
     /// Copies the first `size` bytes of `src` to the host.
-    pub(super) fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+    pub(crate) fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
         let staging = if src.usage().contains(wgpu::BufferUsages::MAP_READ) {
             src.clone()
         } else {

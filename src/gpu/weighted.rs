@@ -130,6 +130,8 @@ impl GpuEngine {
     ) -> Result<WeightedRun, GpuError> {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
+        // 2 words (lo, hi) per cell: the bins, the 4 invalid reasons, then Σw² over the bins,
+        // Σw² over all samples and the overflow count (`shaders/weighted.wgsl`).
         let words = 2 * (bins + 4 + 3);
         if words * 4 > self.gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::TooLarge(format!(

@@ -52,29 +52,21 @@ fn beckmann(l: &Lobe) -> Beckmann {
     Beckmann { ax: l.alpha_x, ay: l.alpha_y }
 }
 
-/// D(h) and the G1 values of ωi and ωr, for a microfacet lobe.
-fn microfacet_terms(l: &Lobe, wi: DVec3, wr: DVec3, h: DVec3) -> (f64, f64, f64) {
-    let g1 = |m: &dyn Fn(DVec3) -> f64| (m(wi), m(wr));
+/// D(h) of a microfacet lobe.
+fn d(l: &Lobe, h: DVec3) -> f64 {
     match l.kind {
-        LobeKind::Ggx => {
-            let m = ggx(l);
-            let (gi, gr) = g1(&|w| m.g1(w));
-            (m.d(h), gi, gr)
-        }
-        LobeKind::Beckmann => {
-            let m = beckmann(l);
-            let (gi, gr) = g1(&|w| w.z.abs() * m.g1_over_cos(w));
-            (m.d(h), gi, gr)
-        }
+        LobeKind::Ggx => ggx(l).d(h),
+        LobeKind::Beckmann => beckmann(l).d(h),
         LobeKind::Ward => unreachable!("Ward is not a microfacet lobe"),
     }
 }
 
-/// G1(ωi) of a microfacet lobe, in its grazing-stable form.
-fn g1_incident(l: &Lobe, wi: DVec3) -> f64 {
+/// Smith's G1(ω) of a microfacet lobe in its grazing-stable form (|cos θ| for ω below the
+/// horizon); 1 for Ward, which has no masking.
+fn g1(l: &Lobe, w: DVec3) -> f64 {
     match l.kind {
-        LobeKind::Ggx => ggx(l).g1(wi),
-        LobeKind::Beckmann => wi.z * beckmann(l).g1_over_cos(wi),
+        LobeKind::Ggx => ggx(l).g1(w),
+        LobeKind::Beckmann => w.z.abs() * beckmann(l).g1_over_cos(w),
         LobeKind::Ward => 1.0,
     }
 }
@@ -89,10 +81,7 @@ impl Effects {
         let f = self.fresnel.reflectance(wi.dot(h));
         match l.kind {
             LobeKind::Ward => f * ward::eval(l.alpha_x, l.alpha_y, wi, wr),
-            _ => {
-                let (d, gi, gr) = microfacet_terms(l, wi, wr, h);
-                f * d * self.masking.g(gi, gr) / (4.0 * wi.z * wr.z)
-            }
+            _ => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
         }
     }
 
@@ -108,11 +97,10 @@ impl Effects {
         if l.kind == LobeKind::Ward {
             return f * wi.dot(h).max(0.0) * h.z.powi(3) * (wr.z.abs() / wi.z).sqrt();
         }
-        let (_, gi, gr) = microfacet_terms(l, wi, wr, h);
-        let g = self.masking.g(gi, gr);
+        let g = self.masking.g(g1(l, wi), g1(l, wr));
         let base = match l.method {
             Method::Ndf => wi.dot(h).max(0.0) / (wi.z * h.z),
-            Method::Vndf => 1.0 / g1_incident(l, wi),
+            Method::Vndf => 1.0 / g1(l, wi),
             Method::Bounded => {
                 let m = ggx(l);
                 let t = DVec3::new(l.alpha_x * wi.x, l.alpha_y * wi.y, wi.z).length();

@@ -78,7 +78,7 @@ pub fn direction(z: f64, phi: f64) -> DVec3 {
 
 /// 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30).
 const GL3_X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
-const GL3_W: [f64; 3] = [0.555_555_555_555_555_6, 0.888_888_888_888_888_9, 0.555_555_555_555_555_6];
+const GL3_W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
 
 /// The tensor Gauss–Legendre rule with nodes `x` and weights `w` on `r`.
 fn rule(f: &impl Fn(f64, f64) -> f64, r: Rect, x: &[f64], w: &[f64]) -> f64 {

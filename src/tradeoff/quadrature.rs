@@ -156,18 +156,7 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
         contents: bytemuck::cast_slice(&nodes),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let out = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("probabilities"),
-        size: bins * 4,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let read = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("probabilities read"),
-        size: bins * 4,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let out = engine.buffer("probabilities", bins * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("quadrature"),
         layout: &pipeline.get_bind_group_layout(0),
@@ -177,22 +166,7 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
             wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() },
         ],
     });
-    let stamps = gpu.has_timestamps().then(|| {
-        let set = device.create_query_set(&wgpu::QuerySetDescriptor { label: None, ty: wgpu::QueryType::Timestamp, count: 2 });
-        let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size: 16,
-            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let read = device.create_buffer(&wgpu::BufferDescriptor {
-            label: None,
-            size: 16,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        (set, resolve, read)
-    });
+    let stamps = gpu.has_timestamps().then(|| engine.timestamp_buffers(2));
     let groups = bins.div_ceil(64);
     let max = gpu.limits.max_compute_workgroups_per_dimension as u64;
     let (gx, gy) = (groups.min(max) as u32, groups.div_ceil(max) as u32);
@@ -209,28 +183,16 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
         pass.set_bind_group(0, &bind, &[]);
         pass.dispatch_workgroups(gx, gy, 1);
     }
-    encoder.copy_buffer_to_buffer(&out, 0, &read, 0, bins * 4);
     if let Some((set, resolve, rd)) = &stamps {
         encoder.resolve_query_set(set, 0..2, resolve, 0);
         encoder.copy_buffer_to_buffer(resolve, 0, rd, 0, 16);
     }
     gpu.queue.submit([encoder.finish()]);
-    let map = |buf: &wgpu::Buffer| -> Result<Vec<u8>, GpuError> {
-        let (tx, rx) = std::sync::mpsc::channel();
-        buf.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Lost(e.to_string()))?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-        let data = buf.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?.to_vec();
-        buf.unmap();
-        Ok(data)
-    };
-    let probabilities: Vec<f32> = bytemuck::cast_slice(&map(&read)?).to_vec();
+    let probabilities: Vec<f32> = bytemuck::cast_slice(&engine.read(&out, bins * 4)?).to_vec();
     let wall_seconds = start.elapsed().as_secs_f64();
     let gpu_seconds = match &stamps {
         Some((_, _, rd)) => {
-            let t: Vec<u64> = bytemuck::cast_slice(&map(rd)?).to_vec();
+            let t: Vec<u64> = bytemuck::cast_slice(&engine.read(rd, 16)?).to_vec();
             Some(t[1].saturating_sub(t[0]) as f64 * gpu.queue.get_timestamp_period() as f64 * 1e-9)
         }
         None => None,
