@@ -292,7 +292,7 @@ pub struct Report {
 
 /// Computes the table on the GPU, writes it to `dir`, and compares it with the f64 quadrature.
 pub fn run(dir: &Path) -> anyhow::Result<Report> {
-    let gpu = lobes::gpu::Gpu::new()?;
+    let gpu = lobes::engine::gpu::Gpu::new()?;
     let t = std::time::Instant::now();
     let lut = dfg_gpu(&gpu.device, &gpu.queue, SAMPLES)?;
     let gpu_seconds = t.elapsed().as_secs_f64();

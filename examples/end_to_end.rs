@@ -9,8 +9,8 @@
 //! GPU adapter opens.
 
 use glam::DVec3;
-use lobes::gpu::GpuEngine;
-use lobes::job::{DiscreteMethod, Job};
+use lobes::engine::gpu::GpuEngine;
+use lobes::engine::job::{DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::chi2::sidak;

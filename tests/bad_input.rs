@@ -201,7 +201,7 @@ fn check_outcome(text: &str, result: Result<Scene, SceneError>) {
             for c in &scene.cases {
                 assert!(c.samples >= 1 && c.samples <= lobes::scene::MAX_SAMPLES);
                 assert!(c.job.bins() >= 1 && c.job.bins() as u64 <= lobes::scene::MAX_BINS);
-                if let lobes::job::Job::Lobe { lobe, grid, .. } = &c.job {
+                if let lobes::engine::job::Job::Lobe { lobe, grid, .. } = &c.job {
                     assert!(lobe.alpha_x.is_finite() && lobe.alpha_x > 0.0 && lobe.alpha_y.is_finite() && lobe.alpha_y > 0.0);
                     assert!(grid.rows % 2 == 0);
                     assert!((0.0..90.0).contains(&c.incident_deg.0) && c.incident_deg.1.abs() <= 360.0);

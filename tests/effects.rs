@@ -2,9 +2,9 @@
 //! histograms whose albedo is judged against f64 quadrature and the weak white furnace, and the
 //! per-bin weight check. Each check is shown to reject a deliberately broken weight.
 
-use lobes::gpu::GpuEngine;
-use lobes::gpu::effects::{self, Composed, Specialisation};
-use lobes::job::Job;
+use lobes::engine::gpu::GpuEngine;
+use lobes::engine::gpu::effects::{self, Composed, Specialisation};
+use lobes::engine::job::Job;
 use lobes::reference::effects::Effects;
 use lobes::reference::fresnel::Fresnel;
 use lobes::reference::masking::Masking;
@@ -176,7 +176,7 @@ fn gpu_and_cpu_weighted_sums_agree() {
     let mut e = engine();
     let n = 1 << 20;
     let gpu = e.weighted(&j, &effects, 3, 0, n, Specialisation::Specialised).unwrap().sums;
-    let cpu = lobes::cpu::weighted(&j, &effects, 3, 0, n);
+    let cpu = lobes::engine::cpu::weighted(&j, &effects, 3, 0, n);
     let (a, b) = (gpu.albedo(n), cpu.albedo(n));
     assert!((a - b).abs() < 1e-5 * b, "GPU {a} vs CPU {b}");
     assert!(cpu.max_weight_error() < 1e-9, "f64 weight check: {}", cpu.max_weight_error());

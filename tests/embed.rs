@@ -12,8 +12,8 @@ mod end_to_end;
 
 use glam::DVec3;
 use lobes::embed::{self, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteTable, Module};
-use lobes::gpu::{Gpu, GpuEngine};
-use lobes::job::{DiscreteMethod, Job};
+use lobes::engine::gpu::{Gpu, GpuEngine};
+use lobes::engine::job::{DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, reflect, rng};
 use wgpu::util::DeviceExt;

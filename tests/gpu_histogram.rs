@@ -2,8 +2,8 @@
 //! A machine with no adapter fails these tests with the fix in the message.
 
 use glam::DVec3;
-use lobes::gpu::GpuEngine;
-use lobes::job::{Counts, DiscreteMethod, Job};
+use lobes::engine::gpu::GpuEngine;
+use lobes::engine::job::{Counts, DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect, ward};
 use lobes::stats::chi2::{self, sidak};
@@ -171,7 +171,7 @@ fn gpu_and_cpu_engines_agree_sample_by_sample() {
     let job = lobe_job(LobeKind::Beckmann, Method::Vndf, 0.4, 0.4, 60.0, 10.0);
     let n = 200_000;
     let g = run(&mut e, &job, 9, n);
-    let c = lobes::cpu::histogram(&job, 9, 0, n);
+    let c = lobes::engine::cpu::histogram(&job, 9, 0, n);
     let moved: u64 = g.bins.iter().zip(&c.bins).map(|(a, b)| a.abs_diff(*b)).sum();
     assert!(moved < n / 5000, "{moved} of {n} samples binned differently");
 }

@@ -5,9 +5,9 @@
 //!
 //! Like `gpu_histogram.rs`, these need a wgpu adapter (lavapipe in CI) and fail without one.
 
-use lobes::gpu::engine::Tiling;
-use lobes::gpu::{Gpu, GpuEngine, GpuError};
-use lobes::job::{Counts, DiscreteMethod, Job};
+use lobes::engine::gpu::engine::Tiling;
+use lobes::engine::gpu::{Gpu, GpuEngine, GpuError};
+use lobes::engine::job::{Counts, DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::histogram::SphereGrid;
@@ -48,7 +48,7 @@ fn discrete(n: usize, method: DiscreteMethod) -> Job {
     Job::Discrete { dist: Distribution::new(&w).unwrap(), method }
 }
 
-fn run(e: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> lobes::gpu::GpuRun {
+fn run(e: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> lobes::engine::gpu::GpuRun {
     let r = e.histogram(job, seed, 0, n, &mut |_| {}).unwrap_or_else(|err| panic!("{job:?}: {err}"));
     assert_eq!(r.counts.total(), n, "bins + invalid = samples");
     r

@@ -9,7 +9,7 @@ use std::process::{Command, Output};
 const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
 
 fn require_gpu() {
-    if let Err(e) = lobes::gpu::GpuEngine::open() {
+    if let Err(e) = lobes::engine::gpu::GpuEngine::open() {
         panic!("GPU tests need a wgpu adapter: {e}");
     }
 }

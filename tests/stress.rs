@@ -1,8 +1,8 @@
 //! The stability suite (`lobes stress`) as tests: every sampler at the inputs where naive
 //! formulas break, on the GPU (f32) and the CPU (f64), plus the discrete hard cases.
 
-use lobes::gpu::GpuEngine;
-use lobes::job::{DiscreteMethod, Job};
+use lobes::engine::gpu::GpuEngine;
+use lobes::engine::job::{DiscreteMethod, Job};
 use lobes::reference::discrete::Distribution;
 use lobes::stats::compare;
 use lobes::stats::expected::Quadrature;
@@ -14,8 +14,8 @@ fn engine() -> GpuEngine {
 #[test]
 fn every_sampler_is_stable_at_the_hard_inputs() {
     let mut e = engine();
-    let rows = lobes::stress::run_all(Some(&mut e)).unwrap();
-    assert_eq!(rows.len(), 2 * lobes::stress::cases().len());
+    let rows = lobes::experiments::stress::run_all(Some(&mut e)).unwrap();
+    assert_eq!(rows.len(), 2 * lobes::experiments::stress::cases().len());
     let failed: Vec<_> = rows.iter().filter(|r| !r.passed).map(|r| format!("{} [{}]", r.case, r.kernel)).collect();
     assert!(failed.is_empty(), "unstable: {failed:?}");
     // the suite exercises invalid samples too (u at 0 and 1, grazing and below-horizon light)
@@ -65,7 +65,7 @@ fn tables_beyond_f32_resolution() {
         let (dist, c) = gpu_counts(&mut e, &w, method, samples);
         let job = Job::Discrete { dist, method };
         let exp = compare::expected_counts(&job, samples, &Quadrature::default());
-        let counts = lobes::job::Counts { bins: c, invalid: [0; 4] };
+        let counts = lobes::engine::job::Counts { bins: c, invalid: [0; 4] };
         let t = compare::chi2_test(&counts, &exp, 0.001);
         assert!(t.passed, "{method:?}: χ² {} / {} p {}", t.statistic, t.dof, t.p_value);
         // the last entry, beyond 2^24, is reached
@@ -115,7 +115,7 @@ fn binning_at_edges_poles_and_the_seam() {
 #[test]
 fn random_search_beyond_the_listed_cases() {
     use lobes::reference::{Lobe, reflect, rng};
-    use lobes::stress::{SAMPLERS as samplers, StressCase, run_case};
+    use lobes::experiments::stress::{SAMPLERS as samplers, StressCase, run_case};
     let mut e = engine();
     let mut failed = Vec::new();
     for i in 0..120u64 {

@@ -2,12 +2,12 @@
 //! f64 kernels, the L1-against-N behaviour and the GPU quadrature. A machine with no adapter
 //! fails these tests with the fix in the message.
 
-use lobes::gpu::GpuEngine;
+use lobes::engine::gpu::GpuEngine;
 use lobes::reference::{LobeKind, Method, reflect};
 use lobes::stats::chi2;
 use lobes::stats::compare;
 use lobes::stats::expected::Quadrature;
-use lobes::tradeoff::{self, Precision, Sampler, quadrature};
+use lobes::experiments::tradeoff::{self, Precision, Sampler, quadrature};
 use std::process::Command;
 
 fn engine() -> GpuEngine {

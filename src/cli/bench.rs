@@ -2,9 +2,9 @@
 //! method and backend. Medians of several runs.
 
 use super::{OutputArgs, emit, emit_json};
-use crate::cpu;
-use crate::gpu::GpuEngine;
-use crate::job::Job;
+use crate::engine::cpu;
+use crate::engine::gpu::GpuEngine;
+use crate::engine::job::Job;
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use clap::Args;
@@ -96,7 +96,7 @@ pub struct EffectsResult {
 }
 
 fn run_effects(args: &BenchArgs, scene: &std::path::PathBuf) -> anyhow::Result<()> {
-    use crate::gpu::effects::Specialisation::{Specialised, Uber};
+    use crate::engine::gpu::effects::Specialisation::{Specialised, Uber};
     let scene = super::run::load_scene(Some(scene))?;
     let runs = args.runs.max(1);
     let mut engine = GpuEngine::open()?;

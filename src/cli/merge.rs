@@ -16,7 +16,7 @@
 //! else.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::job::{Counts, Job};
+use crate::engine::job::{Counts, Job};
 use crate::reference::Invalid;
 use crate::report::output;
 use crate::run::{self, ANGLE_CHECK_SAMPLES, Backend, CaseResult};

@@ -2,7 +2,7 @@
 //! the f64 reference, with per-case outputs and a table.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::gpu::GpuError;
+use crate::engine::gpu::GpuError;
 use crate::report::output;
 use crate::run::{Backend, run_case};
 use crate::scene::{DEFAULT_SCENE, Scene};

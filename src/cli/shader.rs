@@ -2,8 +2,8 @@
 //! case, once per distinct module, with the override constants its pipelines are made with.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::gpu::GpuEngine;
-use crate::gpu::effects::{self, Composed};
+use crate::engine::gpu::GpuEngine;
+use crate::engine::gpu::effects::{self, Composed};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -2,8 +2,8 @@
 //! verdict; exits non-zero if any row fails.
 
 use super::{OutputArgs, emit, emit_json};
-use crate::gpu::GpuEngine;
-use crate::stress;
+use crate::engine::gpu::GpuEngine;
+use crate::experiments::stress;
 use clap::Args;
 
 #[derive(Debug, Clone, Args)]

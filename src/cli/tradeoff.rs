@@ -1,10 +1,10 @@
 //! `lobes tradeoff`: samples × precision, spherical caps against bounded VNDF, and the expected
-//! histogram's quadrature, each against its cost (see [`crate::tradeoff`]).
+//! histogram's quadrature, each against its cost (see [`crate::experiments::tradeoff`]).
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::gpu::GpuEngine;
+use crate::engine::gpu::GpuEngine;
 use crate::report::tradeoff::{self as report, Report};
-use crate::tradeoff::{self, MethodSettings, Precision, Sampler, SweepSettings};
+use crate::experiments::tradeoff::{self, MethodSettings, Precision, Sampler, SweepSettings};
 use clap::Args;
 use std::path::PathBuf;
 

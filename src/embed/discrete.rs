@@ -1,6 +1,6 @@
 //! Uploading a discrete distribution for `shaders/discrete.wgsl`.
 
-use crate::job::DiscreteMethod;
+use crate::engine::job::DiscreteMethod;
 use crate::reference::discrete::{self, AliasTable, Distribution};
 
 /// Items per block of the two-level CDF, and the most items sampled with one uniform

@@ -32,7 +32,7 @@
 //! collide with each other, and declarations at WGSL module scope may come in any order, so a
 //! composed string is all that is needed. It is also exactly the code the χ² tests judge:
 //! [`Module::source`] returns the same `shaders/*.wgsl` text that the test kernels are built
-//! from (`crate::gpu::compose::sources`), plus the pdf, BRDF and estimator-weight functions of `shaders/*_eval.wgsl`,
+//! from (`crate::engine::gpu::compose::sources`), plus the pdf, BRDF and estimator-weight functions of `shaders/*_eval.wgsl`,
 //! which `tests/embed.rs` checks against the f64 reference on the GPU.
 //!
 //! The composed code defines, at module scope, the names listed on each [`Module`] (and a few
@@ -50,8 +50,8 @@ mod discrete;
 
 pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable};
 
-use crate::gpu::compose::sources;
-use crate::gpu::GpuError;
+use crate::engine::gpu::compose::sources;
+use crate::engine::gpu::GpuError;
 
 
 /// A WGSL module of lobes, as embedded by [`wgsl`]. The listed functions are the ones meant for
@@ -318,7 +318,7 @@ pub fn discrete_wgsl(bindings: DiscreteBindings) -> String {
 /// assert!(lobes::embed::validate("fn f() -> f32 { return ggx_d(vec2(0.1), vec3(0.0, 0.0, 1.0)); }").is_err());
 /// ```
 pub fn validate(source: &str) -> Result<(), GpuError> {
-    crate::gpu::compose::validate("embedded lobes WGSL", source).map(|_| ())
+    crate::engine::gpu::compose::validate("embedded lobes WGSL", source).map(|_| ())
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! so a case folder with a `histogram.json` is complete.
 
 use super::heatmap::{self, Heatmap, Scale};
-use crate::job::Job;
+use crate::engine::job::Job;
 use crate::reference::Invalid;
 use crate::run::CaseResult;
 use serde_json::{Value, json};

@@ -4,7 +4,7 @@
 
 use super::heatmap::{draw_text, fill_rect, text_width};
 use super::output::write_atomic;
-use crate::tradeoff::{MethodPoint, Precision, QuadraturePoint, Sweep, SweepPoint};
+use crate::experiments::tradeoff::{MethodPoint, Precision, QuadraturePoint, Sweep, SweepPoint};
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
 use serde::Serialize;

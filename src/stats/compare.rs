@@ -1,7 +1,7 @@
 //! Judging a histogram: the expected count of every cell (bins and invalid reasons), the χ²
 //! test over them, and the per-sample angular check of GPU directions against f64.
 
-use crate::job::{Counts, Job};
+use crate::engine::job::{Counts, Job};
 use crate::reference::Invalid;
 use crate::stats::chi2::{self, Chi2};
 use crate::stats::expected::{self, Expected, Quadrature};

@@ -1,5 +1,5 @@
 //! The kernel precisions that `lobes tradeoff` compares, as rewrites of the composed WGSL
-//! (installed with [`GpuEngine::rewrite`](crate::gpu::GpuEngine::rewrite)). The rewriting
+//! (installed with [`GpuEngine::rewrite`](crate::engine::gpu::GpuEngine::rewrite)). The rewriting
 //! happens here and nowhere else:
 //!
 //! - `f32-accurate`: the kernels as composed (`shaders/*.wgsl`), unchanged;
@@ -10,15 +10,15 @@
 //!   plus `shaders/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann) is appended and replaces the composed `draw` and `explicit_samples`, with the job's α and ωi
 //!   baked in as f64 constants (the kernel's uniform block carries them in f32 only).
 
-use crate::gpu::engine::Rewrite;
-use crate::job::Job;
+use crate::engine::gpu::engine::Rewrite;
+use crate::engine::job::Job;
 use crate::reference::{Lobe, LobeKind, Method};
 use serde::Serialize;
 use std::sync::Arc;
 
-pub const FASTMATH: &str = include_str!("../../shaders/fastmath.wgsl");
-pub const F64: &str = include_str!("../../shaders/f64.wgsl");
-pub const F64_BECKMANN: &str = include_str!("../../shaders/f64_beckmann.wgsl");
+pub const FASTMATH: &str = include_str!("../../../shaders/fastmath.wgsl");
+pub const F64: &str = include_str!("../../../shaders/f64.wgsl");
+pub const F64_BECKMANN: &str = include_str!("../../../shaders/f64_beckmann.wgsl");
 
 /// The arithmetic of a sampling kernel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]

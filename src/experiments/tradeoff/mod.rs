@@ -12,8 +12,8 @@ pub mod variants;
 
 pub use variants::Precision;
 
-use crate::gpu::GpuEngine;
-use crate::job::{Counts, Job};
+use crate::engine::gpu::GpuEngine;
+use crate::engine::job::{Counts, Job};
 use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
 use crate::stats::chi2;
 use crate::stats::compare::{self, ExpectedCounts, angle_between};
@@ -366,7 +366,7 @@ pub fn median(mut v: Vec<f64>) -> f64 {
 
 /// `runs` histograms of samples 0 .. n: the first run's result with the median wall and GPU
 /// times; every run must count exactly the same.
-fn timed_histogram(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64, runs: usize) -> anyhow::Result<(crate::gpu::GpuRun, f64, Option<f64>)> {
+fn timed_histogram(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64, runs: usize) -> anyhow::Result<(crate::engine::gpu::GpuRun, f64, Option<f64>)> {
     let first = engine.histogram(job, seed, 0, n, &mut |_| {})?;
     let (mut wall, mut gpu) = (vec![first.wall_seconds], first.gpu_seconds.map(|g| vec![g]));
     for _ in 1..runs.max(1) {

@@ -2,7 +2,7 @@
 
 use super::compose::{self, SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
-use crate::job::{Counts, DiscreteMethod, Job};
+use crate::engine::job::{Counts, DiscreteMethod, Job};
 use crate::reference::discrete::{self, AliasTable};
 use bytemuck::{Pod, Zeroable};
 use std::collections::HashMap;
@@ -87,10 +87,10 @@ pub struct GpuEngine {
     pub chunking: Chunking,
     /// Number of modules compiled so far (for tests of the cache).
     pub compiled: usize,
-    /// Pipelines of weighted histograms (`src/gpu/weighted.rs`).
+    /// Pipelines of weighted histograms (`src/engine/gpu/weighted.rs`).
     pub(super) weighted: super::weighted::WeightedPipelines,
     /// Rewrites each composed module before it is compiled (`None`: as composed); pipelines
-    /// are cached by the rewritten text. `lobes::tradeoff` sets it for its precision variants.
+    /// are cached by the rewritten text. `lobes::experiments::tradeoff` sets it for its precision variants.
     pub rewrite: Option<Rewrite>,
 }
 

@@ -1,15 +1,15 @@
 //! Running a case end to end: histogram on the GPU (or the CPU engine), expected counts in f64,
 //! the χ² verdict and the per-sample check.
 
-use crate::cpu;
-use crate::gpu::GpuEngine;
-use crate::job::{Counts, Job};
+use crate::engine::cpu;
+use crate::engine::gpu::GpuEngine;
+use crate::engine::job::{Counts, Job};
 use crate::scene::Case;
 use crate::stats::chi2::Chi2;
 use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::Quadrature;
 use crate::stats::weighted::{self, AlbedoCheck, WeightedSums};
-use crate::gpu::effects::Specialisation;
+use crate::engine::gpu::effects::Specialisation;
 use std::time::Instant;
 
 /// Samples regenerated on the CPU for the per-sample check.

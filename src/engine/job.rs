@@ -1,5 +1,5 @@
-//! What a histogram run samples, and what it returns. Shared by the GPU engine ([`crate::gpu`])
-//! and the CPU reference engine ([`crate::cpu`]).
+//! What a histogram run samples, and what it returns. Shared by the GPU engine ([`crate::engine::gpu`])
+//! and the CPU reference engine ([`crate::engine::cpu`]).
 
 use crate::reference::discrete::{AliasTable, Distribution};
 use crate::reference::{Invalid, Lobe};

@@ -4,7 +4,7 @@
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
 use crate::embed::{self, Module};
-use crate::gpu::{GpuEngine, GpuError};
+use crate::engine::gpu::{GpuEngine, GpuError};
 use crate::reference::{Lobe, LobeKind, Method};
 use crate::stats::expected::direction;
 use crate::stats::histogram::SphereGrid;
@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
-pub const QUADRATURE_WGSL: &str = include_str!("../../shaders/quadrature.wgsl");
+pub const QUADRATURE_WGSL: &str = include_str!("../../../shaders/quadrature.wgsl");
 
 /// The n-point Gauss–Legendre nodes and weights on [−1, 1]: the roots of Pₙ by Newton's method
 /// from Tricomi's first guess cos(π(i − ¼)/(n + ½)), Pₙ by its three-term recurrence, weights
@@ -124,7 +124,7 @@ pub struct GpuQuadrature {
 /// The n × n Gauss–Legendre probabilities of every bin on the GPU in f32.
 pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: SphereGrid, n: usize) -> Result<GpuQuadrature, GpuError> {
     let source = gpu_source(lobe, grid, n);
-    crate::gpu::compose::validate("tradeoff quadrature", &source)?;
+    crate::engine::gpu::compose::validate("tradeoff quadrature", &source)?;
     let gpu = &engine.gpu;
     let device = &gpu.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -27,7 +27,7 @@
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
 
-use crate::job::{DiscreteMethod, Job};
+use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::discrete::{Distribution, WeightsError};
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
@@ -40,9 +40,9 @@ use std::ops::Range;
 use toml::{Spanned, Value};
 
 /// The scene `lobes run` uses when no file is given: every lobe and method.
-pub const DEFAULT_SCENE: &str = include_str!("../scenes/all-lobes.toml");
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/all-lobes.toml");
 /// The tutorial's examples as a scene.
-pub const TUTORIAL_SCENE: &str = include_str!("../scenes/tutorial.toml");
+pub const TUTORIAL_SCENE: &str = include_str!("../../scenes/tutorial.toml");
 
 /// The largest sample count a case may ask for (2^40; counts are exact far beyond it).
 pub const MAX_SAMPLES: u64 = 1 << 40;

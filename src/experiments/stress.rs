@@ -7,8 +7,8 @@
 //! agrees with the CPU on validity (away from the horizon, where f32 and f64 may round to
 //! opposite sides) and on the direction to within [`DIRECTION_BOUND`].
 
-use crate::gpu::GpuEngine;
-use crate::job::Job;
+use crate::engine::gpu::GpuEngine;
+use crate::engine::job::Job;
 use crate::reference::{Invalid, Lobe, reflect, rng};
 use crate::stats::compare::angle_between;
 use crate::stats::histogram::SphereGrid;

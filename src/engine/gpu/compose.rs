@@ -2,30 +2,30 @@
 //! job needs, and validates it with naga before any pipeline is made.
 
 use super::context::GpuError;
-use crate::job::{DiscreteMethod, Job};
+use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::{LobeKind, Method};
 
 /// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
 /// `src/stats`).
 pub mod sources {
-    pub const RNG: &str = include_str!("../../shaders/rng.wgsl");
-    pub const REFLECT: &str = include_str!("../../shaders/reflect.wgsl");
-    pub const WARD: &str = include_str!("../../shaders/ward.wgsl");
-    pub const MICROFACET: &str = include_str!("../../shaders/microfacet.wgsl");
-    pub const GGX: &str = include_str!("../../shaders/ggx.wgsl");
-    pub const BECKMANN: &str = include_str!("../../shaders/beckmann.wgsl");
-    pub const DISCRETE: &str = include_str!("../../shaders/discrete.wgsl");
-    pub const HISTOGRAM: &str = include_str!("../../shaders/histogram.wgsl");
-    pub const KERNEL: &str = include_str!("../../shaders/kernel.wgsl");
-    pub const COUNTING_WORKGROUP: &str = include_str!("../../shaders/counting_workgroup.wgsl");
-    pub const COUNTING_GLOBAL: &str = include_str!("../../shaders/counting_global.wgsl");
-    pub const LOBE_KERNEL: &str = include_str!("../../shaders/lobe_kernel.wgsl");
-    pub const WARD_EVAL: &str = include_str!("../../shaders/ward_eval.wgsl");
-    pub const GGX_EVAL: &str = include_str!("../../shaders/ggx_eval.wgsl");
-    pub const BECKMANN_EVAL: &str = include_str!("../../shaders/beckmann_eval.wgsl");
-    pub const FRESNEL: &str = include_str!("../../shaders/fresnel.wgsl");
-    pub const MASKING: &str = include_str!("../../shaders/masking.wgsl");
-    pub const WEIGHTED: &str = include_str!("../../shaders/weighted.wgsl");
+    pub const RNG: &str = include_str!("../../../shaders/rng.wgsl");
+    pub const REFLECT: &str = include_str!("../../../shaders/reflect.wgsl");
+    pub const WARD: &str = include_str!("../../../shaders/ward.wgsl");
+    pub const MICROFACET: &str = include_str!("../../../shaders/microfacet.wgsl");
+    pub const GGX: &str = include_str!("../../../shaders/ggx.wgsl");
+    pub const BECKMANN: &str = include_str!("../../../shaders/beckmann.wgsl");
+    pub const DISCRETE: &str = include_str!("../../../shaders/discrete.wgsl");
+    pub const HISTOGRAM: &str = include_str!("../../../shaders/histogram.wgsl");
+    pub const KERNEL: &str = include_str!("../../../shaders/kernel.wgsl");
+    pub const COUNTING_WORKGROUP: &str = include_str!("../../../shaders/counting_workgroup.wgsl");
+    pub const COUNTING_GLOBAL: &str = include_str!("../../../shaders/counting_global.wgsl");
+    pub const LOBE_KERNEL: &str = include_str!("../../../shaders/lobe_kernel.wgsl");
+    pub const WARD_EVAL: &str = include_str!("../../../shaders/ward_eval.wgsl");
+    pub const GGX_EVAL: &str = include_str!("../../../shaders/ggx_eval.wgsl");
+    pub const BECKMANN_EVAL: &str = include_str!("../../../shaders/beckmann_eval.wgsl");
+    pub const FRESNEL: &str = include_str!("../../../shaders/fresnel.wgsl");
+    pub const MASKING: &str = include_str!("../../../shaders/masking.wgsl");
+    pub const WEIGHTED: &str = include_str!("../../../shaders/weighted.wgsl");
 }
 
 /// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
@@ -129,7 +129,7 @@ pub fn describe(job: &Job) -> String {
 pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
-    // FLOAT64 for lobes::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.
+    // FLOAT64 for lobes::experiments::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.
     let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
         .validate(&module)

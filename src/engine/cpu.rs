@@ -2,7 +2,7 @@
 //! the reference samplers on all cores. It serves where no GPU adapter exists, and as the CPU
 //! backend of the benchmark.
 
-use crate::job::{Counts, DiscreteMethod, Job};
+use crate::engine::job::{Counts, DiscreteMethod, Job};
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
 use crate::reference::discrete::AliasTable;
@@ -11,10 +11,10 @@ use rayon::prelude::*;
 /// Histograms samples `first .. first + samples` of the run keyed by `seed`.
 ///
 /// ```
-/// use lobes::{job::Job, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
+/// use lobes::{engine::job::Job, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
 /// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
 /// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } };
-/// let counts = lobes::cpu::histogram(&job, 1, 0, 10_000);
+/// let counts = lobes::engine::cpu::histogram(&job, 1, 0, 10_000);
 /// assert_eq!(counts.total(), 10_000);
 /// ```
 pub fn histogram(job: &Job, seed: u64, first: u64, samples: u64) -> Counts {

@@ -5,7 +5,7 @@ use super::compose::{SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use super::effects::{self, Composed, Specialisation};
 use super::engine::{GpuEngine, storage};
-use crate::job::Job;
+use crate::engine::job::Job;
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
 use bytemuck::{Pod, Zeroable};

@@ -13,7 +13,7 @@
 //! `effect` uniform.
 
 use super::compose::{self, sources};
-use crate::job::Job;
+use crate::engine::job::Job;
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
