@@ -10,7 +10,7 @@
 
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{DiscreteMethod, Job};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::chi2::sidak;
@@ -48,7 +48,7 @@ pub fn run(engine: &mut GpuEngine, samples: u64, seed: u64) -> anyhow::Result<Ve
     let mut out = Vec::new();
     for (name, job) in cases {
         // Samples 0 .. samples of the stream keyed by `seed`, histogrammed on the GPU.
-        let run = engine.histogram(&job, seed, 0, samples, &mut |_| {})?;
+        let run = engine.histogram(&job, SampleRange::whole(seed, samples), &mut |_| {})?;
         anyhow::ensure!(run.counts.total() == samples, "{name}: every sample is counted once");
         // N × (the pdf integrated over each bin), in f64.
         let expected = compare::expected_counts(&job, samples, &Quadrature::default());
@@ -57,7 +57,7 @@ pub fn run(engine: &mut GpuEngine, samples: u64, seed: u64) -> anyhow::Result<Ve
         // The first 4096 GPU directions against the f64 reference, sample by sample.
         let max_angle_rad = match job {
             Job::Lobe { .. } => {
-                let dirs = engine.directions(&job, seed, 0, 4096)?;
+                let dirs = engine.directions(&job, SampleRange::whole(seed, 4096))?;
                 Some(compare::angle_check(&job, seed, 0, &dirs).max_angle_rad)
             }
             Job::Discrete { .. } => None,

@@ -4,7 +4,7 @@
 
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::gpu::effects::{self, Composed, Specialisation};
-use lobes::engine::job::Job;
+use lobes::engine::job::{Job, SampleRange};
 use lobes::reference::effects::Effects;
 use lobes::reference::fresnel::Fresnel;
 use lobes::reference::masking::Masking;
@@ -79,7 +79,7 @@ fn pipelines_are_made_once_per_effect_set() {
     let scene = Scene::parse("many.toml", &scene).unwrap();
     let mut e = engine();
     for c in &scene.cases {
-        let r = e.weighted(&c.job, c.effects.as_ref().unwrap(), c.seed, 0, c.samples, Specialisation::Specialised).unwrap();
+        let r = e.weighted(&c.job, c.effects.as_ref().unwrap(), SampleRange::whole(c.seed, c.samples), Specialisation::Specialised).unwrap();
         assert_eq!(r.sums.overflow, 0);
     }
     assert_eq!(e.weighted_pipelines_built(), 2, "101 cases of two effect sets");
@@ -87,7 +87,7 @@ fn pipelines_are_made_once_per_effect_set() {
 
 fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&Composed>, level: f64) -> AlbedoCheck {
     let composed = module.cloned().unwrap_or_else(|| e.weighted_module(job, effects, Specialisation::Specialised));
-    let run = e.weighted_with(job, effects, &composed, 7, 0, N).expect("weighted run");
+    let run = e.weighted_with(job, effects, &composed, SampleRange::whole(7, N)).expect("weighted run");
     weighted::albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
 }
 
@@ -175,13 +175,13 @@ fn gpu_and_cpu_weighted_sums_agree() {
     let effects = Effects { fresnel: Fresnel::Conductor { eta: 1.1, k: 2.2 }, masking: Masking::HeightCorrelated };
     let mut e = engine();
     let n = 1 << 20;
-    let gpu = e.weighted(&j, &effects, 3, 0, n, Specialisation::Specialised).unwrap().sums;
-    let cpu = lobes::engine::cpu::weighted(&j, &effects, 3, 0, n);
+    let gpu = e.weighted(&j, &effects, SampleRange::whole(3, n), Specialisation::Specialised).unwrap().sums;
+    let cpu = lobes::engine::cpu::weighted(&j, &effects, SampleRange::whole(3, n));
     let (a, b) = (gpu.albedo(n), cpu.albedo(n));
     assert!((a - b).abs() < 1e-5 * b, "GPU {a} vs CPU {b}");
     assert!(cpu.max_weight_error() < 1e-9, "f64 weight check: {}", cpu.max_weight_error());
     // the uber-kernel draws and weighs the same samples
-    let uber = e.weighted(&j, &effects, 3, 0, n, Specialisation::Uber).unwrap().sums;
+    let uber = e.weighted(&j, &effects, SampleRange::whole(3, n), Specialisation::Uber).unwrap().sums;
     assert!((uber.albedo(n) - a).abs() < 1e-6 * a, "uber {} vs specialised {a}", uber.albedo(n));
 }
 

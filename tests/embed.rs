@@ -13,7 +13,7 @@ mod end_to_end;
 use glam::DVec3;
 use lobes::embed::{self, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteTable, Module};
 use lobes::engine::gpu::{Gpu, GpuEngine};
-use lobes::engine::job::{DiscreteMethod, Job};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, reflect, rng};
 use wgpu::util::DeviceExt;
@@ -284,7 +284,7 @@ fn embedded_discrete_sampling_counts_exactly_like_the_engine() {
         let bytes = dispatch(&gpu, &source, "draw_discrete", &[&own, &tables], &[&g0, &g1], samples, &counts);
         let mine: Vec<u64> = bytemuck::cast_slice::<u8, u32>(&bytes).iter().map(|&c| c as u64).collect();
         let job = Job::Discrete { dist: (*dist).clone(), method };
-        let theirs = engine.histogram(&job, seed, 0, samples as u64, &mut |_| {}).unwrap().counts;
+        let theirs = engine.histogram(&job, SampleRange::whole(seed, samples as u64), &mut |_| {}).unwrap().counts;
         println!("{method:?}, {} items: {:?}", dist.len(), &mine[..12]);
         assert_eq!(mine, theirs.bins, "{method:?}, {} items: embedded sampling differs from the engine's", dist.len());
         assert_eq!(mine.iter().sum::<u64>(), samples as u64);

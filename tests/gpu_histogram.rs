@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{Counts, DiscreteMethod, Job};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect, ward};
 use lobes::stats::chi2::{self, sidak};
@@ -24,7 +24,7 @@ fn lobe_job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, ph
 }
 
 fn run(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> Counts {
-    let r = engine.histogram(job, seed, 0, n, &mut |_| {}).expect("GPU histogram");
+    let r = engine.histogram(job, SampleRange::whole(seed, n), &mut |_| {}).expect("GPU histogram");
     assert_eq!(r.counts.total(), n, "every sample is a bin hit or an invalid sample");
     r.counts
 }
@@ -62,7 +62,7 @@ fn every_lobe_and_method_passes_chi2() {
         let q = exp.quadrature.as_ref().unwrap();
         assert!(q.max_error_sigma < 0.05, "{kind:?} {method:?}: quadrature error {} σ", q.max_error_sigma);
         let t2 = compare::chi2_test(&counts, &exp, level);
-        let dirs = e.directions(&job, 100 + i as u64, 0, 4096).unwrap();
+        let dirs = e.directions(&job, SampleRange::whole(100 + i as u64, 4096)).unwrap();
         let angle = compare::angle_check(&job, 100 + i as u64, 0, &dirs);
         println!("{kind:?} {method:?} α=({ax},{ay}) θ={t}: χ² {:.1}/{} p={:.4} max angle {:.2e} mismatches {}",
             t2.statistic, t2.dof, t2.p_value, angle.max_angle_rad, angle.validity_mismatches);
@@ -142,8 +142,9 @@ fn histograms_are_reproducible_across_runs_chunks_and_shards() {
     e.chunking.chunk_samples = 100_003;
     e.chunking.chunks_per_submit = 3;
     assert_eq!(a, run(&mut e, &job, 5, n), "chunk size changed the histogram");
-    let mut s = e.histogram(&job, 5, 0, 1_234_567, &mut |_| {}).unwrap().counts;
-    s.add(&e.histogram(&job, 5, 1_234_567, n - 1_234_567, &mut |_| {}).unwrap().counts);
+    let (head, tail) = SampleRange::whole(5, n).split_at(1_234_567);
+    let mut s = e.histogram(&job, head, &mut |_| {}).unwrap().counts;
+    s.add(&e.histogram(&job, tail, &mut |_| {}).unwrap().counts);
     assert_eq!(a, s, "shards do not add up to the whole");
     assert_ne!(a, run(&mut e, &job, 6, n), "the seed must matter");
 }
@@ -156,7 +157,7 @@ fn totals_carry_past_32_bits() {
     let near = (1u64 << 32) - 100;
     let initial = Counts { bins: vec![near, (1 << 33) + 5], invalid: [0, 0, 0, u32::MAX as u64] };
     let add = run(&mut e, &job, 3, 100_000);
-    let got = e.histogram_onto(&job, 3, 0, 100_000, Some(&initial), &mut |_| {}).unwrap().counts;
+    let got = e.histogram_onto(&job, SampleRange::whole(3, 100_000), Some(&initial), &mut |_| {}).unwrap().counts;
     let mut want = initial.clone();
     want.add(&add);
     assert_eq!(got, want);
@@ -171,7 +172,7 @@ fn gpu_and_cpu_engines_agree_sample_by_sample() {
     let job = lobe_job(LobeKind::Beckmann, Method::Vndf, 0.4, 0.4, 60.0, 10.0);
     let n = 200_000;
     let g = run(&mut e, &job, 9, n);
-    let c = lobes::engine::cpu::histogram(&job, 9, 0, n);
+    let c = lobes::engine::cpu::histogram(&job, SampleRange::whole(9, n));
     let moved: u64 = g.bins.iter().zip(&c.bins).map(|(a, b)| a.abs_diff(*b)).sum();
     assert!(moved < n / 5000, "{moved} of {n} samples binned differently");
 }

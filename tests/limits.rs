@@ -7,7 +7,7 @@
 
 use lobes::engine::gpu::engine::Tiling;
 use lobes::engine::gpu::{Gpu, GpuEngine, GpuError};
-use lobes::engine::job::{Counts, DiscreteMethod, Job};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::histogram::SphereGrid;
@@ -49,7 +49,7 @@ fn discrete(n: usize, method: DiscreteMethod) -> Job {
 }
 
 fn run(e: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> lobes::engine::gpu::GpuRun {
-    let r = e.histogram(job, seed, 0, n, &mut |_| {}).unwrap_or_else(|err| panic!("{job:?}: {err}"));
+    let r = e.histogram(job, SampleRange::whole(seed, n), &mut |_| {}).unwrap_or_else(|err| panic!("{job:?}: {err}"));
     assert_eq!(r.counts.total(), n, "bins + invalid = samples");
     r
 }
@@ -98,9 +98,10 @@ fn tiled_runs_continue_and_add_up_exactly() {
     let mut e = small(ODD_TILE_BYTES);
     let whole = run(&mut e, &job, 5, n).counts;
     // the first 150 001 samples, then the rest on top of them on the device
-    let head = e.histogram(&job, 5, 0, 150_001, &mut |_| {}).unwrap().counts;
+    let (head, tail) = SampleRange::whole(5, n).split_at(150_001);
+    let head = e.histogram(&job, head, &mut |_| {}).unwrap().counts;
     let mut seen = Vec::new();
-    let tail = e.histogram_onto(&job, 5, 150_001, n - 150_001, Some(&head), &mut |d| seen.push(d)).unwrap();
+    let tail = e.histogram_onto(&job, tail, Some(&head), &mut |d| seen.push(d)).unwrap();
     assert_eq!(tail.tiles, 5);
     assert!(tail.counts == whole, "continued tiled run differs");
     // progress runs over all tiles, never backwards, and ends at the samples of this call
@@ -108,8 +109,9 @@ fn tiled_runs_continue_and_add_up_exactly() {
     assert_eq!(seen.last(), Some(&(n - 150_001)));
     assert!(seen.len() >= 5);
     // shards on differently limited engines add up to the whole
-    let mut a = full().histogram(&job, 5, 0, 123_457, &mut |_| {}).unwrap().counts;
-    let b = small(GLOBAL_TILE_BYTES).histogram(&job, 5, 123_457, n - 123_457, &mut |_| {}).unwrap().counts;
+    let (a, b) = SampleRange::whole(5, n).split_at(123_457);
+    let mut a = full().histogram(&job, a, &mut |_| {}).unwrap().counts;
+    let b = small(GLOBAL_TILE_BYTES).histogram(&job, b, &mut |_| {}).unwrap().counts;
     a.add(&b);
     assert!(a == whole);
 }
@@ -138,7 +140,7 @@ fn the_largest_scene_histogram_runs_at_the_adapters_own_limits() {
 fn a_discrete_table_beyond_a_storage_binding_is_a_clear_error() {
     let job = discrete(2000, DiscreteMethod::Cdf); // 8000 bytes of CDF, binding 4104 bytes
     let mut e = small(ODD_TILE_BYTES);
-    let err = e.histogram(&job, 1, 0, 1000, &mut |_| {}).expect_err("the table cannot be bound");
+    let err = e.histogram(&job, SampleRange::whole(1, 1000), &mut |_| {}).expect_err("the table cannot be bound");
     assert!(matches!(err, GpuError::TooLarge(_)), "{err:?}");
     let msg = err.to_string();
     for want in ["too large for this GPU adapter", "8000 bytes", "max_storage_buffer_binding_size 4104", "at most 1026 weights"] {
@@ -174,7 +176,7 @@ fn counts_from_tiles_keep_64_bit_carries() {
     assert!(hot >= 509, "a tile after the first holds a hit: {hot}");
     init.bins[hot] = u32::MAX as u64;
     init.invalid[1] = u32::MAX as u64 - 1;
-    let r = e.histogram_onto(&job, 2, 0, 200_000, Some(&init), &mut |_| {}).unwrap();
+    let r = e.histogram_onto(&job, SampleRange::whole(2, 200_000), Some(&init), &mut |_| {}).unwrap();
     let mut want = fresh.clone();
     want.add(&init);
     assert!(r.counts == want);

@@ -2,7 +2,7 @@
 //! formulas break, on the GPU (f32) and the CPU (f64), plus the discrete hard cases.
 
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{DiscreteMethod, Job};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::stats::compare;
 use lobes::stats::expected::Quadrature;
@@ -25,7 +25,7 @@ fn every_sampler_is_stable_at_the_hard_inputs() {
 fn gpu_counts(e: &mut GpuEngine, weights: &[f64], method: DiscreteMethod, n: u64) -> (Distribution, Vec<u64>) {
     let dist = Distribution::new(weights).unwrap();
     let job = Job::Discrete { dist: dist.clone(), method };
-    let r = e.histogram(&job, 17, 0, n, &mut |_| {}).unwrap();
+    let r = e.histogram(&job, SampleRange::whole(17, n), &mut |_| {}).unwrap();
     assert_eq!(r.counts.total(), n);
     assert_eq!(r.counts.invalid, [0; 4]);
     (dist, r.counts.bins)

@@ -3,6 +3,7 @@
 //! fails these tests with the fix in the message.
 
 use lobes::engine::gpu::GpuEngine;
+use lobes::engine::job::SampleRange;
 use lobes::reference::{LobeKind, Method, reflect};
 use lobes::stats::chi2;
 use lobes::stats::compare;
@@ -66,7 +67,7 @@ fn chi2_at(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u64) -> (chi2::Chi
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
     let exp = compare::expected_counts(&job, n, &Quadrature::default());
     e.rewrite = prec.rewrite();
-    let r = e.histogram(&job, 1, 0, n, &mut |_| {}).expect("histogram");
+    let r = e.histogram(&job, SampleRange::whole(1, n), &mut |_| {}).expect("histogram");
     e.rewrite = None;
     let p: Vec<f64> = exp.bins.iter().chain(&exp.invalid).map(|x| x / n as f64).collect();
     let noise: f64 = p.iter().map(|&q| tradeoff::poisson_mean_abs_dev(q * n as f64)).sum::<f64>() / n as f64;

@@ -4,7 +4,7 @@
 use super::{OutputArgs, emit, emit_json};
 use crate::engine::cpu;
 use crate::engine::gpu::GpuEngine;
-use crate::engine::job::Job;
+use crate::engine::job::{Job, SampleRange};
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use clap::Args;
@@ -105,7 +105,7 @@ fn run_effects(args: &BenchArgs, scene: &std::path::PathBuf) -> anyhow::Result<(
     for case in scene.cases.iter().filter(|c| c.effects.is_some()) {
         let effects = case.effects.as_ref().expect("filtered");
         let mut time = |how, seed: u64, n: u64| -> anyhow::Result<f64> {
-            let r = engine.weighted(&case.job, effects, seed, 0, n, how)?;
+            let r = engine.weighted(&case.job, effects, SampleRange::whole(seed, n), how)?;
             Ok(r.gpu_seconds.unwrap_or(r.wall_seconds))
         };
         time(Specialised, 0, 1 << 16)?; // compile and warm up both
@@ -154,11 +154,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let adapter = engine.gpu.adapter_name();
     let mut results = Vec::new();
     for job in bench_jobs(args.alpha) {
-        engine.histogram(&job, 0, 0, 1 << 16, &mut |_| {})?; // compile and warm up
+        engine.histogram(&job, SampleRange::whole(0, 1 << 16), &mut |_| {})?; // compile and warm up
         let mut times = Vec::new();
         let mut timing = "wall";
         for r in 0..runs {
-            let g = engine.histogram(&job, r as u64, 0, args.samples, &mut |_| {})?;
+            let g = engine.histogram(&job, SampleRange::whole(r as u64, args.samples), &mut |_| {})?;
             timing = if g.gpu_seconds.is_some() { "gpu timestamps" } else { "wall" };
             times.push(g.gpu_seconds.unwrap_or(g.wall_seconds));
         }
@@ -167,7 +167,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             let times = (0..runs)
                 .map(|r| {
                     let t = Instant::now();
-                    cpu::histogram(&job, r as u64, 0, args.cpu_samples);
+                    cpu::histogram(&job, SampleRange::whole(r as u64, args.cpu_samples));
                     t.elapsed().as_secs_f64()
                 })
                 .collect();

@@ -16,7 +16,8 @@
 //! else.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::engine::job::{Counts, Job};
+use crate::engine::gpu::WeightedRun;
+use crate::engine::job::{Counts, Job, SampleRange};
 use crate::reference::Invalid;
 use crate::report::output;
 use crate::run::{self, ANGLE_CHECK_SAMPLES, Backend, CaseResult};
@@ -162,12 +163,12 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
     for (case_index, case) in scene.cases.iter().enumerate() {
         let range = shard.range(case.samples);
         let n = range.end - range.start;
-        let (counts, gpu_seconds, wall_seconds, workgroup_counting) = run::histogram(&mut backend, case, range.start, n, &mut |_| {})?;
+        let run::HistogramRun { counts, gpu_seconds, wall_seconds, workgroup_counting } = run::histogram(&mut backend, case, range.start, n, &mut |_| {})?;
         anyhow::ensure!(counts.total() == n, "case '{}': {} samples counted for {n} requested", case.name, counts.total());
         let angle = match (&mut backend, &case.job) {
             (Backend::Gpu(engine), Job::Lobe { .. }) if range.start == 0 => {
                 let k = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
-                let dirs = engine.directions(&case.job, case.seed, 0, k)?;
+                let dirs = engine.directions(&case.job, SampleRange::whole(case.seed, k as u64))?;
                 Some(compare::angle_check(&case.job, case.seed, 0, &dirs))
             }
             _ => None,
@@ -190,8 +191,8 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
             "timing": {"gpu_seconds": gpu_seconds, "histogram_wall_seconds": wall_seconds},
             "workgroup_counting": workgroup_counting,
             "per_sample_check": angle,
-            "weighted": weighted.as_ref().map(|w| &w.0),
-            "weighted_timing": weighted.as_ref().map(|w| json!({"gpu_seconds": w.1, "wall_seconds": w.2})),
+            "weighted": weighted.as_ref().map(|w| &w.sums),
+            "weighted_timing": weighted.as_ref().map(|w| json!({"gpu_seconds": w.gpu_seconds, "wall_seconds": w.wall_seconds})),
             // serde_json reads floats back to within an ulp only: the exact bits, for the merge.
             "per_sample_check_f64_bits": angle.as_ref().map(|a| json!({
                 "max_angle_rad": a.max_angle_rad.to_bits(), "mean_angle_rad": a.mean_angle_rad.to_bits()})),
@@ -510,7 +511,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
             counts.add(&s.counts);
         }
         anyhow::ensure!(counts.total() == case.samples, "case '{}': shards add up to {} samples, not {}", case.name, counts.total(), case.samples);
-        let (expected, chi2, quadrature_seconds, _) = run::judge(&mut judge_backend, case, counts.clone(), level)?;
+        let run::Verdict { expected, chi2, quadrature_seconds, .. } = run::judge(&mut judge_backend, case, counts.clone(), level)?;
         let gpu_seconds = parts.iter().map(|s| s.gpu_seconds).sum::<Option<f64>>();
         let weighted = match &case.effects {
             None => None,
@@ -529,7 +530,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
                     gpu = gpu.zip(*g).map(|(a, b)| a + b);
                     wall += t;
                 }
-                Some(run::judge_weighted(case, sums, gpu, wall, level))
+                Some(run::judge_weighted(case, WeightedRun { sums, gpu_seconds: gpu, wall_seconds: wall }, level))
             }
         };
         let wcs: Vec<Option<bool>> = parts.iter().map(|s| s.workgroup_counting).collect();

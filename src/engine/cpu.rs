@@ -2,38 +2,37 @@
 //! the reference samplers on all cores. It serves where no GPU adapter exists, and as the CPU
 //! backend of the benchmark.
 
-use crate::engine::job::{Counts, DiscreteMethod, Job};
+use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
 use crate::reference::discrete::AliasTable;
 use rayon::prelude::*;
 
-/// Histograms samples `first .. first + samples` of the run keyed by `seed`.
+/// Samples per task of the thread pool.
+const BLOCK: u64 = 1 << 16;
+
+/// Histograms the samples of `range`.
 ///
 /// ```
-/// use lobes::{engine::job::Job, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
+/// use lobes::{engine::job::{Job, SampleRange}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
 /// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
 /// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } };
-/// let counts = lobes::engine::cpu::histogram(&job, 1, 0, 10_000);
+/// let counts = lobes::engine::cpu::histogram(&job, SampleRange::whole(1, 10_000));
 /// assert_eq!(counts.total(), 10_000);
 /// ```
-pub fn histogram(job: &Job, seed: u64, first: u64, samples: u64) -> Counts {
+pub fn histogram(job: &Job, range: SampleRange) -> Counts {
     let alias = match job {
         Job::Discrete { dist, method: DiscreteMethod::Alias } => Some(AliasTable::new(dist)),
         _ => None,
     };
     let bins = job.bins();
-    const BLOCK: u64 = 1 << 16;
-    let blocks = samples.div_ceil(BLOCK);
-    let cells = (0..blocks)
+    let cells = (0..range.chunk_count(BLOCK))
         .into_par_iter()
         .fold(
             || vec![0u64; bins + 4],
             |mut cells, b| {
-                let start = first + b * BLOCK;
-                let end = (start + BLOCK).min(first + samples);
-                for i in start..end {
-                    cells[job.cell_f64(seed, i, alias.as_ref())] += 1;
+                for i in range.chunk(b, BLOCK).indices() {
+                    cells[job.cell_f64(range.seed, i, alias.as_ref())] += 1;
                 }
                 cells
             },
@@ -45,21 +44,19 @@ pub fn histogram(job: &Job, seed: u64, first: u64, samples: u64) -> Counts {
     Counts::from_cells(&cells)
 }
 
-/// The weighted histogram of samples `first .. first + samples` of a lobe job with `effects`,
+/// The weighted histogram of the samples of `range` of a lobe job with `effects`,
 /// in f64: the same fixed-point sums as `shaders/weighted.wgsl`, and per bin the largest
 /// relative difference between the weight and eval · cos θr / pdf.
-pub fn weighted(job: &Job, effects: &Effects, seed: u64, first: u64, samples: u64) -> WeightedSums {
+pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSums {
     let Job::Lobe { lobe, incident, grid } = job else { panic!("weighted histograms are for lobe jobs") };
     let bins = job.bins();
-    const BLOCK: u64 = 1 << 16;
-    (0..samples.div_ceil(BLOCK))
+    (0..range.chunk_count(BLOCK))
         .into_par_iter()
         .fold(
             || WeightedSums::zeros(bins),
             |mut sums, b| {
-                let start = first + b * BLOCK;
-                for i in start..(start + BLOCK).min(first + samples) {
-                    let u = crate::reference::rng::uniforms(seed, i);
+                for i in range.chunk(b, BLOCK).indices() {
+                    let u = crate::reference::rng::uniforms(range.seed, i);
                     let s = lobe.sample(*incident, [u[0], u[1]]);
                     let w = effects.weight(lobe, *incident, &s);
                     match s.invalid {

@@ -5,6 +5,59 @@ use crate::reference::discrete::{AliasTable, Distribution};
 use crate::reference::{Invalid, Lobe};
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
+use std::ops::Range;
+
+/// Samples `first .. first + count` of the run keyed by `seed`. Sample `i` draws the uniforms
+/// of the counter `(seed, i)` ([`crate::reference::rng::uniforms`]) wherever it is drawn, so a
+/// run cut into ranges (chunks, tiles, shards) counts exactly what the whole run counts.
+///
+/// ```
+/// use lobes::engine::job::SampleRange;
+/// let (head, tail) = SampleRange::whole(7, 10).split_at(4);
+/// assert_eq!(tail, SampleRange { seed: 7, first: 4, count: 6 });
+/// assert_eq!(head.indices().chain(tail.indices()).collect::<Vec<_>>(), (0..10).collect::<Vec<_>>());
+/// assert_eq!(tail.chunks(4).map(|c| c.count).collect::<Vec<_>>(), [4, 2]);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SampleRange {
+    pub seed: u64,
+    pub first: u64,
+    pub count: u64,
+}
+
+impl SampleRange {
+    /// Samples `0 .. count` of the run keyed by `seed`.
+    pub fn whole(seed: u64, count: u64) -> Self {
+        Self { seed, first: 0, count }
+    }
+
+    /// The sample indices.
+    pub fn indices(&self) -> Range<u64> {
+        self.first..self.first + self.count
+    }
+
+    /// The first `n` samples (at most `count`) and the rest.
+    pub fn split_at(self, n: u64) -> (Self, Self) {
+        let n = n.min(self.count);
+        (Self { count: n, ..self }, Self { first: self.first + n, count: self.count - n, ..self })
+    }
+
+    /// Chunk `index` of the range cut into chunks of `len` samples (the last may be shorter).
+    pub fn chunk(&self, index: u64, len: u64) -> Self {
+        let start = (index * len).min(self.count);
+        Self { first: self.first + start, count: len.min(self.count - start), ..*self }
+    }
+
+    /// The number of chunks of `len` samples: none for an empty range.
+    pub fn chunk_count(&self, len: u64) -> u64 {
+        self.count.div_ceil(len)
+    }
+
+    /// The range cut into chunks of `len` samples, in order.
+    pub fn chunks(self, len: u64) -> impl Iterator<Item = Self> {
+        (0..self.chunk_count(len)).map(move |i| self.chunk(i, len))
+    }
+}
 
 /// How a discrete job samples.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]

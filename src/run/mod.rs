@@ -2,8 +2,8 @@
 //! the χ² verdict and the per-sample check.
 
 use crate::engine::cpu;
-use crate::engine::gpu::GpuEngine;
-use crate::engine::job::{Counts, Job};
+use crate::engine::gpu::{GpuEngine, WeightedRun};
+use crate::engine::job::{Counts, Job, SampleRange};
 use crate::scene::Case;
 use crate::stats::chi2::Chi2;
 use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
@@ -81,54 +81,74 @@ impl CaseResult {
     }
 }
 
+/// The samples `first .. first + count` of a case.
+fn samples(case: &Case, first: u64, count: u64) -> SampleRange {
+    SampleRange { seed: case.seed, first, count }
+}
+
 /// The weighted sums of samples `first .. first + samples` of a case with effects, with the
-/// specialised module on the GPU: (sums, GPU seconds, wall seconds).
-pub fn weighted_sums(backend: &mut Backend, case: &Case, first: u64, samples: u64) -> anyhow::Result<(WeightedSums, Option<f64>, f64)> {
+/// specialised module on the GPU.
+pub fn weighted_sums(backend: &mut Backend, case: &Case, first: u64, count: u64) -> anyhow::Result<WeightedRun> {
     let effects = case.effects.as_ref().expect("a weighted case");
+    let range = samples(case, first, count);
     Ok(match backend {
-        Backend::Gpu(engine) => {
-            let r = engine.weighted(&case.job, effects, case.seed, first, samples, Specialisation::Specialised)?;
-            (r.sums, r.gpu_seconds, r.wall_seconds)
-        }
+        Backend::Gpu(engine) => engine.weighted(&case.job, effects, range, Specialisation::Specialised)?,
         Backend::Cpu => {
             let t = Instant::now();
-            let sums = cpu::weighted(&case.job, effects, case.seed, first, samples);
-            (sums, None, t.elapsed().as_secs_f64())
+            let sums = cpu::weighted(&case.job, effects, range);
+            WeightedRun { sums, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64() }
         }
     })
 }
 
 /// Judges the weighted sums of a whole case.
-pub fn judge_weighted(case: &Case, sums: WeightedSums, gpu_seconds: Option<f64>, wall_seconds: f64, significance: f64) -> WeightedResult {
+pub fn judge_weighted(case: &Case, run: WeightedRun, significance: f64) -> WeightedResult {
     let effects = case.effects.as_ref().expect("a weighted case");
-    let check = weighted::albedo_check(&case.job, effects, &sums, case.samples, significance, &Quadrature::default());
-    WeightedResult { sums, check, gpu_seconds, wall_seconds }
+    let check = weighted::albedo_check(&case.job, effects, &run.sums, case.samples, significance, &Quadrature::default());
+    WeightedResult { sums: run.sums, check, gpu_seconds: run.gpu_seconds, wall_seconds: run.wall_seconds }
 }
 
-/// Histograms samples `first .. first + samples` of a case on `backend`.
-pub fn histogram(
-    backend: &mut Backend,
-    case: &Case,
-    first: u64,
-    samples: u64,
-    progress: &mut dyn FnMut(u64),
-) -> anyhow::Result<(Counts, Option<f64>, f64, Option<bool>)> {
+/// The histogram of some samples of a case, and its times.
+#[derive(Debug, Clone)]
+pub struct HistogramRun {
+    pub counts: Counts,
+    /// GPU time of the sampling passes (timestamp queries), where there are any.
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+    /// Whether the GPU counted bins in workgroup memory (None on the CPU engine).
+    pub workgroup_counting: Option<bool>,
+}
+
+/// Histograms samples `first .. first + count` of a case on `backend`.
+pub fn histogram(backend: &mut Backend, case: &Case, first: u64, count: u64, progress: &mut dyn FnMut(u64)) -> anyhow::Result<HistogramRun> {
+    let range = samples(case, first, count);
     Ok(match backend {
         Backend::Gpu(engine) => {
-            let r = engine.histogram(&case.job, case.seed, first, samples, progress)?;
-            (r.counts, r.gpu_seconds, r.wall_seconds, Some(r.workgroup_counting))
+            let r = engine.histogram(&case.job, range, progress)?;
+            HistogramRun { counts: r.counts, gpu_seconds: r.gpu_seconds, wall_seconds: r.wall_seconds, workgroup_counting: Some(r.workgroup_counting) }
         }
         Backend::Cpu => {
             let t = Instant::now();
-            let c = cpu::histogram(&case.job, case.seed, first, samples);
-            progress(samples);
-            (c, None, t.elapsed().as_secs_f64(), None)
+            let counts = cpu::histogram(&case.job, range);
+            progress(count);
+            HistogramRun { counts, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64(), workgroup_counting: None }
         }
     })
 }
 
+/// The verdict on the counts of a whole case.
+#[derive(Debug, Clone)]
+pub struct Verdict {
+    pub expected: ExpectedCounts,
+    pub chi2: Chi2,
+    /// Time of the f64 quadrature of the expected counts.
+    pub quadrature_seconds: f64,
+    /// The per-sample check, on the GPU for a lobe.
+    pub angle: Option<AngleCheck>,
+}
+
 /// Judges counts of a whole case: expected counts, χ² at `significance`, per-sample check.
-pub fn judge(backend: &mut Backend, case: &Case, counts: Counts, significance: f64) -> anyhow::Result<(ExpectedCounts, Chi2, f64, Option<AngleCheck>)> {
+pub fn judge(backend: &mut Backend, case: &Case, counts: Counts, significance: f64) -> anyhow::Result<Verdict> {
     let t = Instant::now();
     let expected = compare::expected_counts(&case.job, case.samples, &Quadrature::default());
     let quadrature_seconds = t.elapsed().as_secs_f64();
@@ -136,17 +156,17 @@ pub fn judge(backend: &mut Backend, case: &Case, counts: Counts, significance: f
     let angle = match (backend, &case.job) {
         (Backend::Gpu(engine), Job::Lobe { .. }) => {
             let n = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
-            let dirs = engine.directions(&case.job, case.seed, 0, n)?;
+            let dirs = engine.directions(&case.job, samples(case, 0, n as u64))?;
             Some(compare::angle_check(&case.job, case.seed, 0, &dirs))
         }
         _ => None,
     };
-    Ok((expected, chi2, quadrature_seconds, angle))
+    Ok(Verdict { expected, chi2, quadrature_seconds, angle })
 }
 
 /// Runs one case: all its samples, then the verdict.
 pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
-    let (counts, gpu_seconds, histogram_seconds, workgroup_counting) = histogram(backend, case, 0, case.samples, progress)?;
+    let HistogramRun { counts, gpu_seconds, wall_seconds: histogram_seconds, workgroup_counting } = histogram(backend, case, 0, case.samples, progress)?;
     anyhow::ensure!(
         counts.total() == case.samples,
         "case '{}': {} samples counted for {} requested",
@@ -154,12 +174,9 @@ pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress:
         counts.total(),
         case.samples
     );
-    let (expected, chi2, quadrature_seconds, angle) = judge(backend, case, counts.clone(), significance)?;
+    let Verdict { expected, chi2, quadrature_seconds, angle } = judge(backend, case, counts.clone(), significance)?;
     let weighted = match &case.effects {
-        Some(_) => {
-            let (sums, gpu, wall) = weighted_sums(backend, case, 0, case.samples)?;
-            Some(judge_weighted(case, sums, gpu, wall, significance))
-        }
+        Some(_) => Some(judge_weighted(case, weighted_sums(backend, case, 0, case.samples)?, significance)),
         None => None,
     };
     Ok(CaseResult { case: case.clone(), counts, expected, chi2, gpu_seconds, histogram_seconds, quadrature_seconds, angle, workgroup_counting, weighted })

@@ -212,12 +212,12 @@ fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
 /// value where there is one, the per-bin weight check, and no overflow.
 ///
 /// ```
-/// use lobes::{engine::job::Job, stats::{histogram::SphereGrid, expected::Quadrature, weighted::albedo_check}};
+/// use lobes::{engine::job::{Job, SampleRange}, stats::{histogram::SphereGrid, expected::Quadrature, weighted::albedo_check}};
 /// use lobes::reference::{Lobe, LobeKind, Method, effects::Effects, masking::Masking, fresnel::Fresnel, reflect::spherical};
 /// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
 /// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 } };
 /// let effects = Effects { fresnel: Fresnel::None, masking: Masking::G1 };
-/// let sums = lobes::engine::cpu::weighted(&job, &effects, 1, 0, 200_000);
+/// let sums = lobes::engine::cpu::weighted(&job, &effects, SampleRange::whole(1, 200_000));
 /// let check = albedo_check(&job, &effects, &sums, 200_000, 0.01, &Quadrature::default());
 /// assert!(check.passed, "{check:?}");
 /// assert_eq!(check.furnace, Some(1.0)); // F = 1, G = G1(ωi): the weak white furnace

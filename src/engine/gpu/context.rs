@@ -1,5 +1,7 @@
-//! Adapter and device: the one place that talks to wgpu's instance.
+//! Adapter and device: the one place that talks to wgpu's instance, and where the device's
+//! errors are collected.
 
+use std::sync::{Arc, Mutex};
 use thiserror::Error;
 
 /// Why no GPU could be used.
@@ -29,6 +31,9 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
     pub features: wgpu::Features,
+    /// The first error the device reported outside a call that returns one (validation, out
+    /// of memory, loss), until [`Gpu::check_errors`] takes it.
+    errors: Arc<Mutex<Option<String>>>,
 }
 
 impl Gpu {
@@ -65,7 +70,20 @@ impl Gpu {
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
             .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
-        Ok(Self { device, queue, info, limits, features })
+        let errors = Arc::new(Mutex::new(None));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().unwrap().get_or_insert_with(|| e.to_string());
+        }));
+        Ok(Self { device, queue, info, limits, features, errors })
+    }
+
+    /// The error the device reported since the last check, as [`GpuError::Lost`].
+    pub fn check_errors(&self) -> Result<(), GpuError> {
+        match self.errors.lock().unwrap().take() {
+            Some(e) => Err(GpuError::Lost(e)),
+            None => Ok(()),
+        }
     }
 
     /// "name (backend, driver)" for reports.

@@ -2,9 +2,13 @@
 
 pub mod compose;
 pub mod context;
+pub mod dispatch;
 pub mod effects;
 pub mod engine;
+pub mod params;
 pub mod weighted;
 
 pub use context::{Gpu, GpuError};
-pub use engine::{Chunking, GpuEngine, GpuRun};
+pub use dispatch::Chunking;
+pub use engine::{GpuEngine, GpuRun};
+pub use weighted::WeightedRun;

@@ -13,7 +13,7 @@ pub mod variants;
 pub use variants::Precision;
 
 use crate::engine::gpu::GpuEngine;
-use crate::engine::job::{Counts, Job};
+use crate::engine::job::{Counts, Job, SampleRange};
 use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
 use crate::stats::chi2;
 use crate::stats::compare::{self, ExpectedCounts, angle_between};
@@ -310,7 +310,7 @@ fn sweep_one(
     prec: Precision,
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<(Vec<SweepPoint>, Vec<Skipped>)> {
-    engine.histogram(job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?; // compile and warm up
+    engine.histogram(job, SampleRange::whole(set.seed ^ 0x5eed, 1 << 16), &mut |_| {})?; // compile and warm up
     let angle = angle_error(engine, job, set.seed, set.angle_samples, prec)?;
     let mut points: Vec<SweepPoint> = Vec::new();
     let mut skipped = Vec::new();
@@ -367,10 +367,10 @@ pub fn median(mut v: Vec<f64>) -> f64 {
 /// `runs` histograms of samples 0 .. n: the first run's result with the median wall and GPU
 /// times; every run must count exactly the same.
 fn timed_histogram(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64, runs: usize) -> anyhow::Result<(crate::engine::gpu::GpuRun, f64, Option<f64>)> {
-    let first = engine.histogram(job, seed, 0, n, &mut |_| {})?;
+    let first = engine.histogram(job, SampleRange::whole(seed, n), &mut |_| {})?;
     let (mut wall, mut gpu) = (vec![first.wall_seconds], first.gpu_seconds.map(|g| vec![g]));
     for _ in 1..runs.max(1) {
-        let r = engine.histogram(job, seed, 0, n, &mut |_| {})?;
+        let r = engine.histogram(job, SampleRange::whole(seed, n), &mut |_| {})?;
         anyhow::ensure!(r.counts == first.counts, "two runs of the same samples counted differently");
         wall.push(r.wall_seconds);
         if let (Some(g), Some(v)) = (r.gpu_seconds, gpu.as_mut()) {
@@ -461,7 +461,7 @@ pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut d
             for method in [Method::Vndf, Method::Bounded] {
                 let lobe = Sampler { kind: LobeKind::Ggx, method }.lobe(alpha);
                 let job = Job::Lobe { lobe, incident: wi, grid: GRID };
-                engine.histogram(&job, set.seed ^ 0x5eed, 0, 1 << 16, &mut |_| {})?;
+                engine.histogram(&job, SampleRange::whole(set.seed ^ 0x5eed, 1 << 16), &mut |_| {})?;
                 let (_, wall, gpu) = timed_histogram(engine, &job, set.seed, set.gpu_samples, set.runs)?;
                 let seconds = gpu.unwrap_or(wall);
                 let (mean, variance, below) = albedo_estimator(&lobe, wi, set.seed, set.estimator_samples);

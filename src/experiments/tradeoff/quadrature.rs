@@ -4,6 +4,7 @@
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
 use crate::embed::{self, Module};
+use crate::engine::gpu::dispatch::{Pass, Step};
 use crate::engine::gpu::{GpuEngine, GpuError};
 use crate::reference::{Lobe, LobeKind, Method};
 use crate::stats::expected::direction;
@@ -123,22 +124,9 @@ pub struct GpuQuadrature {
 
 /// The n × n Gauss–Legendre probabilities of every bin on the GPU in f32.
 pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: SphereGrid, n: usize) -> Result<GpuQuadrature, GpuError> {
-    let source = gpu_source(lobe, grid, n);
-    crate::engine::gpu::compose::validate("tradeoff quadrature", &source)?;
     let gpu = &engine.gpu;
-    let device = &gpu.device;
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("tradeoff quadrature"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("quadrature"),
-        layout: None,
-        module: &module,
-        entry_point: Some("quadrature"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let module = gpu.module("tradeoff quadrature", &gpu_source(lobe, grid, n))?;
+    let pipeline = gpu.pipeline(&module, None, "quadrature", &[]);
     let params = QuadParams {
         alpha: [lobe.alpha_x as f32, lobe.alpha_y as f32],
         _pad: [0.0; 2],
@@ -146,18 +134,18 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
     };
     let nodes: Vec<[f32; 2]> = gauss_legendre(n).iter().map(|&(x, w)| [x as f32, w as f32]).collect();
     let bins = grid.bins() as u64;
-    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("quadrature params"),
         contents: bytemuck::bytes_of(&params),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let node_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    let node_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("gauss-legendre nodes"),
         contents: bytemuck::cast_slice(&nodes),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let out = engine.buffer("probabilities", bins * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    let out = gpu.buffer("probabilities", bins * 4, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+    let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("quadrature"),
         layout: &pipeline.get_bind_group_layout(0),
         entries: &[
@@ -166,37 +154,11 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
             wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() },
         ],
     });
-    let stamps = gpu.has_timestamps().then(|| engine.timestamp_buffers(2));
-    let groups = bins.div_ceil(64);
-    let max = gpu.limits.max_compute_workgroups_per_dimension as u64;
-    let (gx, gy) = (groups.min(max) as u32, groups.div_ceil(max) as u32);
     let start = Instant::now();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let ts = stamps.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
-            query_set: set,
-            beginning_of_pass_write_index: Some(0),
-            end_of_pass_write_index: Some(1),
-        });
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("quadrature"), timestamp_writes: ts });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups(gx, gy, 1);
-    }
-    if let Some((set, resolve, rd)) = &stamps {
-        encoder.resolve_query_set(set, 0..2, resolve, 0);
-        encoder.copy_buffer_to_buffer(resolve, 0, rd, 0, 16);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let probabilities: Vec<f32> = bytemuck::cast_slice(&engine.read(&out, bins * 4)?).to_vec();
+    let steps = vec![Step { pipeline: &pipeline, groups: bins.div_ceil(64) }];
+    let gpu_seconds = gpu.dispatch(&[Pass { label: "quadrature", bind: &bind, offset: None, steps }])?;
+    let probabilities: Vec<f32> = bytemuck::cast_slice(&gpu.read(&out, bins * 4)?).to_vec();
     let wall_seconds = start.elapsed().as_secs_f64();
-    let gpu_seconds = match &stamps {
-        Some((_, _, rd)) => {
-            let t: Vec<u64> = bytemuck::cast_slice(&engine.read(rd, 16)?).to_vec();
-            Some(t[1].saturating_sub(t[0]) as f64 * gpu.queue.get_timestamp_period() as f64 * 1e-9)
-        }
-        None => None,
-    };
     Ok(GpuQuadrature { probabilities, gpu_seconds, wall_seconds })
 }
 

@@ -1,0 +1,233 @@
+//! The one dispatcher: every pass of the engine (counting, weighted, per-sample) and of the
+//! tradeoff quadrature is compiled, encoded, submitted, timed and read back here.
+
+use super::compose::{self, SAMPLES_PER_THREAD, WG_SIZE};
+use super::context::{Gpu, GpuError};
+use super::params::Params;
+use crate::engine::job::SampleRange;
+
+/// One pipeline dispatched over `groups` workgroups.
+pub struct Step<'a> {
+    pub pipeline: &'a wgpu::ComputePipeline,
+    pub groups: u64,
+}
+
+/// A compute pass: its steps in order over one bind group (at `offset` where the group has a
+/// dynamic uniform).
+pub struct Pass<'a> {
+    pub label: &'a str,
+    pub bind: &'a wgpu::BindGroup,
+    pub offset: Option<u32>,
+    pub steps: Vec<Step<'a>>,
+}
+
+impl Gpu {
+    /// A bind group layout of `entries` and the pipeline layout of that one group.
+    pub fn layout(&self, label: &str, entries: &[wgpu::BindGroupLayoutEntry]) -> (wgpu::BindGroupLayout, wgpu::PipelineLayout) {
+        let group = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries });
+        let pipeline = self.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&group)],
+            immediate_size: 0,
+        });
+        (group, pipeline)
+    }
+
+    /// `source` validated by naga (errors name `what`) and made a shader module.
+    pub fn module(&self, what: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
+        compose::validate(what, source)?;
+        Ok(self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(what), source: wgpu::ShaderSource::Wgsl(source.into()) }))
+    }
+
+    /// The compute pipeline of `entry` in `module`; `layout` None: derived from the module.
+    pub fn pipeline(
+        &self,
+        module: &wgpu::ShaderModule,
+        layout: Option<&wgpu::PipelineLayout>,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> wgpu::ComputePipeline {
+        self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout,
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+            cache: None,
+        })
+    }
+
+    /// A buffer of at least `size` bytes (16 at the least), not mapped.
+    pub fn buffer(&self, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size: size.max(16), usage, mapped_at_creation: false })
+    }
+
+    /// Workgroup grid for `groups` workgroups within the per-dimension limit.
+    pub fn grid(&self, groups: u64) -> (u32, u32) {
+        let max = self.limits.max_compute_workgroups_per_dimension as u64;
+        let x = groups.clamp(1, max);
+        (x as u32, groups.div_ceil(x).max(1) as u32)
+    }
+
+    /// Encodes `passes` into one submission, each timed by timestamp queries where the adapter
+    /// has them, submits it and waits for it: the passes' GPU seconds where timed.
+    pub fn dispatch(&self, passes: &[Pass]) -> Result<Option<f64>, GpuError> {
+        let n = 2 * passes.len() as u32;
+        let queries = (self.has_timestamps() && n > 0).then(|| {
+            let set = self.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("timestamps"), ty: wgpu::QueryType::Timestamp, count: n });
+            let resolve = self.buffer("timestamps", n as u64 * 8, wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC);
+            let read = self.buffer("timestamps read", n as u64 * 8, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+            (set, resolve, read)
+        });
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        for (i, p) in passes.iter().enumerate() {
+            let timestamp_writes = queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
+                query_set: set,
+                beginning_of_pass_write_index: Some(2 * i as u32),
+                end_of_pass_write_index: Some(2 * i as u32 + 1),
+            });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(p.label), timestamp_writes });
+            pass.set_bind_group(0, p.bind, p.offset.as_slice());
+            for step in &p.steps {
+                pass.set_pipeline(step.pipeline);
+                let (x, y) = self.grid(step.groups);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+        }
+        if let Some((set, resolve, read)) = &queries {
+            encoder.resolve_query_set(set, 0..n, resolve, 0);
+            encoder.copy_buffer_to_buffer(resolve, 0, read, 0, n as u64 * 8);
+        }
+        self.queue.submit([encoder.finish()]);
+        let ticks = match &queries {
+            Some((_, _, read)) => {
+                let stamps: Vec<u64> = bytemuck::cast_slice(&self.read(read, n as u64 * 8)?).to_vec();
+                stamps.chunks(2).map(|p| p[1].saturating_sub(p[0])).sum()
+            }
+            None => {
+                self.wait()?;
+                0
+            }
+        };
+        self.check_errors()?;
+        Ok(self.has_timestamps().then(|| ticks as f64 * self.queue.get_timestamp_period() as f64 * 1e-9))
+    }
+
+    /// Zeroes `buffer` on the device.
+    pub fn clear(&self, buffer: &wgpu::Buffer) {
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(buffer, 0, None);
+        self.queue.submit([encoder.finish()]);
+    }
+
+    fn wait(&self) -> Result<(), GpuError> {
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Lost(e.to_string()))?;
+        Ok(())
+    }
+
+    /// Copies the first `size` bytes of `src` to the host.
+    pub fn read(&self, src: &wgpu::Buffer, size: u64) -> Result<Vec<u8>, GpuError> {
+        let staging = if src.usage().contains(wgpu::BufferUsages::MAP_READ) {
+            src.clone()
+        } else {
+            let staging = self.buffer("readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
+            let mut encoder = self.device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+            self.queue.submit([encoder.finish()]);
+            staging
+        };
+        let (tx, rx) = std::sync::mpsc::channel();
+        staging.map_async(wgpu::MapMode::Read, 0..size, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        let data = staging.get_mapped_range(0..size).map_err(|e| GpuError::Readback(e.to_string()))?.to_vec();
+        staging.unmap();
+        Ok(data)
+    }
+
+    /// Reads back `words` 64-bit totals stored as (lo, hi) u32 pairs.
+    pub fn read_u64(&self, src: &wgpu::Buffer, words: u64) -> Result<Vec<u64>, GpuError> {
+        let raw: Vec<u32> = bytemuck::cast_slice(&self.read(src, words * 8)?).to_vec();
+        Ok(raw.chunks(2).map(|p| p[0] as u64 | (p[1] as u64) << 32).collect())
+    }
+}
+
+/// How a run is cut into dispatches.
+#[derive(Debug, Clone, Copy)]
+pub struct Chunking {
+    /// Samples per chunk (one sampling dispatch and one fold); at most 2^31.
+    pub chunk_samples: u64,
+    /// Chunks per submission; progress is reported after each.
+    pub chunks_per_submit: u32,
+}
+
+impl Default for Chunking {
+    fn default() -> Self {
+        Self { chunk_samples: 1 << 26, chunks_per_submit: 4 }
+    }
+}
+
+/// A sampling pass over a range of samples cut into chunks, one compute pass each, every
+/// chunk reading its own [`Params`] at its own offset of one uniform buffer.
+pub struct SamplingPasses<'g> {
+    gpu: &'g Gpu,
+    params: wgpu::Buffer,
+    stride: u64,
+    chunk: u64,
+    per_submit: u64,
+}
+
+impl<'g> SamplingPasses<'g> {
+    pub fn new(gpu: &'g Gpu, chunking: Chunking) -> Self {
+        let per_group = (WG_SIZE * SAMPLES_PER_THREAD) as u64;
+        let dim = gpu.limits.max_compute_workgroups_per_dimension as u64;
+        let chunk = chunking.chunk_samples.clamp(1, (1 << 31).min(dim * dim * per_group));
+        let per_submit = chunking.chunks_per_submit.max(1) as u64;
+        let stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Params>() as u64);
+        let params = gpu.buffer("params", stride * per_submit, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        Self { gpu, params, stride, chunk, per_submit }
+    }
+
+    /// The uniform buffer to bind at binding 0 ([`Params::bind_entry`]).
+    pub fn params(&self) -> &wgpu::Buffer {
+        &self.params
+    }
+
+    /// Workgroups of the sampling kernels for `count` samples.
+    pub fn groups(count: u64) -> u64 {
+        count.div_ceil((WG_SIZE * SAMPLES_PER_THREAD) as u64)
+    }
+
+    /// Runs `steps` once per chunk of `range` with `bind` and the chunk's `params`; `progress`
+    /// is called with the samples done after each submission. The GPU seconds where timed.
+    pub fn run<'a>(
+        &self,
+        range: SampleRange,
+        bind: &'a wgpu::BindGroup,
+        params: impl Fn(SampleRange) -> Params,
+        steps: impl Fn(SampleRange) -> Vec<Step<'a>>,
+        progress: &mut dyn FnMut(u64),
+    ) -> Result<Option<f64>, GpuError> {
+        let mut seconds = self.gpu.has_timestamps().then_some(0.0);
+        let mut chunks = range.chunks(self.chunk).peekable();
+        while chunks.peek().is_some() {
+            let group: Vec<SampleRange> = chunks.by_ref().take(self.per_submit as usize).collect();
+            let passes: Vec<Pass> = group
+                .iter()
+                .enumerate()
+                .map(|(c, &chunk)| {
+                    let offset = c as u64 * self.stride;
+                    self.gpu.queue.write_buffer(&self.params, offset, bytemuck::bytes_of(&params(chunk)));
+                    Pass { label: "sample", bind, offset: Some(offset as u32), steps: steps(chunk) }
+                })
+                .collect();
+            let t = self.gpu.dispatch(&passes)?;
+            seconds = seconds.zip(t).map(|(a, b)| a + b);
+            let last = group.last().expect("a submission has chunks");
+            progress(last.first + last.count - range.first);
+        }
+        Ok(seconds)
+    }
+}

@@ -1,0 +1,95 @@
+//! The uniform block every sampling pass reads (`Params` in `shaders/kernel.wgsl`, bound at
+//! binding 0 of the counting and the weighted layouts) and the layout entries those share.
+
+use crate::engine::job::{Job, SampleRange};
+use bytemuck::{Pod, Zeroable};
+
+/// The kernel's uniform block (`Params` in `shaders/kernel.wgsl`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable)]
+pub struct Params {
+    seed: [u32; 2],
+    base: [u32; 2],
+    count: u32,
+    n_items: u32,
+    last_positive: u32,
+    /// First bin of the tile being counted (see [`super::GpuEngine::tiling`]; 0 when untiled).
+    tile_first: u32,
+    alpha: [f32; 2],
+    _pad1: [f32; 2],
+    wi: [f32; 4],
+}
+
+impl Params {
+    /// The parameters of one dispatch over `range` (at most 2^32 − 1 samples) of `job`.
+    pub fn new(job: &Job, range: SampleRange) -> Self {
+        let count = u32::try_from(range.count).expect("one dispatch draws fewer than 2^32 samples");
+        let mut p = Params {
+            seed: [range.seed as u32, (range.seed >> 32) as u32],
+            base: [range.first as u32, (range.first >> 32) as u32],
+            count,
+            n_items: 0,
+            last_positive: 0,
+            tile_first: 0,
+            alpha: [0.0; 2],
+            _pad1: [0.0; 2],
+            wi: [0.0; 4],
+        };
+        match job {
+            Job::Lobe { lobe, incident, .. } => {
+                p.alpha = [lobe.alpha_x as f32, lobe.alpha_y as f32];
+                p.wi = [incident.x as f32, incident.y as f32, incident.z as f32, 0.0];
+            }
+            Job::Discrete { dist, .. } => {
+                p.n_items = dist.len() as u32;
+                p.last_positive = dist.pmf().iter().rposition(|&x| x > 0.0).unwrap_or(0) as u32;
+            }
+        }
+        p
+    }
+
+    /// As `self`, counting the tile of bins from `first` on.
+    pub fn tile(self, first: u32) -> Self {
+        Self { tile_first: first, ..self }
+    }
+
+    /// Binding 0: the parameters, at a dynamic offset per dispatch.
+    pub fn layout_entry() -> wgpu::BindGroupLayoutEntry {
+        wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+            },
+            count: None,
+        }
+    }
+
+    /// Binding 0 bound to one `Params` of `buffer` (the dispatch picks which by its offset).
+    pub fn bind_entry(buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+        wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: 0,
+                size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+            }),
+        }
+    }
+}
+
+/// A compute storage buffer entry at `binding`.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
