@@ -2,9 +2,8 @@
 //! the f64 reference, with per-case outputs and a table.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::engine::gpu::GpuError;
 use crate::report::output;
-use crate::run::{Backend, run_case};
+use crate::run::{Backend, device_lost, run_case};
 use crate::scene::{DEFAULT_SCENE, Scene};
 use crate::stats::chi2::sidak;
 use clap::Args;
@@ -110,11 +109,6 @@ fn run_and_write(
     output::write_case(out, &result, &adapter, backend.name())
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok(result)
-}
-
-/// Whether `err` left the GPU device unusable.
-fn device_lost(err: &anyhow::Error) -> bool {
-    err.chain().any(|e| matches!(e.downcast_ref::<GpuError>(), Some(GpuError::Lost(_))))
 }
 
 fn progress_bar(samples: u64, name: &str) -> ProgressBar {

@@ -2,7 +2,7 @@
 //! the χ² verdict and the per-sample check.
 
 use crate::engine::cpu;
-use crate::engine::gpu::{GpuEngine, WeightedRun};
+use crate::engine::gpu::{GpuEngine, GpuError, WeightedRun};
 use crate::engine::job::{Counts, Job, SampleRange};
 use crate::scene::Case;
 use crate::stats::chi2::Chi2;
@@ -180,4 +180,24 @@ pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress:
         None => None,
     };
     Ok(CaseResult { case: case.clone(), counts, expected, chi2, gpu_seconds, histogram_seconds, quadrature_seconds, angle, workgroup_counting, weighted })
+}
+
+/// Whether `err` left the GPU device unusable, so that `lobes run` moves the remaining cases
+/// to the CPU engine ([`GpuError::is_device_lost`] anywhere in its chain).
+pub fn device_lost(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| e.downcast_ref::<GpuError>().is_some_and(GpuError::is_device_lost))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lost_device_moves_the_run_to_the_cpu_and_an_inconsistent_tile_does_not() {
+        let lost = anyhow::Error::new(GpuError::Lost("Parent device is lost".into())).context("case 'a'");
+        assert!(device_lost(&lost));
+        let tile = anyhow::Error::new(GpuError::Inconsistent("tile 1 of 3 counted invalid samples".into())).context("case 'a'");
+        assert!(!device_lost(&tile));
+        assert!(!device_lost(&anyhow::anyhow!("writing the outputs failed")));
+    }
 }

@@ -22,6 +22,17 @@ pub enum GpuError {
     Lost(String),
     #[error("too large for this GPU adapter: {0}")]
     TooLarge(String),
+    /// The engine's passes disagree with each other (the device still works).
+    #[error("the GPU engine's results are inconsistent: {0}")]
+    Inconsistent(String),
+}
+
+impl GpuError {
+    /// Whether the device is unusable after this error, so that further work should go
+    /// elsewhere; every other error concerns one job only.
+    pub fn is_device_lost(&self) -> bool {
+        matches!(self, GpuError::Lost(_))
+    }
 }
 
 /// A wgpu device and what its adapter offers.
@@ -100,5 +111,27 @@ impl Gpu {
     /// Whether the device runs WGSL `f64` (the adapter has SHADER_F64).
     pub fn has_f64(&self) -> bool {
         self.features.contains(wgpu::Features::SHADER_F64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::GpuError;
+
+    #[test]
+    fn only_a_lost_device_is_device_loss() {
+        assert!(GpuError::Lost("device lost".into()).is_device_lost());
+        // A tile that counted invalid samples unlike the first one is the engine's fault, not
+        // the device's: the remaining cases may still run on it.
+        let tile = GpuError::Inconsistent("tile 1 of 2 counted invalid samples [1, 0, 0, 0] where tile 0 counted [0, 0, 0, 0]".into());
+        assert!(!tile.is_device_lost());
+        for e in [
+            GpuError::NoAdapter("none".into()),
+            GpuError::Shader { what: "w".into(), message: "m".into() },
+            GpuError::Readback("r".into()),
+            GpuError::TooLarge("t".into()),
+        ] {
+            assert!(!e.is_device_lost(), "{e}");
+        }
     }
 }

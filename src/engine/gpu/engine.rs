@@ -270,7 +270,7 @@ impl GpuEngine {
             if tile == 0 {
                 result.invalid = invalid;
             } else if invalid != result.invalid {
-                return Err(GpuError::Lost(format!(
+                return Err(GpuError::Inconsistent(format!(
                     "tile {tile} of {} counted invalid samples {invalid:?} where tile 0 counted {:?}: the same samples drew differently",
                     tiling.tiles, result.invalid
                 )));
