@@ -20,7 +20,7 @@ use lobes::reference::ggx::Ggx;
 use lobes::reference::microfacet::Microfacet;
 use lobes::reference::reflect::{reflect, spherical};
 use lobes::reference::{Lobe, LobeKind, Method, rng};
-use reference_quadrature::GaussLegendre;
+use reference_quadrature::{GaussLegendre, composite};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -137,9 +137,9 @@ fn check_h(sample: impl Fn([f64; 2]) -> DVec3, pdf_h: impl Fn(DVec3) -> f64, ax:
     for w in edges.windows(2) {
         for p in 0..H_PHI {
             let (p0, p1) = (TAU * p as f64 / H_PHI as f64, TAU * (p + 1) as f64 / H_PHI as f64);
-            let mass = gl.integrate(w[0], w[1], 4, |theta| {
+            let mass = composite(&gl, w[0], w[1], 4, |theta| {
                 let (st, ct) = theta.sin_cos();
-                st * gl.integrate(p0, p1, 3, |phi| {
+                st * composite(&gl, p0, p1, 3, |phi| {
                     let (sp, cp) = phi.sin_cos();
                     pdf_h(DVec3::new(st * cp, st * sp, ct))
                 })
@@ -179,9 +179,9 @@ fn check_r(
         let (c0, c1) = (c as f64 / R_COS as f64, (c + 1) as f64 / R_COS as f64);
         for p in 0..R_PHI {
             let (p0, p1) = (TAU * p as f64 / R_PHI as f64, TAU * (p + 1) as f64 / R_PHI as f64);
-            let mass = gl.integrate(c0, c1, 3, |z| {
+            let mass = composite(&gl, c0, c1, 3, |z| {
                 let s = (1.0 - z * z).max(0.0).sqrt();
-                gl.integrate(p0, p1, 3, |phi| {
+                composite(&gl, p0, p1, 3, |phi| {
                     let (sp, cp) = phi.sin_cos();
                     pdf_r(DVec3::new(s * cp, s * sp, z))
                 })
