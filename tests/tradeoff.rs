@@ -16,7 +16,7 @@ fn engine() -> GpuEngine {
 
 const GGX_VNDF: Sampler = Sampler { kind: LobeKind::Ggx, method: Method::Vndf };
 
-fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> tradeoff::AngleError {
+fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> compare::AngleCheck {
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
     e.rewrite = prec.rewrite();
     let a = tradeoff::angle_error(e, &job, 1, n, prec).expect("angle check");

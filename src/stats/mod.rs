@@ -5,4 +5,5 @@ pub mod compare;
 pub mod expected;
 pub mod gauss_legendre;
 pub mod histogram;
+pub mod median;
 pub mod weighted;
