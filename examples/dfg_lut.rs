@@ -32,6 +32,7 @@ use glam::DVec3;
 use lobes::embed::{self, Module};
 use lobes::reference::ggx::Ggx;
 use lobes::reference::microfacet;
+use lobes::stats::gauss_legendre::GaussLegendre;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use wgpu::util::DeviceExt;
@@ -156,43 +157,17 @@ pub fn dfg_gpu(device: &wgpu::Device, queue: &wgpu::Queue, samples: u32) -> anyh
     Ok(bytemuck::cast_slice::<u8, [f32; 2]>(&data).to_vec())
 }
 
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on the Legendre recurrence).
-fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    (0..n)
-        .map(|i| {
-            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 0.0;
-            for _ in 0..100 {
-                let (mut p0, mut p1) = (1.0, x);
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
-                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                let dx = p1 / dp;
-                x -= dx;
-                if dx.abs() < 1e-16 {
-                    break;
-                }
-            }
-            (x, 2.0 / ((1.0 - x * x) * dp * dp))
-        })
-        .collect()
-}
-
-fn integrate(rule: &[(f64, f64)], a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; 2]) -> [f64; 2] {
-    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+fn integrate(rule: &GaussLegendre, a: f64, b: f64, f: &mut impl FnMut(f64) -> [f64; 2]) -> [f64; 2] {
     let mut s = [0.0; 2];
-    for &(x, w) in rule {
-        let v = f(m + h * x);
-        s[0] += w * h * v[0];
-        s[1] += w * h * v[1];
+    for (x, w) in rule.on(a, b) {
+        let v = f(x);
+        s[0] += w * v[0];
+        s[1] += w * v[1];
     }
     s
 }
 
-fn adaptive(rule: &[(f64, f64)], a: f64, b: f64, whole: [f64; 2], depth: u32, f: &mut impl FnMut(f64) -> [f64; 2]) -> [f64; 2] {
+fn adaptive(rule: &GaussLegendre, a: f64, b: f64, whole: [f64; 2], depth: u32, f: &mut impl FnMut(f64) -> [f64; 2]) -> [f64; 2] {
     let m = 0.5 * (a + b);
     let (l, r) = (integrate(rule, a, m, f), integrate(rule, m, b, f));
     let halves = [l[0] + r[0], l[1] + r[1]];
@@ -210,8 +185,8 @@ pub fn dfg_f64(n_dot_v: f64, roughness: f64) -> [f64; 2] {
     let ggx = Ggx { ax: alpha, ay: alpha };
     let sin_v = (1.0 - n_dot_v * n_dot_v).sqrt();
     let v = DVec3::new(sin_v, 0.0, n_dot_v);
-    let phi_rule = gauss_legendre(48);
-    let psi_rule = gauss_legendre(10);
+    let phi_rule = GaussLegendre::new(48);
+    let psi_rule = GaussLegendre::new(10);
     // ∫ over ψ of (1/π) sin ψ cos ψ · 2 ∫_0^{φmax} G2 (V·H) / (NdotV NdotH) (1 − Fc, Fc) dφ
     // (the integrand is even in φ); NdotL = 2 (V·H) NdotH − NdotV > 0 ⟺ cos φ > c0.
     let mut inner = |psi: f64| -> [f64; 2] {

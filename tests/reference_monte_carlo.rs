@@ -20,7 +20,8 @@ use lobes::reference::ggx::Ggx;
 use lobes::reference::microfacet::Microfacet;
 use lobes::reference::reflect::{reflect, spherical};
 use lobes::reference::{Lobe, LobeKind, Method, rng};
-use reference_quadrature::GaussLegendre;
+use lobes::stats::chi2;
+use reference_quadrature::{GaussLegendre, composite};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
@@ -31,46 +32,13 @@ const PASS_P: f64 = 1e-4;
 /// A broken pair must be rejected far beyond any doubt.
 const BROKEN_P: f64 = 1e-12;
 
-/// χ² statistic, degrees of freedom and p-value of observed against expected counts. Cells are
-/// sorted by expected count and those below 5 pooled, a pooled cell being emitted whenever its
-/// sum reaches 5 (the remainder joins the last pooled cell); an observation in a cell expected
-/// to hold nothing makes p = 0.
-fn chi_square(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
-    assert_eq!(observed.len(), expected.len());
-    if observed.iter().zip(expected).any(|(&o, &e)| o > 0.0 && e <= 0.0) {
-        return (f64::INFINITY, 0, 0.0);
-    }
-    let mut cells: Vec<(f64, f64)> = expected.iter().copied().zip(observed.iter().copied()).collect();
-    cells.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut pooled: Vec<(f64, f64)> = Vec::new();
-    let (mut pe, mut po) = (0.0, 0.0);
-    let mut out = Vec::new();
-    for (e, o) in cells {
-        if e < 5.0 {
-            pe += e;
-            po += o;
-            if pe >= 5.0 {
-                pooled.push((pe, po));
-                (pe, po) = (0.0, 0.0);
-            }
-        } else {
-            out.push((e, o));
-        }
-    }
-    if pe > 0.0 {
-        match pooled.last_mut() {
-            Some(last) => {
-                last.0 += pe;
-                last.1 += po;
-            }
-            None => pooled.push((pe, po)),
-        }
-    }
-    out.extend(pooled);
-    let stat: f64 = out.iter().map(|&(e, o)| (o - e) * (o - e) / e).sum();
-    let dof = out.len().saturating_sub(1).max(1);
-    let p = ChiSquared::new(dof as f64).unwrap().sf(stat);
-    (stat, dof, p)
+/// χ² statistic, degrees of freedom and p-value of observed against expected counts, by the
+/// library's test ([`chi2::test`]): cells sorted by expected count, those below 5 pooled, the
+/// remainder joining the last pooled cell; an observation in a cell expected to hold nothing
+/// makes p = 0.
+fn chi_square(observed: &[u64], expected: &[f64]) -> (f64, u64, f64) {
+    let t = chi2::test(observed, expected, PASS_P);
+    (t.statistic, t.dof, t.p_value)
 }
 
 /// The p-value against tabulated χ² quantiles, and pooling by hand.
@@ -82,14 +50,14 @@ fn chi_square_p_values_match_tables() {
     assert!((sf(18.307_038_053_275_146, 10.0) - 0.05).abs() < 1e-9);
     assert!((sf(36.190_869_129_270_05, 19.0) - 0.01).abs() < 1e-9);
     // Perfect agreement: statistic 0, p = 1; the three small cells (2 + 2 + 2) pool into one.
-    let (stat, dof, p) = chi_square(&[10.0, 20.0, 2.0, 2.0, 2.0], &[10.0, 20.0, 2.0, 2.0, 2.0]);
+    let (stat, dof, p) = chi_square(&[10, 20, 2, 2, 2], &[10.0, 20.0, 2.0, 2.0, 2.0]);
     assert_eq!((stat, dof, p), (0.0, 2, 1.0));
     // 2 degrees of freedom: sf(x) = e^{−x/2}. Cells 100/100/100 observed 110/90/100: χ² = 2.
-    let (stat, dof, p) = chi_square(&[110.0, 90.0, 100.0], &[100.0, 100.0, 100.0]);
+    let (stat, dof, p) = chi_square(&[110, 90, 100], &[100.0, 100.0, 100.0]);
     assert_eq!(dof, 2);
     assert!((stat - 2.0).abs() < 1e-12 && (p - (-1.0f64).exp()).abs() < 1e-12);
     // a sample where nothing is expected rejects outright
-    assert_eq!(chi_square(&[1.0, 9.0], &[0.0, 10.0]).2, 0.0);
+    assert_eq!(chi_square(&[1, 9], &[0.0, 10.0]).2, 0.0);
 }
 
 fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64) -> Lobe {
@@ -114,12 +82,12 @@ fn h_edges(ax: f64, ay: f64) -> Vec<f64> {
 }
 
 /// χ² of a half-vector sampler against `pdf_h` over 20 θh × 8 φh cells: (statistic, dof, p).
-fn check_h(sample: impl Fn([f64; 2]) -> DVec3, pdf_h: impl Fn(DVec3) -> f64, ax: f64, ay: f64, seed: u64) -> (f64, usize, f64) {
+fn check_h(sample: impl Fn([f64; 2]) -> DVec3, pdf_h: impl Fn(DVec3) -> f64, ax: f64, ay: f64, seed: u64) -> (f64, u64, f64) {
     let edges = h_edges(ax, ay);
     // Last cell: h below the surface or not finite. A half vector exactly on the horizon (the
     // rng's uniforms lie on a 2⁻²⁴ grid that includes 0, and e.g. Ward maps u1 = 0 to θh = 90°)
     // belongs to the last θ bin, which is closed at 90°.
-    let mut observed = vec![0.0; H_THETA * H_PHI + 1];
+    let mut observed = vec![0u64; H_THETA * H_PHI + 1];
     for i in 0..N {
         let u = rng::uniforms(seed, i);
         let h = sample([u[0], u[1]]);
@@ -130,16 +98,16 @@ fn check_h(sample: impl Fn([f64; 2]) -> DVec3, pdf_h: impl Fn(DVec3) -> f64, ax:
         } else {
             H_THETA * H_PHI
         };
-        observed[cell] += 1.0;
+        observed[cell] += 1;
     }
     let gl = GaussLegendre::new(8);
     let mut expected = Vec::with_capacity(H_THETA * H_PHI + 1);
     for w in edges.windows(2) {
         for p in 0..H_PHI {
             let (p0, p1) = (TAU * p as f64 / H_PHI as f64, TAU * (p + 1) as f64 / H_PHI as f64);
-            let mass = gl.integrate(w[0], w[1], 4, |theta| {
+            let mass = composite(&gl, w[0], w[1], 4, |theta| {
                 let (st, ct) = theta.sin_cos();
-                st * gl.integrate(p0, p1, 3, |phi| {
+                st * composite(&gl, p0, p1, 3, |phi| {
                     let (sp, cp) = phi.sin_cos();
                     pdf_h(DVec3::new(st * cp, st * sp, ct))
                 })
@@ -159,8 +127,8 @@ fn check_r(
     sample: impl Fn([f64; 2]) -> (DVec3, bool),
     pdf_r: impl Fn(DVec3) -> f64,
     seed: u64,
-) -> (f64, usize, f64) {
-    let mut observed = vec![0.0; R_COS * R_PHI + 1];
+) -> (f64, u64, f64) {
+    let mut observed = vec![0u64; R_COS * R_PHI + 1];
     for i in 0..N {
         let u = rng::uniforms(seed, i);
         let (wr, valid) = sample([u[0], u[1]]);
@@ -171,7 +139,7 @@ fn check_r(
         } else {
             R_COS * R_PHI
         };
-        observed[cell] += 1.0;
+        observed[cell] += 1;
     }
     let gl = GaussLegendre::new(6);
     let mut expected = Vec::with_capacity(R_COS * R_PHI + 1);
@@ -179,9 +147,9 @@ fn check_r(
         let (c0, c1) = (c as f64 / R_COS as f64, (c + 1) as f64 / R_COS as f64);
         for p in 0..R_PHI {
             let (p0, p1) = (TAU * p as f64 / R_PHI as f64, TAU * (p + 1) as f64 / R_PHI as f64);
-            let mass = gl.integrate(c0, c1, 3, |z| {
+            let mass = composite(&gl, c0, c1, 3, |z| {
                 let s = (1.0 - z * z).max(0.0).sqrt();
-                gl.integrate(p0, p1, 3, |phi| {
+                composite(&gl, p0, p1, 3, |phi| {
                     let (sp, cp) = phi.sin_cos();
                     pdf_r(DVec3::new(s * cp, s * sp, z))
                 })

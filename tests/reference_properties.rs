@@ -8,7 +8,7 @@ use lobes::reference::discrete::{AliasTable, Distribution};
 use lobes::reference::reflect::reflect;
 use lobes::reference::{Lobe, LobeKind, Method};
 use proptest::prelude::*;
-use statrs::function::erf::erf;
+use libm::erf;
 use std::f64::consts::PI;
 
 const KINDS: [(LobeKind, Method); 6] = lobes::reference::SAMPLERS;

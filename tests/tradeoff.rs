@@ -17,7 +17,7 @@ fn engine() -> GpuEngine {
 
 const GGX_VNDF: Sampler = Sampler { kind: LobeKind::Ggx, method: Method::Vndf };
 
-fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> tradeoff::AngleError {
+fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> compare::AngleCheck {
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
     e.rewrite = prec.rewrite();
     let a = tradeoff::angle_error(e, &job, 1, n, prec).expect("angle check");
@@ -25,11 +25,12 @@ fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> tradeoff::An
     a
 }
 
-/// The f64 kernels reproduce the f64 reference to far below f32 resolution: every sample's
-/// angle < 1e-9 rad (f32 kernels: ~1e-7), with no validity disagreement. Measured: 2e-15 rad,
-/// except Beckmann's visible normals at 3.9e-11 rad, where the reference's erfc (statrs 0.18) is
-/// off by up to 1e-10 relative for x ≥ 0.5 (erfc(0.5) = 0.479500122236 against 0.479500122187)
-/// and moves the visible-slope root near x = 0.5; the kernel's own erfc is within 1.3e-12.
+/// The f64 kernels reproduce the f64 reference to far below f32 resolution (f32 kernels: ~1e-7
+/// rad), with no validity disagreement. Measured on lavapipe: ≤ 1.9e-15 rad, except Beckmann's
+/// visible normals at 5.8e-14 rad, where the kernel's own straight-line erfc (within 1.3e-12 of
+/// the exact value, `variants::erfc_straight_line`) moves the visible-slope root; the
+/// reference's erfc is libm's (~1 ulp). With statrs 0.18's erfc (off by up to 1e-10) the
+/// reference itself was off, and Beckmann's visible normals differed by 3.9e-11 rad.
 #[test]
 fn f64_kernels_match_the_f64_reference() {
     let mut e = engine();
@@ -42,7 +43,8 @@ fn f64_kernels_match_the_f64_reference() {
         eprintln!("{} f64: {a:?}", s.name());
         assert_eq!(a.validity_mismatches, 0, "{}", s.name());
         assert!(a.compared > 30_000, "{}: {a:?}", s.name());
-        assert!(a.max_angle_rad < 1e-9, "{}: {a:?}", s.name());
+        let bound = if (s.kind, s.method) == (LobeKind::Beckmann, Method::Vndf) { 2e-13 } else { 1e-14 };
+        assert!(a.max_angle_rad < bound, "{}: {a:?}", s.name());
     }
 }
 

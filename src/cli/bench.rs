@@ -7,6 +7,7 @@ use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Job, SampleRange};
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
+use crate::stats::median::median;
 use clap::Args;
 use serde::Serialize;
 use std::time::Instant;
@@ -63,11 +64,6 @@ pub fn bench_jobs(alpha: f64) -> Vec<Job> {
             grid: SphereGrid { rows: 64, cols: 128 },
         })
         .collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn result(job: &Job, backend: &str, samples: u64, seconds: f64, timing: &str, alpha: f64) -> BenchResult {

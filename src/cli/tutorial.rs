@@ -6,21 +6,28 @@ use super::{
     IncidentArgs, LobeArgs, NumberList, OutputArgs, emit, emit_json, parse_non_negative, parse_number_list,
     parse_polar_90, parse_unit_list, parse_unit_pair, usage,
 };
+use crate::engine::job::DiscreteMethod;
 use crate::reference::discrete::{AliasTable, DiscreteSample, Distribution};
 use crate::reference::{Invalid, reflect};
+use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use serde::Serialize;
 use std::fmt::Write as _;
 
-/// How `discrete` inverts the distribution.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DiscreteMethod {
-    /// Binary search for the first CDF entry ≥ u (the tutorial's rule).
-    Cdf,
-    /// Walker's alias table (Vose's construction), one uniform per draw.
-    Alias,
+/// `--method` takes the library's [`DiscreteMethod`] by its names; clap stays inside `cli/`.
+impl ValueEnum for DiscreteMethod {
+    fn value_variants<'a>() -> &'a [Self] {
+        &DiscreteMethod::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        let help = match self {
+            DiscreteMethod::Cdf => "Binary search for the first CDF entry ≥ u (the tutorial's rule)",
+            DiscreteMethod::Alias => "Walker's alias table (Vose's construction), one uniform per draw",
+        };
+        Some(PossibleValue::new(self.name()).help(help))
+    }
 }
 
 /// Arguments of `lobes discrete`.

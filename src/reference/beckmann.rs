@@ -11,12 +11,16 @@
 //!   a unit Gaussian slope, rotate by φi, unstretch. Here C is inverted to f64 precision by
 //!   Newton steps safeguarded by bisection, where Jakob 2014 ("An Improved Visible Normal
 //!   Sampling Routine for the Beckmann Distribution") stops after a fixed number of steps.
+//!
+//! erfc is libm's (within ~1 ulp; statrs 0.18's is off by up to 1e-10 relative), erf⁻¹ is
+//! statrs's (within ~1 ulp); both are checked against 50-digit values below.
 
 use super::microfacet::{Microfacet, stretch};
 use super::reflect::from_tan_theta;
 use super::ward;
 use glam::DVec3;
-use statrs::function::erf::{erf_inv, erfc};
+use libm::erfc;
+use statrs::function::erf::erf_inv;
 use std::f64::consts::{FRAC_2_SQRT_PI, PI};
 
 #[derive(Debug, Clone, Copy)]
@@ -144,8 +148,45 @@ mod tests {
         let b = Beckmann { ax: 0.4, ay: 0.4 };
         let w = DVec3::new(0.6, 0.0, 0.8);
         let a = 0.8 / (0.4 * 0.6);
-        let expect = (statrs::function::erf::erf(a) - 1.0) / 2.0 + (-a * a).exp() / (2.0 * a * PI.sqrt());
+        let expect = (libm::erf(a) - 1.0) / 2.0 + (-a * a).exp() / (2.0 * a * PI.sqrt());
         assert!((b.lambda(w) - expect).abs() < 1e-15);
+    }
+
+    /// erfc and erf⁻¹ at doubles x against mpmath 1.3 at 50 digits (`float(mpmath.erfc(x))`,
+    /// `float(mpmath.erfinv(x))`), rounded to the nearest double: within 2 ulp.
+    #[test]
+    fn erfc_and_erf_inv_match_high_precision_values() {
+        let erfc_table = [
+            (0.1, 0.887537083981715),
+            (0.5, 0.4795001221869535),
+            (0.7, 0.32219880616258156),
+            (1.0, 0.15729920705028513),
+            (1.5, 0.033894853524689274),
+            (2.0, 0.004677734981047266),
+            (3.0, 2.209049699858544e-05),
+            (5.0, 1.537459794428035e-12),
+            (10.0, 2.088487583762545e-45),
+            (26.0, 5.663192408856143e-296),
+            (-0.5, 1.5204998778130465),
+            (-2.0, 1.9953222650189528),
+        ];
+        let erf_inv_table = [
+            (1e-3, 0.0008862271574665521),
+            (0.3, 0.2724627147267543),
+            (0.5, 0.4769362762044699),
+            (0.9, 1.1630871536766743),
+            (0.99, 1.8213863677184494),
+            (-0.7, -0.7328690779592167),
+            (1.0 - 2f64.powi(-20), 3.465505025803331),
+            (1.0 - 2f64.powi(-40), 5.05125408524939),
+        ];
+        let ulp2 = 2.0 * f64::EPSILON;
+        for (x, want) in erfc_table {
+            assert!((erfc(x) - want).abs() <= ulp2 * want, "erfc({x}) = {} vs {want}", erfc(x));
+        }
+        for (x, want) in erf_inv_table {
+            assert!((erf_inv(x) - want).abs() <= ulp2 * want.abs(), "erf⁻¹({x}) = {} vs {want}", erf_inv(x));
+        }
     }
 
     #[test]

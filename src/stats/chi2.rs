@@ -1,5 +1,6 @@
-//! Pearson's χ² test of a histogram against expected counts, with the pooling of sparse cells
-//! used by Mitsuba 3's `ChiSquareTest` and pbrt-v4's BSDF tests.
+//! Pearson's χ² test of a histogram against expected counts, with sparse cells pooled in the
+//! manner of Mitsuba 3's `ChiSquareTest` (which also drives pbrt-v4's BSDF tests' threshold of 5),
+//! except that no cell is ever left out.
 
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -35,9 +36,15 @@ pub fn p_value(statistic: f64, dof: u64) -> f64 {
 }
 
 /// Pearson's test. Cells are sorted by expected count; those with expected < 5 are summed into
-/// a pool, and a pooled cell is emitted each time the pool's expected count reaches 5 (Mitsuba 3);
-/// a final pool below 5 is merged into the last emitted cell. Observed counts in cells with
-/// expected exactly 0 reject outright. dof = cells − 1 (the total is fixed).
+/// a pool, and a pooled cell is emitted each time the pool's expected count reaches 5, as in
+/// Mitsuba 3 (`chi2` in `mitsuba/core/math.h`, which waits for it to exceed 5). Sorted, the
+/// small cells all come first, and a pool left below 5 at the end holds the largest of them:
+/// it is merged into the pooled cell emitted last, its neighbour in expectation (or, when no
+/// pooled cell was emitted, into the smallest cell ≥ 5; a lone pool becomes the only cell).
+/// **Mitsuba drops that leftover pool** from the statistic and the degrees of freedom; here
+/// every sample counts (nothing is dropped), so mass misplaced among the sparsest cells still
+/// shows. Observed counts in cells with expected exactly 0 reject outright.
+/// dof = cells − 1 (the total is fixed).
 ///
 /// ```
 /// let t = lobes::stats::chi2::test(&[10, 20, 30], &[10.0, 20.0, 30.0], 0.01);
@@ -47,7 +54,9 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
     assert_eq!(observed.len(), expected.len());
     let mut order: Vec<usize> = (0..expected.len()).collect();
     order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
+    // (observed, expected) per cell: the pooled cells first, then the cells ≥ 5, both increasing
     let mut cells: Vec<(f64, f64)> = Vec::new();
+    let mut pooled_cells = 0;
     let (mut pool_o, mut pool_e) = (0.0, 0.0);
     let mut impossible = 0;
     for i in order {
@@ -59,6 +68,7 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
             pool_e += e;
             if pool_e >= MIN_EXPECTED {
                 cells.push((pool_o, pool_e));
+                pooled_cells += 1;
                 (pool_o, pool_e) = (0.0, 0.0);
             }
         } else {
@@ -66,8 +76,8 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
         }
     }
     if pool_e > 0.0 {
-        match cells.first_mut() {
-            // the cells are in increasing order of expectation; the smallest absorbs the rest
+        // the last pooled cell, else the smallest cell ≥ 5
+        match cells.get_mut(pooled_cells.max(1) - 1) {
             Some(c) => {
                 c.0 += pool_o;
                 c.1 += pool_e;
@@ -130,6 +140,29 @@ mod tests {
         assert_eq!(t.statistic, 0.0);
         let t = test(&[1, 100], &[0.0, 101.0], 0.01);
         assert_eq!((t.in_impossible_cells, t.passed), (1, false));
+    }
+
+    /// The leftover pool joins the last pooled cell, worked by hand. Expected counts sorted:
+    /// 1, 1.5, 2.5 | 3, 3.5 | 4 | 10, 20, observed 0, 2, 1 | 5, 4 | 6 | 12, 15. Pools:
+    /// (o 3, e 5), then (9, 6.5); the leftover (6, 4) joins the second: (15, 10.5).
+    /// χ² = (3 − 5)²/5 + (15 − 10.5)²/10.5 + (12 − 10)²/10 + (15 − 20)²/20
+    ///    = 4/5 + 27/14 + 2/5 + 5/4 = 613/140, over 4 cells: dof 3.
+    /// (Merged into the first pooled cell instead, it would be 0 + 6.25/6.5 + 2/5 + 5/4 ≈ 2.61.)
+    #[test]
+    fn leftover_pool_joins_the_last_pooled_cell() {
+        let expected = [20.0, 1.0, 3.5, 4.0, 2.5, 10.0, 1.5, 3.0];
+        let observed = [15, 0, 4, 6, 1, 12, 2, 5];
+        let t = test(&observed, &expected, 0.01);
+        assert_eq!(t.dof, 3);
+        assert!((t.statistic - 613.0 / 140.0).abs() < 1e-14, "{}", t.statistic);
+        // no pooled cell before the leftover: it joins the smallest cell ≥ 5
+        // (o 3 + 6, e 2 + 8) and (9, 9): χ² = 1/10 + 0, dof 1
+        let t = test(&[2, 1, 6, 9], &[1.0, 1.0, 8.0, 9.0], 0.01);
+        assert_eq!(t.dof, 1);
+        assert!((t.statistic - 0.1).abs() < 1e-15, "{}", t.statistic);
+        // only small cells, never reaching 5: one cell, dof 0, p = 1
+        let t = test(&[1, 2], &[1.0, 2.0], 0.01);
+        assert_eq!((t.dof, t.statistic, t.p_value), (0, 0.0, 1.0));
     }
 
     #[test]

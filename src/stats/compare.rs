@@ -42,8 +42,9 @@ pub fn chi2_test(counts: &Counts, expected: &ExpectedCounts, significance: f64) 
     chi2::test(&observed, &exp, significance)
 }
 
-/// GPU f32 directions against the f64 reference, sample by sample.
-#[derive(Debug, Clone, Default, Serialize)]
+/// GPU directions against the f64 reference, sample by sample: `lobes run`'s per-sample check
+/// and `lobes tradeoff`'s angle per precision.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct AngleCheck {
     /// Samples compared (valid on both sides).
     pub compared: u64,
@@ -51,6 +52,38 @@ pub struct AngleCheck {
     pub validity_mismatches: u64,
     pub max_angle_rad: f64,
     pub mean_angle_rad: f64,
+}
+
+impl AngleCheck {
+    /// Summarises (GPU direction, f64 direction) pairs, each `None` where that side flagged the
+    /// sample invalid. The GPU direction is normalised first; the reference's is a unit vector.
+    ///
+    /// ```
+    /// use glam::DVec3;
+    /// use lobes::stats::compare::AngleCheck;
+    /// let tilted = DVec3::new(1e-3, 0.0, 1.0); // 1e-3 rad (to 3e-7) off the normal
+    /// let a = AngleCheck::from_pairs([(Some(tilted), Some(DVec3::Z)), (None, None), (Some(DVec3::Z), None)]);
+    /// assert_eq!((a.compared, a.validity_mismatches), (1, 1));
+    /// assert!((a.max_angle_rad - 1e-3).abs() < 1e-9 && a.mean_angle_rad == a.max_angle_rad);
+    /// ```
+    pub fn from_pairs(pairs: impl IntoIterator<Item = (Option<DVec3>, Option<DVec3>)>) -> Self {
+        let mut out = AngleCheck::default();
+        let mut sum = 0.0;
+        for pair in pairs {
+            match pair {
+                (Some(gpu), Some(reference)) => {
+                    let a = angle_between(gpu.normalize(), reference);
+                    out.compared += 1;
+                    sum += a;
+                    out.max_angle_rad = out.max_angle_rad.max(a);
+                }
+                (None, None) => {}
+                _ => out.validity_mismatches += 1,
+            }
+        }
+        out.mean_angle_rad = if out.compared > 0 { sum / out.compared as f64 } else { 0.0 };
+        out
+    }
 }
 
 /// The angle between two unit vectors, atan2(|a × b|, a · b) (accurate at small angles).
@@ -61,23 +94,10 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
 /// Compares the GPU's directions of samples `first ..` (each `[x, y, z, reason]`) with f64.
 pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleCheck {
     let Job::Lobe { lobe, incident, .. } = job else { return AngleCheck::default() };
-    let mut out = AngleCheck::default();
-    let mut sum = 0.0;
-    for (k, g) in gpu.iter().enumerate() {
+    AngleCheck::from_pairs(gpu.iter().enumerate().map(|(k, g)| {
         let u = crate::reference::rng::uniforms(seed, first + k as u64);
         let s = lobe.sample(*incident, [u[0], u[1]]);
-        let gpu_valid = g[3] == 0.0;
-        if gpu_valid != s.invalid.is_none() {
-            out.validity_mismatches += 1;
-            continue;
-        }
-        if gpu_valid {
-            let a = angle_between(DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64).normalize(), s.omega_r);
-            out.compared += 1;
-            sum += a;
-            out.max_angle_rad = out.max_angle_rad.max(a);
-        }
-    }
-    out.mean_angle_rad = if out.compared > 0 { sum / out.compared as f64 } else { 0.0 };
-    out
+        let gpu = (g[3] == 0.0).then(|| DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64));
+        (gpu, s.invalid.is_none().then_some(s.omega_r))
+    }))
 }

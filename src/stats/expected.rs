@@ -10,13 +10,15 @@
 //! form total mass.
 
 use crate::reference::Lobe;
+use crate::stats::gauss_legendre::GaussLegendre;
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::LazyLock;
 
-/// 5-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30).
-const GL_X: [f64; 5] = [-0.906_179_845_938_664, -0.538_469_310_105_683_1, 0.0, 0.538_469_310_105_683_1, 0.906_179_845_938_664];
-const GL_W: [f64; 5] = [0.236_926_885_056_189_1, 0.478_628_670_499_366_5, 0.568_888_888_888_888_9, 0.478_628_670_499_366_5, 0.236_926_885_056_189_1];
+/// The 5-point rule of every part, and the 3-point rule it is checked against.
+static GL5: LazyLock<GaussLegendre> = LazyLock::new(|| GaussLegendre::new(5));
+static GL3: LazyLock<GaussLegendre> = LazyLock::new(|| GaussLegendre::new(3));
 
 /// Sample count at which the quadrature error must be far below the statistical error.
 pub const REFERENCE_SAMPLES: f64 = 1e8;
@@ -76,25 +78,8 @@ pub fn direction(z: f64, phi: f64) -> DVec3 {
     DVec3::new(s * phi.cos(), s * phi.sin(), z)
 }
 
-/// 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30).
-const GL3_X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
-const GL3_W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
-
-/// The tensor Gauss–Legendre rule with nodes `x` and weights `w` on `r`.
-fn rule(f: &impl Fn(f64, f64) -> f64, r: Rect, x: &[f64], w: &[f64]) -> f64 {
-    let (hz, cz) = (0.5 * (r.z.1 - r.z.0), 0.5 * (r.z.1 + r.z.0));
-    let (hp, cp) = (0.5 * (r.phi.1 - r.phi.0), 0.5 * (r.phi.1 + r.phi.0));
-    let mut sum = 0.0;
-    for (xi, wi) in x.iter().zip(w) {
-        for (xj, wj) in x.iter().zip(w) {
-            sum += wi * wj * f(cz + hz * xi, cp + hp * xj);
-        }
-    }
-    sum * hz * hp
-}
-
 fn gauss(f: &impl Fn(f64, f64) -> f64, r: Rect) -> f64 {
-    rule(f, r, &GL_X, &GL_W)
+    GL5.integrate_2d(r.z, r.phi, f)
 }
 
 /// The tolerance on a part whose integral is about `value`.
@@ -131,7 +116,7 @@ fn integrate_bin(f: &impl Fn(f64, f64) -> f64, bin: Rect, m: u32, q: &Quadrature
             // which bounds the 5-point rule's (exact to degree 9) for a smooth integrand. Where
             // they disagree, the part is refined as below.
             let g5 = gauss(f, r);
-            let g3 = rule(f, r, &GL3_X, &GL3_W);
+            let g3 = GL3.integrate_2d(r.z, r.phi, f);
             let (v, e) = if (g5 - g3).abs() <= tolerance(g5, q) { (g5, (g5 - g3).abs()) } else { adapt(f, r, g5, q, 0) };
             acc = (acc.0 + v, acc.1 + e);
         }

@@ -204,7 +204,7 @@ fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
         return (0.0, 1.0);
     }
     let z = diff / sigma;
-    (z, statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2))
+    (z, libm::erfc(z.abs() / std::f64::consts::SQRT_2))
 }
 
 /// Judges `sums` of `n` samples of a lobe case with `effects` at per-case `significance`:

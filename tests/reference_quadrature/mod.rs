@@ -1,5 +1,5 @@
 //! Quadrature shared by the reference's integration tests (`reference_normalization.rs`,
-//! `reference_monte_carlo.rs`): Gauss–Legendre rules and an integrator over the upper
+//! `reference_monte_carlo.rs`): composite Gauss–Legendre (the library's rule) and an integrator over the upper
 //! hemisphere of half vectors h that stays accurate for very peaked lobes (α = 0.01).
 //!
 //! The hemisphere is parameterised by *stretched slopes*: h ∝ (αx r cos φ, αy r sin φ, 1), so
@@ -19,63 +19,20 @@
 #![allow(dead_code)]
 
 use glam::DVec3;
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+pub use lobes::stats::gauss_legendre::GaussLegendre;
+use std::f64::consts::{FRAC_PI_2, TAU};
 
-/// An n-point Gauss–Legendre rule on [−1, 1].
-#[derive(Debug, Clone)]
-pub struct GaussLegendre {
-    x: Vec<f64>,
-    w: Vec<f64>,
-}
-
-impl GaussLegendre {
-    /// Nodes by Newton's method on the Legendre polynomial P_n (the classic "gauleg").
-    pub fn new(n: usize) -> Self {
-        assert!(n >= 1);
-        let (mut x, mut w) = (vec![0.0; n], vec![0.0; n]);
-        for i in 0..n.div_ceil(2) {
-            let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-            let mut dp = 1.0;
-            for _ in 0..100 {
-                let (mut p1, mut p2) = (1.0, 0.0);
-                for j in 0..n {
-                    let p3 = p2;
-                    p2 = p1;
-                    p1 = ((2 * j + 1) as f64 * z * p2 - j as f64 * p3) / (j + 1) as f64;
-                }
-                dp = n as f64 * (z * p1 - p2) / (z * z - 1.0);
-                let dz = p1 / dp;
-                z -= dz;
-                if dz.abs() < 1e-16 {
-                    break;
-                }
-            }
-            x[i] = -z;
-            x[n - 1 - i] = z;
-            w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-            w[n - 1 - i] = w[i];
+/// ∫_a^b f by the rule `gl` composite over `panels` equal panels.
+pub fn composite(gl: &GaussLegendre, a: f64, b: f64, panels: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
+    let step = (b - a) / panels as f64;
+    let mut sum = 0.0;
+    for k in 0..panels {
+        let (lo, hi) = (a + k as f64 * step, if k + 1 == panels { b } else { a + (k + 1) as f64 * step });
+        for (x, w) in gl.on(lo, hi) {
+            sum += w * f(x);
         }
-        Self { x, w }
     }
-
-    /// The (node, weight) pairs of the rule mapped to [a, b].
-    pub fn on(&self, a: f64, b: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
-        let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
-        self.x.iter().zip(&self.w).map(move |(&x, &w)| (c + h * x, h * w))
-    }
-
-    /// ∫_a^b f, composite over `panels` equal panels.
-    pub fn integrate(&self, a: f64, b: f64, panels: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
-        let step = (b - a) / panels as f64;
-        let mut sum = 0.0;
-        for k in 0..panels {
-            let (lo, hi) = (a + k as f64 * step, if k + 1 == panels { b } else { a + (k + 1) as f64 * step });
-            for (x, w) in self.on(lo, hi) {
-                sum += w * f(x);
-            }
-        }
-        sum
-    }
+    sum
 }
 
 /// Where the integrand may be non-smooth, as seen from the hemisphere integrator.
@@ -185,7 +142,7 @@ impl Hemisphere {
                 psis.dedup_by(|a, b| (*a - *b).abs() < 1e-14);
                 let mut ray = 0.0;
                 for seg in psis.windows(2) {
-                    ray += self.gl.integrate(seg[0], seg[1], self.psi_sub, |psi| {
+                    ray += composite(&self.gl, seg[0], seg[1], self.psi_sub, |psi| {
                         let r = psi.tan();
                         let (sx, sy) = (r * e.0, r * e.1);
                         let hz = 1.0 / (1.0 + sx * sx + sy * sy).sqrt();

@@ -16,9 +16,10 @@ use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Counts, Job, SampleRange};
 use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
 use crate::stats::chi2;
-use crate::stats::compare::{self, ExpectedCounts, angle_between};
+use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::{self, Quadrature, REFERENCE_SAMPLES};
 use crate::stats::histogram::SphereGrid;
+use crate::stats::median::median;
 use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -117,15 +118,6 @@ impl SweepSettings {
     }
 }
 
-/// The per-sample angle of a precision's kernel against the f64 reference.
-#[derive(Debug, Clone, Serialize)]
-pub struct AngleError {
-    pub compared: u64,
-    pub validity_mismatches: u64,
-    pub max_angle_rad: f64,
-    pub mean_angle_rad: f64,
-}
-
 /// One point of the sweep.
 #[derive(Debug, Clone, Serialize)]
 pub struct SweepPoint {
@@ -144,7 +136,7 @@ pub struct SweepPoint {
     /// X ~ Poisson(λ = N p) per cell.
     pub l1_noise: f64,
     /// The per-sample check (the same for every N of a sampler and precision).
-    pub angle: AngleError,
+    pub angle: AngleCheck,
 }
 
 impl SweepPoint {
@@ -228,7 +220,7 @@ pub fn unavailable(engine: &GpuEngine, sampler: Sampler, precision: Precision) -
 
 /// The GPU directions of samples 0 .. n of `job` under the engine's current precision against
 /// the f64 reference. For the f64 kernel the directions come back as f32 hi + lo pairs.
-pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precision: Precision) -> anyhow::Result<AngleError> {
+pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precision: Precision) -> anyhow::Result<AngleCheck> {
     let Job::Lobe { lobe, incident, .. } = job else { anyhow::bail!("angle_error: a lobe job") };
     let u: Vec<[f32; 2]> = (0..n as u64)
         .map(|i| {
@@ -237,32 +229,17 @@ pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precisi
         })
         .collect();
     let gpu = engine.explicit(job, &u)?;
-    let per: Vec<(bool, f64)> = gpu
+    let pairs: Vec<(Option<DVec3>, Option<DVec3>)> = gpu
         .par_iter()
         .zip(u.par_iter())
         .map(|(g, u)| {
             let s = lobe.sample(*incident, [u[0] as f64, u[1] as f64]);
-            let gpu_valid = g[0][3] == 0.0;
-            if gpu_valid != s.invalid.is_none() {
-                return (false, f64::NAN);
-            }
-            if !gpu_valid {
-                return (true, f64::NAN);
-            }
             let hi = DVec3::new(g[0][0] as f64, g[0][1] as f64, g[0][2] as f64);
             let w = if precision == Precision::F64 { hi + DVec3::new(g[1][0] as f64, g[1][1] as f64, g[1][2] as f64) } else { hi };
-            (true, angle_between(w.normalize(), s.omega_r))
+            ((g[0][3] == 0.0).then_some(w), s.invalid.is_none().then_some(s.omega_r))
         })
         .collect();
-    let mismatches = per.iter().filter(|p| !p.0).count() as u64;
-    let angles: Vec<f64> = per.iter().filter(|p| p.0 && !p.1.is_nan()).map(|p| p.1).collect();
-    let compared = angles.len() as u64;
-    Ok(AngleError {
-        compared,
-        validity_mismatches: mismatches,
-        max_angle_rad: angles.iter().copied().fold(0.0, f64::max),
-        mean_angle_rad: if compared > 0 { angles.iter().sum::<f64>() / compared as f64 } else { 0.0 },
-    })
+    Ok(AngleCheck::from_pairs(pairs))
 }
 
 /// The job of a sampler at the sweep's α and θi.
@@ -356,12 +333,6 @@ fn sweep_one(
         points.push(point);
     }
     Ok((points, skipped))
-}
-
-/// The median of `v` (upper median for an even count).
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// `runs` histograms of samples 0 .. n: the first run's result with the median wall and GPU
