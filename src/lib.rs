@@ -15,11 +15,13 @@
 //! - [`scene`]: scene files and their cases.
 //! - [`run`](mod@run): a case end to end: histogram, expected counts, verdicts.
 //! - [`experiments`]: the stress suite and the accuracy-against-time sweep.
+//! - [`check`]: judging a user's own WGSL sampler (`lobes check`).
 //! - [`report`]: heat maps, plots, tables and output files.
 //! - [`cli`]: the `lobes` command line (argument parsing, validation, printing).
 //! - [`embed`]: the WGSL samplers, densities and BRDFs for your own wgpu shaders, and helpers
 //!   that upload discrete distributions.
 
+pub mod check;
 pub mod cli;
 pub mod embed;
 pub mod engine;

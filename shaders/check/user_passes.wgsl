@@ -1,0 +1,230 @@
+// The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
+// functions through three wrappers that the composing host generates (src/check/compose.rs):
+//   fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32>   // (d, pdf the sampler reports)
+//   fn lobes_user_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32
+//   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
+// and `const LOBES_DOMAIN_PLANE: bool`. Every name here starts with `lobes_` so that it cannot
+// collide with the user's own.
+
+struct LobesCheckParams {
+    // the user's 16 numbers, zero-padded
+    user: array<vec4<f32>, 4>,
+    wi: vec4<f32>,
+    // plane: (x0, y0, x1, y1); sphere: unused
+    bounds: vec4<f32>,
+    seed: vec2<u32>,
+    base: vec2<u32>,
+    count: u32,
+    // finite-difference step of the probe pass
+    eps: f32,
+    samples_per_thread: u32,
+    // the histogram's grid
+    rows: u32,
+    cols: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var<uniform> lobes_check: LobesCheckParams;
+@group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
+
+// x > 0 and finite, read from the bits (not relying on NaN comparing false, which fast-math
+// lowerings may not keep).
+fn lobes_positive(x: f32) -> bool {
+    let bits = bitcast<u32>(x);
+    return (bits & 0x7f800000u) != 0x7f800000u && x > 0.0;
+}
+
+// The point of the domain at coordinates (a, b) of a rectangle in hemisphere `h` (±1): on the
+// sphere, a = 1 − |cos θ| (the distance from the nearer pole, exact in f32 where a peak sits at
+// a pole) and b = φ, so the direction is (s cos φ, s sin φ, h (1 − a)) with s = √(a (2 − a)), and
+// the solid-angle element is da dφ: a rectangle's integral needs no Jacobian. On the plane, the
+// point (a, b).
+fn lobes_domain_point(a: f32, b: f32, h: f32) -> vec3<f32> {
+    if (LOBES_DOMAIN_PLANE) {
+        return vec3<f32>(a, b, 0.0);
+    }
+    let s = sqrt(max(0.0, a * (2.0 - a)));
+    return vec3<f32>(s * cos(b), s * sin(b), h * (1.0 - a));
+}
+
+// 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30),
+// the pair the f64 quadrature (src/stats/expected.rs) uses.
+const LOBES_GL5_X = array<f32, 5>(-0.906179845938664, -0.538469310105683, 0.0, 0.538469310105683, 0.906179845938664);
+const LOBES_GL5_W = array<f32, 5>(0.236926885056189, 0.478628670499367, 0.568888888888889, 0.478628670499367, 0.236926885056189);
+const LOBES_GL3_X = array<f32, 3>(-0.774596669241483, 0.0, 0.774596669241483);
+const LOBES_GL3_W = array<f32, 3>(0.555555555555556, 0.888888888888889, 0.555555555555556);
+
+// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign in lobes_in[count + i].x,
+// integrated with the 5 × 5 and the 3 × 3 tensor
+// Gauss–Legendre rules: (∫ pdf by 5 × 5, by 3 × 3, ∫ eval by 5 × 5, by 3 × 3). A pdf that is
+// NaN, infinite or negative at a node is returned as such: the host reports it.
+@compute @workgroup_size(64)
+fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let r = lobes_in[i];
+    let h = lobes_in[lobes_check.count + i].x;
+    let ha = 0.5 * (r.y - r.x);
+    let ca = 0.5 * (r.y + r.x);
+    let hb = 0.5 * (r.w - r.z);
+    let cb = 0.5 * (r.w + r.z);
+    let wi = lobes_check.wi.xyz;
+    var p5 = 0.0;
+    var e5 = 0.0;
+    for (var j = 0; j < 5; j++) {
+        for (var k = 0; k < 5; k++) {
+            let d = lobes_domain_point(ca + ha * LOBES_GL5_X[j], cb + hb * LOBES_GL5_X[k], h);
+            let w = LOBES_GL5_W[j] * LOBES_GL5_W[k];
+            p5 += w * lobes_user_pdf(wi, d);
+            e5 += w * lobes_user_eval(wi, d);
+        }
+    }
+    var p3 = 0.0;
+    var e3 = 0.0;
+    for (var j = 0; j < 3; j++) {
+        for (var k = 0; k < 3; k++) {
+            let d = lobes_domain_point(ca + ha * LOBES_GL3_X[j], cb + hb * LOBES_GL3_X[k], h);
+            let w = LOBES_GL3_W[j] * LOBES_GL3_W[k];
+            p3 += w * lobes_user_pdf(wi, d);
+            e3 += w * lobes_user_eval(wi, d);
+        }
+    }
+    let area = ha * hb;
+    lobes_out[i] = vec4<f32>(p5, p3, e5, e3) * area;
+}
+
+// The sample map around item i of lobes_in = (u, wi): per item 7 vec4s,
+//   0: sample(u) as (d, reported pdf)
+//   1, 2: sample(u ± eps in u.x); 3, 4: sample(u ± eps in u.y)
+//   5: sample(u with u.z and u.w moved by ½, mod 1): differs from 0 where the map branches on them
+//   6: (pdf(d), eval(d), |d|, 0) at d of 0
+// The host differentiates in f64 (src/check/jacobian.rs) and classifies (src/check/hard.rs).
+@compute @workgroup_size(64)
+fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let u = lobes_in[2u * i];
+    let wi = lobes_in[2u * i + 1u].xyz;
+    let e = lobes_check.eps;
+    let s = lobes_user_sample(wi, u);
+    let o = 7u * i;
+    lobes_out[o] = s;
+    let px = lobes_user_sample(wi, u + vec4<f32>(e, 0.0, 0.0, 0.0));
+    let mx = lobes_user_sample(wi, u - vec4<f32>(e, 0.0, 0.0, 0.0));
+    let py = lobes_user_sample(wi, u + vec4<f32>(0.0, e, 0.0, 0.0));
+    let my = lobes_user_sample(wi, u - vec4<f32>(0.0, e, 0.0, 0.0));
+    lobes_out[o + 1u] = px;
+    lobes_out[o + 2u] = mx;
+    lobes_out[o + 3u] = py;
+    lobes_out[o + 4u] = my;
+    lobes_out[o + 5u] = lobes_user_sample(wi, vec4<f32>(u.xy, fract(u.zw + 0.5)));
+    lobes_out[o + 6u] = vec4<f32>(lobes_user_pdf(wi, s.xyz), lobes_user_eval(wi, s.xyz), length(s.xyz), 0.0);
+}
+
+// Estimator weights of samples base + (gid · samples_per_thread + k): per invocation
+// (Σ w, Σ w², the largest |w − w_pdf| / w_pdf, number of samples with eval > 0), where
+// w = eval(d) / (the reported pdf) is the weight a renderer computes from the sampler alone and
+// w_pdf = eval(d) / pdf(d) the one from the pdf function. Invalid samples weigh 0.
+@compute @workgroup_size(64)
+fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let t = gid.x;
+    let first = t * lobes_check.samples_per_thread;
+    if (first >= lobes_check.count) {
+        return;
+    }
+    let wi = lobes_check.wi.xyz;
+    var acc = vec4<f32>(0.0);
+    for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
+        let local = first + k;
+        if (local < lobes_check.count) {
+            let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+            let e = lobes_user_eval(wi, s.xyz);
+            let pdf = lobes_user_pdf(wi, s.xyz);
+            if (e > 0.0 && lobes_positive(s.w) && lobes_positive(pdf)) {
+                let w = e / s.w;
+                let w_pdf = e / pdf;
+                acc += vec4<f32>(w, w * w, 0.0, 1.0);
+                acc.z = max(acc.z, abs(w - w_pdf) / w_pdf);
+            }
+        }
+    }
+    lobes_out[t] = acc;
+}
+
+// Reason codes of invalid samples (src/check/mod.rs: REASONS), counted after the bins.
+const LOBES_NON_FINITE_POINT: u32 = 1u;
+const LOBES_OUTSIDE_DOMAIN: u32 = 2u;
+const LOBES_NON_FINITE_PDF: u32 = 3u;
+const LOBES_ZERO_PDF: u32 = 4u;
+
+fn lobes_finite3(d: vec3<f32>) -> bool {
+    let b = bitcast<vec3<u32>>(d) & vec3<u32>(0x7f800000u);
+    return all(b != vec3<u32>(0x7f800000u));
+}
+
+// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1. Bins as lobes bins
+// directions (src/stats/histogram.rs): rows uniform in cos θ over [−1, 1], columns in φ over
+// [−π, π), φ = π wrapping to column 0; on the plane, rows in y and columns in x over the bounds.
+fn lobes_cell(s: vec4<f32>) -> u32 {
+    let bins = lobes_check.rows * lobes_check.cols;
+    if (!lobes_finite3(s.xyz)) {
+        return bins + LOBES_NON_FINITE_POINT - 1u;
+    }
+    var row = 0u;
+    var col = 0u;
+    if (LOBES_DOMAIN_PLANE) {
+        let lo = lobes_check.bounds.xy;
+        let hi = lobes_check.bounds.zw;
+        if (any(s.xy < lo) || any(s.xy > hi)) {
+            return bins + LOBES_OUTSIDE_DOMAIN - 1u;
+        }
+        let t = (s.xy - lo) / (hi - lo);
+        col = min(u32(t.x * f32(lobes_check.cols)), lobes_check.cols - 1u);
+        row = min(u32(t.y * f32(lobes_check.rows)), lobes_check.rows - 1u);
+    } else {
+        if (abs(length(s.xyz) - 1.0) > 1e-3) {
+            return bins + LOBES_OUTSIDE_DOMAIN - 1u;
+        }
+        let z = clamp(s.z, -1.0, 1.0);
+        row = min(u32((z + 1.0) * 0.5 * f32(lobes_check.rows)), lobes_check.rows - 1u);
+        var t = 0.5;
+        if (s.x != 0.0 || s.y != 0.0) {
+            t = (atan2(s.y, s.x) + 3.14159265358979) * (0.5 / 3.14159265358979);
+        }
+        col = u32(max(t, 0.0) * f32(lobes_check.cols));
+        if (col >= lobes_check.cols) {
+            col = 0u;
+        }
+    }
+    let bits = bitcast<u32>(s.w);
+    if ((bits & 0x7f800000u) == 0x7f800000u) {
+        return bins + LOBES_NON_FINITE_PDF - 1u;
+    }
+    if (!(s.w > 0.0)) {
+        return bins + LOBES_ZERO_PDF - 1u;
+    }
+    return row * lobes_check.cols + col;
+}
+
+// Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
+// keeps each dispatch under 2^32 samples and adds into 64-bit totals).
+@compute @workgroup_size(64)
+fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let first = gid.x * lobes_check.samples_per_thread;
+    let wi = lobes_check.wi.xyz;
+    for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
+        let local = first + k;
+        if (local < lobes_check.count) {
+            let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+            atomicAdd(&lobes_counts[lobes_cell(s)], 1u);
+        }
+    }
+}

@@ -1,0 +1,95 @@
+//! The user's sampler at the inputs where samplers break: every component of u at 0, 2⁻²⁴, ½,
+//! 1 − 2⁻²⁴ and 1 (625 combinations), from normal, oblique, grazing and below-the-surface
+//! incidence. A sample must be either rejected (reported pdf exactly 0) or valid: a finite point
+//! (a unit direction on the sphere, inside the bounds on the plane) with a finite reported pdf
+//! > 0 and a finite pdf(d) ≥ 0. NaN, ∞ or a negative pdf is never acceptable.
+
+use serde::{Deserialize, Serialize};
+
+/// The values every component of u takes.
+pub const U_VALUES: [f32; 5] = [0.0, 1.0 / 16_777_216.0, 0.5, 1.0 - 1.0 / 16_777_216.0, 1.0];
+/// Incident θ in degrees on the sphere: normal, oblique, grazing, and from below the surface
+/// (for samplers of transmission or phase functions; a reflection-only sampler rejects those).
+pub const INCIDENT_THETA: [f64; 7] = [0.0, 45.0, 89.9, 89.999, 90.001, 135.0, 180.0];
+
+/// Every u of the table, in order.
+pub fn uniforms() -> Vec<[f32; 4]> {
+    let v = U_VALUES;
+    let mut out = Vec::with_capacity(625);
+    for a in v {
+        for b in v {
+            for c in v {
+                for d in v {
+                    out.push([a, b, c, d]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// One incident direction's row of the table.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct HardRow {
+    /// Incident θ in degrees (on the plane: the run's).
+    pub incident_theta: f64,
+    pub samples: u32,
+    pub valid: u32,
+    /// Reported pdf exactly 0.
+    pub rejected: u32,
+    /// Reported pdf NaN, ∞ or negative.
+    pub bad_pdf: u32,
+    /// pdf > 0 but the point is not finite, not a unit direction, or outside the bounds.
+    pub bad_point: u32,
+    /// pdf(d) of a valid sample NaN, ∞ or negative.
+    pub bad_pdf_function: u32,
+    /// The u of the first failing sample.
+    pub first_failure: Option<[f32; 4]>,
+    pub passed: bool,
+}
+
+/// Classifies the probed samples of one row (`probe[0]` = (d, reported pdf), `probe[6]` =
+/// (pdf(d), eval(d), |d|)).
+pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds: Option<[f64; 4]>) -> HardRow {
+    let mut r = HardRow {
+        incident_theta,
+        samples: probes.len() as u32,
+        valid: 0,
+        rejected: 0,
+        bad_pdf: 0,
+        bad_point: 0,
+        bad_pdf_function: 0,
+        first_failure: None,
+        passed: true,
+    };
+    for (p, u) in probes.iter().zip(u) {
+        let (d, pdf) = (p[0], p[0][3]);
+        let in_domain = d[..3].iter().all(|x| x.is_finite())
+            && match bounds {
+                Some([x0, y0, x1, y1]) => (x0..=x1).contains(&(d[0] as f64)) && (y0..=y1).contains(&(d[1] as f64)),
+                None => (p[6][2] as f64 - 1.0).abs() <= 1e-3,
+            };
+        let fn_pdf = p[6][0];
+        let failed = if !pdf.is_finite() || pdf < 0.0 {
+            r.bad_pdf += 1;
+            true
+        } else if pdf == 0.0 {
+            r.rejected += 1;
+            false
+        } else if !in_domain {
+            r.bad_point += 1;
+            true
+        } else if !fn_pdf.is_finite() || fn_pdf < 0.0 {
+            r.bad_pdf_function += 1;
+            true
+        } else {
+            r.valid += 1;
+            false
+        };
+        if failed && r.first_failure.is_none() {
+            r.first_failure = Some(*u);
+        }
+    }
+    r.passed = r.first_failure.is_none();
+    r
+}

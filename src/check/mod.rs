@@ -1,0 +1,521 @@
+//! Testing your own sampler: `lobes check` for any WGSL sampler and pdf.
+//!
+//! A renderer's WGSL file defines, under names of its choosing (the contract, in
+//! `docs/testing-your-own-sampler.md`):
+//!
+//! ```wgsl
+//! fn my_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> // (d, pdf)
+//! fn my_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32
+//! fn my_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32          // optional
+//! ```
+//!
+//! and [`check`] judges it on the GPU as lobes judges its own samplers:
+//! 1. `chi2`: the GPU histogram of the samples against the expected histogram, the user's pdf
+//!    integrated per bin by adaptive quadrature on the GPU ([`quadrature`]);
+//! 2. `pdf_consistency`: the pdf the sampler reports against the pdf function at the same point;
+//! 3. `jacobian`: the pdf against the finite-difference Jacobian of the map u ↦ d ([`jacobian`]);
+//! 4. `weights` and `albedo` (with an eval): eval/pdf from the sampler against eval/pdf(d), and
+//!    the mean weight against the quadrature of eval;
+//! 5. `hard_cases`: u at 0, 2⁻²⁴, ½, 1 − 2⁻²⁴, 1 and grazing or below-surface incidence
+//!    ([`hard`]);
+//! 6. `pdf_values`: the pdf never NaN, ∞ or negative at the quadrature's nodes.
+//!
+//! ```no_run
+//! use lobes::check::{check, Settings, UserSampler, Domain};
+//! let sampler = UserSampler::from_files(&["my_ggx.wgsl".into()], "my_sample", "my_pdf", None, Domain::Sphere)?;
+//! let gpu = lobes::engine::gpu::Gpu::new()?;
+//! let report = check(&gpu, &sampler, &Settings { params: vec![0.3, 0.3], ..Settings::default() })?;
+//! report.assert_passed();
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod compose;
+mod gpu;
+pub mod hard;
+pub mod jacobian;
+pub mod quadrature;
+
+pub use compose::Source;
+
+use crate::engine::gpu::{Gpu, GpuError};
+use crate::reference::rng;
+use crate::stats::chi2::{self, Chi2};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Why a check could not be run (as opposed to a check that ran and failed).
+#[derive(Debug, thiserror::Error)]
+pub enum CheckError {
+    /// Bad input: a flag, a file, a function name.
+    #[error("{0}")]
+    Input(String),
+    /// The user's WGSL does not parse or validate; the message points at file:line:column.
+    #[error("{0}")]
+    Wgsl(String),
+    /// The device failed (lost, out of memory, readback).
+    #[error("the GPU failed: {0}")]
+    Device(String),
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// A fault of lobes itself.
+    #[error("internal error in lobes check: {0}")]
+    Internal(String),
+}
+
+impl CheckError {
+    /// Whether the error is the user's input (exit code 2) rather than a failure to run (1).
+    pub fn is_input(&self) -> bool {
+        matches!(self, CheckError::Input(_) | CheckError::Wgsl(_))
+    }
+}
+
+/// Where the sampled points live.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", tag = "kind")]
+pub enum Domain {
+    /// Unit directions anywhere on the sphere, binned in (cos θ, φ) as lobes bins its lobes.
+    Sphere,
+    /// Points (d.x, d.y) of the box `[x0, y0, x1, y1]`, binned on a rows × cols grid of it.
+    Plane { bounds: [f64; 4] },
+}
+
+/// A user's sampler: WGSL files and the names of its functions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UserSampler {
+    pub sources: Vec<Source>,
+    pub sample: String,
+    pub pdf: String,
+    pub eval: Option<String>,
+    pub domain: Domain,
+}
+
+/// The user's parameters: at most this many numbers (`params: array<vec4<f32>, 4>`).
+pub const MAX_PARAMS: usize = 16;
+
+impl UserSampler {
+    /// Reads the files (in order) and checks the functions against the contract.
+    pub fn from_files(paths: &[PathBuf], sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
+        let sources = paths.iter().map(|p| Source::read(p)).collect::<Result<Vec<_>, _>>()?;
+        let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain };
+        s.validate()?;
+        Ok(s)
+    }
+
+    /// The files alone must validate, define the named functions with the contract's
+    /// signatures, and leave lobes' own names free.
+    pub fn validate(&self) -> Result<(), CheckError> {
+        if let Domain::Plane { bounds: [x0, y0, x1, y1] } = self.domain
+            && !(x0 < x1 && y0 < y1 && [x0, y0, x1, y1].iter().all(|v| v.is_finite()))
+        {
+            return Err(CheckError::Input(format!("--bounds: {x0},{y0},{x1},{y1} is not a box: need X0 < X1 and Y0 < Y1, all finite")));
+        }
+        let mut functions = vec![(self.sample.as_str(), compose::SAMPLE), (self.pdf.as_str(), compose::PDF)];
+        if let Some(e) = &self.eval {
+            functions.push((e.as_str(), compose::EVAL));
+        }
+        let module = compose::check_user(&self.sources, &functions)?;
+        if let Some(name) = compose::global_names(&module).into_iter().find(|n| gpu::reserved(n)) {
+            return Err(CheckError::Input(format!(
+                "{}: the name `{name}` is lobes' own (its RNG or a `lobes_` name); rename it in your file",
+                self.sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// The composed WGSL that `check` runs (the user's files, the glue, lobes' passes).
+    pub fn composed(&self) -> Result<String, CheckError> {
+        Ok(gpu::compose(self)?.text)
+    }
+}
+
+/// How to check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    /// The user's numbers (at most 16), zero-padded into `params`.
+    pub params: Vec<f64>,
+    /// Incident direction: θ from the normal (+z) and φ from +x, in degrees.
+    pub incident_theta: f64,
+    pub incident_phi: f64,
+    pub samples: u64,
+    /// Histogram rows × cols; `None` takes 64 × 128 on the sphere, 64 × 64 on the plane.
+    pub bins: Option<(u32, u32)>,
+    pub seed: u64,
+    /// Significance of the χ² and albedo tests.
+    pub significance: f64,
+    /// Samples probed for the Jacobian and pdf-consistency checks.
+    pub probe_samples: u32,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            params: Vec::new(),
+            incident_theta: 30.0,
+            incident_phi: 0.0,
+            samples: 1 << 22,
+            bins: None,
+            seed: 1,
+            significance: 0.01,
+            probe_samples: 4096,
+        }
+    }
+}
+
+impl Settings {
+    pub fn grid(&self, domain: &Domain) -> (u32, u32) {
+        self.bins.unwrap_or(match domain {
+            Domain::Sphere => (64, 128),
+            Domain::Plane { .. } => (64, 64),
+        })
+    }
+    fn validate(&self) -> Result<(), CheckError> {
+        let bad = |flag: &str, what: String| Err(CheckError::Input(format!("{flag}: {what}")));
+        if self.params.len() > MAX_PARAMS {
+            return bad("--params", format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
+        }
+        if let Some(p) = self.params.iter().find(|p| !p.is_finite()) {
+            return bad("--params", format!("{p} is not a finite number"));
+        }
+        if !(self.incident_theta.is_finite() && (0.0..=180.0).contains(&self.incident_theta)) {
+            return bad("--incident-theta", format!("{} is outside [0, 180] degrees", self.incident_theta));
+        }
+        if !self.incident_phi.is_finite() {
+            return bad("--incident-phi", format!("{} is not finite", self.incident_phi));
+        }
+        if self.samples == 0 {
+            return bad("--samples", "must be at least 1".into());
+        }
+        if let Some((r, c)) = self.bins
+            && (r == 0 || c == 0 || r as u64 * c as u64 > 1 << 24)
+        {
+            return bad("--bins", format!("{r},{c}: rows and cols must be ≥ 1 with at most 2^24 bins"));
+        }
+        if !(self.significance > 0.0 && self.significance < 1.0) {
+            return bad("--significance", format!("{} is outside (0, 1)", self.significance));
+        }
+        Ok(())
+    }
+}
+
+/// One check's verdict and figures.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Check {
+    pub name: String,
+    pub passed: bool,
+    /// One line a person reads.
+    pub summary: String,
+    /// The check's numbers (its own typed struct, serialised).
+    pub figures: serde_json::Value,
+}
+
+/// Names of the invalid-sample reasons, in the order of their cells after the bins.
+pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
+
+/// Everything a check of a user's sampler found.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Report {
+    pub passed: bool,
+    pub checks: Vec<Check>,
+    pub sampler: String,
+    pub domain: Domain,
+    pub samples: u64,
+    pub rows: u32,
+    pub cols: u32,
+    pub adapter: String,
+    /// Counts per bin (row-major), and per reason of [`REASONS`].
+    pub counts: Vec<u64>,
+    pub invalid: [u64; 4],
+    /// Expected counts per bin from the quadrature of the pdf.
+    pub expected: Vec<f64>,
+}
+
+impl Report {
+    /// The check called `name`.
+    pub fn get(&self, name: &str) -> Option<&Check> {
+        self.checks.iter().find(|c| c.name == name)
+    }
+
+    /// Panics, naming every failed check and its summary, unless every check passed.
+    pub fn assert_passed(&self) {
+        self.assert_passed_with(None)
+    }
+
+    /// As [`Report::assert_passed`], naming where the outputs were written.
+    pub fn assert_passed_with(&self, outputs: Option<&Path>) {
+        if self.passed {
+            return;
+        }
+        let failed: Vec<String> = self.checks.iter().filter(|c| !c.passed).map(|c| format!("  {}: {}", c.name, c.summary)).collect();
+        let out = outputs.map(|p| format!("\noutputs: {}", p.display())).unwrap_or_default();
+        panic!("lobes check: {} failed {} of {} checks:\n{}{out}", self.sampler, failed.len(), self.checks.len(), failed.join("\n"));
+    }
+}
+
+fn check_of<T: Serialize>(name: &str, passed: bool, summary: String, figures: &T) -> Check {
+    Check { name: name.into(), passed, summary, figures: serde_json::to_value(figures).expect("figures serialise") }
+}
+
+/// The incident direction at θ, φ in degrees.
+fn incident(theta: f64, phi: f64) -> [f32; 3] {
+    let w = crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians());
+    [w.x as f32, w.y as f32, w.z as f32]
+}
+
+/// The χ² figures with the pdf's total integral.
+#[derive(Serialize)]
+struct Chi2Figures<'a> {
+    #[serde(flatten)]
+    chi2: &'a Chi2,
+    /// Σ over bins of ∫ pdf: 1 for a pdf that is normalised over the domain.
+    pdf_integral: f64,
+    invalid: [u64; 4],
+    expected_invalid: f64,
+    quadrature: &'a quadrature::Integrals,
+}
+
+/// The weights figures.
+#[derive(Serialize)]
+struct WeightFigures {
+    max_weight_error: f64,
+    limit: f64,
+}
+
+#[derive(Serialize)]
+struct AlbedoFigures {
+    mean_weight: f64,
+    std_error: f64,
+    quadrature: f64,
+    quadrature_error: f64,
+    z: f64,
+    p_value: f64,
+    significance: f64,
+}
+
+#[derive(Serialize)]
+struct ConsistencyFigures {
+    compared: u64,
+    max_relative_difference: f64,
+    worst_u: [f32; 4],
+    limit: f64,
+}
+
+/// Largest relative difference allowed between the reported pdf and the pdf function (f32
+/// evaluation of the same formula in two places: agreement to a few ulps is expected, 10⁻³
+/// leaves room for a differently-ordered but equivalent expression).
+pub const PDF_CONSISTENCY_LIMIT: f64 = 1e-3;
+
+/// Runs every check of `sampler` on `gpu`.
+pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
+    settings.validate()?;
+    sampler.validate()?;
+    let (rows, cols) = settings.grid(&sampler.domain);
+    let composed = gpu::compose(sampler)?;
+    let passes = gpu::Passes::new(gpu, &composed)?;
+    let mut user = [[0f32; 4]; 4];
+    for (i, p) in settings.params.iter().enumerate() {
+        user[i / 4][i % 4] = *p as f32;
+    }
+    let wi = incident(settings.incident_theta, settings.incident_phi);
+    let bounds = match sampler.domain {
+        Domain::Plane { bounds } => bounds.map(|b| b as f32),
+        Domain::Sphere => [0.0; 4],
+    };
+    let params = gpu::Params {
+        user,
+        wi: [wi[0], wi[1], wi[2], 0.0],
+        bounds,
+        seed: gpu::split(settings.seed),
+        base: [0, 0],
+        count: 0,
+        eps: jacobian::EPS,
+        samples_per_thread: 1,
+        rows,
+        cols,
+        _pad: [0; 3],
+    };
+    let plane = matches!(sampler.domain, Domain::Plane { .. });
+    let mut checks = Vec::new();
+
+    // The histogram, in dispatches of at most 2^26 samples.
+    let bins = (rows * cols) as usize;
+    let mut totals = vec![0u64; bins + 4];
+    let chunk = 1u64 << 26;
+    let mut first = 0;
+    while first < settings.samples {
+        let n = chunk.min(settings.samples - first) as u32;
+        for (t, c) in totals.iter_mut().zip(passes.histogram(&params, first, n, bins + 4)?) {
+            *t += c as u64;
+        }
+        first += n as u64;
+    }
+    let counted: u64 = totals.iter().sum();
+    if counted != settings.samples {
+        return Err(CheckError::Internal(format!("{counted} samples counted for {} drawn", settings.samples)));
+    }
+
+    // The probe: uniforms away from the edges by 2ε, so that u ± ε stays in [0, 1].
+    let margin = 2.0 * jacobian::EPS as f64;
+    let probe_u: Vec<[f32; 4]> = (0..settings.probe_samples as u64)
+        .map(|i| rng::uniforms(settings.seed ^ 0x9e37_79b9_7f4a_7c15, i).map(|x| (margin + (1.0 - 2.0 * margin) * x) as f32))
+        .collect();
+    let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, wi)).collect();
+    let probes = passes.probe(&params, &items)?;
+
+    // pdf consistency: the reported pdf against the pdf function, at valid samples.
+    let mut consistency = ConsistencyFigures { compared: 0, max_relative_difference: 0.0, worst_u: [0.0; 4], limit: PDF_CONSISTENCY_LIMIT };
+    let mut p_max: f64 = 0.0;
+    for (p, u) in probes.iter().zip(&probe_u) {
+        let (rep, fun) = (p[0][3] as f64, p[6][0] as f64);
+        if rep > 0.0 && rep.is_finite() && p[0][..3].iter().all(|x| x.is_finite()) {
+            consistency.compared += 1;
+            let diff = if fun.is_finite() { (rep - fun).abs() / rep.max(fun) } else { f64::INFINITY };
+            if diff > consistency.max_relative_difference {
+                consistency.max_relative_difference = diff;
+                consistency.worst_u = *u;
+            }
+            p_max = p_max.max(rep);
+        }
+    }
+    let consistent = consistency.max_relative_difference <= PDF_CONSISTENCY_LIMIT;
+    checks.push(check_of(
+        "pdf_consistency",
+        consistent,
+        format!(
+            "the pdf the sampler reports and {}(d) differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e}) over {} samples",
+            sampler.pdf, consistency.max_relative_difference, consistency.compared
+        ),
+        &consistency,
+    ));
+
+    // The Jacobian.
+    let jac = jacobian::judge(&probes, &probe_u, plane);
+    let summary = if jac.applicable {
+        format!(
+            "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%)",
+            jac.median_ratio,
+            jac.worst_ratio,
+            100.0 * jac.share_off,
+            jac.compared,
+            100.0 * jac.tolerance,
+            100.0 * jacobian::MAX_SHARE_OFF
+        )
+    } else {
+        format!(
+            "not applicable: only {} of {} samples comparable ({} use u.z/u.w to choose, {} not smooth, {} invalid)",
+            jac.compared, jac.probed, jac.skipped_selection, jac.skipped_not_smooth, jac.skipped_invalid
+        )
+    };
+    checks.push(check_of("jacobian", jac.passed, summary, &jac));
+
+    // The expected histogram.
+    let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
+    let width = if plane { width } else { width.min(0.25) };
+    let integrals = quadrature::integrate(&passes, &params, &sampler.domain, rows, cols, width, settings.samples)?;
+    let n = settings.samples as f64;
+    let pdf_total: f64 = integrals.probabilities.iter().sum();
+    checks.push(check_of(
+        "pdf_values",
+        integrals.bad_parts == 0,
+        if integrals.bad_parts == 0 {
+            format!("{}(d) finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf, integrals.parts)
+        } else {
+            format!("{}(d) returned NaN, ∞ or a negative value in {} of {} quadrature parts", sampler.pdf, integrals.bad_parts, integrals.parts)
+        },
+        &integrals.bad_parts,
+    ));
+    let expected: Vec<f64> = integrals.probabilities.iter().map(|p| n * p).collect();
+    let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
+    let expected_invalid = n * (1.0 - pdf_total).max(0.0);
+    let observed: Vec<u64> = totals[..bins].iter().copied().chain([invalid.iter().sum()]).collect();
+    let exp: Vec<f64> = expected.iter().copied().chain([expected_invalid]).collect();
+    let chi2 = chi2::test(&observed, &exp, settings.significance);
+    let summary = format!(
+        "χ² = {:.1} on {} dof, p = {:.3e} (significance {}); ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
+        chi2.statistic, chi2.dof, chi2.p_value, settings.significance, pdf_total, chi2.in_impossible_cells, integrals.max_error_sigma
+    );
+    let figures = Chi2Figures { chi2: &chi2, pdf_integral: pdf_total, invalid, expected_invalid, quadrature: &integrals };
+    checks.push(check_of("chi2", chi2.passed, summary, &figures));
+
+    // Weights and albedo, with an eval.
+    if sampler.eval.is_some() {
+        let (mut sw, mut sw2, mut max_err) = (0.0f64, 0.0f64, 0.0f64);
+        let mut first = 0;
+        while first < settings.samples {
+            let n = chunk.min(settings.samples - first) as u32;
+            for v in passes.weights(&params, first, n)? {
+                sw += v[0] as f64;
+                sw2 += v[1] as f64;
+                max_err = max_err.max(v[2] as f64);
+            }
+            first += n as u64;
+        }
+        let limit = crate::stats::weighted::WEIGHT_ERROR_LIMIT as f64;
+        let wf = WeightFigures { max_weight_error: max_err, limit };
+        checks.push(check_of(
+            "weights",
+            max_err <= limit,
+            format!("eval/pdf from the sampler and eval/{}(d) differ by at most {max_err:.2e} (limit {limit:.0e})", sampler.pdf),
+            &wf,
+        ));
+        let mean = sw / n;
+        let var = (sw2 / n - mean * mean).max(0.0);
+        let se = (var / n).sqrt();
+        let quad: f64 = integrals.eval.iter().sum();
+        let quad_err = 2e-6 * quad.abs() + integrals.error_estimate;
+        let z = (mean - quad) / (se * se + quad_err * quad_err).sqrt().max(f64::MIN_POSITIVE);
+        let p = statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2);
+        let af = AlbedoFigures { mean_weight: mean, std_error: se, quadrature: quad, quadrature_error: quad_err, z, p_value: p, significance: settings.significance };
+        checks.push(check_of(
+            "albedo",
+            p >= settings.significance,
+            format!("mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6}: z = {z:.2}, p = {p:.3e}"),
+            &af,
+        ));
+    }
+
+    // Hard cases.
+    let us = hard::uniforms();
+    let thetas: Vec<f64> = if plane { vec![settings.incident_theta] } else { hard::INCIDENT_THETA.to_vec() };
+    let items: Vec<([f32; 4], [f32; 3])> =
+        thetas.iter().flat_map(|&t| us.iter().map(move |u| (*u, incident(t, settings.incident_phi)))).collect();
+    let probes = passes.probe(&params, &items)?;
+    let bounds = match sampler.domain {
+        Domain::Plane { bounds } => Some(bounds),
+        Domain::Sphere => None,
+    };
+    let table: Vec<hard::HardRow> =
+        thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
+    let failing: Vec<String> = table.iter().filter(|r| !r.passed).map(|r| format!("θi {}° (first at u = {:?})", r.incident_theta, r.first_failure.unwrap_or_default())).collect();
+    checks.push(check_of(
+        "hard_cases",
+        failing.is_empty(),
+        if failing.is_empty() {
+            format!("{} inputs at u ∈ {{0, 2⁻²⁴, ½, 1 − 2⁻²⁴, 1}}⁴ × {} incident angles: every sample valid or rejected with pdf 0", items.len(), thetas.len())
+        } else {
+            format!("NaN, ∞, a negative pdf or a bad point at {}", failing.join(", "))
+        },
+        &table,
+    ));
+
+    let passed = checks.iter().all(|c| c.passed);
+    Ok(Report {
+        passed,
+        checks,
+        sampler: describe(sampler),
+        domain: sampler.domain,
+        samples: settings.samples,
+        rows,
+        cols,
+        adapter: gpu.adapter_name(),
+        counts: totals[..bins].to_vec(),
+        invalid,
+        expected,
+    })
+}
+
+/// "my_sample/my_pdf in file.wgsl".
+fn describe(s: &UserSampler) -> String {
+    let files: Vec<&str> = s.sources.iter().map(|f| f.name.as_str()).collect();
+    format!("{}/{} in {}", s.sample, s.pdf, files.join(", "))
+}
