@@ -25,3 +25,106 @@ fn henyey_greenstein_passes() {
         r.assert_passed();
     }
 }
+
+fn ggx(extra: &[&str], sample: &str, pdf: &str, eval: Option<&str>) -> UserSampler {
+    let mut names = vec!["ggx_vndf.wgsl"];
+    names.extend_from_slice(extra);
+    UserSampler::from_files(&files(&names), sample, pdf, eval, Domain::Sphere).unwrap()
+}
+
+fn show(r: &lobes::check::Report) {
+    for c in &r.checks {
+        eprintln!("{}: {} {} {}", r.sampler, c.name, c.passed, c.summary);
+    }
+}
+
+/// A GGX visible-normal sampler written from the papers passes, at a rough, a smooth, an
+/// anisotropic and a grazing configuration.
+#[test]
+fn ggx_vndf_from_scratch_passes() {
+    let gpu = gpu();
+    let s = ggx(&[], "ggx_sample", "ggx_pdf", Some("ggx_eval"));
+    for (a, theta) in [((0.5, 0.5), 30.0), ((0.05, 0.05), 0.0), ((0.3, 0.08), 60.0), ((0.2, 0.2), 85.0)] {
+        let r = check(&gpu, &s, &Settings { params: vec![a.0, a.1], incident_theta: theta, ..Settings::default() }).unwrap();
+        show(&r);
+        r.assert_passed();
+    }
+}
+
+/// Without the reflection Jacobian the histogram and the map's Jacobian both disagree with the pdf.
+#[test]
+fn missing_reflection_jacobian_is_rejected() {
+    let gpu = gpu();
+    let s = ggx(&["broken_no_jacobian.wgsl"], "broken_sample_no_jacobian", "broken_pdf_no_jacobian", None);
+    let r = check(&gpu, &s, &Settings { params: vec![0.3, 0.3], incident_theta: 30.0, ..Settings::default() }).unwrap();
+    show(&r);
+    assert!(!r.passed);
+    assert!(!r.get("chi2").unwrap().passed, "chi2 must reject a pdf without 1/(4|d·h|)");
+    assert!(!r.get("jacobian").unwrap().passed, "the Jacobian check must reject it too");
+    assert!(r.get("pdf_consistency").unwrap().passed, "the sampler reports the same (wrong) pdf");
+}
+
+fn temp_wgsl(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lobes-check-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const GOOD_SAMPLE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n    return vec4<f32>(0.0, 0.0, 1.0, 1.0);\n}\n";
+
+/// WGSL errors point at the user's file, line and column; a missing function or a wrong
+/// signature names the expected signature.
+#[test]
+fn broken_input_is_reported_at_the_users_file() {
+    let syntax = temp_wgsl("syntax.wgsl", "fn s(wi: vec3<f32>) -> f32 {\n    return 1.0\n}\n");
+    let e = UserSampler::from_files(&[syntax.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
+    assert!(e.is_input());
+    assert!(e.to_string().starts_with(&format!("{}:3:1: expected `;`", syntax.display())), "{e}");
+
+    let two = temp_wgsl("second.wgsl", "fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n    return nope;\n}\n");
+    let first = temp_wgsl("first.wgsl", GOOD_SAMPLE);
+    let e = UserSampler::from_files(&[first.clone(), two.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
+    assert!(e.to_string().starts_with(&format!("{}:2:12:", two.display())), "the second file's own line: {e}");
+
+    let e = UserSampler::from_files(&[first.clone()], "s", "missing", None, Domain::Sphere).unwrap_err();
+    assert!(e.to_string().contains("no function `missing`") && e.to_string().contains("-> f32`"), "{e}");
+
+    let wrong = temp_wgsl("wrong.wgsl", &format!("{GOOD_SAMPLE}fn p(wi: vec3<f32>, d: vec3<f32>) -> f32 {{\n    return 1.0;\n}}\n"));
+    let e = UserSampler::from_files(&[wrong.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
+    assert!(e.to_string().starts_with(&format!("{}:4:1: the pdf function `p` has the wrong signature", wrong.display())), "{e}");
+    assert!(e.to_string().contains("expected `fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"), "{e}");
+
+    let clash = temp_wgsl("clash.wgsl", &format!("{GOOD_SAMPLE}fn pcg4d(x: f32) -> f32 {{ return x; }}\nfn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{ return 1.0; }}\n"));
+    let e = UserSampler::from_files(&[clash], "s", "p", None, Domain::Sphere).unwrap_err();
+    assert!(e.to_string().contains("`pcg4d`"), "{e}");
+}
+
+/// A sampler whose pdf is NaN, infinite or negative in places is counted by reason and judged,
+/// never a crash: uniform directions whose reported pdf is NaN for z > 0.9 and negative for
+/// z < −0.9, with a pdf function that is negative on the same cap.
+#[test]
+fn bad_pdf_values_are_counted_by_reason() {
+    let src = temp_wgsl(
+        "nan.wgsl",
+        "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
+         let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
+         let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
+         var pdf = 0.0795775;\n if (z > 0.9) { pdf = sqrt(-z); }\n if (z < -0.9) { pdf = -1.0; }\n\
+         return vec4<f32>(d, pdf);\n}\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
+         if (d.z < -0.9) { return -1.0; }\n return 0.0795775;\n}\n",
+    );
+    let s = UserSampler::from_files(&[src], "s", "p", None, Domain::Sphere).unwrap();
+    let r = check(&gpu(), &s, &Settings { samples: 1 << 20, ..Settings::default() }).unwrap();
+    show(&r);
+    let n = (1u64 << 20) as f64;
+    // 5% of the sphere above z = 0.9 and 5% below −0.9: counted as non-finite and zero pdf
+    assert!((r.invalid[2] as f64 / n - 0.05).abs() < 0.002, "non_finite_pdf {:?}", r.invalid);
+    assert!((r.invalid[3] as f64 / n - 0.05).abs() < 0.002, "zero_pdf {:?}", r.invalid);
+    assert_eq!(r.counts.iter().sum::<u64>() + r.invalid.iter().sum::<u64>(), 1 << 20, "every sample is a bin hit or an invalid sample");
+    assert!(!r.get("pdf_values").unwrap().passed);
+    assert!(!r.get("hard_cases").unwrap().passed);
+    assert!(!r.passed);
+}

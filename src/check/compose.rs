@@ -118,7 +118,7 @@ impl Composed {
                 let at = self.locate(loc.line_number, loc.line_position);
                 let src = self.line(loc.line_number);
                 let caret = " ".repeat(loc.line_position.saturating_sub(1) as usize) + &"^".repeat((loc.length as usize).clamp(1, 60));
-                format!("{at}: error: {message}\n    {src}\n    {caret}")
+                format!("{at}: {message}\n    {src}\n    {caret}")
             }
             None => format!("error: {message}"),
         };

@@ -13,6 +13,7 @@
 //! [`UsageError`] whose message starts with the flag.
 
 pub mod bench;
+pub mod check;
 pub mod merge;
 pub mod run;
 pub mod shader;
@@ -68,6 +69,9 @@ pub enum Command {
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
     Merge(merge::MergeArgs),
+    /// Judge your own WGSL sampler: its histogram against the GPU quadrature of its pdf (χ²),
+    /// the pdf against the map's Jacobian, weights and albedo with an eval, and hard cases.
+    Check(check::CheckArgs),
     /// Accuracy against cost: sample count × kernel precision (f32 fast / f32 / f64), spherical
     /// caps against bounded VNDF, and the expected histogram's quadrature; writes tradeoff.md,
     /// tradeoff.png and tradeoff.json with --out.
@@ -87,6 +91,7 @@ impl Cli {
             Command::Merge(args) => merge::run(&args),
             Command::Shader(args) => shader::run(&args),
             Command::Tradeoff(args) => tradeoff::run(&args),
+            Command::Check(args) => check::run(&args),
         }
     }
 }

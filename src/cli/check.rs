@@ -1,0 +1,127 @@
+//! `lobes check`: judge a user's WGSL sampler (see [`crate::check`]).
+
+use super::{NumberList, OutputArgs, emit, emit_json, parse_azimuth, parse_number_list, parse_polar_180, usage};
+use crate::check::{self, CheckError, Domain, Settings, UserSampler};
+use crate::engine::gpu::Gpu;
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// Where the user's sampler puts its points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DomainChoice {
+    /// Unit directions anywhere on the sphere.
+    Sphere,
+    /// Points (d.x, d.y) of the box given by --bounds.
+    Plane,
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// The WGSL files that define the sampler, in order.
+    #[arg(required = true, value_name = "FILE.wgsl")]
+    pub files: Vec<PathBuf>,
+    /// The sampling function: fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>.
+    #[arg(long, value_name = "NAME")]
+    pub sample: String,
+    /// The density: fn(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32.
+    #[arg(long, value_name = "NAME")]
+    pub pdf: String,
+    /// Optional f·|cos| (or the phase function), same signature as --pdf: adds the weight and
+    /// albedo checks.
+    #[arg(long, value_name = "NAME")]
+    pub eval: Option<String>,
+    #[arg(long, value_enum, default_value = "sphere")]
+    pub domain: DomainChoice,
+    /// The plane's box, X0,Y0,X1,Y1 (with --domain plane).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_number_list, allow_hyphen_values = true)]
+    pub bounds: Option<NumberList>,
+    /// Up to 16 numbers passed to every function as `params` (zero-padded).
+    #[arg(long, value_name = "P1,P2,...", value_parser = parse_number_list, allow_hyphen_values = true)]
+    pub params: Option<NumberList>,
+    /// Incident θ in degrees from the normal (+z), [0, 180]; θ > 90 comes from below.
+    #[arg(long, value_name = "DEG", value_parser = parse_polar_180, default_value = "30")]
+    pub incident_theta: f64,
+    /// Incident φ in degrees from +x.
+    #[arg(long, value_name = "DEG", value_parser = parse_azimuth, allow_hyphen_values = true, default_value = "0")]
+    pub incident_phi: f64,
+    /// Samples drawn for the histogram (and the weights).
+    #[arg(long, value_name = "N", default_value_t = 1 << 22)]
+    pub samples: u64,
+    /// Histogram ROWS,COLS (default 64,128 on the sphere, 64,64 on the plane).
+    #[arg(long, value_name = "ROWS,COLS", value_parser = parse_number_list)]
+    pub bins: Option<NumberList>,
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+    /// Significance of the χ² and albedo tests.
+    #[arg(long, value_name = "A", default_value_t = 0.01)]
+    pub significance: f64,
+    /// Write report.json (and the composed WGSL) to this folder.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub output: OutputArgs,
+}
+
+fn input(e: CheckError) -> anyhow::Error {
+    if e.is_input() { usage(e.to_string()) } else { e.into() }
+}
+
+impl CheckArgs {
+    fn sampler(&self) -> anyhow::Result<UserSampler> {
+        let domain = match (self.domain, &self.bounds) {
+            (DomainChoice::Sphere, None) => Domain::Sphere,
+            (DomainChoice::Sphere, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
+            (DomainChoice::Plane, None) => return Err(usage("--domain plane needs --bounds X0,Y0,X1,Y1")),
+            (DomainChoice::Plane, Some(b)) => match b.0[..] {
+                [x0, y0, x1, y1] => Domain::Plane { bounds: [x0, y0, x1, y1] },
+                _ => return Err(usage(format!("--bounds: expected 4 numbers X0,Y0,X1,Y1, got {}", b.0.len()))),
+            },
+        };
+        UserSampler::from_files(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain).map_err(input)
+    }
+
+    fn settings(&self) -> anyhow::Result<Settings> {
+        let bins = match &self.bins {
+            None => None,
+            Some(b) => match b.0[..] {
+                [r, c] if r >= 1.0 && c >= 1.0 && r.fract() == 0.0 && c.fract() == 0.0 && r * c <= (1u64 << 24) as f64 => Some((r as u32, c as u32)),
+                _ => return Err(usage("--bins: expected ROWS,COLS, two whole numbers ≥ 1 with at most 2^24 bins, e.g. 64,128")),
+            },
+        };
+        Ok(Settings {
+            params: self.params.as_ref().map(|p| p.0.clone()).unwrap_or_default(),
+            incident_theta: self.incident_theta,
+            incident_phi: self.incident_phi,
+            samples: self.samples,
+            bins,
+            seed: self.seed,
+            significance: self.significance,
+            ..Settings::default()
+        })
+    }
+}
+
+pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
+    let sampler = args.sampler()?;
+    let settings = args.settings()?;
+    let gpu = Gpu::new()?;
+    let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--out {}: {e}", dir.display()))?;
+        crate::report::output::write_atomic(&dir.join("composed.wgsl"), sampler.composed().map_err(input)?.as_bytes())?;
+        crate::report::output::write_atomic(&dir.join("report.json"), serde_json::to_string(&report)?.as_bytes())?;
+    }
+    if args.output.json {
+        emit_json(&report)?;
+    } else {
+        let mut t = format!("{} on {} ({} samples, {}×{} bins)\n", report.sampler, report.adapter, report.samples, report.rows, report.cols);
+        for c in &report.checks {
+            t += &format!("  {:<16} {:<4}  {}\n", c.name, if c.passed { "ok" } else { "FAIL" }, c.summary);
+        }
+        t += if report.passed { "passed\n" } else { "FAILED\n" };
+        emit(&t)?;
+    }
+    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect();
+    anyhow::ensure!(failed.is_empty(), "{} failed: {}", report.sampler, failed.join(", "));
+    Ok(())
+}
