@@ -128,3 +128,30 @@ fn bad_pdf_values_are_counted_by_reason() {
     assert!(!r.get("hard_cases").unwrap().passed);
     assert!(!r.passed);
 }
+
+/// A piecewise-constant 2-D distribution on the plane passes, and its zero-weight cells get no
+/// samples; the same map with the density of a uniform square (a pdf that forgot the table) fails.
+#[test]
+fn piecewise_constant_2d_warp_on_the_plane() {
+    let gpu = gpu();
+    let plane = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
+    let s = UserSampler::from_files(&files(&["piecewise_2d.wgsl"]), "env_sample", "env_pdf", None, plane).unwrap();
+    let r = check(&gpu, &s, &Settings::default()).unwrap();
+    show(&r);
+    r.assert_passed();
+    // The table's second row (y in [0.25, 0.5)) has weight 0: rows 16..32 of the 64 × 64 grid.
+    let empty: u64 = r.counts[16 * 64..32 * 64].iter().sum();
+    assert_eq!(empty, 0);
+    // Independent value: the first row (y < 0.25) holds its weights 1+2+3+4+4+3+2+1 = 20 of Σw = 60.
+    let first: u64 = r.counts[..16 * 64].iter().sum();
+    let expect = 20.0 / 60.0;
+    let n = r.samples as f64;
+    assert!((first as f64 / n - expect).abs() < 4.0 * (expect * (1.0 - expect) / n).sqrt(), "{first}");
+
+    let uniform = temp_wgsl("uniform_pdf.wgsl", "fn uniform_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n    return 1.0;\n}\n");
+    let mut paths = files(&["piecewise_2d.wgsl"]);
+    paths.push(uniform);
+    let broken = UserSampler::from_files(&paths, "env_sample", "uniform_pdf", None, plane).unwrap();
+    let r = check(&gpu, &broken, &Settings::default()).unwrap();
+    assert!(!r.get("chi2").unwrap().passed && !r.get("pdf_consistency").unwrap().passed && !r.get("jacobian").unwrap().passed);
+}
