@@ -55,6 +55,10 @@ pub struct CheckArgs {
     /// Significance of the χ² and albedo tests.
     #[arg(long, value_name = "A", default_value_t = 0.01)]
     pub significance: f64,
+    /// Run the whole check at 2^16, 2^18, … samples up to --samples and print the χ² p-value and
+    /// time at each: from which sample count is an error caught?
+    #[arg(long)]
+    pub power: bool,
     /// Write report.json (and the composed WGSL) to this folder.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -105,6 +109,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let sampler = args.sampler()?;
     let settings = args.settings()?;
     let gpu = Gpu::new()?;
+    if args.power {
+        return power(&gpu, &sampler, &settings, args.output.json);
+    }
     let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--out {}: {e}", dir.display()))?;
@@ -124,4 +131,21 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect();
     anyhow::ensure!(failed.is_empty(), "{} failed: {}", report.sampler, failed.join(", "));
     Ok(())
+}
+
+fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, json: bool) -> anyhow::Result<()> {
+    let points = check::power(gpu, sampler, settings).map_err(input)?;
+    if json {
+        return emit_json(&serde_json::json!({ "sampler": sampler_name(sampler), "points": points }));
+    }
+    let mut t = format!("{}\n{:>12}  {:>10}  {:>5}  {:>13}  {:>5}  {:>8}\n", sampler_name(sampler), "samples", "chi2 p", "chi2", "normalization", "all", "seconds");
+    for p in &points {
+        let v = |b: bool| if b { "ok" } else { "FAIL" };
+        t += &format!("{:>12}  {:>10.3e}  {:>5}  {:>13}  {:>5}  {:>8.2}\n", p.samples, p.p_value, v(p.chi2_passed), v(p.normalization_passed), v(p.passed), p.seconds);
+    }
+    emit(&t)
+}
+
+fn sampler_name(s: &UserSampler) -> String {
+    format!("{}/{}", s.sample, s.pdf)
 }
