@@ -79,7 +79,7 @@ const GOOD_SAMPLE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<
 #[test]
 fn broken_input_is_reported_at_the_users_file() {
     let syntax = temp_wgsl("syntax.wgsl", "fn s(wi: vec3<f32>) -> f32 {\n    return 1.0\n}\n");
-    let e = UserSampler::from_files(&[syntax.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
+    let e = UserSampler::from_files(std::slice::from_ref(&syntax), "s", "p", None, Domain::Sphere).unwrap_err();
     assert!(e.is_input());
     assert!(e.to_string().starts_with(&format!("{}:3:1: expected `;`", syntax.display())), "{e}");
 
@@ -88,11 +88,11 @@ fn broken_input_is_reported_at_the_users_file() {
     let e = UserSampler::from_files(&[first.clone(), two.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
     assert!(e.to_string().starts_with(&format!("{}:2:12:", two.display())), "the second file's own line: {e}");
 
-    let e = UserSampler::from_files(&[first.clone()], "s", "missing", None, Domain::Sphere).unwrap_err();
+    let e = UserSampler::from_files(std::slice::from_ref(&first), "s", "missing", None, Domain::Sphere).unwrap_err();
     assert!(e.to_string().contains("no function `missing`") && e.to_string().contains("-> f32`"), "{e}");
 
     let wrong = temp_wgsl("wrong.wgsl", &format!("{GOOD_SAMPLE}fn p(wi: vec3<f32>, d: vec3<f32>) -> f32 {{\n    return 1.0;\n}}\n"));
-    let e = UserSampler::from_files(&[wrong.clone()], "s", "p", None, Domain::Sphere).unwrap_err();
+    let e = UserSampler::from_files(std::slice::from_ref(&wrong), "s", "p", None, Domain::Sphere).unwrap_err();
     assert!(e.to_string().starts_with(&format!("{}:4:1: the pdf function `p` has the wrong signature", wrong.display())), "{e}");
     assert!(e.to_string().contains("expected `fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"), "{e}");
 

@@ -69,6 +69,8 @@ impl Part {
     }
 }
 
+type Piece = ((f64, f64), (f64, f64), f32, u32);
+
 /// The tolerance on a part whose integral is about `value`, for a run of `n` samples.
 fn tolerance(value: f64, n: f64) -> f64 {
     0.01 * (value.abs() / n).sqrt() + 1e-3 / n + 2e-6 * value.abs()
@@ -82,7 +84,8 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64) -> Vec<Part>
     for r in 0..rows {
         for c in 0..cols {
             let bin = r * cols + c;
-            let mut pieces: Vec<((f64, f64), (f64, f64), f32, u32)> = Vec::new();
+            // (a range, b range, hemisphere, initial split per axis)
+            let mut pieces: Vec<Piece> = Vec::new();
             match *domain {
                 Domain::Plane { bounds: [x0, y0, x1, y1] } => {
                     let (dx, dy) = ((x1 - x0) / cols as f64, (y1 - y0) / rows as f64);
