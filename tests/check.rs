@@ -194,3 +194,24 @@ fn mitsuba_rational_g1_is_rejected() {
     show(&r);
     assert!(!r.get("chi2").unwrap().passed, "at 2^26 samples the histogram sees it too");
 }
+
+/// Through the library, an f64 Rust closure can stand in for the WGSL pdf as the reference the
+/// histogram is judged against: Henyey–Greenstein's closed form passes, a wrong g fails.
+#[test]
+fn an_f64_reference_pdf_from_rust() {
+    use lobes::check::Reference;
+    let gpu = gpu();
+    let s = UserSampler::from_files(&files(&["henyey_greenstein.wgsl"]), "hg_sample", "hg_pdf", None, Domain::Sphere).unwrap();
+    let hg = |g: f64| {
+        Reference::new(move |wi: glam::DVec3, d: glam::DVec3| {
+            let c = (-wi).dot(d).clamp(-1.0, 1.0);
+            (1.0 - g * g) / (4.0 * std::f64::consts::PI * (1.0 + g * g - 2.0 * g * c).powf(1.5))
+        })
+    };
+    let settings = |g: f64| Settings { params: vec![0.5], reference: Some(hg(g)), ..Settings::default() };
+    let r = check(&gpu, &s, &settings(0.5)).unwrap();
+    show(&r);
+    r.assert_passed();
+    let r = check(&gpu, &s, &settings(0.45)).unwrap();
+    assert!(!r.get("chi2").unwrap().passed);
+}

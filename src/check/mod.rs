@@ -147,6 +147,36 @@ pub struct Settings {
     pub significance: f64,
     /// Samples probed for the Jacobian and pdf-consistency checks.
     pub probe_samples: u32,
+    /// An f64 reference pdf p(wi, d) on the CPU (the design's "CPU reference"): when given, the
+    /// expected histogram integrates it instead of the WGSL pdf, in f64.
+    pub reference: Option<Reference>,
+}
+
+/// An f64 pdf p(wi, d) written in Rust, integrated with the f64 quadrature instead of the WGSL pdf.
+///
+/// ```
+/// let uniform = lobes::check::Reference::new(|_wi, _d| 1.0 / (4.0 * std::f64::consts::PI));
+/// assert!(((uniform.0)(glam::DVec3::Z, glam::DVec3::X) - 0.0795775).abs() < 1e-7);
+/// ```
+#[derive(Clone)]
+pub struct Reference(pub std::sync::Arc<dyn Fn(glam::DVec3, glam::DVec3) -> f64 + Send + Sync>);
+
+impl Reference {
+    pub fn new(pdf: impl Fn(glam::DVec3, glam::DVec3) -> f64 + Send + Sync + 'static) -> Self {
+        Self(std::sync::Arc::new(pdf))
+    }
+}
+
+impl std::fmt::Debug for Reference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Reference(f64 pdf)")
+    }
+}
+
+impl PartialEq for Reference {
+    fn eq(&self, other: &Self) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 impl Default for Settings {
@@ -160,6 +190,7 @@ impl Default for Settings {
             seed: 1,
             significance: 0.01,
             probe_samples: 4096,
+            reference: None,
         }
     }
 }
@@ -422,7 +453,20 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     // The expected histogram.
     let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
     let width = if plane { width } else { width.min(0.25) };
-    let integrals = quadrature::integrate(&passes, &params, &sampler.domain, rows, cols, width, settings.samples)?;
+    let integrals = match &settings.reference {
+        None => quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples)?,
+        Some(reference) => {
+            let wi = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
+            let pdf = |d: glam::DVec3| (reference.0)(wi, d);
+            let cpu = quadrature::CpuPdf { pdf: &pdf, plane };
+            let mut i = quadrature::integrate(&cpu, &sampler.domain, rows, cols, width, settings.samples)?;
+            // eval has no f64 twin: its integral stays the GPU's
+            if sampler.eval.is_some() {
+                i.eval = quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples)?.eval;
+            }
+            i
+        }
+    };
     let n = settings.samples as f64;
     let pdf_total: f64 = integrals.probabilities.iter().sum();
     checks.push(check_of(

@@ -15,6 +15,7 @@
 //! `lobes_domain_point`), so that parts next to a pole keep their f32 resolution.
 
 use super::gpu::{Params, Passes};
+
 use super::{CheckError, Domain};
 use serde::{Deserialize, Serialize};
 
@@ -64,16 +65,85 @@ impl Part {
         let q = |a, b| Part { a, b, depth: self.depth + 1, coarse: Some(coarse), ..*self };
         [q((self.a.0, am), (self.b.0, bm)), q((am, self.a.1), (self.b.0, bm)), q((self.a.0, am), (bm, self.b.1)), q((am, self.a.1), (bm, self.b.1))]
     }
-    fn rect(&self) -> ([f32; 4], f32) {
-        ([self.a.0 as f32, self.a.1 as f32, self.b.0 as f32, self.b.1 as f32], self.h)
+    fn rect(&self) -> ([f64; 4], f32) {
+        ([self.a.0, self.a.1, self.b.0, self.b.1], self.h)
     }
 }
 
 type Piece = ((f64, f64), (f64, f64), f32, u32);
 
-/// The tolerance on a part whose integral is about `value`, for a run of `n` samples.
-fn tolerance(value: f64, n: f64) -> f64 {
-    0.01 * (value.abs() / n).sqrt() + 1e-3 / n + 2e-6 * value.abs()
+/// The tolerance on a part whose integral is about `value`, for a run of `n` samples, where the
+/// integrand is evaluated with relative rounding `rounding`.
+fn tolerance(value: f64, n: f64, rounding: f64) -> f64 {
+    0.01 * (value.abs() / n).sqrt() + 1e-3 / n + rounding * value.abs()
+}
+
+/// Relative rounding of a part's sum on the GPU (25 f32 terms) and of the f64 reference.
+pub const GPU_ROUNDING: f64 = 2e-6;
+pub const CPU_ROUNDING: f64 = 1e-13;
+
+/// What integrates the parts: per (a0, a1, b0, b1, hemisphere) the 5 × 5 and 3 × 3 rules of the
+/// pdf and of eval, and the relative rounding of those sums.
+pub(super) trait Integrand {
+    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError>;
+    fn rounding(&self) -> f64;
+}
+
+impl Integrand for (&Passes<'_>, &Params) {
+    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError> {
+        let rects32: Vec<([f32; 4], f32)> = rects.iter().map(|(r, h)| (r.map(|x| x as f32), *h)).collect();
+        Ok(self.0.integrate(self.1, &rects32)?.into_iter().map(|v| v.map(f64::from)).collect())
+    }
+    fn rounding(&self) -> f64 {
+        GPU_ROUNDING
+    }
+}
+
+/// An f64 pdf on the CPU: the user's reference through the library API.
+pub(super) struct CpuPdf<'a> {
+    pub pdf: &'a (dyn Fn(glam::DVec3) -> f64 + Send + Sync),
+    pub plane: bool,
+}
+
+/// 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30).
+const GL5: [(f64, f64); 5] = [
+    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.0, 0.568_888_888_888_888_9),
+    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+];
+const GL3: [(f64, f64); 3] = [(-0.774_596_669_241_483_4, 5.0 / 9.0), (0.0, 8.0 / 9.0), (0.774_596_669_241_483_4, 5.0 / 9.0)];
+
+impl CpuPdf<'_> {
+    /// The point at (a, b) of a part in hemisphere h (`lobes_domain_point` in f64).
+    fn point(&self, a: f64, b: f64, h: f32) -> glam::DVec3 {
+        if self.plane {
+            return glam::DVec3::new(a, b, 0.0);
+        }
+        let s = (a * (2.0 - a)).max(0.0).sqrt();
+        glam::DVec3::new(s * b.cos(), s * b.sin(), h as f64 * (1.0 - a))
+    }
+    fn rule(&self, r: &[f64; 4], h: f32, nodes: &[(f64, f64)]) -> f64 {
+        let (ha, ca, hb, cb) = (0.5 * (r[1] - r[0]), 0.5 * (r[1] + r[0]), 0.5 * (r[3] - r[2]), 0.5 * (r[3] + r[2]));
+        let mut sum = 0.0;
+        for (x, wx) in nodes {
+            for (y, wy) in nodes {
+                sum += wx * wy * (self.pdf)(self.point(ca + ha * x, cb + hb * y, h));
+            }
+        }
+        sum * ha * hb
+    }
+}
+
+impl Integrand for CpuPdf<'_> {
+    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError> {
+        use rayon::prelude::*;
+        Ok(rects.par_iter().map(|(r, h)| [self.rule(r, *h, &GL5), self.rule(r, *h, &GL3), 0.0, 0.0]).collect())
+    }
+    fn rounding(&self) -> f64 {
+        CPU_ROUNDING
+    }
 }
 
 /// The parts a bin starts as: on the sphere its (a, φ) rectangle per hemisphere it touches,
@@ -131,8 +201,10 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64) -> Vec<Part>
 
 /// Integrates the user's pdf and eval over every bin. `width` is the narrowest feature expected,
 /// in radians on the sphere or domain units on the plane; `samples` the run's sample count.
-pub(super) fn integrate(passes: &Passes, params: &Params, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64) -> Result<Integrals, CheckError> {
+pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64) -> Result<Integrals, CheckError> {
     let n = samples.max(1) as f64;
+    let rounding = f.rounding();
+    let tolerance = |v: f64, n: f64| tolerance(v, n, rounding);
     let bins = (rows * cols) as usize;
     let mut out = Integrals {
         probabilities: vec![0.0; bins],
@@ -149,15 +221,15 @@ pub(super) fn integrate(passes: &Passes, params: &Params, domain: &Domain, rows:
     while !pending.is_empty() {
         out.rounds += 1;
         out.parts += pending.len() as u64;
-        let rects: Vec<([f32; 4], f32)> = pending.iter().map(Part::rect).collect();
-        let values = passes.integrate(params, &rects)?;
+        let rects: Vec<([f64; 4], f32)> = pending.iter().map(Part::rect).collect();
+        let values = f.rules(&rects)?;
         let mut next = Vec::new();
         let mut accept = |out: &mut Integrals, part: &Part, pdf: f64, eval: f64, err: f64| {
             out.probabilities[part.bin as usize] += pdf;
             out.eval[part.bin as usize] += eval;
             bin_error[part.bin as usize] += err;
         };
-        let bad = |v: &[f32; 4]| !(v[0].is_finite() && v[1].is_finite() && v[0] >= 0.0 && v[1] >= 0.0);
+        let bad = |v: &[f64; 4]| !(v[0].is_finite() && v[1].is_finite() && v[0] >= 0.0 && v[1] >= 0.0);
         let room = |len: usize| len + 4 <= MAX_PARTS;
         let mut i = 0;
         while i < pending.len() {
@@ -165,7 +237,7 @@ pub(super) fn integrate(passes: &Passes, params: &Params, domain: &Domain, rows:
             match part.coarse {
                 None => {
                     let v = values[i];
-                    let (p5, p3, e5, e3) = (v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64);
+                    let [p5, p3, e5, e3] = v;
                     if bad(&v) {
                         out.bad_parts += 1;
                     } else if ((p5 - p3).abs() <= tolerance(p5, n) && (e5 - e3).abs() <= tolerance(e5, n)) || !room(next.len()) {
@@ -184,15 +256,15 @@ pub(super) fn integrate(passes: &Passes, params: &Params, domain: &Domain, rows:
                         i += 4;
                         continue;
                     }
-                    let fine: f64 = group.iter().map(|v| v[0] as f64).sum();
-                    let fine_e: f64 = group.iter().map(|v| v[2] as f64).sum();
+                    let fine: f64 = group.iter().map(|v| v[0]).sum();
+                    let fine_e: f64 = group.iter().map(|v| v[2]).sum();
                     let agree = (fine - cp).abs() <= tolerance(fine, n) && (fine_e - ce).abs() <= tolerance(fine_e, n);
                     if agree || part.depth >= MAX_DEPTH || !room(next.len() + 12) {
                         out.unconverged_parts += u64::from(!agree);
                         accept(&mut out, &part, fine, fine_e, (fine - cp).abs());
                     } else {
                         for (k, q) in pending[i..i + 4].iter().enumerate() {
-                            next.extend(q.quarters((group[k][0] as f64, group[k][2] as f64)));
+                            next.extend(q.quarters((group[k][0], group[k][2])));
                         }
                     }
                     i += 4;
