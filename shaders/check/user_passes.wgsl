@@ -63,8 +63,8 @@ const LOBES_GL3_W = array<f32, 3>(0.555555555555556, 0.888888888888889, 0.555555
 // Gauss–Legendre rules: (∫ pdf by 5 × 5, by 3 × 3, ∫ eval by 5 × 5, by 3 × 3). A pdf that is
 // NaN, infinite or negative at a node is returned as such: the host reports it.
 @compute @workgroup_size(64)
-fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
     if (i >= lobes_check.count) {
         return;
     }
@@ -106,8 +106,8 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>) {
 //   6: (pdf(d), eval(d), |d|, 0) at d of 0
 // The host differentiates in f64 (src/check/jacobian.rs) and classifies (src/check/hard.rs).
 @compute @workgroup_size(64)
-fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
     if (i >= lobes_check.count) {
         return;
     }
@@ -134,8 +134,8 @@ fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>) {
 // w = eval(d) / (the reported pdf) is the weight a renderer computes from the sampler alone and
 // w_pdf = eval(d) / pdf(d) the one from the pdf function. Invalid samples weigh 0.
 @compute @workgroup_size(64)
-fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = gid.x;
+fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let t = gid.x + gid.y * nwg.x * 64u;
     let first = t * lobes_check.samples_per_thread;
     if (first >= lobes_check.count) {
         return;
@@ -217,8 +217,8 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
 // Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
 // keeps each dispatch under 2^32 samples and adds into 64-bit totals).
 @compute @workgroup_size(64)
-fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let first = gid.x * lobes_check.samples_per_thread;
+fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let first = (gid.x + gid.y * nwg.x * 64u) * lobes_check.samples_per_thread;
     let wi = lobes_check.wi.xyz;
     for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
         let local = first + k;

@@ -4,6 +4,7 @@
 use super::compose::Composed;
 use super::{CheckError, Domain, UserSampler};
 use crate::engine::gpu::Gpu;
+use crate::engine::gpu::dispatch::{Pass, Step};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
@@ -76,100 +77,52 @@ pub(super) fn reserved(name: &str) -> bool {
 
 impl<'g> Passes<'g> {
     pub fn new(gpu: &'g Gpu, composed: &Composed) -> Result<Self, CheckError> {
-        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        // `composed` is already validated with its errors mapped to the user's files
         let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("lobes check"),
             source: wgpu::ShaderSource::Wgsl(composed.text.as_str().into()),
         });
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(CheckError::Internal(format!("the composed module was refused by the device: {e}")));
-        }
+        gpu.check_errors()?;
         Ok(Self { gpu, module })
     }
 
-    fn pipeline(&self, entry: &str) -> wgpu::ComputePipeline {
-        self.gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: None,
-            module: &self.module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    }
-
-    fn storage(&self, label: &str, contents: &[u8], extra: wgpu::BufferUsages) -> wgpu::Buffer {
-        let mut bytes = contents.to_vec();
-        bytes.resize(bytes.len().max(16), 0);
-        self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: &bytes,
-            usage: wgpu::BufferUsages::STORAGE | extra,
-        })
-    }
-
-    /// Runs `entry` over `invocations` invocations and reads back `out_words` u32 words of the
-    /// buffer it writes (binding 2, or binding 3 for the histogram).
+    /// Runs `entry` over `invocations` invocations through the engine's dispatcher and reads back
+    /// `out_bytes` of the buffer it writes (binding 2, or binding 3 for the histogram's counters).
     fn run(&self, entry: &str, params: &Params, input: &[[f32; 4]], invocations: u32, out_bytes: u64, counts: bool) -> Result<Vec<u8>, CheckError> {
-        let device = &self.gpu.device;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let pipeline = self.pipeline(entry);
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        let gpu = self.gpu;
+        let pipeline = gpu.pipeline(&self.module, None, entry, &[]);
+        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check params"),
             contents: bytemuck::bytes_of(params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let copy = wgpu::BufferUsages::COPY_SRC;
-        let out = self.storage("check out", &vec![0u8; out_bytes as usize], copy);
+        let out = gpu.buffer("check out", out_bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let mut padded = bytemuck::cast_slice::<_, u8>(input).to_vec();
+        padded.resize(padded.len().max(16), 0);
+        let input_buf = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("check in"),
+            contents: &padded,
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
-        let input_buf;
         if counts {
             entries.push(wgpu::BindGroupEntry { binding: 3, resource: out.as_entire_binding() });
         } else {
-            input_buf = self.storage("check in", bytemuck::cast_slice(input), wgpu::BufferUsages::empty());
             if !input.is_empty() {
                 entries.push(wgpu::BindGroupEntry { binding: 1, resource: input_buf.as_entire_binding() });
             }
             entries.push(wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() });
         }
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(entry), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
-        let read = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("check read"),
-            size: out.size(),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind, &[]);
-            let groups = invocations.div_ceil(WG);
-            let max = self.gpu.limits.max_compute_workgroups_per_dimension;
-            if groups > max {
-                return Err(CheckError::Internal(format!("{entry}: {groups} workgroups exceed the adapter's {max}")));
-            }
-            pass.dispatch_workgroups(groups.max(1), 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&out, 0, &read, 0, out.size());
-        self.gpu.queue.submit([encoder.finish()]);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(CheckError::Internal(format!("{entry}: {e}")));
-        }
-        let (tx, rx) = std::sync::mpsc::channel();
-        read.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| CheckError::Device(e.to_string()))?;
-        rx.recv().map_err(|e| CheckError::Device(e.to_string()))?.map_err(|e| CheckError::Device(e.to_string()))?;
-        let data = read.get_mapped_range(..).map_err(|e| CheckError::Device(e.to_string()))?[..out_bytes as usize].to_vec();
-        Ok(data)
+        let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(entry), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
+        let step = Step { pipeline: &pipeline, groups: invocations.div_ceil(WG) as u64 };
+        gpu.dispatch(&[Pass { label: entry, bind: &bind, offset: None, steps: vec![step] }])?;
+        Ok(gpu.read(&out, out_bytes)?)
     }
 
     /// Per rectangle (a0, a1, b0, b1) in hemisphere h: (∫pdf 5×5, ∫pdf 3×3, ∫eval 5×5, ∫eval 3×3).
     pub fn integrate(&self, params: &Params, rects: &[([f32; 4], f32)]) -> Result<Vec<[f32; 4]>, CheckError> {
         let mut out = Vec::with_capacity(rects.len());
-        let per_call = (self.gpu.limits.max_compute_workgroups_per_dimension as usize * WG as usize).min(1 << 20);
+        let per_call = 1 << 20;
         for chunk in rects.chunks(per_call) {
             let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1, 0.0, 0.0, 0.0])).collect();
             let p = Params { count: chunk.len() as u32, ..*params };
