@@ -1,0 +1,89 @@
+//! The renderer's diffuse sampler, judged by lobes on the GPU (lavapipe in CI).
+
+use lobes::check::{Domain, Report, Settings, Source, UserSampler, check};
+use lobes::engine::gpu::Gpu;
+
+fn gpu() -> Gpu {
+    Gpu::new().unwrap_or_else(|e| panic!("the sampler tests need a GPU adapter: {e}"))
+}
+
+/// The embedded diffuse shader, followed by `extra` test-only files (name, text).
+fn sampler(extra: &[(&str, &str)], sample: &str, pdf: &str, eval: Option<&str>) -> UserSampler {
+    let mut sources = vec![Source { name: "shaders/diffuse.wgsl".into(), text: renderer_example::diffuse_wgsl().into() }];
+    sources.extend(extra.iter().map(|(name, text)| Source { name: (*name).into(), text: (*text).into() }));
+    let s = UserSampler { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain: Domain::Sphere };
+    s.validate().unwrap_or_else(|e| panic!("{e}"));
+    s
+}
+
+fn print(label: &str, report: &Report) {
+    for c in &report.checks {
+        eprintln!("{label}: {} {} {}", c.name, if c.passed { "passed" } else { "FAILED" }, c.summary);
+    }
+}
+
+#[test]
+fn diffuse_lobe_passes() {
+    let gpu = gpu();
+    let diffuse = sampler(&[], "diffuse_sample", "diffuse_pdf", Some("diffuse_eval"));
+    for (albedo, theta) in [(0.8, 30.0), (0.5, 0.0), (1.0, 89.0)] {
+        let settings = Settings { params: vec![albedo], incident_theta: theta, incident_phi: 40.0, ..Settings::default() };
+        let report = check(&gpu, &diffuse, &settings).unwrap_or_else(|e| panic!("{e}"));
+        print(&format!("albedo {albedo}, θi {theta}°"), &report);
+        report.assert_passed();
+        // every check ran, and the mean weight is the albedo (eval / pdf = albedo exactly)
+        for name in ["chi2", "pdf_values", "pdf_consistency", "jacobian", "weights", "albedo", "hard_cases"] {
+            assert!(report.get(name).is_some_and(|c| c.passed), "check `{name}` missing or failed");
+        }
+        let mean = report.get("albedo").unwrap().figures["mean_weight"].as_f64().unwrap();
+        assert!((mean - albedo).abs() < 1e-5 * albedo, "mean weight {mean} for albedo {albedo}");
+        // Samples from above are rejected only where f32 rounding puts them on the rim of the
+        // disk (z = 0): u within a few ulps of the square's edge, a few in 2²² samples at most.
+        let invalid: u64 = report.invalid.iter().sum();
+        eprintln!("albedo {albedo}, θi {theta}°: invalid samples by reason {:?}", report.invalid);
+        assert!(invalid <= 40 && report.invalid[..3] == [0, 0, 0], "invalid samples: {:?}", report.invalid);
+    }
+}
+
+#[test]
+fn incident_direction_from_below_is_rejected() {
+    let gpu = gpu();
+    let diffuse = sampler(&[], "diffuse_sample", "diffuse_pdf", Some("diffuse_eval"));
+    let settings = Settings { params: vec![0.8], incident_theta: 120.0, samples: 1 << 16, ..Settings::default() };
+    let report = check(&gpu, &diffuse, &settings).unwrap_or_else(|e| panic!("{e}"));
+    print("θi 120°", &report);
+    report.assert_passed();
+    // every sample is rejected with pdf 0 (lobes' reason "zero_pdf"), and the pdf integrates to 0
+    assert_eq!(report.invalid, [0, 0, 0, 1 << 16]);
+    let integral = report.get("chi2").unwrap().figures["pdf_integral"].as_f64().unwrap();
+    assert_eq!(integral, 0.0);
+}
+
+#[test]
+fn a_pdf_off_by_a_factor_of_two_is_caught() {
+    let gpu = gpu();
+    let half = sampler(&[("tests/half_pdf.wgsl", include_str!("half_pdf.wgsl"))], "half_sample", "half_pdf", Some("diffuse_eval"));
+    let report = check(&gpu, &half, &Settings { params: vec![0.8], ..Settings::default() }).unwrap_or_else(|e| panic!("{e}"));
+    print("pdf cos θ/(2π)", &report);
+    assert!(!report.passed);
+    let chi2 = report.get("chi2").expect("a chi2 check");
+    assert!(!chi2.passed, "{}", chi2.summary);
+    // The expected histogram holds half the samples: the other half is expected among the
+    // invalid samples, and none are there.
+    let integral = chi2.figures["pdf_integral"].as_f64().unwrap();
+    assert!((integral - 0.5).abs() < 1e-4, "∫pdf = {integral}");
+    // The map's density is cos θ/π, twice the pdf: pdf · |J| = ½ at every smooth sample.
+    let jacobian = report.get("jacobian").unwrap();
+    let median = jacobian.figures["median_ratio"].as_f64().unwrap();
+    assert!(!jacobian.passed && (median - 0.5).abs() < 0.01, "{}", jacobian.summary);
+    // The sampler reports the same wrong pdf as the pdf function, so those agree ...
+    assert!(report.get("pdf_consistency").unwrap().passed);
+    // ... and the weights eval/pdf come out twice the albedo: the mean weight is off too.
+    let albedo = report.get("albedo").unwrap();
+    let mean = albedo.figures["mean_weight"].as_f64().unwrap();
+    assert!(!albedo.passed && (mean - 1.6).abs() < 1e-4, "{}", albedo.summary);
+    // The panic message of assert_passed names the failed checks.
+    let message = std::panic::catch_unwind(|| report.assert_passed()).unwrap_err();
+    let message = message.downcast_ref::<String>().expect("a formatted panic message");
+    assert!(message.contains("chi2:") && message.contains("jacobian:"), "{message}");
+}

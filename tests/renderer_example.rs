@@ -1,0 +1,37 @@
+//! The example renderer crate (examples/renderer), which uses lobes as a dev-dependency the way
+//! a renderer would, passes its own `cargo test`: its diffuse sampler passes `lobes::check` and a
+//! pdf off by a factor of two is caught. It is a crate of its own (its own `[workspace]`), so it is
+//! run here with cargo, in lobes' target directory so that lobes' dependencies are not rebuilt.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Where lobes' own build goes: `CARGO_TARGET_DIR` if set (relative to the package root, as
+/// cargo reads it when run there), else `target/` of the package.
+fn target_dir(root: &Path) -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => root.join(dir),
+        None => root.join("target"),
+    }
+}
+
+#[test]
+fn renderer_example_passes_its_own_tests() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifest = root.join("examples/renderer/Cargo.toml");
+    assert!(manifest.is_file(), "{} is missing: this test runs in lobes' repository, not a packaged crate", manifest.display());
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let output = Command::new(&cargo)
+        .args(["test", "--release", "--manifest-path"])
+        .arg(&manifest)
+        .env("CARGO_TARGET_DIR", target_dir(root))
+        .current_dir(root)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {}: {e}", Path::new(&cargo).display()));
+    let text = format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "`cargo test --release --manifest-path {}` failed ({}):\n{text}", manifest.display(), output.status);
+    // the renderer's tests ran, each by name (not a build that found no tests)
+    for test in ["diffuse_lobe_passes", "incident_direction_from_below_is_rejected", "a_pdf_off_by_a_factor_of_two_is_caught"] {
+        assert!(text.contains(&format!("test {test} ... ok")), "`{test}` did not run and pass:\n{text}");
+    }
+}
