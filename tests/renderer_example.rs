@@ -31,7 +31,12 @@ fn renderer_example_passes_its_own_tests() {
     let text = format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
     assert!(output.status.success(), "`cargo test --release --manifest-path {}` failed ({}):\n{text}", manifest.display(), output.status);
     // the renderer's tests ran, each by name (not a build that found no tests)
-    for test in ["diffuse_lobe_passes", "incident_direction_from_below_is_rejected", "a_pdf_off_by_a_factor_of_two_is_caught"] {
+    for test in [
+        "diffuse_lobe_passes",
+        "incident_direction_from_below_is_rejected",
+        "a_pdf_off_by_a_factor_of_two_is_caught",
+        "an_error_of_a_fraction_of_a_percent_is_caught_by_chi2_with_many_samples",
+    ] {
         assert!(text.contains(&format!("test {test} ... ok")), "`{test}` did not run and pass:\n{text}");
     }
 }
