@@ -35,6 +35,7 @@ fn renderer_example_passes_its_own_tests() {
         "diffuse_lobe_passes",
         "incident_direction_from_below_is_rejected",
         "a_pdf_off_by_a_factor_of_two_is_caught",
+        "a_reported_pdf_that_differs_from_the_pdf_function_is_caught",
         "an_error_of_a_fraction_of_a_percent_is_caught_by_chi2_with_many_samples",
     ] {
         assert!(text.contains(&format!("test {test} ... ok")), "`{test}` did not run and pass:\n{text}");

@@ -103,3 +103,22 @@ fn an_error_of_a_fraction_of_a_percent_is_caught_by_chi2_with_many_samples() {
     let p = report.get("chi2").unwrap().figures["p_value"].as_f64().unwrap();
     assert!(p < 1e-4, "χ² p = {p}");
 }
+
+#[test]
+fn a_reported_pdf_that_differs_from_the_pdf_function_is_caught() {
+    let gpu = gpu();
+    let squared = sampler(&[("tests/reported_pdf.wgsl", include_str!("reported_pdf.wgsl"))], "squared_sample", "diffuse_pdf", Some("diffuse_eval"));
+    let report = check(&gpu, &squared, &Settings { params: vec![0.8], ..Settings::default() }).unwrap_or_else(|e| panic!("{e}"));
+    print("reported pdf cos² θ/π", &report);
+    // The samples and diffuse_pdf agree: the histogram and the map's Jacobian pass.
+    for name in ["chi2", "jacobian", "pdf_values", "hard_cases"] {
+        assert!(report.get(name).unwrap().passed, "{name}: {}", report.get(name).unwrap().summary);
+    }
+    // The reported pdf is off by a factor cos θ: consistency and weights fail, and the weights
+    // eval / reported pdf = albedo / cos θ average to 2 · albedo (∫ (1/cos θ) cos θ/π dω = 2).
+    for name in ["pdf_consistency", "weights", "albedo"] {
+        assert!(!report.get(name).unwrap().passed, "{name} passed");
+    }
+    let mean = report.get("albedo").unwrap().figures["mean_weight"].as_f64().unwrap();
+    assert!((mean - 1.6).abs() < 0.05, "mean weight {mean}");
+}
