@@ -32,7 +32,7 @@ fn diffuse_lobe_passes() {
         print(&format!("albedo {albedo}, θi {theta}°"), &report);
         report.assert_passed();
         // every check ran, and the mean weight is the albedo (eval / pdf = albedo exactly)
-        for name in ["chi2", "pdf_values", "pdf_consistency", "jacobian", "weights", "albedo", "hard_cases"] {
+        for name in ["chi2", "normalization", "pdf_values", "pdf_consistency", "jacobian", "weights", "albedo", "hard_cases"] {
             assert!(report.get(name).is_some_and(|c| c.passed), "check `{name}` missing or failed");
         }
         let mean = report.get("albedo").unwrap().figures["mean_weight"].as_f64().unwrap();
@@ -72,6 +72,9 @@ fn a_pdf_off_by_a_factor_of_two_is_caught() {
     // invalid samples, and none are there.
     let integral = chi2.figures["pdf_integral"].as_f64().unwrap();
     assert!((integral - 0.5).abs() < 1e-4, "∫pdf = {integral}");
+    // ... which the normalisation check compares with the valid fraction of the samples, 1.
+    let normalization = report.get("normalization").expect("a normalization check");
+    assert!(!normalization.passed && normalization.figures["valid_fraction"].as_f64().unwrap() > 0.999_99, "{}", normalization.summary);
     // The map's density is cos θ/π, twice the pdf: pdf · |J| = ½ at every smooth sample.
     let jacobian = report.get("jacobian").unwrap();
     let median = jacobian.figures["median_ratio"].as_f64().unwrap();
@@ -110,8 +113,8 @@ fn a_reported_pdf_that_differs_from_the_pdf_function_is_caught() {
     let squared = sampler(&[("tests/reported_pdf.wgsl", include_str!("reported_pdf.wgsl"))], "squared_sample", "diffuse_pdf", Some("diffuse_eval"));
     let report = check(&gpu, &squared, &Settings { params: vec![0.8], ..Settings::default() }).unwrap_or_else(|e| panic!("{e}"));
     print("reported pdf cos² θ/π", &report);
-    // The samples and diffuse_pdf agree: the histogram and the map's Jacobian pass.
-    for name in ["chi2", "jacobian", "pdf_values", "hard_cases"] {
+    // The samples and diffuse_pdf agree: the histogram, the normalisation and the map's Jacobian pass.
+    for name in ["chi2", "normalization", "jacobian", "pdf_values", "hard_cases"] {
         assert!(report.get(name).unwrap().passed, "{name}: {}", report.get(name).unwrap().summary);
     }
     // The reported pdf is off by a factor cos θ: consistency and weights fail, and the weights
