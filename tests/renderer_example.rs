@@ -33,6 +33,7 @@ fn renderer_example_passes_its_own_tests() {
     // the renderer's tests ran, each by name (not a build that found no tests)
     for test in [
         "diffuse_lobe_passes",
+        "diffuse_lobe_passes_against_an_f64_reference_pdf",
         "incident_direction_from_below_is_rejected",
         "a_pdf_off_by_a_factor_of_two_is_caught",
         "a_reported_pdf_that_differs_from_the_pdf_function_is_caught",

@@ -1,6 +1,6 @@
 //! The renderer's diffuse sampler, judged by lobes on the GPU (lavapipe in CI).
 
-use lobes::check::{Domain, Report, Settings, Source, UserSampler, check};
+use lobes::check::{Domain, Reference, Report, Settings, Source, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 
 fn gpu() -> Gpu {
@@ -43,6 +43,22 @@ fn diffuse_lobe_passes() {
         eprintln!("albedo {albedo}, θi {theta}°: invalid samples by reason {:?}", report.invalid);
         assert!(invalid <= 40 && report.invalid[..3] == [0, 0, 0], "invalid samples: {:?}", report.invalid);
     }
+}
+
+#[test]
+fn diffuse_lobe_passes_against_an_f64_reference_pdf() {
+    // A renderer with a CPU twin of its BSDF can give it as the reference: the expected histogram
+    // then integrates this f64 pdf on the CPU instead of the WGSL one.
+    let gpu = gpu();
+    let diffuse = sampler(&[], "diffuse_sample", "diffuse_pdf", Some("diffuse_eval"));
+    let cosine = Reference::new(|wi, d| if wi.z > 0.0 && d.z > 0.0 { d.z / std::f64::consts::PI } else { 0.0 });
+    let settings = Settings { params: vec![0.8], incident_theta: 45.0, reference: Some(cosine), ..Settings::default() };
+    let report = check(&gpu, &diffuse, &settings).unwrap_or_else(|e| panic!("{e}"));
+    print("f64 reference", &report);
+    report.assert_passed();
+    // In f64 the cosine lobe integrates to 1 far below f32 rounding (2·10⁻⁶ of the GPU's sum).
+    let integral = report.get("normalization").unwrap().figures["pdf_integral"].as_f64().unwrap();
+    assert!((integral - 1.0).abs() < 1e-9, "∫pdf = {integral}");
 }
 
 #[test]
