@@ -542,7 +542,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         let quad: f64 = integrals.eval.iter().sum();
         let quad_err = 2e-6 * quad.abs() + integrals.error_estimate;
         let z = (mean - quad) / (se * se + quad_err * quad_err).sqrt().max(f64::MIN_POSITIVE);
-        let p = statrs::function::erf::erfc(z.abs() / std::f64::consts::SQRT_2);
+        let p = libm::erfc(z.abs() / std::f64::consts::SQRT_2);
         let af = AlbedoFigures { mean_weight: mean, std_error: se, quadrature: quad, quadrature_error: quad_err, z, p_value: p, significance: settings.significance };
         checks.push(check_of(
             "albedo",
