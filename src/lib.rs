@@ -17,11 +17,13 @@
 //! - [`experiments`]: the stress suite and the accuracy-against-time sweep.
 //! - [`check`]: judging a user's own WGSL sampler (`lobes check`).
 //! - [`report`]: heat maps, plots, tables and output files.
-//! - [`cli`]: the `lobes` command line (argument parsing, validation, printing).
+//! - `cli`: the `lobes` command line (argument parsing, validation, printing), behind the
+//!   default feature `cli` (clap, indicatif).
 //! - [`embed`]: the WGSL samplers, densities and BRDFs for your own wgpu shaders, and helpers
 //!   that upload discrete distributions.
 
 pub mod check;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod embed;
 pub mod engine;
