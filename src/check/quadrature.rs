@@ -17,6 +17,7 @@
 use super::gpu::{Params, Passes};
 
 use super::{CheckError, Domain};
+use crate::stats::gauss_legendre::GaussLegendre;
 use serde::{Deserialize, Serialize};
 
 /// Deepest split of a part (a quarter per level).
@@ -105,16 +106,6 @@ pub(super) struct CpuPdf<'a> {
     pub plane: bool,
 }
 
-/// 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30).
-const GL5: [(f64, f64); 5] = [
-    (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
-    (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
-    (0.0, 0.568_888_888_888_888_9),
-    (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
-    (0.906_179_845_938_664, 0.236_926_885_056_189_1),
-];
-const GL3: [(f64, f64); 3] = [(-0.774_596_669_241_483_4, 5.0 / 9.0), (0.0, 8.0 / 9.0), (0.774_596_669_241_483_4, 5.0 / 9.0)];
-
 impl CpuPdf<'_> {
     /// The point at (a, b) of a part in hemisphere h (`lobes_domain_point` in f64).
     fn point(&self, a: f64, b: f64, h: f32) -> glam::DVec3 {
@@ -124,22 +115,17 @@ impl CpuPdf<'_> {
         let s = (a * (2.0 - a)).max(0.0).sqrt();
         glam::DVec3::new(s * b.cos(), s * b.sin(), h as f64 * (1.0 - a))
     }
-    fn rule(&self, r: &[f64; 4], h: f32, nodes: &[(f64, f64)]) -> f64 {
-        let (ha, ca, hb, cb) = (0.5 * (r[1] - r[0]), 0.5 * (r[1] + r[0]), 0.5 * (r[3] - r[2]), 0.5 * (r[3] + r[2]));
-        let mut sum = 0.0;
-        for (x, wx) in nodes {
-            for (y, wy) in nodes {
-                sum += wx * wy * (self.pdf)(self.point(ca + ha * x, cb + hb * y, h));
-            }
-        }
-        sum * ha * hb
+    fn rule(&self, r: &[f64; 4], h: f32, rule: &GaussLegendre) -> f64 {
+        rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |a, b| (self.pdf)(self.point(a, b, h)))
     }
 }
 
 impl Integrand for CpuPdf<'_> {
     fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError> {
         use rayon::prelude::*;
-        Ok(rects.par_iter().map(|(r, h)| [self.rule(r, *h, &GL5), self.rule(r, *h, &GL3), 0.0, 0.0]).collect())
+        // the pair of rules the GPU pass and the f64 quadrature of stats::expected use
+        let (g5, g3) = (GaussLegendre::new(5), GaussLegendre::new(3));
+        Ok(rects.par_iter().map(|(r, h)| [self.rule(r, *h, &g5), self.rule(r, *h, &g3), 0.0, 0.0]).collect())
     }
     fn rounding(&self) -> f64 {
         CPU_ROUNDING
