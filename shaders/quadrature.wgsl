@@ -2,9 +2,9 @@
 // ROWS x COLS grid (rows uniform in cos th over [-1, 1], columns uniform in phi over [-pi, pi),
 // as shaders/histogram.wgsl), each integrating p(wr) over its bin by the fixed N_NODES x N_NODES
 // Gauss-Legendre product rule in (cos th, phi), where the solid-angle element is d cos th d phi
-// (the same rule as src/tradeoff/quadrature.rs fixed_probabilities in f64). The host prepends
-// ROWS, COLS and N_NODES and the lobes::embed modules, and replaces PDF_FN by the lobe's density
-// (ggx_pdf_vndf, ward_pdf, ...: (a, wi, wr) -> f32).
+// (the same rule as src/experiments/tradeoff/quadrature.rs fixed_probabilities in f64). The host
+// prepends ROWS, COLS and N_NODES, the lobe's files and `sampler_pdf(a, wi, wr) -> f32`, the
+// call site of the sampler's density (src/reference/sampler.rs).
 
 struct QuadParams {
     alpha: vec2<f32>,
@@ -44,7 +44,7 @@ fn quadrature(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         for (var j = 0u; j < N_NODES; j++) {
             let phi = cp + hp * gl_nodes[j].x;
             let w = vec3<f32>(s * cos(phi), s * sin(phi), z);
-            row_sum += gl_nodes[j].y * PDF_FN(qp.alpha, qp.wi.xyz, w);
+            row_sum += gl_nodes[j].y * sampler_pdf(qp.alpha, qp.wi.xyz, w);
         }
         sum += gl_nodes[i].y * row_sum;
     }

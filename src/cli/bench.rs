@@ -5,7 +5,7 @@ use super::{OutputArgs, emit, emit_json};
 use crate::engine::cpu;
 use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Job, SampleRange};
-use crate::reference::{Lobe, LobeKind, Method, reflect};
+use crate::reference::{Lobe, SAMPLERS, reflect};
 use crate::stats::histogram::SphereGrid;
 use crate::stats::median::median;
 use clap::Args;
@@ -54,9 +54,7 @@ pub struct BenchResult {
 
 /// The lobes and methods benchmarked, at 45° incidence on a 64 × 128 grid.
 pub fn bench_jobs(alpha: f64) -> Vec<Job> {
-    use LobeKind::*;
-    use Method::*;
-    [(Ward, Ndf), (Beckmann, Ndf), (Beckmann, Vndf), (Ggx, Ndf), (Ggx, Vndf), (Ggx, Bounded)]
+    SAMPLERS
         .into_iter()
         .map(|(kind, method)| Job::Lobe {
             lobe: Lobe { kind, method, alpha_x: alpha, alpha_y: alpha },

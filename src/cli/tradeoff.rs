@@ -84,15 +84,14 @@ fn list<T>(flag: &str, s: &str, parse: impl Fn(&str) -> Option<T>, allowed: &str
         .collect()
 }
 
-const SAMPLERS: &str = "ward-ndf, beckmann-ndf, beckmann-vndf, ggx-ndf, ggx-vndf, ggx-bounded";
-
 pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
-    let samplers = list("--samplers", &args.samplers, Sampler::parse, SAMPLERS)?;
+    let all = Sampler::ALL.map(|s| s.name()).join(", ");
+    let samplers = list("--samplers", &args.samplers, Sampler::parse, &all)?;
     let precisions = list("--precisions", &args.precisions, Precision::parse, "f32-fast, f32-accurate, f64")?;
     let parts = list("--parts", &args.parts, |s| ["sweep", "methods", "quadrature"].contains(&s).then(|| s.to_string()), "sweep, methods, quadrature")?;
     let long = match args.long.trim() {
         "none" => None,
-        s => Some(Sampler::parse(s).ok_or_else(|| usage(format!("--long: '{s}' is unknown; use none or {SAMPLERS}")))?),
+        s => Some(Sampler::parse(s).ok_or_else(|| usage(format!("--long: '{s}' is unknown; use none or {all}")))?),
     };
     if args.min_log2 > args.max_log2 {
         return Err(usage(format!("--min-log2 {} is above --max-log2 {}; give min ≤ max", args.min_log2, args.max_log2)));

@@ -13,12 +13,12 @@ pub mod masking;
 pub mod microfacet;
 pub mod reflect;
 pub mod rng;
+pub mod sampler;
 pub mod ward;
 
 use beckmann::Beckmann;
 use ggx::Ggx;
 use glam::DVec3;
-use microfacet::{Microfacet, pdf_ndf, pdf_vndf};
 use serde::{Deserialize, Serialize};
 
 /// Which lobe.
@@ -52,11 +52,7 @@ impl LobeKind {
     }
     /// Whether this lobe has a sampler for `method`.
     pub fn supports(self, method: Method) -> bool {
-        match self {
-            LobeKind::Ward => method == Method::Ndf,
-            LobeKind::Beckmann => method != Method::Bounded,
-            LobeKind::Ggx => true,
-        }
+        sampler::of_kind(self).any(|s| s.method == method)
     }
 }
 
@@ -70,16 +66,7 @@ impl Method {
     }
 }
 
-/// Every sampler: each lobe with each method it supports (the uber-kernel's sampler ids are
-/// indices into this list).
-pub const SAMPLERS: [(LobeKind, Method); 6] = [
-    (LobeKind::Ward, Method::Ndf),
-    (LobeKind::Beckmann, Method::Ndf),
-    (LobeKind::Beckmann, Method::Vndf),
-    (LobeKind::Ggx, Method::Ndf),
-    (LobeKind::Ggx, Method::Vndf),
-    (LobeKind::Ggx, Method::Bounded),
-];
+pub use sampler::SAMPLERS;
 
 /// Why a sample is not a usable reflected direction. Every invalid sample is counted under
 /// exactly one reason, checked in this order.
@@ -167,12 +154,8 @@ impl Lobe {
         let h = self.sample_h(wi, u);
         let omega_r = reflect::reflect(wi, h);
         let pdf_h = self.pdf_h(wi, h);
-        let pdf_r = match (self.kind, self.method) {
-            // no reflection from below the surface, and none into it: p(ωr) = 0 there, as in pdf_r
-            _ if wi.z < 0.0 || omega_r.z <= 0.0 => 0.0,
-            (LobeKind::Ggx, Method::Bounded) if omega_r.z > 0.0 => self.ggx().pdf_bounded_r(wi, h),
-            _ => reflect::pdf_reflected(pdf_h, omega_r, h),
-        };
+        // no reflection from below the surface, and none into it: p(ωr) = 0 there, as in pdf_r
+        let pdf_r = if wi.z < 0.0 || omega_r.z <= 0.0 { 0.0 } else { self.pdf_r_of_h(wi, omega_r, h, pdf_h) };
         LobeSample { h, omega_r, pdf_h, pdf_r, invalid: Invalid::check(omega_r, pdf_r) }
     }
 
@@ -183,30 +166,28 @@ impl Lobe {
         Beckmann { ax: self.alpha_x, ay: self.alpha_y }
     }
 
+    /// The f64 reference of this lobe's sampler (the registry's entry).
+    fn reference(&self) -> sampler::Reference {
+        let spec = sampler::find(self.kind, self.method);
+        spec.reference.unwrap_or_else(|| panic!("the sampler {} has no f64 reference", spec.name()))
+    }
+
     /// The half vector for uniforms `u`.
     pub fn sample_h(&self, wi: DVec3, u: [f64; 2]) -> DVec3 {
-        match (self.kind, self.method) {
-            (LobeKind::Ward, _) => ward::sample_h(self.alpha_x, self.alpha_y, u),
-            (LobeKind::Beckmann, Method::Ndf) => self.beckmann().sample_ndf(u),
-            (LobeKind::Beckmann, _) => self.beckmann().sample_vndf(wi, u),
-            (LobeKind::Ggx, Method::Ndf) => self.ggx().sample_ndf(u),
-            (LobeKind::Ggx, Method::Vndf) => self.ggx().sample_vndf(wi, u),
-            (LobeKind::Ggx, Method::Bounded) => self.ggx().sample_bounded(wi, u),
-        }
+        (self.reference().sample_h)(self, wi, u)
     }
 
     /// The density of h under this lobe's sampling method, per unit solid angle.
     pub fn pdf_h(&self, wi: DVec3, h: DVec3) -> f64 {
-        match (self.kind, self.method) {
-            (LobeKind::Ward, _) => ward::pdf_h(self.alpha_x, self.alpha_y, h),
-            (LobeKind::Beckmann, Method::Ndf) => pdf_ndf(&self.beckmann(), h),
-            (LobeKind::Beckmann, _) => pdf_vndf(&self.beckmann(), wi, h),
-            (LobeKind::Ggx, Method::Ndf) => pdf_ndf(&self.ggx(), h),
-            (LobeKind::Ggx, Method::Vndf) => pdf_vndf(&self.ggx(), wi, h),
-            (LobeKind::Ggx, Method::Bounded) => {
-                let wr = reflect::reflect(wi, h);
-                if wr.z > 0.0 { self.ggx().pdf_bounded_r(wi, h) * 4.0 * wi.dot(h).abs() } else { 0.0 }
-            }
+        (self.reference().pdf_h)(self, wi, h)
+    }
+
+    /// p(ωr) of the reflection about h: the method's own reflected density, else
+    /// p(h) / (4 |ωr·h|).
+    fn pdf_r_of_h(&self, wi: DVec3, wr: DVec3, h: DVec3, pdf_h: f64) -> f64 {
+        match self.reference().pdf_r {
+            Some(pdf_r) => pdf_r(self, wi, h),
+            None => reflect::pdf_reflected(pdf_h, wr, h),
         }
     }
 
@@ -217,10 +198,7 @@ impl Lobe {
             return 0.0;
         }
         let Some(h) = reflect::half_vector(wi, wr) else { return 0.0 };
-        match (self.kind, self.method) {
-            (LobeKind::Ggx, Method::Bounded) => self.ggx().pdf_bounded_r(wi, h),
-            _ => reflect::pdf_reflected(self.pdf_h(wi, h), wr, h),
-        }
+        self.pdf_r_of_h(wi, wr, h, self.pdf_h(wi, h))
     }
 
     /// The BRDF value f(ωi, ωr) without Fresnel: Ward's (ρs = 1), or the microfacet BRDF with

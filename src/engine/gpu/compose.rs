@@ -3,7 +3,7 @@
 
 use super::context::GpuError;
 use crate::engine::job::{DiscreteMethod, Job};
-use crate::reference::{LobeKind, Method};
+use crate::reference::sampler::{self, SamplerSpec};
 
 /// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
 /// `src/stats`).
@@ -26,6 +26,21 @@ pub mod sources {
     pub const FRESNEL: &str = include_str!("../../../shaders/fresnel.wgsl");
     pub const MASKING: &str = include_str!("../../../shaders/masking.wgsl");
     pub const WEIGHTED: &str = include_str!("../../../shaders/weighted.wgsl");
+
+    /// The file `shaders/{stem}.wgsl` of a sampler or lobe (as named in
+    /// [`crate::reference::sampler::Wgsl`]).
+    pub fn file(stem: &str) -> &'static str {
+        match stem {
+            "ward" => WARD,
+            "microfacet" => MICROFACET,
+            "ggx" => GGX,
+            "beckmann" => BECKMANN,
+            "ward_eval" => WARD_EVAL,
+            "ggx_eval" => GGX_EVAL,
+            "beckmann_eval" => BECKMANN_EVAL,
+            other => panic!("no shader file shaders/{other}.wgsl"),
+        }
+    }
 }
 
 /// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
@@ -34,25 +49,11 @@ pub const SAMPLES_PER_THREAD: u32 = 255;
 pub const WG_SIZE: u32 = 256;
 const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
 
-/// The WGSL sampler function of a lobe and method.
-pub fn sample_fn(kind: LobeKind, method: Method) -> &'static str {
-    match (kind, method) {
-        (LobeKind::Ward, _) => "ward_sample",
-        (LobeKind::Beckmann, Method::Ndf) => "beckmann_sample_ndf",
-        (LobeKind::Beckmann, _) => "beckmann_sample_vndf",
-        (LobeKind::Ggx, Method::Ndf) => "ggx_sample_ndf",
-        (LobeKind::Ggx, Method::Vndf) => "ggx_sample_vndf",
-        (LobeKind::Ggx, Method::Bounded) => "ggx_sample_bounded",
-    }
-}
-
-/// The modules a lobe's samplers need, in order.
-pub(crate) fn lobe_modules(kind: LobeKind) -> &'static [&'static str] {
-    match kind {
-        LobeKind::Ward => &[sources::WARD],
-        LobeKind::Beckmann => &[sources::MICROFACET, sources::BECKMANN],
-        LobeKind::Ggx => &[sources::MICROFACET, sources::GGX],
-    }
+/// The files of a sampler, then those of its density and weight: `eval` false for the counting
+/// kernels, which only draw.
+pub(crate) fn sampler_files(spec: &SamplerSpec, eval: bool) -> Vec<&'static str> {
+    let stems = spec.wgsl.sample_files.iter().chain(if eval { spec.wgsl.eval_files } else { &[] });
+    stems.map(|s| sources::file(s)).collect()
 }
 
 /// The composed WGSL of `job`, counting all its bins.
@@ -68,8 +69,9 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     let mut src = header(job, workgroup_words, tile_bins);
     match job {
         Job::Lobe { lobe, .. } => {
-            push_all(&mut src, lobe_modules(lobe.kind));
-            src.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", sample_fn(lobe.kind, lobe.method)));
+            let spec = sampler::find(lobe.kind, lobe.method);
+            push_all(&mut src, &sampler_files(spec, false));
+            src.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", spec.wgsl.sample));
         }
         Job::Discrete { method, .. } => {
             src.push_str(sources::DISCRETE);

@@ -17,6 +17,7 @@ use crate::engine::job::Job;
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
+use crate::reference::sampler::{self, REGISTRY, SamplerSpec, Wgsl};
 use crate::reference::{LobeKind, Method};
 
 /// How a weighted module resolves its effects.
@@ -44,59 +45,9 @@ impl Composed {
 
 pub use crate::reference::SAMPLERS;
 
-/// The uber-kernel's id of a sampler.
+/// The uber-kernel's id of a sampler (its index in the registry).
 pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
-    let method = if kind == LobeKind::Ward { Method::Ndf } else { method };
-    SAMPLERS.iter().position(|&s| s == (kind, method)).expect("every lobe/method pair is listed") as u32
-}
-
-/// The WGSL expressions of one sampler, in terms of `a`, `wi`, `wr`, `h` and the sample `s`.
-struct SamplerGlue {
-    /// The estimator weight without Fresnel and masking (see `Effects::weight`).
-    weight: &'static str,
-    /// f without Fresnel and masking: D / (4 cos θi cos θr), or Ward's BRDF.
-    eval: &'static str,
-    /// Smith's G1(w) (microfacet lobes).
-    g1: Option<&'static str>,
-    /// The sampler's density p(ωr), from the lobe's pdf functions.
-    pdf: &'static str,
-}
-
-fn sampler_glue(kind: LobeKind, method: Method) -> SamplerGlue {
-    let (weight, eval, g1, pdf) = match (kind, method) {
-        (LobeKind::Ward, _) => ("ward_weight(wi, s.h, s.wr)", "ward_eval(a, wi, wr)", None, "ward_pdf(a, wi, wr)"),
-        (LobeKind::Ggx, m) => (
-            match m {
-                Method::Ndf => "microfacet_ndf_weight(wi, s.h)",
-                Method::Vndf => "ggx_vndf_weight(a, wi)",
-                Method::Bounded => "ggx_bounded_weight(a, wi)",
-            },
-            "ggx_d(a, h) / (4.0 * wi.z * wr.z)",
-            Some("ggx_g1(a, w)"),
-            match m {
-                Method::Ndf => "ggx_pdf_ndf(a, wi, wr)",
-                Method::Vndf => "ggx_pdf_vndf(a, wi, wr)",
-                Method::Bounded => "ggx_pdf_bounded(a, wi, wr)",
-            },
-        ),
-        (LobeKind::Beckmann, m) => (
-            if m == Method::Ndf { "microfacet_ndf_weight(wi, s.h)" } else { "beckmann_vndf_weight(a, wi)" },
-            "beckmann_d(a, h) / (4.0 * wi.z * wr.z)",
-            Some("beckmann_g1(a, w)"),
-            if m == Method::Ndf { "beckmann_pdf_ndf(a, wi, wr)" } else { "beckmann_pdf_vndf(a, wi, wr)" },
-        ),
-    };
-    SamplerGlue { weight, eval, g1, pdf }
-}
-
-/// The file of a lobe's BRDF, pdf and weight functions (its samplers' files are
-/// [`compose::lobe_modules`], already in the counting module).
-fn eval_file(kind: LobeKind) -> &'static str {
-    match kind {
-        LobeKind::Ward => sources::WARD_EVAL,
-        LobeKind::Beckmann => sources::BECKMANN_EVAL,
-        LobeKind::Ggx => sources::GGX_EVAL,
-    }
+    sampler::find(kind, method).id()
 }
 
 /// A glue function `fn NAME(ARGS) -> RET` returning one expression per sampler: directly in a
@@ -115,22 +66,15 @@ fn sampler_fn(name: &str, args: &str, ret: &str, arms: &[(u32, String)]) -> Stri
 }
 
 /// The glue of the samplers `samplers` (one in a specialised module, all in the uber-kernel).
-fn samplers_glue(samplers: &[(LobeKind, Method)], masking: bool) -> String {
-    let arms = |f: &dyn Fn(LobeKind, Method) -> String| -> Vec<(u32, String)> {
-        samplers.iter().map(|&(k, m)| (sampler_id(k, m), f(k, m))).collect()
-    };
+fn samplers_glue(samplers: &[&SamplerSpec], masking: bool) -> String {
+    let arms = |f: &dyn Fn(&Wgsl) -> String| -> Vec<(u32, String)> { samplers.iter().map(|s| (s.id(), f(&s.wgsl))).collect() };
     let mut src = String::new();
-    src.push_str(&sampler_fn(
-        "sampler_sample",
-        "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>",
-        "LobeSample",
-        &arms(&|k, m| format!("{}(a, wi, u)", compose::sample_fn(k, m))),
-    ));
-    src.push_str(&sampler_fn("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", &arms(&|k, m| sampler_glue(k, m).weight.into())));
-    src.push_str(&sampler_fn("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", &arms(&|k, m| sampler_glue(k, m).eval.into())));
-    src.push_str(&sampler_fn("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &arms(&|k, m| sampler_glue(k, m).pdf.into())));
+    src.push_str(&sampler_fn("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", &arms(&|w| format!("{}(a, wi, u)", w.sample))));
+    src.push_str(&sampler_fn("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", &arms(&|w| w.weight.into())));
+    src.push_str(&sampler_fn("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", &arms(&|w| w.eval.into())));
+    src.push_str(&sampler_fn("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &arms(&|w| w.pdf.into())));
     if masking {
-        src.push_str(&sampler_fn("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", &arms(&|k, m| sampler_glue(k, m).g1.unwrap_or("1.0").into())));
+        src.push_str(&sampler_fn("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", &arms(&|w| w.g1.unwrap_or("1.0").into())));
     }
     src
 }
@@ -208,10 +152,10 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
     let Job::Lobe { lobe, .. } = job else { panic!("effects apply to lobe jobs only") };
     match how {
         Specialisation::Specialised => {
+            let spec = sampler::find(lobe.kind, lobe.method);
             let mut source = compose::compose(job, workgroup_words);
             source.push('\n');
-            source.push_str(eval_file(lobe.kind));
-            source.push('\n');
+            compose::push_all(&mut source, &spec.wgsl.eval_files.iter().map(|f| sources::file(f)).collect::<Vec<_>>());
             let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
             source.push_str("override ANISOTROPIC: bool = true;\n");
             let fresnel = effects.fresnel != Fresnel::None;
@@ -226,7 +170,7 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
                 constants.push(("MASKING", effects.masking.mode() as f64));
                 source.push_str(sources::MASKING);
             }
-            source.push_str(&samplers_glue(&[(lobe.kind, lobe.method)], masking));
+            source.push_str(&samplers_glue(&[spec], masking));
             source.push_str(&fresnel_glue(fresnel.then_some("FRESNEL")));
             source.push_str(&masking_glue(masking.then_some("MASKING")));
             source.push_str(&EFFECT_GLUE.replace("ANISOTROPIC_SEL", "ANISOTROPIC"));
@@ -251,10 +195,18 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
     let mut source = compose::header(job, workgroup_words, job.bins() as u32);
     source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
-    compose::push_all(&mut source, &[sources::MICROFACET, sources::WARD, sources::GGX, sources::BECKMANN]);
-    compose::push_all(&mut source, &[sources::WARD_EVAL, sources::GGX_EVAL, sources::BECKMANN_EVAL, sources::FRESNEL, sources::MASKING]);
+    let mut files: Vec<&str> = Vec::new();
+    for spec in &REGISTRY {
+        for f in compose::sampler_files(spec, true) {
+            if !files.contains(&f) {
+                files.push(f);
+            }
+        }
+    }
+    files.extend([sources::FRESNEL, sources::MASKING]);
+    compose::push_all(&mut source, &files);
     source.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", "sampler_sample"));
-    source.push_str(&samplers_glue(&SAMPLERS, true));
+    source.push_str(&samplers_glue(&REGISTRY.iter().collect::<Vec<_>>(), true));
     source.push_str(&fresnel_glue(Some("effect.modes.y")));
     source.push_str(&masking_glue(Some("effect.modes.z")));
     source.push_str(&EFFECT_GLUE.replace("ANISOTROPIC_SEL", "effect.modes.w != 0u"));

@@ -14,7 +14,7 @@ pub use variants::Precision;
 
 use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Counts, Job, SampleRange};
-use crate::reference::{Invalid, Lobe, LobeKind, Method, reflect, rng};
+use crate::reference::{Invalid, Lobe, LobeKind, Method, SAMPLERS, reflect, rng, sampler};
 use crate::stats::chi2;
 use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::{self, Quadrature, REFERENCE_SAMPLES};
@@ -37,14 +37,16 @@ pub struct Sampler {
 }
 
 impl Sampler {
-    pub const ALL: [Sampler; 6] = [
-        Sampler { kind: LobeKind::Ward, method: Method::Ndf },
-        Sampler { kind: LobeKind::Beckmann, method: Method::Ndf },
-        Sampler { kind: LobeKind::Beckmann, method: Method::Vndf },
-        Sampler { kind: LobeKind::Ggx, method: Method::Ndf },
-        Sampler { kind: LobeKind::Ggx, method: Method::Vndf },
-        Sampler { kind: LobeKind::Ggx, method: Method::Bounded },
-    ];
+    /// Every sampler of the registry ([`crate::reference::sampler::REGISTRY`]), in its order.
+    pub const ALL: [Sampler; SAMPLERS.len()] = {
+        let mut out = [Sampler { kind: LobeKind::Ward, method: Method::Ndf }; SAMPLERS.len()];
+        let mut i = 0;
+        while i < SAMPLERS.len() {
+            out[i] = Sampler { kind: SAMPLERS[i].0, method: SAMPLERS[i].1 };
+            i += 1;
+        }
+        out
+    };
 
     pub fn name(&self) -> String {
         format!("{}-{}", self.kind.name(), self.method.name())
@@ -86,14 +88,7 @@ pub struct SweepSettings {
 impl Default for SweepSettings {
     fn default() -> Self {
         Self {
-            samplers: vec![
-                Sampler { kind: LobeKind::Ward, method: Method::Ndf },
-                Sampler { kind: LobeKind::Beckmann, method: Method::Ndf },
-                Sampler { kind: LobeKind::Beckmann, method: Method::Vndf },
-                Sampler { kind: LobeKind::Ggx, method: Method::Ndf },
-                Sampler { kind: LobeKind::Ggx, method: Method::Vndf },
-                Sampler { kind: LobeKind::Ggx, method: Method::Bounded },
-            ],
+            samplers: Sampler::ALL.to_vec(),
             precisions: Precision::ALL.to_vec(),
             alpha: 0.3,
             incident_theta_deg: 45.0,
@@ -212,7 +207,7 @@ pub fn unavailable(engine: &GpuEngine, sampler: Sampler, precision: Precision) -
     if !engine.gpu.has_f64() {
         return Some(format!("the adapter '{}' has no SHADER_F64", engine.gpu.info.name));
     }
-    if variants::sampler64(&sampler.lobe(1.0)).is_none() {
+    if sampler::find(sampler.kind, sampler.method).wgsl.sample64.is_none() {
         return Some(format!("no f64 kernel for {} (it would need f64 erfc and erfinv)", sampler.name()));
     }
     None

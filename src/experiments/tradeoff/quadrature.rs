@@ -3,10 +3,9 @@
 //! element is d cos θ dφ), on the CPU in f64 and on the GPU in f32 (`shaders/quadrature.wgsl`),
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
-use crate::embed::{self, Module};
 use crate::engine::gpu::dispatch::{Pass, Step};
-use crate::engine::gpu::{GpuEngine, GpuError};
-use crate::reference::{Lobe, LobeKind, Method};
+use crate::engine::gpu::{GpuEngine, GpuError, compose};
+use crate::reference::{Lobe, sampler};
 use crate::stats::expected::direction;
 use crate::stats::gauss_legendre::GaussLegendre;
 use crate::stats::histogram::SphereGrid;
@@ -37,28 +36,15 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
         .collect()
 }
 
-/// The WGSL density of a lobe in `lobes::embed` and the module that holds it.
-pub fn pdf_fn(lobe: &Lobe) -> (Module, &'static str) {
-    match (lobe.kind, lobe.method) {
-        (LobeKind::Ward, _) => (Module::Ward, "ward_pdf"),
-        (LobeKind::Beckmann, Method::Ndf) => (Module::Beckmann, "beckmann_pdf_ndf"),
-        (LobeKind::Beckmann, _) => (Module::Beckmann, "beckmann_pdf_vndf"),
-        (LobeKind::Ggx, Method::Ndf) => (Module::Ggx, "ggx_pdf_ndf"),
-        (LobeKind::Ggx, Method::Vndf) => (Module::Ggx, "ggx_pdf_vndf"),
-        (LobeKind::Ggx, Method::Bounded) => (Module::Ggx, "ggx_pdf_bounded"),
-    }
-}
-
-/// The composed quadrature kernel for a lobe, grid and rule size.
+/// The composed quadrature kernel for a lobe, grid and rule size: the lobe's files (from the
+/// sampler registry), the call site `sampler_pdf` of its density, and `shaders/quadrature.wgsl`.
 pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
-    let (module, pdf) = pdf_fn(lobe);
-    format!(
-        "{}\nconst ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n{}",
-        embed::wgsl(&[module]),
-        grid.rows,
-        grid.cols,
-        QUADRATURE_WGSL.replace("PDF_FN(", &format!("{pdf}("))
-    )
+    let spec = sampler::find(lobe.kind, lobe.method);
+    let mut src = format!("const ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n", grid.rows, grid.cols);
+    compose::push_all(&mut src, &[compose::sources::REFLECT]);
+    compose::push_all(&mut src, &compose::sampler_files(spec, true));
+    src += &format!("fn sampler_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {{\n    return {};\n}}\n", spec.wgsl.pdf);
+    src + QUADRATURE_WGSL
 }
 
 #[repr(C)]

@@ -12,7 +12,7 @@
 
 use crate::engine::gpu::engine::Rewrite;
 use crate::engine::job::Job;
-use crate::reference::{Lobe, LobeKind, Method};
+use crate::reference::{LobeKind, sampler};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -55,19 +55,6 @@ impl Precision {
             Precision::F32Fast => Some(Arc::new(|_job: &Job, src: String| fast(&src))),
             Precision::F64 => Some(Arc::new(|job: &Job, src: String| f64_kernel(job, &src))),
         }
-    }
-}
-
-/// The f64 sampler of `shaders/f64.wgsl` for a lobe and method (every one has one; the
-/// `Option` leaves room for samplers without an f64 twin).
-pub fn sampler64(lobe: &Lobe) -> Option<&'static str> {
-    match (lobe.kind, lobe.method) {
-        (LobeKind::Ward, _) => Some("ward_sample64"),
-        (LobeKind::Beckmann, Method::Ndf) => Some("beckmann_sample_ndf64"),
-        (LobeKind::Beckmann, _) => Some("beckmann_sample_vndf64"),
-        (LobeKind::Ggx, Method::Ndf) => Some("ggx_sample_ndf64"),
-        (LobeKind::Ggx, Method::Vndf) => Some("ggx_sample_vndf64"),
-        (LobeKind::Ggx, Method::Bounded) => Some("ggx_sample_bounded64"),
     }
 }
 
@@ -146,10 +133,10 @@ pub fn erfc_straight_line() -> String {
 /// The `f64` module of a lobe job: the composed `draw` and `explicit_samples` renamed out of
 /// the way (`*_f32`), `shaders/f64.wgsl` appended with the job's sampler, α and ωi in f64.
 ///
-/// Panics for a job without an f64 sampler ([`sampler64`]); callers check first.
+/// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
 pub fn f64_kernel(job: &Job, src: &str) -> String {
     let Job::Lobe { lobe, incident, .. } = job else { panic!("lobes tradeoff: f64 kernels exist for lobes only") };
-    let sampler = sampler64(lobe).unwrap_or_else(|| {
+    let sampler = sampler::find(lobe.kind, lobe.method).wgsl.sample64.unwrap_or_else(|| {
         panic!("lobes tradeoff: no f64 sampler for {} {}", lobe.kind.name(), lobe.method.name())
     });
     // definitions start a line (comments may mention them too)

@@ -1,0 +1,248 @@
+//! The sampler registry: one [`SamplerSpec`] per (lobe, method), the single list every other
+//! list of samplers comes from (the uber-kernel's ids, `lobes bench`, `lobes tradeoff`, the
+//! stress suite, the WGSL call sites of the counting and weighted kernels).
+//!
+//! An entry names the sampler, the `shaders/` files that define its WGSL functions, the call
+//! sites of those functions, and its f64 twins: the Rust reference ([`Reference`], `None` for a
+//! sampler known only as WGSL) and the f64 WGSL sampler of `lobes tradeoff` (`sample64`).
+//! Adding a sampler is one entry here plus its files.
+
+use super::microfacet::{Microfacet, pdf_ndf, pdf_vndf};
+use super::{Lobe, LobeKind, Method, ward};
+use glam::DVec3;
+
+/// One sampler: a lobe and the method that draws its half vectors.
+#[derive(Debug, Clone, Copy)]
+pub struct SamplerSpec {
+    pub kind: LobeKind,
+    pub method: Method,
+    pub wgsl: Wgsl,
+    /// The f64 reference the GPU sampler is judged against (`None`: no f64 twin).
+    pub reference: Option<Reference>,
+}
+
+/// A sampler's WGSL: its files and the call sites of its functions. The call sites are
+/// expressions in the names of the kernels that call them: `a: vec2<f32>` (αx, αy), `wi`,
+/// `wr: vec3<f32>`, `h = normalize(wi + wr)`, `u: vec2<f32>` and a drawn `s: LobeSample`.
+#[derive(Debug, Clone, Copy)]
+pub struct Wgsl {
+    /// The `shaders/` files (without `.wgsl`) that define the sampler, in order, after the
+    /// `rng` and `reflect` every kernel has.
+    pub sample_files: &'static [&'static str],
+    /// The files that define its density, BRDF and weight (after `sample_files`).
+    pub eval_files: &'static [&'static str],
+    /// `fn (a, wi, u) -> LobeSample`.
+    pub sample: &'static str,
+    /// p(ωr), the sampler's density, in terms of `a`, `wi`, `wr`.
+    pub pdf: &'static str,
+    /// f without Fresnel and masking, in terms of `a`, `wi`, `wr`, `h`: D / (4 cos θi cos θr)
+    /// for microfacets, Ward's BRDF.
+    pub eval: &'static str,
+    /// The estimator weight without Fresnel and masking (see
+    /// [`Effects::weight`](super::effects::Effects::weight)), in terms of `a`, `wi`, `s`.
+    pub weight: &'static str,
+    /// Smith's G1(w) in terms of `a`, `w` (microfacet lobes; `None`: no masking).
+    pub g1: Option<&'static str>,
+    /// The f64 sampler of `shaders/f64.wgsl` (`lobes tradeoff`), `fn (a: vec2<f64>, wi:
+    /// vec3<f64>, u: vec2<f32>) -> LobeSample64`; `None`: no f64 kernel.
+    pub sample64: Option<&'static str>,
+}
+
+/// The f64 reference of a sampler (`src/reference`).
+#[derive(Debug, Clone, Copy)]
+pub struct Reference {
+    /// The half vector drawn for uniforms `u`.
+    pub sample_h: fn(&Lobe, DVec3, [f64; 2]) -> DVec3,
+    /// The density of h, per unit solid angle.
+    pub pdf_h: fn(&Lobe, DVec3, DVec3) -> f64,
+    /// p(ωr) given h, where the method defines its own reflected density rather than
+    /// p(h) / (4 |ωr·h|) (bounded VNDF).
+    pub pdf_r: Option<fn(&Lobe, DVec3, DVec3) -> f64>,
+}
+
+const MICROFACET_NDF_WEIGHT: &str = "microfacet_ndf_weight(wi, s.h)";
+const GGX_EVAL: &str = "ggx_d(a, h) / (4.0 * wi.z * wr.z)";
+const BECKMANN_EVAL: &str = "beckmann_d(a, h) / (4.0 * wi.z * wr.z)";
+const GGX_FILES: &[&str] = &["microfacet", "ggx"];
+const BECKMANN_FILES: &[&str] = &["microfacet", "beckmann"];
+
+/// Every sampler; an uber-kernel's sampler id is its index here.
+pub const REGISTRY: [SamplerSpec; 6] = [
+    SamplerSpec {
+        kind: LobeKind::Ward,
+        method: Method::Ndf,
+        wgsl: Wgsl {
+            sample_files: &["ward"],
+            eval_files: &["ward_eval"],
+            sample: "ward_sample",
+            pdf: "ward_pdf(a, wi, wr)",
+            eval: "ward_eval(a, wi, wr)",
+            weight: "ward_weight(wi, s.h, s.wr)",
+            g1: None,
+            sample64: Some("ward_sample64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, _, u| ward::sample_h(l.alpha_x, l.alpha_y, u),
+            pdf_h: |l, _, h| ward::pdf_h(l.alpha_x, l.alpha_y, h),
+            pdf_r: None,
+        }),
+    },
+    SamplerSpec {
+        kind: LobeKind::Beckmann,
+        method: Method::Ndf,
+        wgsl: Wgsl {
+            sample_files: BECKMANN_FILES,
+            eval_files: &["beckmann_eval"],
+            sample: "beckmann_sample_ndf",
+            pdf: "beckmann_pdf_ndf(a, wi, wr)",
+            eval: BECKMANN_EVAL,
+            weight: MICROFACET_NDF_WEIGHT,
+            g1: Some("beckmann_g1(a, w)"),
+            sample64: Some("beckmann_sample_ndf64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, _, u| l.beckmann().sample_ndf(u),
+            pdf_h: |l, _, h| pdf_ndf(&l.beckmann(), h),
+            pdf_r: None,
+        }),
+    },
+    SamplerSpec {
+        kind: LobeKind::Beckmann,
+        method: Method::Vndf,
+        wgsl: Wgsl {
+            sample_files: BECKMANN_FILES,
+            eval_files: &["beckmann_eval"],
+            sample: "beckmann_sample_vndf",
+            pdf: "beckmann_pdf_vndf(a, wi, wr)",
+            eval: BECKMANN_EVAL,
+            weight: "beckmann_vndf_weight(a, wi)",
+            g1: Some("beckmann_g1(a, w)"),
+            sample64: Some("beckmann_sample_vndf64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, wi, u| l.beckmann().sample_vndf(wi, u),
+            pdf_h: |l, wi, h| pdf_vndf(&l.beckmann(), wi, h),
+            pdf_r: None,
+        }),
+    },
+    SamplerSpec {
+        kind: LobeKind::Ggx,
+        method: Method::Ndf,
+        wgsl: Wgsl {
+            sample_files: GGX_FILES,
+            eval_files: &["ggx_eval"],
+            sample: "ggx_sample_ndf",
+            pdf: "ggx_pdf_ndf(a, wi, wr)",
+            eval: GGX_EVAL,
+            weight: MICROFACET_NDF_WEIGHT,
+            g1: Some("ggx_g1(a, w)"),
+            sample64: Some("ggx_sample_ndf64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, _, u| l.ggx().sample_ndf(u),
+            pdf_h: |l, _, h| pdf_ndf(&l.ggx(), h),
+            pdf_r: None,
+        }),
+    },
+    SamplerSpec {
+        kind: LobeKind::Ggx,
+        method: Method::Vndf,
+        wgsl: Wgsl {
+            sample_files: GGX_FILES,
+            eval_files: &["ggx_eval"],
+            sample: "ggx_sample_vndf",
+            pdf: "ggx_pdf_vndf(a, wi, wr)",
+            eval: GGX_EVAL,
+            weight: "ggx_vndf_weight(a, wi)",
+            g1: Some("ggx_g1(a, w)"),
+            sample64: Some("ggx_sample_vndf64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, wi, u| l.ggx().sample_vndf(wi, u),
+            pdf_h: |l, wi, h| pdf_vndf(&l.ggx(), wi, h),
+            pdf_r: None,
+        }),
+    },
+    SamplerSpec {
+        kind: LobeKind::Ggx,
+        method: Method::Bounded,
+        wgsl: Wgsl {
+            sample_files: GGX_FILES,
+            eval_files: &["ggx_eval"],
+            sample: "ggx_sample_bounded",
+            pdf: "ggx_pdf_bounded(a, wi, wr)",
+            eval: GGX_EVAL,
+            weight: "ggx_bounded_weight(a, wi)",
+            g1: Some("ggx_g1(a, w)"),
+            sample64: Some("ggx_sample_bounded64"),
+        },
+        reference: Some(Reference {
+            sample_h: |l, wi, u| l.ggx().sample_bounded(wi, u),
+            // the reflected density (Eto & Tokuyoshi 2023, listing 2) through the reflection Jacobian
+            pdf_h: |l, wi, h| {
+                let wr = super::reflect::reflect(wi, h);
+                if wr.z > 0.0 { l.ggx().pdf_bounded_r(wi, h) * 4.0 * wi.dot(h).abs() } else { 0.0 }
+            },
+            pdf_r: Some(|l, wi, h| l.ggx().pdf_bounded_r(wi, h)),
+        }),
+    },
+];
+
+/// Every (lobe, method) pair of the registry, in its order.
+pub const SAMPLERS: [(LobeKind, Method); REGISTRY.len()] = {
+    let mut out = [(LobeKind::Ward, Method::Ndf); REGISTRY.len()];
+    let mut i = 0;
+    while i < REGISTRY.len() {
+        out[i] = (REGISTRY[i].kind, REGISTRY[i].method);
+        i += 1;
+    }
+    out
+};
+
+impl SamplerSpec {
+    /// `ggx-vndf`, `ward-ndf`, … .
+    pub fn name(&self) -> String {
+        format!("{}-{}", self.kind.name(), self.method.name())
+    }
+
+    /// The uber-kernel's id of this sampler: its index in [`REGISTRY`].
+    pub fn id(&self) -> u32 {
+        REGISTRY.iter().position(|s| (s.kind, s.method) == (self.kind, self.method)).expect("an entry of the registry") as u32
+    }
+}
+
+/// The entry of a lobe and method. Ward has one sampler, whatever the method (as `lobes run`
+/// rejects other methods for it before this is asked), and Beckmann's visible normals stand for
+/// every method but NDF.
+pub fn find(kind: LobeKind, method: Method) -> &'static SamplerSpec {
+    let method = match kind {
+        LobeKind::Ward => Method::Ndf,
+        LobeKind::Beckmann if method != Method::Ndf => Method::Vndf,
+        _ => method,
+    };
+    REGISTRY.iter().find(|s| (s.kind, s.method) == (kind, method)).expect("every supported lobe/method pair has an entry")
+}
+
+/// The entry named `name` (`ggx-vndf`, …).
+pub fn by_name(name: &str) -> Option<&'static SamplerSpec> {
+    REGISTRY.iter().find(|s| s.name() == name.trim())
+}
+
+/// The samplers of `kind`.
+pub fn of_kind(kind: LobeKind) -> impl Iterator<Item = &'static SamplerSpec> {
+    REGISTRY.iter().filter(move |s| s.kind == kind)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairs_are_unique_and_supported() {
+        for (i, s) in REGISTRY.iter().enumerate() {
+            assert!(s.kind.supports(s.method), "{}", s.name());
+            assert_eq!(s.id() as usize, i, "{} listed twice", s.name());
+            assert_eq!(find(s.kind, s.method).name(), s.name());
+        }
+    }
+}
