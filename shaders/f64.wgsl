@@ -352,7 +352,7 @@ fn draw(index: vec2<u32>) -> u32 {
 
 // Sample i uses explicit_u[i] and writes (hi(wr), reason), then (lo(wr), f32(pdf_r)), where
 // hi = f32(x) and lo = f32(x - hi): hi + lo carries wr to ~2^-48.
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {

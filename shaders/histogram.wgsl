@@ -1,14 +1,8 @@
 // Binning and exact counting; CPU twin: src/stats/histogram.rs.
 // The composing host prepends: ROWS, COLS, BINS (= ROWS * COLS, or the item count of a discrete
-// job), CELLS (= BINS + N_REASONS), and for the lobe kernels nothing else from here.
+// job), CELLS (= BINS + N_REASONS), and the reason codes REASON_* (src/engine/gpu/layout.rs).
 // Cell layout: BINS bins, then one counter per invalid reason (codes 1..N_REASONS, in the order of
 // reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
-
-const N_REASONS: u32 = 4u;
-const REASON_NON_FINITE_DIRECTION: u32 = 1u;
-const REASON_BELOW_HORIZON: u32 = 2u;
-const REASON_NON_FINITE_PDF: u32 = 3u;
-const REASON_ZERO_PDF: u32 = 4u;
 const F32_MAX: f32 = 3.40282347e38;
 
 // x is neither NaN nor +-infinity (written without relying on IEEE comparisons of NaN being false).

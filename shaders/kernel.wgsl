@@ -1,5 +1,6 @@
-// The sampling-and-histogram kernels. The composing host (src/gpu/compose.rs) prepends the
-// constants (ROWS, COLS, BINS, TILE_BINS, CELLS, WG_WORDS, SAMPLES_PER_THREAD), the modules a job needs, and
+// The sampling-and-histogram kernels. The composing host (src/engine/gpu/compose.rs) prepends the
+// constants (ROWS, COLS, BINS, TILE_BINS, CELLS, WG_WORDS, and those of src/engine/gpu/layout.rs:
+// WG_SIZE, SAMPLES_PER_THREAD, N_REASONS, ...), the modules a job needs, and
 // `fn draw(index: vec2<u32>) -> u32`, which returns the bin of sample `index` or BINS + reason - 1.
 //
 // Counting is exact: per workgroup, bins are packed two to a u32 word of workgroup atomics
@@ -7,8 +8,7 @@
 // per-chunk u32 global counters (a chunk holds < 2^32 samples), which `fold` adds into 64-bit
 // totals (lo, hi pairs with carry) after every chunk.
 
-const WG_SIZE: u32 = 256u;
-
+// Params in src/engine/gpu/params.rs, whose layout a test checks against this one.
 struct Params {
     seed: vec2<u32>,
     base: vec2<u32>,
@@ -30,7 +30,7 @@ fn flat_group(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return wg.x + wg.y * nwg.x;
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn sample_histogram(
     @builtin(local_invocation_index) lid: u32,
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -66,7 +66,7 @@ fn sample_histogram(
 }
 
 // totals[i] += counts[i] with carry into the high word; counts[i] = 0.
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn fold(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * WG_SIZE;
     if (i >= CELLS) {

@@ -17,7 +17,7 @@ fn draw(index: vec2<u32>) -> u32 {
 }
 
 // Writes (wr, reason code) of samples base .. base + count, for the per-sample check against f64.
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {
@@ -31,7 +31,7 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
 // pass, 0 and 1 included) and writes (wr, reason code), then (h, pdf_r).
 @group(0) @binding(3) var<storage, read> explicit_u: array<vec2<f32>>;
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {
@@ -44,7 +44,7 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // Binning of explicit directions for the stability suite: direction i is packed in explicit_u
 // as (x, y) at 2i and (z, unused) at 2i + 1; its bin is written to directions_out[i].x.
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn bin_explicit(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {

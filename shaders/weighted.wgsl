@@ -3,7 +3,7 @@
 // receives; and, per bin, the largest relative difference between the sampler's own weight and
 // eval(wi, wr) cos th_r / pdf(wr) formed independently. CPU twin: src/stats/weighted.rs.
 //
-// The composing host (src/gpu/compose.rs) prepends the effect glue: `effect_sample(u)`,
+// The composing host (src/engine/gpu/effects.rs) prepends the effect glue: `effect_sample(u)`,
 // `effect_weight(s)` (the sampler's weight with the case's Fresnel and masking) and
 // `effect_check(wr)` (eval · cos th_r / pdf from the lobe's eval and pdf functions).
 //
@@ -27,9 +27,8 @@ struct Effect {
 // Per bin: the f32 bits of the largest relative weight difference (non-negative f32 order as u32).
 @group(0) @binding(8) var<storage, read_write> weight_error: array<atomic<u32>>;
 
-const WEIGHT_SCALE: f32 = 1048576.0; // 2^20 (src/stats/weighted.rs)
-const SQUARE_SCALE: f32 = 65536.0; // 2^16
-const WEIGHT_LIMIT: f32 = 8388608.0; // 2^23
+// WEIGHT_SCALE (2^20), SQUARE_SCALE (2^16) and WEIGHT_LIMIT (2^23) come from src/stats/weighted.rs
+// through the composed header (src/engine/gpu/layout.rs).
 const SQUARES_BINS: u32 = CELLS;
 const SQUARES_ALL: u32 = CELLS + 1u;
 const WEIGHT_OVERFLOW: u32 = CELLS + 2u;
@@ -69,7 +68,7 @@ fn relative_error_bits(w: f32, check: f32) -> u32 {
     return bitcast<u32>(e);
 }
 
-@compute @workgroup_size(256)
+@compute @workgroup_size(WG_SIZE)
 fn weighted_histogram(
     @builtin(local_invocation_index) lid: u32,
     @builtin(workgroup_id) wg: vec3<u32>,

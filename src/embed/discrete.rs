@@ -40,7 +40,7 @@ impl Default for DiscreteBindings {
 /// ```
 /// assert_eq!(std::mem::size_of::<lobes::embed::DiscreteInfo>(), 16);
 /// ```
-#[repr(C)]
+#[repr(C, align(8))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Pod, Zeroable)]
 pub struct DiscreteInfo {
     /// The number of items n (the length of the tables).
@@ -246,5 +246,21 @@ impl DiscreteBuffers {
             wgpu::BindGroupEntry { binding: bindings.table, resource: self.table.as_entire_binding() },
             wgpu::BindGroupEntry { binding: bindings.alias, resource: self.alias.as_entire_binding() },
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn info_layout() {
+        let members = [
+            ("n_items", offset_of!(DiscreteInfo, n_items)),
+            ("last_positive", offset_of!(DiscreteInfo, last_positive)),
+            ("_pad", offset_of!(DiscreteInfo, _pad)),
+        ];
+        crate::engine::gpu::layout::check_struct(DISCRETE_INFO_WGSL, "DiscreteInfo", size_of::<DiscreteInfo>(), align_of::<DiscreteInfo>(), &members).unwrap();
     }
 }

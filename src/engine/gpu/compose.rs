@@ -2,6 +2,7 @@
 //! job needs, and validates it with naga before any pipeline is made.
 
 use super::context::GpuError;
+use super::layout;
 use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::sampler::{self, SamplerSpec};
 
@@ -43,11 +44,7 @@ pub mod sources {
     }
 }
 
-/// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
-/// under the 65535 that a 16-bit packed workgroup counter holds.
-pub const SAMPLES_PER_THREAD: u32 = 255;
-pub const WG_SIZE: u32 = 256;
-const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
+pub use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 
 /// The files of a sampler, then those of its density and weight: `eval` false for the counting
 /// kernels, which only draw.
@@ -102,9 +99,9 @@ pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String 
     let mut src = format!(
         "// Composed by lobes for {}\n\
          const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + 4u;\nconst WG_WORDS: u32 = {wg_words}u;\n\
-         const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n\n",
-        describe(job)
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n{}\n",
+        describe(job),
+        layout::consts_wgsl()
     );
     let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
     push_all(&mut src, &[sources::RNG, sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);

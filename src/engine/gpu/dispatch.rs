@@ -1,7 +1,8 @@
 //! The one dispatcher: every pass of the engine (counting, weighted, per-sample) and of the
 //! tradeoff quadrature is compiled, encoded, submitted, timed and read back here.
 
-use super::compose::{self, SAMPLES_PER_THREAD, WG_SIZE};
+use super::compose;
+use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use super::params::Params;
 use crate::engine::job::SampleRange;

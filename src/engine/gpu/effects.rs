@@ -86,9 +86,9 @@ fn fresnel_glue(selector: Option<&str>) -> String {
         "fn effect_fresnel(c: f32) -> f32 {{
     var f = 1.0;
     switch {sel} {{
-        case 1u: {{ f = fresnel_schlick(c, effect.fresnel.x); }}
-        case 2u: {{ f = fresnel_conductor(c, effect.fresnel.x, effect.fresnel.y); }}
-        case 3u: {{ f = fresnel_dielectric(c, effect.fresnel.x); }}
+        case FRESNEL_SCHLICK: {{ f = fresnel_schlick(c, effect.fresnel.x); }}
+        case FRESNEL_CONDUCTOR: {{ f = fresnel_conductor(c, effect.fresnel.x, effect.fresnel.y); }}
+        case FRESNEL_DIELECTRIC: {{ f = fresnel_dielectric(c, effect.fresnel.x); }}
         default: {{}}
     }}
     return f;
@@ -107,9 +107,9 @@ fn masking_glue(selector: Option<&str>) -> String {
     let gi = sampler_g1(a, wi);
     var g = 1.0;
     switch {sel} {{
-        case 1u: {{ g = gi; }}
-        case 2u: {{ g = masking_separable(gi, sampler_g1(a, wr)); }}
-        case 3u: {{ g = masking_height_correlated(gi, sampler_g1(a, wr)); }}
+        case MASKING_G1: {{ g = gi; }}
+        case MASKING_SEPARABLE: {{ g = masking_separable(gi, sampler_g1(a, wr)); }}
+        case MASKING_HEIGHT_CORRELATED: {{ g = masking_height_correlated(gi, sampler_g1(a, wr)); }}
         default: {{}}
     }}
     return g;

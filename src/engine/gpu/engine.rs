@@ -1,7 +1,8 @@
 //! Runs a job's kernels: sampling and histogramming in chunks, exact 64-bit totals, readback;
 //! the per-sample passes; and the weighted passes of [`super::weighted`].
 
-use super::compose::{self, WG_SIZE};
+use super::compose;
+use super::layout::{N_REASONS, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
@@ -127,13 +128,13 @@ impl GpuEngine {
                 )));
             }
         }
-        if max_cells < 5 {
+        if max_cells <= N_REASONS as u64 {
             return Err(GpuError::TooLarge(format!(
                 "{what}: this adapter's limits hold no histogram ({limit_names}, max_compute_workgroups_per_dimension {dim})"
             )));
         }
         let bins = (job.bins() as u64).max(1);
-        let tile_bins = bins.min(max_cells - 4);
+        let tile_bins = bins.min(max_cells - N_REASONS as u64);
         Ok(Tiling { tile_bins, tiles: bins.div_ceil(tile_bins) })
     }
 
@@ -219,7 +220,7 @@ impl GpuEngine {
         };
         let bins = job.bins() as u64;
         let tile_bins = tiling.tile_bins;
-        let cells = tile_bins + 4;
+        let cells = tile_bins + N_REASONS as u64;
         if let Some(init) = initial {
             assert_eq!(init.bins.len() as u64, bins, "initial counts must match the job's bins");
         }

@@ -5,6 +5,7 @@ pub mod context;
 pub mod dispatch;
 pub mod effects;
 pub mod engine;
+pub mod layout;
 pub mod params;
 pub mod weighted;
 

@@ -4,8 +4,9 @@
 use crate::engine::job::{Job, SampleRange};
 use bytemuck::{Pod, Zeroable};
 
-/// The kernel's uniform block (`Params` in `shaders/kernel.wgsl`).
-#[repr(C)]
+/// The kernel's uniform block (`Params` in `shaders/kernel.wgsl`; `tests::params_layout`
+/// checks the two layouts agree).
+#[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct Params {
     seed: [u32; 2],
@@ -91,5 +92,30 @@ pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntr
             min_binding_size: None,
         },
         count: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::job::DiscreteMethod;
+    use std::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn params_layout() {
+        let members = [
+            ("seed", offset_of!(Params, seed)),
+            ("base", offset_of!(Params, base)),
+            ("count", offset_of!(Params, count)),
+            ("n_items", offset_of!(Params, n_items)),
+            ("last_positive", offset_of!(Params, last_positive)),
+            ("tile_first", offset_of!(Params, tile_first)),
+            ("alpha", offset_of!(Params, alpha)),
+            ("_pad1", offset_of!(Params, _pad1)),
+            ("wi", offset_of!(Params, wi)),
+        ];
+        let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();
+        let source = super::super::compose::compose(&Job::Discrete { dist, method: DiscreteMethod::Alias }, 4096);
+        super::super::layout::check_struct(&source, "Params", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
     }
 }

@@ -4,6 +4,7 @@
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, SamplingPasses, Step};
 use super::effects::{self, Composed};
+use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS};
 use super::params::{Params, storage_entry};
 use crate::engine::job::{Job, SampleRange};
 use crate::reference::effects::Effects;
@@ -13,8 +14,9 @@ use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The `effect` uniform (`Effect` in `shaders/weighted.wgsl`).
-#[repr(C)]
+/// The `effect` uniform (`Effect` in `shaders/weighted.wgsl`; `tests::effect_layout` checks
+/// the two layouts agree).
+#[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 struct EffectUniform {
     modes: [u32; 4],
@@ -72,7 +74,7 @@ impl WeightedPipelines {
         let bins = job.bins() as u64;
         // 2 words (lo, hi) per cell: the bins, the 4 invalid reasons, then Σw² over the bins,
         // Σw² over all samples and the overflow count (`shaders/weighted.wgsl`).
-        let words = 2 * (bins + 4 + 3);
+        let words = 2 * (bins + (N_REASONS + WEIGHT_EXTRA_CELLS) as u64);
         if words * 4 > gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::TooLarge(format!(
                 "{}: a weighted histogram of {bins} bins needs {} bytes in one storage buffer, over this adapter's max_storage_buffer_binding_size {}; use fewer bins",
@@ -107,12 +109,13 @@ impl WeightedPipelines {
         gpu.check_errors()?;
         let wall_seconds = start.elapsed().as_secs_f64();
         let n = bins as usize;
+        let extra = n + N_REASONS as usize;
         let sums = WeightedSums {
             bins: cells[..n].to_vec(),
-            invalid: cells[n..n + 4].try_into().expect("four reasons"),
-            squares_bins: cells[n + 4],
-            squares_all: cells[n + 5],
-            overflow: cells[n + 6],
+            invalid: cells[n..extra].try_into().expect("four reasons"),
+            squares_bins: cells[extra],
+            squares_all: cells[extra + 1],
+            overflow: cells[extra + 2],
             max_error,
         };
         Ok(WeightedRun { sums, gpu_seconds, wall_seconds })
@@ -126,4 +129,19 @@ pub struct WeightedRun {
     /// GPU time of the weighted passes (timestamp queries), where the adapter has them.
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn effect_layout() {
+        let lobe = crate::reference::Lobe { kind: crate::reference::LobeKind::Ggx, method: crate::reference::Method::Vndf, alpha_x: 0.3, alpha_y: 0.3 };
+        let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: crate::stats::histogram::SphereGrid { rows: 4, cols: 8 } };
+        let source = effects::compose_effects(&job, &Effects::NONE, 4096, effects::Specialisation::Uber).source;
+        let members = [("modes", offset_of!(EffectUniform, modes)), ("fresnel", offset_of!(EffectUniform, fresnel))];
+        super::super::layout::check_struct(&source, "Effect", size_of::<EffectUniform>(), align_of::<EffectUniform>(), &members).unwrap();
+    }
 }

@@ -47,7 +47,8 @@ pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     src + QUADRATURE_WGSL
 }
 
-#[repr(C)]
+/// `QuadParams` of `shaders/quadrature.wgsl` (`layout_tests::quad_params_layout` checks the layouts agree).
+#[repr(C, align(16))]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct QuadParams {
     alpha: [f32; 2],
@@ -103,4 +104,18 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
     let probabilities: Vec<f32> = bytemuck::cast_slice(&gpu.read(&out, bins * 4)?).to_vec();
     let wall_seconds = start.elapsed().as_secs_f64();
     Ok(GpuQuadrature { probabilities, gpu_seconds, wall_seconds })
+}
+
+#[cfg(test)]
+mod layout_tests {
+    use super::*;
+    use std::mem::{align_of, offset_of, size_of};
+
+    #[test]
+    fn quad_params_layout() {
+        let lobe = Lobe { kind: crate::reference::LobeKind::Ward, method: crate::reference::Method::Ndf, alpha_x: 0.3, alpha_y: 0.3 };
+        let source = gpu_source(&lobe, SphereGrid { rows: 4, cols: 8 }, 3);
+        let members = [("alpha", offset_of!(QuadParams, alpha)), ("_pad", offset_of!(QuadParams, _pad)), ("wi", offset_of!(QuadParams, wi))];
+        crate::engine::gpu::layout::check_struct(&source, "QuadParams", size_of::<QuadParams>(), align_of::<QuadParams>(), &members).unwrap();
+    }
 }
