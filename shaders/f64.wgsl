@@ -2,7 +2,8 @@
 // GGX NDF, spherical caps and bounded VNDF), each line by line the same algebra as src/reference (ward.rs,
 // beckmann.rs sample_ndf, ggx.rs, microfacet.rs, reflect.rs), plus f64 binning
 // (src/stats/histogram.rs). Appended by src/tradeoff/variants.rs to a composed f32 kernel, whose
-// `draw` and `explicit_samples` it replaces (the host prepends A64, WI64 and SAMPLE64).
+// `draw` and `explicit_samples` it replaces (the host adds A64, WI64 and the call site
+// sampler_sample64 of the job's f64 sampler, src/reference/sampler.rs).
 //
 // SPIR-V's GLSL.std.450 defines sin, cos, atan2, exp and log for 16- and 32-bit floats only, so
 // the f64 versions are written here: range reduction and polynomials (Cody & Waite, "Software
@@ -338,7 +339,7 @@ fn bin_of64(w: vec3<f64>) -> u32 {
 }
 
 fn lobe_sample64(u: vec2<f32>) -> LobeSample64 {
-    return SAMPLE64(A64, WI64, u);
+    return sampler_sample64(A64, WI64, u);
 }
 
 fn draw(index: vec2<u32>) -> u32 {

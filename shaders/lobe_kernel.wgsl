@@ -1,10 +1,10 @@
-// Glue for a lobe job: SAMPLE_FN is replaced by the composing host with the sampler of the case's
-// lobe and method (ward_sample, ggx_sample_ndf, ggx_sample_vndf, ggx_sample_bounded,
-// beckmann_sample_ndf, beckmann_sample_vndf), all of signature (alpha, wi, u) -> LobeSample.
+// The draw of a lobe job: sampler_sample(alpha, wi, u) -> LobeSample is the generated call site
+// of the case's sampler (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs), or in the
+// uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site).
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
     let u = rng_uniforms(params.seed, index);
-    return SAMPLE_FN(params.alpha, params.wi.xyz, u.xy);
+    return sampler_sample(params.alpha, params.wi.xyz, u.xy);
 }
 
 fn draw(index: vec2<u32>) -> u32 {
@@ -37,7 +37,7 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.count) {
         return;
     }
-    let s = SAMPLE_FN(params.alpha, params.wi.xyz, explicit_u[i]);
+    let s = sampler_sample(params.alpha, params.wi.xyz, explicit_u[i]);
     directions_out[2u * i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
     directions_out[2u * i + 1u] = vec4<f32>(s.h, s.pdf_r);
 }

@@ -27,6 +27,9 @@ pub mod sources {
     pub const FRESNEL: &str = include_str!("../../../shaders/fresnel.wgsl");
     pub const MASKING: &str = include_str!("../../../shaders/masking.wgsl");
     pub const WEIGHTED: &str = include_str!("../../../shaders/weighted.wgsl");
+    pub const EFFECT: &str = include_str!("../../../shaders/effect.wgsl");
+    pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/effect_fresnel.wgsl");
+    pub const EFFECT_MASKING: &str = include_str!("../../../shaders/effect_masking.wgsl");
 
     /// The file `shaders/{stem}.wgsl` of a sampler or lobe (as named in
     /// [`crate::reference::sampler::Wgsl`]).
@@ -53,6 +56,26 @@ pub(crate) fn sampler_files(spec: &SamplerSpec, eval: bool) -> Vec<&'static str>
     stems.map(|s| sources::file(s)).collect()
 }
 
+/// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
+/// [`Wgsl`](crate::reference::sampler::Wgsl): directly for one sampler, for several by a
+/// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/weighted.wgsl`).
+pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], expr: impl Fn(&sampler::Wgsl) -> String) -> String {
+    if let [only] = samplers {
+        return format!("fn {name}({args}) -> {ret} {{\n    return {};\n}}\n", expr(&only.wgsl));
+    }
+    let mut body = format!("fn {name}({args}) -> {ret} {{\n    var r: {ret};\n    switch effect.modes.x {{\n");
+    for (i, s) in samplers.iter().enumerate() {
+        let label = if i + 1 == samplers.len() { "default".to_string() } else { format!("case {}u", s.id()) };
+        body += &format!("        {label}: {{ r = {}; }}\n", expr(&s.wgsl));
+    }
+    body + "    }\n    return r;\n}\n"
+}
+
+/// `sampler_sample(a, wi, u) -> LobeSample`, what `shaders/lobe_kernel.wgsl` draws with.
+pub(crate) fn sampler_call_site(samplers: &[&SamplerSpec]) -> String {
+    call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample))
+}
+
 /// The composed WGSL of `job`, counting all its bins.
 pub fn compose(job: &Job, workgroup_words: u32) -> String {
     compose_tile(job, workgroup_words, job.bins() as u32)
@@ -68,7 +91,8 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
         Job::Lobe { lobe, .. } => {
             let spec = sampler::find(lobe.kind, lobe.method);
             push_all(&mut src, &sampler_files(spec, false));
-            src.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", spec.wgsl.sample));
+            src.push_str(&sampler_call_site(&[spec]));
+            src.push_str(sources::LOBE_KERNEL);
         }
         Job::Discrete { method, .. } => {
             src.push_str(sources::DISCRETE);

@@ -3,7 +3,10 @@
 //!
 //! Two levels of specialisation:
 //! - composition: a module includes the shader files of its lobe only, `shaders/fresnel.wgsl`
-//!   only with a Fresnel term, `shaders/masking.wgsl` only with masking;
+//!   (with `shaders/effect_fresnel.wgsl`) only with a Fresnel term, `shaders/masking.wgsl`
+//!   (with `shaders/effect_masking.wgsl`) only with masking; all glue is in those files and
+//!   `shaders/effect.wgsl`, and what this module generates is a few one-line call sites (which
+//!   sampler's functions, which selector: [`effect_call_sites`]);
 //! - override constants: what is left to choose inside a file (which Fresnel form, which
 //!   masking term, isotropic or not) is a `switch` on a WGSL `override`, fixed when the
 //!   pipeline is made, so the driver folds the branch away.
@@ -12,12 +15,12 @@
 //! costs: every lobe, sampler and effect in one module, all switched at run time from the
 //! `effect` uniform.
 
-use super::compose::{self, sources};
+use super::compose::{self, call_site, sources};
 use crate::engine::job::Job;
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
-use crate::reference::sampler::{self, REGISTRY, SamplerSpec, Wgsl};
+use crate::reference::sampler::{self, REGISTRY, SamplerSpec};
 use crate::reference::{LobeKind, Method};
 
 /// How a weighted module resolves its effects.
@@ -50,100 +53,61 @@ pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
     sampler::find(kind, method).id()
 }
 
-/// A glue function `fn NAME(ARGS) -> RET` returning one expression per sampler: directly in a
-/// specialised module, by a run-time switch on the sampler id in the uber-kernel.
-fn sampler_fn(name: &str, args: &str, ret: &str, arms: &[(u32, String)]) -> String {
-    if let [(_, only)] = arms {
-        return format!("fn {name}({args}) -> {ret} {{\n    return {only};\n}}\n");
-    }
-    let mut body = format!("fn {name}({args}) -> {ret} {{\n    var r: {ret};\n    switch effect.modes.x {{\n");
-    for (i, (id, expr)) in arms.iter().enumerate() {
-        let label = if i + 1 == arms.len() { "default".to_string() } else { format!("case {id}u") };
-        body.push_str(&format!("        {label}: {{ r = {expr}; }}\n"));
-    }
-    body.push_str("    }\n    return r;\n}\n");
-    body
-}
-
-/// The glue of the samplers `samplers` (one in a specialised module, all in the uber-kernel).
+/// The call sites of the samplers' weight, BRDF, density and (with masking) G1 that
+/// `shaders/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
+/// `sampler_sample` comes with the counting kernels, [`compose::sampler_call_site`]).
 fn samplers_glue(samplers: &[&SamplerSpec], masking: bool) -> String {
-    let arms = |f: &dyn Fn(&Wgsl) -> String| -> Vec<(u32, String)> { samplers.iter().map(|s| (s.id(), f(&s.wgsl))).collect() };
-    let mut src = String::new();
-    src.push_str(&sampler_fn("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", &arms(&|w| format!("{}(a, wi, u)", w.sample))));
-    src.push_str(&sampler_fn("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", &arms(&|w| w.weight.into())));
-    src.push_str(&sampler_fn("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", &arms(&|w| w.eval.into())));
-    src.push_str(&sampler_fn("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &arms(&|w| w.pdf.into())));
+    let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, |w| w.weight.into());
+    src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, |w| w.eval.into());
+    src += &call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", samplers, |w| w.pdf.into());
     if masking {
-        src.push_str(&sampler_fn("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", &arms(&|w| w.g1.unwrap_or("1.0").into())));
+        src += &call_site("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", samplers, |w| w.g1.unwrap_or("1.0").into());
     }
     src
 }
 
-/// `effect_fresnel(c)`: F at cos θ = ωi·h, the form chosen by `selector`; 1 without Fresnel.
-fn fresnel_glue(selector: Option<&str>) -> String {
-    let Some(sel) = selector else { return "fn effect_fresnel(c: f32) -> f32 {\n    return 1.0;\n}\n".into() };
-    format!(
-        "fn effect_fresnel(c: f32) -> f32 {{
-    var f = 1.0;
-    switch {sel} {{
-        case FRESNEL_SCHLICK: {{ f = fresnel_schlick(c, effect.fresnel.x); }}
-        case FRESNEL_CONDUCTOR: {{ f = fresnel_conductor(c, effect.fresnel.x, effect.fresnel.y); }}
-        case FRESNEL_DIELECTRIC: {{ f = fresnel_dielectric(c, effect.fresnel.x); }}
-        default: {{}}
-    }}
-    return f;
-}}
-"
-    )
+/// How a weighted module picks what is left to choose: the override constants of a
+/// specialised module, or the `effect` uniform's modes in the uber-kernel.
+struct Selectors {
+    anisotropic: &'static str,
+    fresnel: &'static str,
+    masking: &'static str,
 }
 
-/// `effect_masking(a, wi, wr)`: G, the term chosen by `selector`; 1 without masking.
-fn masking_glue(selector: Option<&str>) -> String {
-    let Some(sel) = selector else {
-        return "fn effect_masking(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {\n    return 1.0;\n}\n".into();
+const OVERRIDES: Selectors = Selectors { anisotropic: "ANISOTROPIC", fresnel: "FRESNEL", masking: "MASKING" };
+const UNIFORM: Selectors = Selectors { anisotropic: "effect.modes.w != 0u", fresnel: "effect.modes.y", masking: "effect.modes.z" };
+
+/// The generated call sites of `shaders/effect.wgsl` and its effect files: which sampler,
+/// whether α is anisotropic, and for each effect either its mode (and the effect's file follows)
+/// or the constant 1.
+fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
+    let mut src = format!("fn effect_anisotropic() -> bool {{\n    return {};\n}}\n", sel.anisotropic);
+    src += &if fresnel {
+        format!("fn fresnel_mode() -> u32 {{\n    return {};\n}}\n", sel.fresnel)
+    } else {
+        "fn effect_fresnel(c: f32) -> f32 {\n    return 1.0;\n}\n".into()
     };
-    format!(
-        "fn effect_masking(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {{
-    let gi = sampler_g1(a, wi);
-    var g = 1.0;
-    switch {sel} {{
-        case MASKING_G1: {{ g = gi; }}
-        case MASKING_SEPARABLE: {{ g = masking_separable(gi, sampler_g1(a, wr)); }}
-        case MASKING_HEIGHT_CORRELATED: {{ g = masking_height_correlated(gi, sampler_g1(a, wr)); }}
-        default: {{}}
-    }}
-    return g;
-}}
-"
-    )
+    src += &if masking {
+        format!("fn masking_mode() -> u32 {{\n    return {};\n}}\n", sel.masking)
+    } else {
+        "fn effect_masking(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {\n    return 1.0;\n}\n".into()
+    };
+    src
 }
 
-/// What `shaders/weighted.wgsl` calls, in terms of the glue above.
-const EFFECT_GLUE: &str = "
-fn effect_alpha() -> vec2<f32> {
-    return select(params.alpha.xx, params.alpha, ANISOTROPIC_SEL);
+/// The effect files of a module with (or without) Fresnel and masking, then the estimator and
+/// the weighted pass.
+fn effect_files(fresnel: bool, masking: bool) -> Vec<&'static str> {
+    let mut files = Vec::new();
+    if fresnel {
+        files.extend([sources::FRESNEL, sources::EFFECT_FRESNEL]);
+    }
+    if masking {
+        files.extend([sources::MASKING, sources::EFFECT_MASKING]);
+    }
+    files.extend([sources::EFFECT, sources::WEIGHTED]);
+    files
 }
-
-fn effect_sample(u: vec2<f32>) -> LobeSample {
-    return sampler_sample(effect_alpha(), params.wi.xyz, u);
-}
-
-// w = F(wi.h) G(wi, wr) w_0: the sampler's closed-form weight (src/reference/effects.rs).
-fn effect_weight(s: LobeSample) -> f32 {
-    let a = effect_alpha();
-    let wi = params.wi.xyz;
-    return effect_fresnel(dot(wi, s.h)) * effect_masking(a, wi, s.wr) * sampler_weight(a, wi, s);
-}
-
-// eval(wi, wr) cos th_r / pdf(wr), each formed on its own from wr (h = normalize(wi + wr)).
-fn effect_check(wr: vec3<f32>) -> f32 {
-    let a = effect_alpha();
-    let wi = params.wi.xyz;
-    let h = normalize(wi + wr);
-    let f = effect_fresnel(dot(wi, h)) * effect_masking(a, wi, wr) * sampler_eval(a, wi, wr, h);
-    return f * wr.z / sampler_pdf(a, wi, wr);
-}
-";
 
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
 /// that one module serves both passes of the case), the effect files it needs, the glue and
@@ -163,18 +127,14 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
             if fresnel {
                 source.push_str("override FRESNEL: u32 = 1u;\n");
                 constants.push(("FRESNEL", effects.fresnel.mode() as f64));
-                source.push_str(sources::FRESNEL);
             }
             if masking {
                 source.push_str("override MASKING: u32 = 1u;\n");
                 constants.push(("MASKING", effects.masking.mode() as f64));
-                source.push_str(sources::MASKING);
             }
             source.push_str(&samplers_glue(&[spec], masking));
-            source.push_str(&fresnel_glue(fresnel.then_some("FRESNEL")));
-            source.push_str(&masking_glue(masking.then_some("MASKING")));
-            source.push_str(&EFFECT_GLUE.replace("ANISOTROPIC_SEL", "ANISOTROPIC"));
-            source.push_str(sources::WEIGHTED);
+            source.push_str(&effect_call_sites(&OVERRIDES, fresnel, masking));
+            compose::push_all(&mut source, &effect_files(fresnel, masking));
             Composed { source, constants }
         }
         Specialisation::Uber => Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() },
@@ -203,14 +163,12 @@ fn compose_uber(job: &Job, workgroup_words: u32) -> String {
             }
         }
     }
-    files.extend([sources::FRESNEL, sources::MASKING]);
     compose::push_all(&mut source, &files);
-    source.push_str(&sources::LOBE_KERNEL.replace("SAMPLE_FN", "sampler_sample"));
+    source.push_str(&compose::sampler_call_site(&REGISTRY.iter().collect::<Vec<_>>()));
+    source.push_str(sources::LOBE_KERNEL);
     source.push_str(&samplers_glue(&REGISTRY.iter().collect::<Vec<_>>(), true));
-    source.push_str(&fresnel_glue(Some("effect.modes.y")));
-    source.push_str(&masking_glue(Some("effect.modes.z")));
-    source.push_str(&EFFECT_GLUE.replace("ANISOTROPIC_SEL", "effect.modes.w != 0u"));
-    source.push_str(sources::WEIGHTED);
+    source.push_str(&effect_call_sites(&UNIFORM, true, true));
+    compose::push_all(&mut source, &effect_files(true, true));
     source
 }
 

@@ -10,6 +10,7 @@
 //!   plus `shaders/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann) is appended and replaces the composed `draw` and `explicit_samples`, with the job's α and ωi
 //!   baked in as f64 constants (the kernel's uniform block carries them in f32 only).
 
+use crate::engine::gpu::compose;
 use crate::engine::gpu::engine::Rewrite;
 use crate::engine::job::Job;
 use crate::reference::{LobeKind, sampler};
@@ -136,9 +137,8 @@ pub fn erfc_straight_line() -> String {
 /// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
 pub fn f64_kernel(job: &Job, src: &str) -> String {
     let Job::Lobe { lobe, incident, .. } = job else { panic!("lobes tradeoff: f64 kernels exist for lobes only") };
-    let sampler = sampler::find(lobe.kind, lobe.method).wgsl.sample64.unwrap_or_else(|| {
-        panic!("lobes tradeoff: no f64 sampler for {} {}", lobe.kind.name(), lobe.method.name())
-    });
+    let spec = sampler::find(lobe.kind, lobe.method);
+    let Some(sample64) = spec.wgsl.sample64 else { panic!("lobes tradeoff: no f64 sampler for {}", spec.name()) };
     // definitions start a line (comments may mention them too)
     let mut s = src.replacen("\nfn draw(", "\nfn draw_f32(", 1).replacen("\nfn explicit_samples(", "\nfn explicit_samples_f32(", 1);
     assert!(s.contains("\nfn draw_f32(") && s.contains("\nfn explicit_samples_f32("), "composed lobe kernel lacks draw/explicit_samples");
@@ -151,7 +151,10 @@ pub fn f64_kernel(job: &Job, src: &str) -> String {
         lit(incident.y),
         lit(incident.z)
     ));
-    s.push_str(&F64.replace("SAMPLE64(", &format!("{sampler}(")));
+    s.push_str(&compose::call_site("sampler_sample64", "a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>", "LobeSample64", &[spec], |_| {
+        format!("{sample64}(a, wi, u)")
+    }));
+    s.push_str(F64);
     if lobe.kind == LobeKind::Beckmann {
         s.push_str(F64_BECKMANN);
         s.push_str(&erfc_straight_line());

@@ -1,0 +1,33 @@
+// The estimator of a weighted histogram (shaders/weighted.wgsl calls it): the sampler drawn with
+// the case's roughness, its weight with the case's Fresnel and masking, and the independent
+// check eval cos th_r / pdf. CPU twin: src/reference/effects.rs.
+//
+// What it calls is chosen by the composing host (src/engine/gpu/effects.rs), as a generated
+// call-site file of one-line functions: sampler_sample, sampler_weight, sampler_eval,
+// sampler_pdf (the registry's call sites, src/reference/sampler.rs); effect_anisotropic();
+// effect_fresnel and effect_masking (shaders/effect_fresnel.wgsl and shaders/effect_masking.wgsl
+// where the case has the effect, else 1).
+
+fn effect_alpha() -> vec2<f32> {
+    return select(params.alpha.xx, params.alpha, effect_anisotropic());
+}
+
+fn effect_sample(u: vec2<f32>) -> LobeSample {
+    return sampler_sample(effect_alpha(), params.wi.xyz, u);
+}
+
+// w = F(wi.h) G(wi, wr) w_0: the sampler's closed-form weight (src/reference/effects.rs).
+fn effect_weight(s: LobeSample) -> f32 {
+    let a = effect_alpha();
+    let wi = params.wi.xyz;
+    return effect_fresnel(dot(wi, s.h)) * effect_masking(a, wi, s.wr) * sampler_weight(a, wi, s);
+}
+
+// eval(wi, wr) cos th_r / pdf(wr), each formed on its own from wr (h = normalize(wi + wr)).
+fn effect_check(wr: vec3<f32>) -> f32 {
+    let a = effect_alpha();
+    let wi = params.wi.xyz;
+    let h = normalize(wi + wr);
+    let f = effect_fresnel(dot(wi, h)) * effect_masking(a, wi, wr) * sampler_eval(a, wi, wr, h);
+    return f * wr.z / sampler_pdf(a, wi, wr);
+}
