@@ -6,7 +6,7 @@
 //!   (with `shaders/effect_fresnel.wgsl`) only with a Fresnel term, `shaders/masking.wgsl`
 //!   (with `shaders/effect_masking.wgsl`) only with masking; all glue is in those files and
 //!   `shaders/effect.wgsl`, and what this module generates is a few one-line call sites (which
-//!   sampler's functions, which selector: [`effect_call_sites`]);
+//!   sampler's functions, which selector: `effect_call_sites`);
 //! - override constants: what is left to choose inside a file (which Fresnel form, which
 //!   masking term, isotropic or not) is a `switch` on a WGSL `override`, fixed when the
 //!   pipeline is made, so the driver folds the branch away.
