@@ -21,7 +21,7 @@ fn erfc_approx(x: f32) -> f32 {
     p = 0.09678418 + t * p;
     p = 0.37409196 + t * p;
     p = 1.00002368 + t * p;
-    let r = t * exp(-z * z - 1.26551223 + t * p);
+    let r = t * math_exp(-z * z - 1.26551223 + t * p);
     return select(2.0 - r, r, x >= 0.0);
 }
 
@@ -34,7 +34,7 @@ fn erfinv_unit(u: f32) -> f32 {
     if (u >= 1.0) {
         return BIG_SLOPE;
     }
-    var w = -log(4.0 * u * (1.0 - u));
+    var w = -math_log(4.0 * u * (1.0 - u));
     var p: f32;
     if (w < 5.0) {
         w = w - 2.5;
@@ -72,7 +72,7 @@ fn beckmann_d(a: vec2<f32>, h: vec3<f32>) -> f32 {
     if (q2 > 87.0 * z2) {
         return 0.0; // exp(-q2/hz^2) < 2^-126: underflows, and hz^4 may too (0/0)
     }
-    return exp(-q2 / z2) / (PI * a.x * a.y * z2 * z2);
+    return math_exp(-q2 / z2) / (PI * a.x * a.y * z2 * z2);
 }
 
 // G1(w) / cos th = 1 / (cos th + cos th Lambda), cos th Lambda = -cos th erfc(a)/2 + a_w e^{-a^2}/(2 sqrt(pi)),
@@ -84,12 +84,12 @@ fn beckmann_g1_over_cos(a: vec2<f32>, w: vec3<f32>) -> f32 {
         return 1.0 / c; // a > 10: Lambda < 1e-45
     }
     let x = c / aw;
-    return 1.0 / (c - 0.5 * c * erfc_approx(x) + aw * exp(-x * x) * INV_SQRT_PI * 0.5);
+    return 1.0 / (c - 0.5 * c * erfc_approx(x) + aw * math_exp(-x * x) * INV_SQRT_PI * 0.5);
 }
 
 fn beckmann_sample_ndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
     let phi = 2.0 * PI * u.y;
-    let d = a * vec2<f32>(cos(phi), sin(phi));
+    let d = a * vec2<f32>(math_cos(phi), math_sin(phi));
     let len = length(d);
     let h = from_tan_theta(sqrt(neg_ln(1.0 - u.x)) * len, d.x / len, d.y / len);
     return reflect_sample(wi, h, beckmann_d(a, h) * h.z);
@@ -97,7 +97,7 @@ fn beckmann_sample_ndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample 
 
 // Heitz & d'Eon 2014: unnormalised CDF of the visible slope, C(x) = erfc(-x)/2 + tan e^{-x^2}/(2 sqrt(pi)).
 fn beckmann_visible_cdf(x: f32, tan_t: f32) -> f32 {
-    return 0.5 * erfc_approx(-x) + 0.5 * tan_t * INV_SQRT_PI * exp(-x * x);
+    return 0.5 * erfc_approx(-x) + 0.5 * tan_t * INV_SQRT_PI * math_exp(-x * x);
 }
 
 // The complement D(x) = C(hi) - C(x), which keeps f32 precision as u -> 1 where C(x) -> C(hi).
@@ -114,11 +114,11 @@ fn beckmann_visible_rest(x: f32, tan_t: f32, hi: f32, hi_is_cot: bool, k_hi: f32
         for (var k = 0; k < 4; k++) {
             let s = d * gx[k];
             let t = hi - s;
-            integral += gw[k] * s * exp(-t * t);
+            integral += gw[k] * s * math_exp(-t * t);
         }
         return integral * d * tan_t * INV_SQRT_PI;
     }
-    return 0.5 * erfc_approx(x) - 0.5 * tan_t * INV_SQRT_PI * exp(-x * x) - k_hi;
+    return 0.5 * erfc_approx(x) - 0.5 * tan_t * INV_SQRT_PI * math_exp(-x * x) - k_hi;
 }
 
 // The slope x with C(x) = u C(cot): Newton steps (C' = (1 - x tan) e^{-x^2}/sqrt(pi)) kept inside a
@@ -147,7 +147,7 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
     let upper = u > 0.5;
     let goal = select(u * top, (1.0 - u) * top, upper);
     let top_hi = hi;
-    let k_hi = 0.5 * erfc_approx(hi) - 0.5 * tan_t * INV_SQRT_PI * exp(-hi * hi);
+    let k_hi = 0.5 * erfc_approx(hi) - 0.5 * tan_t * INV_SQRT_PI * math_exp(-hi * hi);
     // First guess: the Gaussian quantile near normal incidence; near grazing, where
     // C(x) ~ tan e^{-x^2}/(2 sqrt(pi)) dominates, the inverse of that limit, -sqrt(-ln u).
     var x = clamp(select(erfinv_unit(u), -sqrt(neg_ln(u)), tan_t > 2.0), lo, hi);
@@ -165,7 +165,7 @@ fn beckmann_visible_slope(tan_t: f32, u: f32) -> f32 {
         } else {
             lo = x;
         }
-        let df = (1.0 - x * tan_t) * exp(-x * x) * INV_SQRT_PI;
+        let df = (1.0 - x * tan_t) * math_exp(-x * x) * INV_SQRT_PI;
         var next = 0.5 * (lo + hi);
         if (df > 1.0e-30) {
             let newton = x - f / df;

@@ -13,7 +13,7 @@ fn beckmann_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
         return 0.0;
     }
     let x = c / l;
-    return -0.5 * erfc_approx(x) + exp(-x * x) * INV_SQRT_PI / (2.0 * x);
+    return -0.5 * erfc_approx(x) + math_exp(-x * x) * INV_SQRT_PI / (2.0 * x);
 }
 
 // Height-correlated Smith G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99).

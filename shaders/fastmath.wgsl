@@ -1,6 +1,7 @@
 // Cheap f32 approximations of the transcendental functions the samplers and the binning call,
-// for `lobes tradeoff`'s "f32-fast" kernels. src/tradeoff/variants.rs appends this file to a
-// composed kernel after replacing the calls log, exp, sin, cos, atan2 and neg_ln with fast_*.
+// for `lobes tradeoff`'s "f32-fast" kernels: the math module that the composing host
+// (src/engine/gpu/compose.rs) includes in place of shaders/math_f32.wgsl, with the same names
+// (math_log, math_exp, math_sin, math_cos, math_atan2, neg_ln) defined at the end.
 // Errors quoted are the sources' (and checked by tests/tradeoff.rs through the sampled angles).
 
 // log2 by the float's bit pattern plus a rational correction of the mantissa: P. Mineiro,
@@ -16,10 +17,6 @@ fn fast_log(x: f32) -> f32 {
     return 0.69314718 * fast_log2(x);
 }
 
-// -ln u without the accurate series of shaders/reflect.wgsl (u = 0 gives about 89, not 3e38).
-fn fast_neg_ln(u: f32) -> f32 {
-    return -fast_log(u);
-}
 
 // 2^p by writing the exponent bits: Mineiro (2011), fastpow2; relative error about 1e-4.
 fn fast_pow2(p: f32) -> f32 {
@@ -62,4 +59,30 @@ fn fast_atan2(y: f32, x: f32) -> f32 {
         a = 3.14159265 - a;
     }
     return select(a, -a, y < 0.0);
+}
+
+// The names the samplers call (shaders/math_f32.wgsl).
+fn math_log(x: f32) -> f32 {
+    return fast_log(x);
+}
+
+fn math_exp(x: f32) -> f32 {
+    return fast_exp(x);
+}
+
+fn math_sin(x: f32) -> f32 {
+    return fast_sin(x);
+}
+
+fn math_cos(x: f32) -> f32 {
+    return fast_cos(x);
+}
+
+fn math_atan2(y: f32, x: f32) -> f32 {
+    return fast_atan2(y, x);
+}
+
+// -ln u without the accurate series of shaders/math_f32.wgsl (u = 0 gives about 89, not 3e38).
+fn neg_ln(u: f32) -> f32 {
+    return -fast_log(u);
 }

@@ -19,7 +19,7 @@ fn ggx_g1(a: vec2<f32>, w: vec3<f32>) -> f32 {
 fn ggx_sample_ndf(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {
     let phi = 2.0 * PI * u.y;
     let r = sqrt(u.x);
-    let h = normalize(vec3<f32>(a * (r * vec2<f32>(cos(phi), sin(phi))), sqrt(max(1.0 - u.x, 0.0))));
+    let h = normalize(vec3<f32>(a * (r * vec2<f32>(math_cos(phi), math_sin(phi))), sqrt(max(1.0 - u.x, 0.0))));
     return reflect_sample(wi, h, ggx_d(a, h) * h.z);
 }
 
@@ -44,11 +44,11 @@ fn ggx_cap_sample(a: vec2<f32>, wi: vec3<f32>, ws: vec3<f32>, b: f32, ws_minus_b
     let s = (1.0 - u.y) * (1.0 + b);
     let one_minus_b = one_minus_stretched_z(a, wi) + ws_minus_b;
     let st = sqrt(clamp((s + one_minus_b) * ((1.0 + b) - s), 0.0, 1.0));
-    let hs = vec3<f32>(st * cos(phi) + ws.x, st * sin(phi) + ws.y, s + ws_minus_b);
+    let hs = vec3<f32>(st * math_cos(phi) + ws.x, st * math_sin(phi) + ws.y, s + ws_minus_b);
     if (dot(hs, hs) == 0.0) {
         // u.y = 1 at wi = +z: the rim of the cap is the single point -ws; the limit is the
         // horizon normal at azimuth phi.
-        return normalize(vec3<f32>(a * vec2<f32>(cos(phi), sin(phi)), 0.0));
+        return normalize(vec3<f32>(a * vec2<f32>(math_cos(phi), math_sin(phi)), 0.0));
     }
     return normalize(vec3<f32>(a * hs.xy, hs.z));
 }

@@ -36,7 +36,7 @@ fn bin_of(w: vec3<f32>) -> u32 {
     // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
     var t = 0.5;
     if (w.x != 0.0 || w.y != 0.0) {
-        t = (atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
+        t = (math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
     }
     var col = u32(max(t, 0.0) * f32(COLS));
     if (col >= COLS) {

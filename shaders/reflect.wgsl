@@ -51,27 +51,3 @@ fn from_tan_theta(t: f32, c: f32, s: f32) -> vec3<f32> {
     }
     return vec3<f32>(st * c, st * s, ct);
 }
-
-// -ln u. For u > 1/2, ln u = 2 atanh(s) with s = (u - 1)/(u + 1), |s| <= 1/3, summed as its
-// series 2 s (1 + s^2/3 + s^4/5 + ...) to 9 terms: full f32 relative precision near u = 1,
-// where the builtin log only promises an absolute error of 2^-21. u = 0 gives 3e38 ("infinity").
-fn neg_ln(u: f32) -> f32 {
-    if (u <= 0.0) {
-        return 3.0e38;
-    }
-    if (u <= 0.5) {
-        return -log(u);
-    }
-    let s = (u - 1.0) / (u + 1.0);
-    let s2 = s * s;
-    var p = 1.0 / 17.0;
-    p = p * s2 + 1.0 / 15.0;
-    p = p * s2 + 1.0 / 13.0;
-    p = p * s2 + 1.0 / 11.0;
-    p = p * s2 + 1.0 / 9.0;
-    p = p * s2 + 1.0 / 7.0;
-    p = p * s2 + 1.0 / 5.0;
-    p = p * s2 + 1.0 / 3.0;
-    p = p * s2 + 1.0;
-    return -2.0 * s * p;
-}

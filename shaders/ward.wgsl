@@ -4,7 +4,7 @@
 
 fn ward_sample_h(a: vec2<f32>, u: vec2<f32>) -> vec3<f32> {
     let phi = 2.0 * PI * u.y;
-    let d = a * vec2<f32>(cos(phi), sin(phi));
+    let d = a * vec2<f32>(math_cos(phi), math_sin(phi));
     let len = length(d);
     return from_tan_theta(sqrt(neg_ln(u.x)) * len, d.x / len, d.y / len);
 }
@@ -18,7 +18,7 @@ fn ward_pdf_h(a: vec2<f32>, h: vec3<f32>) -> f32 {
     if (q2 > 87.0 * h.z * h.z) {
         return 0.0; // exp(-q2/hz^2) < 2^-126: underflows, and hz^3 may too (0/0)
     }
-    return exp(-q2 / (h.z * h.z)) / (PI * a.x * a.y * h.z * h.z * h.z);
+    return math_exp(-q2 / (h.z * h.z)) / (PI * a.x * a.y * h.z * h.z * h.z);
 }
 
 fn ward_sample(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {

@@ -10,7 +10,7 @@ fn ward_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     }
     let h = normalize(wi + wr);
     let q = h.xy / a;
-    return exp(-dot(q, q) / (h.z * h.z)) / (4.0 * PI * a.x * a.y * sqrt(wi.z * wr.z));
+    return math_exp(-dot(q, q) / (h.z * h.z)) / (4.0 * PI * a.x * a.y * sqrt(wi.z * wr.z));
 }
 
 // The density of wr under ward_sample: p(h) / (4 |wr.h|) (Walter 2005, eq. 9); 0 for wr at or

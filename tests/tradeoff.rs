@@ -19,9 +19,9 @@ const GGX_VNDF: Sampler = Sampler { kind: LobeKind::Ggx, method: Method::Vndf };
 
 fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> compare::AngleCheck {
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
-    e.rewrite = prec.rewrite();
+    e.precision = prec;
     let a = tradeoff::angle_error(e, &job, 1, n, prec).expect("angle check");
-    e.rewrite = None;
+    e.precision = Precision::F32Accurate;
     a
 }
 
@@ -68,9 +68,9 @@ fn fast_kernels_are_less_accurate_but_bounded() {
 fn chi2_at(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u64) -> (chi2::Chi2, f64, f64) {
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
     let exp = compare::expected_counts(&job, n, &Quadrature::default());
-    e.rewrite = prec.rewrite();
+    e.precision = prec;
     let r = e.histogram(&job, SampleRange::whole(1, n), &mut |_| {}).expect("histogram");
-    e.rewrite = None;
+    e.precision = Precision::F32Accurate;
     let p: Vec<f64> = exp.bins.iter().chain(&exp.invalid).map(|x| x / n as f64).collect();
     let noise: f64 = p.iter().map(|&q| tradeoff::poisson_mean_abs_dev(q * n as f64)).sum::<f64>() / n as f64;
     (compare::chi2_test(&r.counts, &exp, 0.01), tradeoff::l1_distance(&r.counts, &p), noise)

@@ -154,7 +154,7 @@ impl Module {
     fn parts(self) -> &'static [&'static str] {
         match self {
             Module::Rng => &[sources::RNG],
-            Module::Reflect => &[sources::REFLECT],
+            Module::Reflect => &[sources::MATH_F32, sources::REFLECT],
             Module::Microfacet => &[sources::MICROFACET],
             Module::Ward => &[sources::WARD, sources::WARD_EVAL],
             Module::Ggx => &[sources::GGX, sources::GGX_EVAL],

@@ -3,6 +3,7 @@
 
 use super::context::GpuError;
 use super::layout;
+use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::sampler::{self, SamplerSpec};
 
@@ -27,6 +28,11 @@ pub mod sources {
     pub const FRESNEL: &str = include_str!("../../../shaders/fresnel.wgsl");
     pub const MASKING: &str = include_str!("../../../shaders/masking.wgsl");
     pub const WEIGHTED: &str = include_str!("../../../shaders/weighted.wgsl");
+    pub const LOBE_DRAW: &str = include_str!("../../../shaders/lobe_draw.wgsl");
+    pub const MATH_F32: &str = include_str!("../../../shaders/math_f32.wgsl");
+    pub const FASTMATH: &str = include_str!("../../../shaders/fastmath.wgsl");
+    pub const F64: &str = include_str!("../../../shaders/f64.wgsl");
+    pub const F64_BECKMANN: &str = include_str!("../../../shaders/f64_beckmann.wgsl");
     pub const EFFECT: &str = include_str!("../../../shaders/effect.wgsl");
     pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/effect_fresnel.wgsl");
     pub const EFFECT_MASKING: &str = include_str!("../../../shaders/effect_masking.wgsl");
@@ -86,13 +92,23 @@ pub fn compose(job: &Job, workgroup_words: u32) -> String {
 /// workgroup memory when `ceil(tile_bins / 2)` words fit in `workgroup_words`, else in global
 /// memory.
 pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
-    let mut src = header(job, workgroup_words, tile_bins);
+    compose_precision(job, workgroup_words, tile_bins, Precision::F32Accurate)
+}
+
+/// As [`compose_tile`], in the arithmetic of `precision` (`lobes tradeoff`; see
+/// [`super::precision`]).
+pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
+    let mut src = header(job, workgroup_words, tile_bins, precision);
     match job {
         Job::Lobe { lobe, .. } => {
             let spec = sampler::find(lobe.kind, lobe.method);
             push_all(&mut src, &sampler_files(spec, false));
             src.push_str(&sampler_call_site(&[spec]));
-            src.push_str(sources::LOBE_KERNEL);
+            push_all(&mut src, &[sources::LOBE_KERNEL]);
+            match precision {
+                Precision::F64 => src.push_str(&precision::f64_draw(job)),
+                _ => src.push_str(sources::LOBE_DRAW),
+            }
         }
         Job::Discrete { method, .. } => {
             src.push_str(sources::DISCRETE);
@@ -111,8 +127,9 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     src
 }
 
-/// The constants, the RNG, binning and counting kernels every job's module starts with.
-pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
+/// The constants, the RNG, the math of `precision`, binning and counting kernels every job's
+/// module starts with.
+pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
@@ -128,7 +145,7 @@ pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32) -> String 
         layout::consts_wgsl()
     );
     let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
-    push_all(&mut src, &[sources::RNG, sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
+    push_all(&mut src, &[sources::RNG, precision.math(), sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
     src
 }
 

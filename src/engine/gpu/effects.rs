@@ -16,6 +16,7 @@
 //! `effect` uniform.
 
 use super::compose::{self, call_site, sources};
+use super::precision::Precision;
 use crate::engine::job::Job;
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
@@ -153,7 +154,7 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
-    let mut source = compose::header(job, workgroup_words, job.bins() as u32);
+    let mut source = compose::header(job, workgroup_words, job.bins() as u32, Precision::F32Accurate);
     source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
     let mut files: Vec<&str> = Vec::new();
     for spec in &REGISTRY {
@@ -165,7 +166,7 @@ fn compose_uber(job: &Job, workgroup_words: u32) -> String {
     }
     compose::push_all(&mut source, &files);
     source.push_str(&compose::sampler_call_site(&REGISTRY.iter().collect::<Vec<_>>()));
-    source.push_str(sources::LOBE_KERNEL);
+    compose::push_all(&mut source, &[sources::LOBE_KERNEL, sources::LOBE_DRAW]);
     source.push_str(&samplers_glue(&REGISTRY.iter().collect::<Vec<_>>(), true));
     source.push_str(&effect_call_sites(&UNIFORM, true, true));
     compose::push_all(&mut source, &effect_files(true, true));

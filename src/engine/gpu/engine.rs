@@ -3,6 +3,7 @@
 
 use super::compose;
 use super::layout::{N_REASONS, WG_SIZE};
+use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
@@ -63,13 +64,11 @@ pub struct GpuEngine {
     pub compiled: usize,
     /// Pipelines of weighted histograms.
     weighted: WeightedPipelines,
-    /// Rewrites each composed module before it is compiled (`None`: as composed); pipelines
-    /// are cached by the rewritten text. `lobes::experiments::tradeoff` sets it for its precision variants.
-    pub rewrite: Option<Rewrite>,
+    /// The arithmetic of the counting kernels it composes (f32 with the builtin functions
+    /// unless `lobes::experiments::tradeoff` sets another); pipelines are cached by the composed
+    /// text, which differs by precision.
+    pub precision: Precision,
 }
-
-/// A rewrite of a job's composed WGSL (see [`GpuEngine::rewrite`]).
-pub type Rewrite = Arc<dyn Fn(&Job, String) -> String + Send + Sync>;
 
 impl GpuEngine {
     pub fn new(gpu: Gpu) -> Self {
@@ -83,7 +82,7 @@ impl GpuEngine {
         ];
         let (layout, pipeline_layout) = gpu.layout("lobes kernel", &entries);
         let weighted = WeightedPipelines::new(&gpu);
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, rewrite: None }
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate }
     }
 
     /// Opens the default adapter.
@@ -95,9 +94,9 @@ impl GpuEngine {
         self.gpu.limits.max_compute_workgroup_storage_size / 4
     }
 
-    /// The composed WGSL for `job` on this adapter.
-    pub fn source(&self, job: &Job) -> String {
-        compose::compose(job, self.workgroup_words())
+    /// The composed WGSL for `job` on this adapter, counting `tile` bins (all when `None`).
+    pub fn source(&self, job: &Job, tile: Option<u32>) -> String {
+        compose::compose_precision(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision)
     }
 
     /// The largest storage buffer of counters this adapter binds, in bytes.
@@ -145,14 +144,8 @@ impl GpuEngine {
     /// The kernel of `job`, counting all bins (`tile` None) or the `tile` bins from
     /// `params.tile_first` on.
     fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<Kernel>, GpuError> {
-        let (source, in_workgroup) = match tile {
-            None => (self.source(job), job.bins().div_ceil(2) as u32 <= self.workgroup_words()),
-            Some(t) => (compose::compose_tile(job, self.workgroup_words(), t), t.div_ceil(2) <= self.workgroup_words()),
-        };
-        let source = match &self.rewrite {
-            Some(rewrite) => rewrite(job, source),
-            None => source,
-        };
+        let source = self.source(job, tile);
+        let in_workgroup = tile.unwrap_or(job.bins() as u32).div_ceil(2) <= self.workgroup_words();
         if let Some(k) = self.cache.get(&source) {
             return Ok(k.clone());
         }

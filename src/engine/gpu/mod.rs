@@ -7,6 +7,7 @@ pub mod effects;
 pub mod engine;
 pub mod layout;
 pub mod params;
+pub mod precision;
 pub mod weighted;
 
 pub use context::{Gpu, GpuError};

@@ -8,9 +8,7 @@
 //! adaptive f64 quadrature that `lobes run` uses.
 
 pub mod quadrature;
-pub mod variants;
-
-pub use variants::Precision;
+pub use crate::engine::gpu::precision::Precision;
 
 use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Counts, Job, SampleRange};
@@ -262,9 +260,9 @@ pub fn sweep(engine: &mut GpuEngine, set: &SweepSettings, log: &mut dyn FnMut(&s
                 out.unavailable.push(Unavailable { sampler: s.name(), precision: prec, reason });
                 continue;
             }
-            engine.rewrite = prec.rewrite();
+            engine.precision = prec;
             let result = sweep_one(engine, set, s, &job, &p, prec, log);
-            engine.rewrite = None;
+            engine.precision = Precision::F32Accurate;
             let (points, skipped) = result?;
             out.points.extend(points);
             out.skipped.extend(skipped);
@@ -414,7 +412,7 @@ pub fn albedo_estimator(lobe: &Lobe, wi: DVec3, seed: u64, n: u64) -> (f64, f64,
 
 /// Time per sample and albedo-estimator variance of GGX spherical caps and bounded VNDF.
 pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<MethodPoint>> {
-    engine.rewrite = None;
+    engine.precision = Precision::F32Accurate;
     let mut out = Vec::new();
     for &alpha in &set.alphas {
         for &theta in &set.thetas_deg {

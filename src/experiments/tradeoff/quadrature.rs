@@ -41,7 +41,7 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
 pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     let spec = sampler::find(lobe.kind, lobe.method);
     let mut src = format!("const ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n", grid.rows, grid.cols);
-    compose::push_all(&mut src, &[compose::sources::REFLECT]);
+    compose::push_all(&mut src, &[compose::sources::MATH_F32, compose::sources::REFLECT]);
     compose::push_all(&mut src, &compose::sampler_files(spec, true));
     src += &format!("fn sampler_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {{\n    return {};\n}}\n", spec.wgsl.pdf);
     src + QUADRATURE_WGSL
