@@ -9,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 const PASSES: &str = include_str!("../../shaders/check/user_passes.wgsl");
-const RNG: &str = include_str!("../../shaders/rng.wgsl");
+const RNG: &str = include_str!("../../shaders/lib/rng.wgsl");
 /// Invocations per workgroup of every pass (`@workgroup_size(64)`).
 const WG: u32 = 64;
 
@@ -62,7 +62,7 @@ pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
         c.push(&s.name, &s.text);
     }
     c.push("<lobes check glue>", &glue(sampler));
-    c.push("shaders/rng.wgsl", RNG);
+    c.push("shaders/lib/rng.wgsl", RNG);
     c.push("shaders/check/user_passes.wgsl", PASSES);
     c.validate()?;
     Ok(c)

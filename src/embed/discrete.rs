@@ -1,4 +1,4 @@
-//! Uploading a discrete distribution for `shaders/discrete.wgsl`.
+//! Uploading a discrete distribution for `shaders/lib/discrete.wgsl`.
 
 use crate::engine::job::DiscreteMethod;
 use crate::reference::discrete::{self, AliasTable, Distribution};

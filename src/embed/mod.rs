@@ -58,7 +58,7 @@ use crate::engine::gpu::GpuError;
 /// callers; [`Module::symbols`] lists every name the module defines.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Module {
-    /// `shaders/rng.wgsl`: counter-based uniforms, bit-identical to
+    /// `shaders/lib/rng.wgsl`: counter-based uniforms, bit-identical to
     /// [`crate::reference::rng::uniforms`].
     ///
     /// - `rng_uniforms(seed: vec2<u32>, index: vec2<u32>) -> vec4<f32>`: four uniforms of sample
@@ -67,7 +67,7 @@ pub enum Module {
     /// - `pcg4d(v: vec4<u32>) -> vec4<u32>` (Jarzynski & Olano 2020), `rng_to_unit`,
     ///   `add64(a: vec2<u32>, b: u32) -> vec2<u32>` (64-bit counter plus offset).
     Rng,
-    /// `shaders/reflect.wgsl`: the half vector → reflected direction change of variables.
+    /// `shaders/lib/reflect.wgsl`: the half vector → reflected direction change of variables.
     ///
     /// - `struct LobeSample { h: vec3<f32>, wr: vec3<f32>, pdf_r: f32 }`: what every sampler
     ///   returns: the half vector, ωr, and p(ωr). ωr may be below the horizon (`wr.z <= 0`):
@@ -75,15 +75,15 @@ pub enum Module {
     /// - `reflect_about(wi, h) -> vec3<f32>`, `reflect_sample(wi, h, pdf_h) -> LobeSample`
     ///   (p(ωr) = p(h) / (4 |ωr·h|)), `from_tan_theta`, `neg_ln`, `const PI: f32`.
     Reflect,
-    /// `shaders/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz).
+    /// `shaders/lib/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz).
     Microfacet,
-    /// `shaders/ward.wgsl` and `shaders/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
+    /// `shaders/lib/ward.wgsl` and `shaders/lib/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
     ///
     /// - `ward_sample(a, wi, u: vec2<f32>) -> LobeSample`;
     /// - `ward_pdf(a, wi, wr) -> f32` (the density of `ward_sample`), `ward_eval(a, wi, wr) -> f32`
     ///   (Ward's BRDF, ρs = 1), `ward_pdf_h(a, h)`, `ward_sample_h(a, u)`.
     Ward,
-    /// `shaders/ggx.wgsl` and `shaders/ggx_eval.wgsl`: GGX (Trowbridge–Reitz).
+    /// `shaders/lib/ggx.wgsl` and `shaders/lib/ggx_eval.wgsl`: GGX (Trowbridge–Reitz).
     ///
     /// - samplers `ggx_sample_ndf`, `ggx_sample_vndf` (spherical caps, Dupuy & Benyoub 2023),
     ///   `ggx_sample_bounded` (Eto & Tokuyoshi 2023), all `(a, wi, u: vec2<f32>) -> LobeSample`;
@@ -92,7 +92,7 @@ pub enum Module {
     /// - `ggx_eval(a, wi, wr)`: D G2 / (4 cos θi cos θr) with height-correlated Smith G2;
     ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`.
     Ggx,
-    /// `shaders/beckmann.wgsl` and `shaders/beckmann_eval.wgsl`: Beckmann.
+    /// `shaders/lib/beckmann.wgsl` and `shaders/lib/beckmann_eval.wgsl`: Beckmann.
     ///
     /// - samplers `beckmann_sample_ndf`, `beckmann_sample_vndf` (Heitz & d'Eon 2014),
     ///   `(a, wi, u: vec2<f32>) -> LobeSample`;
@@ -100,7 +100,7 @@ pub enum Module {
     /// - `beckmann_eval(a, wi, wr)`, `beckmann_d`, `beckmann_g1`, `beckmann_lambda`,
     ///   `beckmann_g2`.
     Beckmann,
-    /// `shaders/discrete.wgsl`: discrete 1D distributions. Declares two storage buffers,
+    /// `shaders/lib/discrete.wgsl`: discrete 1D distributions. Declares two storage buffers,
     /// `discrete_f: array<f32>` and `discrete_u: array<u32>` (see [`DiscreteBindings`] for their
     /// numbers and [`DiscreteTable`] for their contents).
     ///
@@ -118,7 +118,7 @@ impl Module {
     pub const ALL: [Module; 7] =
         [Module::Rng, Module::Reflect, Module::Microfacet, Module::Ward, Module::Ggx, Module::Beckmann, Module::Discrete];
 
-    /// The file name of the module's main source (`"ggx"` for `shaders/ggx.wgsl`).
+    /// The file name of the module's main source (`"ggx"` for `shaders/lib/ggx.wgsl`).
     ///
     /// ```
     /// assert_eq!(lobes::embed::Module::Ggx.name(), "ggx");
@@ -279,7 +279,7 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
     out
 }
 
-/// `shaders/discrete.wgsl` with its two storage buffers at `bindings`: the f32 table
+/// `shaders/lib/discrete.wgsl` with its two storage buffers at `bindings`: the f32 table
 /// (`discrete_f`) at `@group(bindings.group) @binding(bindings.table)` and the u32 aliases
 /// (`discrete_u`) at `@binding(bindings.alias)`. The sampling functions are unchanged.
 ///
@@ -307,7 +307,7 @@ pub fn discrete_wgsl(bindings: DiscreteBindings) -> String {
         }
         out.push('\n');
     }
-    assert!(found == [true, true], "shaders/discrete.wgsl no longer declares discrete_f and discrete_u");
+    assert!(found == [true, true], "shaders/lib/discrete.wgsl no longer declares discrete_f and discrete_u");
     out
 }
 

@@ -45,7 +45,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
 }
 
 /// The weighted histogram of the samples of `range` of a lobe job with `effects`,
-/// in f64: the same fixed-point sums as `shaders/weighted.wgsl`, and per bin the largest
+/// in f64: the same fixed-point sums as `shaders/passes/weighted.wgsl`, and per bin the largest
 /// relative difference between the weight and eval · cos θr / pdf.
 pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSums {
     let Job::Lobe { lobe, incident, grid } = job else { panic!("weighted histograms are for lobe jobs") };

@@ -1,4 +1,4 @@
-//! The Beckmann distribution: the CPU twin of `shaders/beckmann.wgsl`.
+//! The Beckmann distribution: the CPU twin of `shaders/lib/beckmann.wgsl`.
 //!
 //! - D(h) = exp(−(hx²/αx² + hy²/αy²)/hz²) / (π αx αy hz⁴) (Heitz 2014, eq. 71, Cartesian form).
 //! - Λ(ω) = (erf(a) − 1)/2 + exp(−a²)/(2a√π), a = ωz / √(αx² ωx² + αy² ωy²) (Heitz 2014,

@@ -1,4 +1,4 @@
-//! Discrete 1D distributions: the CPU twin of `shaders/discrete.wgsl`.
+//! Discrete 1D distributions: the CPU twin of `shaders/lib/discrete.wgsl`.
 //!
 //! Weights → pmf → CDF, sampled by inverting the CDF with a binary search (pbrt-v4 §A.1,
 //! "SampleDiscrete"), and Walker's alias method as built by Vose (1991), "A linear algorithm

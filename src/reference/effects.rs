@@ -1,6 +1,6 @@
 //! Effects: what multiplies a lobe's BRDF besides its distribution (Fresnel, Smith masking),
 //! and the estimator weight w = f(ωi, ωr) cos θr / p(ωr) each sampler returns. The f64 twin of
-//! the effect glue that `src/engine/gpu/compose.rs` writes around `shaders/weighted.wgsl`.
+//! the effect glue that `src/engine/gpu/compose.rs` writes around `shaders/passes/weighted.wgsl`.
 //!
 //! With effects, a lobe's BRDF is
 //! - microfacet (Walter et al. 2007, eq. 20): f = F(ωi·h) D(h) G(ωi, ωr) / (4 cos θi cos θr);

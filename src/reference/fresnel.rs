@@ -1,5 +1,5 @@
 //! Fresnel reflectance at the angle cos θ = ωi·h between the incident direction and the
-//! microfacet (or Ward half vector); the f64 twin of `shaders/fresnel.wgsl`.
+//! microfacet (or Ward half vector); the f64 twin of `shaders/lib/fresnel.wgsl`.
 
 use serde::Serialize;
 

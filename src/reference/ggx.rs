@@ -1,4 +1,4 @@
-//! The GGX (Trowbridge–Reitz) distribution: the CPU twin of `shaders/ggx.wgsl`.
+//! The GGX (Trowbridge–Reitz) distribution: the CPU twin of `shaders/lib/ggx.wgsl`.
 //!
 //! - D(h) = 1 / (π αx αy (hx²/αx² + hy²/αy² + hz²)²) (Heitz 2014, eq. 85, in Cartesian form
 //!   so that no tan θ appears).

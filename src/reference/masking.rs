@@ -1,5 +1,5 @@
 //! Smith masking-shadowing G2 from the masking terms G1(ωi) and G1(ωr); the f64 twin of
-//! `shaders/masking.wgsl`.
+//! `shaders/lib/masking.wgsl`.
 
 use serde::Serialize;
 

@@ -1,5 +1,5 @@
 //! What Beckmann and GGX share: the normal distribution D, Smith's Λ and G1, and the densities
-//! of the two ways of sampling a half vector. The CPU twin of `shaders/microfacet.wgsl`.
+//! of the two ways of sampling a half vector. The CPU twin of `shaders/lib/microfacet.wgsl`.
 //!
 //! - NDF sampling draws h with density D(h) cos θh (Walter et al. 2007, eq. 24's normalisation
 //!   ∫ D(h) cos θh dωh = 1).

@@ -94,7 +94,7 @@ impl Invalid {
             Invalid::ZeroPdf => "zero_pdf",
         }
     }
-    /// The code the GPU kernels use for this reason (`shaders/histogram.wgsl`).
+    /// The code the GPU kernels use for this reason (`shaders/lib/histogram.wgsl`).
     pub fn code(self) -> u32 {
         self as u32 + 1
     }

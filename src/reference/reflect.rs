@@ -1,5 +1,5 @@
 //! The half-vector → reflected-direction change of variables: the CPU twin of
-//! `shaders/reflect.wgsl`.
+//! `shaders/lib/reflect.wgsl`.
 //!
 //! ωr = 2(ωi·h)h − ωi, and since dωh/dωr = 1/(4|ωr·h|) (tutorial part 2; Walter et al. 2007,
 //! eq. 14), p(ωr) = p(ωh) / (4 |ωr·ωh|).

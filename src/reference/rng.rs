@@ -1,4 +1,4 @@
-//! Counter-based random numbers: the CPU twin of `shaders/rng.wgsl`.
+//! Counter-based random numbers: the CPU twin of `shaders/lib/rng.wgsl`.
 //!
 //! Sample `i` of a run with seed `s` draws its uniforms from `pcg4d(i_lo, i_hi, s_lo, s_hi)`,
 //! the 4D PCG hash of Jarzynski & Olano, "Hash Functions for GPU Rendering" (JCGT 9(3), 2020),

@@ -43,7 +43,7 @@ pub struct Wgsl {
     pub weight: &'static str,
     /// Smith's G1(w) in terms of `a`, `w` (microfacet lobes; `None`: no masking).
     pub g1: Option<&'static str>,
-    /// The f64 sampler of `shaders/f64.wgsl` (`lobes tradeoff`), `fn (a: vec2<f64>, wi:
+    /// The f64 sampler of `shaders/math/f64.wgsl` (`lobes tradeoff`), `fn (a: vec2<f64>, wi:
     /// vec3<f64>, u: vec2<f32>) -> LobeSample64`; `None`: no f64 kernel.
     pub sample64: Option<&'static str>,
 }

@@ -1,4 +1,4 @@
-//! The Ward lobe with Walter's corrected pdf: the CPU twin of `shaders/ward.wgsl`.
+//! The Ward lobe with Walter's corrected pdf: the CPU twin of `shaders/lib/ward.wgsl`.
 //!
 //! B. Walter, "Notes on the Ward BRDF", Cornell PCG TR-2005-06:
 //! - half-vector pdf (his eq. 9): p(h) = exp(−tan²θh (cos²φh/αx² + sin²φh/αy²)) / (π αx αy cos³θh);

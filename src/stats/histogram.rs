@@ -1,4 +1,4 @@
-//! Binning of directions: the CPU twin of `shaders/histogram.wgsl`.
+//! Binning of directions: the CPU twin of `shaders/lib/histogram.wgsl`.
 //!
 //! Bins are uniform in cos θ ∈ [−1, 1] (rows) and φ ∈ [−π, π) (columns), so every bin spans
 //! the same solid angle 4π / (rows · cols) (Archimedes' hat-box theorem).

@@ -1,5 +1,5 @@
 //! Weighted histograms: per cell the sum of the estimator weights w = f cos θr / p(ωr), as
-//! exact 64-bit fixed-point integers (the layout of `shaders/weighted.wgsl`, its GPU twin), and
+//! exact 64-bit fixed-point integers (the layout of `shaders/passes/weighted.wgsl`, its GPU twin), and
 //! what they estimate: the directional albedo, its standard error, and the weak white furnace.
 
 use serde::{Deserialize, Serialize};

@@ -10,32 +10,32 @@ use crate::reference::sampler::{self, SamplerSpec};
 /// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
 /// `src/stats`).
 pub mod sources {
-    pub const RNG: &str = include_str!("../../../shaders/rng.wgsl");
-    pub const REFLECT: &str = include_str!("../../../shaders/reflect.wgsl");
-    pub const WARD: &str = include_str!("../../../shaders/ward.wgsl");
-    pub const MICROFACET: &str = include_str!("../../../shaders/microfacet.wgsl");
-    pub const GGX: &str = include_str!("../../../shaders/ggx.wgsl");
-    pub const BECKMANN: &str = include_str!("../../../shaders/beckmann.wgsl");
-    pub const DISCRETE: &str = include_str!("../../../shaders/discrete.wgsl");
-    pub const HISTOGRAM: &str = include_str!("../../../shaders/histogram.wgsl");
-    pub const KERNEL: &str = include_str!("../../../shaders/kernel.wgsl");
-    pub const COUNTING_WORKGROUP: &str = include_str!("../../../shaders/counting_workgroup.wgsl");
-    pub const COUNTING_GLOBAL: &str = include_str!("../../../shaders/counting_global.wgsl");
-    pub const LOBE_KERNEL: &str = include_str!("../../../shaders/lobe_kernel.wgsl");
-    pub const WARD_EVAL: &str = include_str!("../../../shaders/ward_eval.wgsl");
-    pub const GGX_EVAL: &str = include_str!("../../../shaders/ggx_eval.wgsl");
-    pub const BECKMANN_EVAL: &str = include_str!("../../../shaders/beckmann_eval.wgsl");
-    pub const FRESNEL: &str = include_str!("../../../shaders/fresnel.wgsl");
-    pub const MASKING: &str = include_str!("../../../shaders/masking.wgsl");
-    pub const WEIGHTED: &str = include_str!("../../../shaders/weighted.wgsl");
-    pub const LOBE_DRAW: &str = include_str!("../../../shaders/lobe_draw.wgsl");
-    pub const MATH_F32: &str = include_str!("../../../shaders/math_f32.wgsl");
-    pub const FASTMATH: &str = include_str!("../../../shaders/fastmath.wgsl");
-    pub const F64: &str = include_str!("../../../shaders/f64.wgsl");
-    pub const F64_BECKMANN: &str = include_str!("../../../shaders/f64_beckmann.wgsl");
-    pub const EFFECT: &str = include_str!("../../../shaders/effect.wgsl");
-    pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/effect_fresnel.wgsl");
-    pub const EFFECT_MASKING: &str = include_str!("../../../shaders/effect_masking.wgsl");
+    pub const RNG: &str = include_str!("../../../shaders/lib/rng.wgsl");
+    pub const REFLECT: &str = include_str!("../../../shaders/lib/reflect.wgsl");
+    pub const WARD: &str = include_str!("../../../shaders/lib/ward.wgsl");
+    pub const MICROFACET: &str = include_str!("../../../shaders/lib/microfacet.wgsl");
+    pub const GGX: &str = include_str!("../../../shaders/lib/ggx.wgsl");
+    pub const BECKMANN: &str = include_str!("../../../shaders/lib/beckmann.wgsl");
+    pub const DISCRETE: &str = include_str!("../../../shaders/lib/discrete.wgsl");
+    pub const HISTOGRAM: &str = include_str!("../../../shaders/lib/histogram.wgsl");
+    pub const KERNEL: &str = include_str!("../../../shaders/passes/kernel.wgsl");
+    pub const COUNTING_WORKGROUP: &str = include_str!("../../../shaders/passes/counting_workgroup.wgsl");
+    pub const COUNTING_GLOBAL: &str = include_str!("../../../shaders/passes/counting_global.wgsl");
+    pub const LOBE_KERNEL: &str = include_str!("../../../shaders/passes/lobe_kernel.wgsl");
+    pub const WARD_EVAL: &str = include_str!("../../../shaders/lib/ward_eval.wgsl");
+    pub const GGX_EVAL: &str = include_str!("../../../shaders/lib/ggx_eval.wgsl");
+    pub const BECKMANN_EVAL: &str = include_str!("../../../shaders/lib/beckmann_eval.wgsl");
+    pub const FRESNEL: &str = include_str!("../../../shaders/lib/fresnel.wgsl");
+    pub const MASKING: &str = include_str!("../../../shaders/lib/masking.wgsl");
+    pub const WEIGHTED: &str = include_str!("../../../shaders/passes/weighted.wgsl");
+    pub const LOBE_DRAW: &str = include_str!("../../../shaders/passes/lobe_draw.wgsl");
+    pub const MATH_F32: &str = include_str!("../../../shaders/math/f32.wgsl");
+    pub const FASTMATH: &str = include_str!("../../../shaders/math/f32_fast.wgsl");
+    pub const F64: &str = include_str!("../../../shaders/math/f64.wgsl");
+    pub const F64_BECKMANN: &str = include_str!("../../../shaders/math/f64_beckmann.wgsl");
+    pub const EFFECT: &str = include_str!("../../../shaders/passes/effect.wgsl");
+    pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/passes/effect_fresnel.wgsl");
+    pub const EFFECT_MASKING: &str = include_str!("../../../shaders/passes/effect_masking.wgsl");
 
     /// The file `shaders/{stem}.wgsl` of a sampler or lobe (as named in
     /// [`crate::reference::sampler::Wgsl`]).
@@ -64,7 +64,7 @@ pub(crate) fn sampler_files(spec: &SamplerSpec, eval: bool) -> Vec<&'static str>
 
 /// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
 /// [`Wgsl`](crate::reference::sampler::Wgsl): directly for one sampler, for several by a
-/// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/weighted.wgsl`).
+/// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/passes/weighted.wgsl`).
 pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], expr: impl Fn(&sampler::Wgsl) -> String) -> String {
     if let [only] = samplers {
         return format!("fn {name}({args}) -> {ret} {{\n    return {};\n}}\n", expr(&only.wgsl));
@@ -77,7 +77,7 @@ pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerS
     body + "    }\n    return r;\n}\n"
 }
 
-/// `sampler_sample(a, wi, u) -> LobeSample`, what `shaders/lobe_kernel.wgsl` draws with.
+/// `sampler_sample(a, wi, u) -> LobeSample`, what `shaders/passes/lobe_kernel.wgsl` draws with.
 pub(crate) fn sampler_call_site(samplers: &[&SamplerSpec]) -> String {
     call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample))
 }

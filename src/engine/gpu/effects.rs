@@ -2,10 +2,10 @@
 //! composed into one WGSL module that holds only the code those effects need.
 //!
 //! Two levels of specialisation:
-//! - composition: a module includes the shader files of its lobe only, `shaders/fresnel.wgsl`
-//!   (with `shaders/effect_fresnel.wgsl`) only with a Fresnel term, `shaders/masking.wgsl`
-//!   (with `shaders/effect_masking.wgsl`) only with masking; all glue is in those files and
-//!   `shaders/effect.wgsl`, and what this module generates is a few one-line call sites (which
+//! - composition: a module includes the shader files of its lobe only, `shaders/lib/fresnel.wgsl`
+//!   (with `shaders/passes/effect_fresnel.wgsl`) only with a Fresnel term, `shaders/lib/masking.wgsl`
+//!   (with `shaders/passes/effect_masking.wgsl`) only with masking; all glue is in those files and
+//!   `shaders/passes/effect.wgsl`, and what this module generates is a few one-line call sites (which
 //!   sampler's functions, which selector: `effect_call_sites`);
 //! - override constants: what is left to choose inside a file (which Fresnel form, which
 //!   masking term, isotropic or not) is a `switch` on a WGSL `override`, fixed when the
@@ -55,7 +55,7 @@ pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
 }
 
 /// The call sites of the samplers' weight, BRDF, density and (with masking) G1 that
-/// `shaders/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
+/// `shaders/passes/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
 /// `sampler_sample` comes with the counting kernels, [`compose::sampler_call_site`]).
 fn samplers_glue(samplers: &[&SamplerSpec], masking: bool) -> String {
     let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, |w| w.weight.into());
@@ -78,7 +78,7 @@ struct Selectors {
 const OVERRIDES: Selectors = Selectors { anisotropic: "ANISOTROPIC", fresnel: "FRESNEL", masking: "MASKING" };
 const UNIFORM: Selectors = Selectors { anisotropic: "effect.modes.w != 0u", fresnel: "effect.modes.y", masking: "effect.modes.z" };
 
-/// The generated call sites of `shaders/effect.wgsl` and its effect files: which sampler,
+/// The generated call sites of `shaders/passes/effect.wgsl` and its effect files: which sampler,
 /// whether α is anisotropic, and for each effect either its mode (and the effect's file follows)
 /// or the constant 1.
 fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
@@ -112,7 +112,7 @@ fn effect_files(fresnel: bool, masking: bool) -> Vec<&'static str> {
 
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
 /// that one module serves both passes of the case), the effect files it needs, the glue and
-/// `shaders/weighted.wgsl`.
+/// `shaders/passes/weighted.wgsl`.
 pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: Specialisation) -> Composed {
     let Job::Lobe { lobe, .. } = job else { panic!("effects apply to lobe jobs only") };
     match how {
@@ -173,7 +173,7 @@ fn compose_uber(job: &Job, workgroup_words: u32) -> String {
     source
 }
 
-/// The `effect` uniform of a case (`Effect` in `shaders/weighted.wgsl`).
+/// The `effect` uniform of a case (`Effect` in `shaders/passes/weighted.wgsl`).
 pub fn effect_uniform(kind: LobeKind, method: Method, anisotropic: bool, effects: &Effects) -> ([u32; 4], [f32; 4]) {
     let masking = if kind == LobeKind::Ward { 0 } else { effects.masking.mode() };
     ([sampler_id(kind, method), effects.fresnel.mode(), masking, u32::from(anisotropic)], effects.fresnel.params())

@@ -302,7 +302,7 @@ impl GpuEngine {
         Ok(out.chunks(2).map(|p| [p[0], p[1]]).collect())
     }
 
-    /// The GPU's bins (`shaders/histogram.wgsl`'s `bin_of`, on `job`'s grid) of f32 directions.
+    /// The GPU's bins (`shaders/lib/histogram.wgsl`'s `bin_of`, on `job`'s grid) of f32 directions.
     pub fn bins_of(&mut self, job: &Job, dirs: &[[f32; 3]]) -> Result<Vec<u32>, GpuError> {
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.bin_explicit else { return Ok(Vec::new()) };

@@ -15,10 +15,10 @@ pub const WG_SIZE: u32 = 256;
 const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
 
 /// Counters after a histogram's bins: one per invalid reason, codes 1 ..= N_REASONS in the
-/// order of [`Invalid::ALL`] (`shaders/histogram.wgsl`).
+/// order of [`Invalid::ALL`] (`shaders/lib/histogram.wgsl`).
 pub const N_REASONS: u32 = Invalid::ALL.len() as u32;
 
-/// Cells after a weighted histogram's bins and reasons (`shaders/weighted.wgsl`): Σw² over the
+/// Cells after a weighted histogram's bins and reasons (`shaders/passes/weighted.wgsl`): Σw² over the
 /// bins, Σw² over all samples, and the count of weights not summed.
 pub const WEIGHT_EXTRA_CELLS: u32 = 3;
 
@@ -28,7 +28,7 @@ fn constant_name(prefix: &str, name: &str) -> String {
 }
 
 /// The WGSL declarations of the shared constants: workgroup shape, reason codes, Fresnel and
-/// masking modes (the `effect.modes` and override values of `shaders/weighted.wgsl`), and the
+/// masking modes (the `effect.modes` and override values of `shaders/passes/weighted.wgsl`), and the
 /// fixed-point scales of the weighted sums (`src/stats/weighted.rs`).
 pub fn consts_wgsl() -> String {
     let mut src = format!(

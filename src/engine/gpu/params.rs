@@ -1,10 +1,10 @@
-//! The uniform block every sampling pass reads (`Params` in `shaders/kernel.wgsl`, bound at
+//! The uniform block every sampling pass reads (`Params` in `shaders/passes/kernel.wgsl`, bound at
 //! binding 0 of the counting and the weighted layouts) and the layout entries those share.
 
 use crate::engine::job::{Job, SampleRange};
 use bytemuck::{Pod, Zeroable};
 
-/// The kernel's uniform block (`Params` in `shaders/kernel.wgsl`; `tests::params_layout`
+/// The kernel's uniform block (`Params` in `shaders/passes/kernel.wgsl`; `tests::params_layout`
 /// checks the two layouts agree).
 #[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]

@@ -1,13 +1,13 @@
 //! The arithmetic of a kernel ([`Precision`]), chosen when its module is composed: the math
-//! module of the f32 kernels (`shaders/math_f32.wgsl`, or the approximations of
-//! `shaders/fastmath.wgsl` under the same names), and for f64 the draw of `shaders/f64.wgsl` in
-//! place of `shaders/lobe_draw.wgsl`. `lobes tradeoff` compares the three.
+//! module of the f32 kernels (`shaders/math/f32.wgsl`, or the approximations of
+//! `shaders/math/f32_fast.wgsl` under the same names), and for f64 the draw of `shaders/math/f64.wgsl` in
+//! place of `shaders/passes/lobe_draw.wgsl`. `lobes tradeoff` compares the three.
 //!
 //! - `f32-accurate`: the kernels `lobes run` judges;
 //! - `f32-fast`: `math_log`, `math_exp`, `math_sin`, `math_cos`, `math_atan2` and `neg_ln` are
 //!   bit tricks and low-order polynomials (errors 1e-4 to 1.5e-3);
-//! - `f64`: `shaders/f64.wgsl` (f64 samplers, f64 binning, its own f64 sin/cos/atan2/exp/ln;
-//!   plus `shaders/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann), with the job's α and
+//! - `f64`: `shaders/math/f64.wgsl` (f64 samplers, f64 binning, its own f64 sin/cos/atan2/exp/ln;
+//!   plus `shaders/math/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann), with the job's α and
 //!   ωi as f64 constants (the kernel's uniform block carries them in f32 only).
 
 use super::compose::{self, sources};
@@ -60,7 +60,7 @@ fn lit(x: f64) -> String {
     format!("{x:.16e}lf")
 }
 
-/// Straight-line WGSL for `shaders/f64_beckmann.wgsl`'s erfc (no loops: llvmpipe ends a
+/// Straight-line WGSL for `shaders/math/f64_beckmann.wgsl`'s erfc (no loops: llvmpipe ends a
 /// shader's loops after 65535 iterations per invocation, counted over all loops together,
 /// gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`). Relative errors against glibc's erfc, measured in f64 on
 /// a 0.001 grid: 1.3e-12 below 2.5, 5e-15 above.
@@ -89,7 +89,7 @@ pub fn erfc_straight_line() -> String {
 }
 
 /// The f64 draw of a lobe job: the job's α and ωi as f64 constants, the call site
-/// `sampler_sample64` of its f64 sampler, `shaders/f64.wgsl` (and for Beckmann the f64 erfc and
+/// `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64 erfc and
 /// erf⁻¹).
 ///
 /// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.

@@ -1,4 +1,4 @@
-//! Runs weighted histograms (`shaders/weighted.wgsl`): per cell the exact fixed-point sum of
+//! Runs weighted histograms (`shaders/passes/weighted.wgsl`): per cell the exact fixed-point sum of
 //! the estimator weights, and per bin the largest weight difference against eval · cos / pdf.
 
 use super::context::{Gpu, GpuError};
@@ -14,7 +14,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The `effect` uniform (`Effect` in `shaders/weighted.wgsl`; `tests::effect_layout` checks
+/// The `effect` uniform (`Effect` in `shaders/passes/weighted.wgsl`; `tests::effect_layout` checks
 /// the two layouts agree).
 #[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
@@ -73,7 +73,7 @@ impl WeightedPipelines {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
         // 2 words (lo, hi) per cell: the bins, the 4 invalid reasons, then Σw² over the bins,
-        // Σw² over all samples and the overflow count (`shaders/weighted.wgsl`).
+        // Σw² over all samples and the overflow count (`shaders/passes/weighted.wgsl`).
         let words = 2 * (bins + (N_REASONS + WEIGHT_EXTRA_CELLS) as u64);
         if words * 4 > gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::TooLarge(format!(

@@ -1,6 +1,6 @@
 //! The expected histogram at fixed resolutions, for `lobes tradeoff`'s quadrature sweep: each
 //! bin integrated by an n × n Gauss–Legendre product rule in (cos θ, φ) (the solid-angle
-//! element is d cos θ dφ), on the CPU in f64 and on the GPU in f32 (`shaders/quadrature.wgsl`),
+//! element is d cos θ dφ), on the CPU in f64 and on the GPU in f32 (`shaders/passes/quadrature.wgsl`),
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
 use crate::engine::gpu::dispatch::{Pass, Step};
@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
-pub const QUADRATURE_WGSL: &str = include_str!("../../../shaders/quadrature.wgsl");
+pub const QUADRATURE_WGSL: &str = include_str!("../../../shaders/passes/quadrature.wgsl");
 
 /// Each bin's probability under the density `pdf` (zero below the horizon) by the n × n
 /// Gauss–Legendre rule per bin, in f64, rows in parallel.
@@ -37,7 +37,7 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
 }
 
 /// The composed quadrature kernel for a lobe, grid and rule size: the lobe's files (from the
-/// sampler registry), the call site `sampler_pdf` of its density, and `shaders/quadrature.wgsl`.
+/// sampler registry), the call site `sampler_pdf` of its density, and `shaders/passes/quadrature.wgsl`.
 pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     let spec = sampler::find(lobe.kind, lobe.method);
     let mut src = format!("const ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n", grid.rows, grid.cols);
@@ -47,7 +47,7 @@ pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     src + QUADRATURE_WGSL
 }
 
-/// `QuadParams` of `shaders/quadrature.wgsl` (`layout_tests::quad_params_layout` checks the layouts agree).
+/// `QuadParams` of `shaders/passes/quadrature.wgsl` (`layout_tests::quad_params_layout` checks the layouts agree).
 #[repr(C, align(16))]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct QuadParams {

@@ -1,11 +1,11 @@
-// The estimator of a weighted histogram (shaders/weighted.wgsl calls it): the sampler drawn with
+// The estimator of a weighted histogram (shaders/passes/weighted.wgsl calls it): the sampler drawn with
 // the case's roughness, its weight with the case's Fresnel and masking, and the independent
 // check eval cos th_r / pdf. CPU twin: src/reference/effects.rs.
 //
 // What it calls is chosen by the composing host (src/engine/gpu/effects.rs), as a generated
 // call-site file of one-line functions: sampler_sample, sampler_weight, sampler_eval,
 // sampler_pdf (the registry's call sites, src/reference/sampler.rs); effect_anisotropic();
-// effect_fresnel and effect_masking (shaders/effect_fresnel.wgsl and shaders/effect_masking.wgsl
+// effect_fresnel and effect_masking (shaders/passes/effect_fresnel.wgsl and shaders/passes/effect_masking.wgsl
 // where the case has the effect, else 1).
 
 fn effect_alpha() -> vec2<f32> {

@@ -1,8 +1,8 @@
 // The f32 math of the samplers and the binning: the transcendental functions they call, as
 // math_log, math_exp, math_sin, math_cos, math_atan2 and neg_ln. This module is the f32 one (the
-// WGSL builtins, plus an accurate -ln u); shaders/fastmath.wgsl defines the same names with cheap
+// WGSL builtins, plus an accurate -ln u); shaders/math/f32_fast.wgsl defines the same names with cheap
 // approximations for `lobes tradeoff`'s f32-fast kernels, and the composing host
-// (src/engine/gpu/compose.rs) includes one of the two. The f64 kernels (shaders/f64.wgsl) have
+// (src/engine/gpu/compose.rs) includes one of the two. The f64 kernels (shaders/math/f64.wgsl) have
 // their own f64 math: SPIR-V defines these functions for 16- and 32-bit floats only.
 
 fn math_log(x: f32) -> f32 {

@@ -1,8 +1,8 @@
 // The draw of a lobe job: sampler_sample(alpha, wi, u) -> LobeSample is the generated call site
 // of the case's sampler (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs), or in the
 // uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site). The entry points
-// that draw in the kernel's precision, draw and explicit_samples, are in shaders/lobe_draw.wgsl
-// (f32) or shaders/f64.wgsl (f64).
+// that draw in the kernel's precision, draw and explicit_samples, are in shaders/passes/lobe_draw.wgsl
+// (f32) or shaders/math/f64.wgsl (f64).
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
     let u = rng_uniforms(params.seed, index);
@@ -20,7 +20,7 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
     directions_out[i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
 }
 
-// Explicit uniforms for the stability suite (explicit_samples, shaders/lobe_draw.wgsl), or
+// Explicit uniforms for the stability suite (explicit_samples, shaders/passes/lobe_draw.wgsl), or
 // explicit directions for bin_explicit.
 @group(0) @binding(3) var<storage, read> explicit_u: array<vec2<f32>>;
 

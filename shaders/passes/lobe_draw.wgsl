@@ -1,5 +1,5 @@
-// The f32 draw of a lobe job (shaders/f64.wgsl has the f64 one): `draw`, which the counting kernel
-// (shaders/kernel.wgsl) calls, and the per-sample entry point of the stability suite.
+// The f32 draw of a lobe job (shaders/math/f64.wgsl has the f64 one): `draw`, which the counting kernel
+// (shaders/passes/kernel.wgsl) calls, and the per-sample entry point of the stability suite.
 
 fn draw(index: vec2<u32>) -> u32 {
     let s = lobe_sample_at(index);
@@ -10,7 +10,7 @@ fn draw(index: vec2<u32>) -> u32 {
     return bin_of(s.wr);
 }
 
-// Sample i uses explicit_u[i] (shaders/lobe_kernel.wgsl; any u a caller can pass, 0 and 1
+// Sample i uses explicit_u[i] (shaders/passes/lobe_kernel.wgsl; any u a caller can pass, 0 and 1
 // included) and writes (wr, reason code), then (h, pdf_r).
 @compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {

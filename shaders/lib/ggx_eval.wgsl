@@ -61,7 +61,7 @@ fn ggx_pdf_bounded(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    // k as the sampler forms it (shaders/ggx.wgsl, Eto & Tokuyoshi 2023 listing 1)
+    // k as the sampler forms it (shaders/lib/ggx.wgsl, Eto & Tokuyoshi 2023 listing 1)
     let k = 1.0 - ggx_bounded_one_minus_k(a, wi);
     let t = length(vec3<f32>(a * wi.xy, wi.z));
     return ggx_d(a, h) / (2.0 * (k * wi.z + t));

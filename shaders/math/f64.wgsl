@@ -303,7 +303,7 @@ fn ggx_sample_bounded64(a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>) -> LobeSample
     return LobeSample64(h, wr, pdf);
 }
 
-// Reason codes of shaders/histogram.wgsl, in the order of reference::Invalid::check. Nothing
+// Reason codes of shaders/lib/histogram.wgsl, in the order of reference::Invalid::check. Nothing
 // above makes an infinity (u = 0 is mapped to INF_SLOPE64), and a NaN from a degenerate input
 // fails the self-comparison where the driver keeps IEEE comparisons (not guaranteed: the f32
 // kernels test bit patterns instead; no NaN occurred in tests/tradeoff.rs).

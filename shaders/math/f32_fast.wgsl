@@ -1,6 +1,6 @@
 // Cheap f32 approximations of the transcendental functions the samplers and the binning call,
 // for `lobes tradeoff`'s "f32-fast" kernels: the math module that the composing host
-// (src/engine/gpu/compose.rs) includes in place of shaders/math_f32.wgsl, with the same names
+// (src/engine/gpu/compose.rs) includes in place of shaders/math/f32.wgsl, with the same names
 // (math_log, math_exp, math_sin, math_cos, math_atan2, neg_ln) defined at the end.
 // Errors quoted are the sources' (and checked by tests/tradeoff.rs through the sampled angles).
 
@@ -61,7 +61,7 @@ fn fast_atan2(y: f32, x: f32) -> f32 {
     return select(a, -a, y < 0.0);
 }
 
-// The names the samplers call (shaders/math_f32.wgsl).
+// The names the samplers call (shaders/math/f32.wgsl).
 fn math_log(x: f32) -> f32 {
     return fast_log(x);
 }
@@ -82,7 +82,7 @@ fn math_atan2(y: f32, x: f32) -> f32 {
     return fast_atan2(y, x);
 }
 
-// -ln u without the accurate series of shaders/math_f32.wgsl (u = 0 gives about 89, not 3e38).
+// -ln u without the accurate series of shaders/math/f32.wgsl (u = 0 gives about 89, not 3e38).
 fn neg_ln(u: f32) -> f32 {
     return -fast_log(u);
 }

@@ -1,7 +1,7 @@
 // f64 Beckmann visible normals for `lobes tradeoff` (src/reference/beckmann.rs sample_vndf, line
 // by line): f64 erfc and erf^-1 written here (SPIR-V has neither), the safeguarded Newton
-// inversion of the visible-slope CDF to the f64 resolution of x. Appended after shaders/f64.wgsl
-// to a composed Beckmann kernel only (the f32 erfinv_unit of shaders/beckmann.wgsl seeds the
+// inversion of the visible-slope CDF to the f64 resolution of x. Appended after shaders/math/f64.wgsl
+// to a composed Beckmann kernel only (the f32 erfinv_unit of shaders/lib/beckmann.wgsl seeds the
 // Newton steps).
 
 const INV_SQRT_PI64: f64 = 0.5641895835477563lf;
@@ -35,7 +35,7 @@ fn erfc64(x: f64) -> f64 {
 
 // erf^{-1}(2u - 1) (statrs erf_inv in src/reference/beckmann.rs): |y| solves erfc |y| = 2 min(u, 1 - u)
 // (exact for a uniform on the 2^-24 grid) by Newton steps from the f32 Giles guess of
-// shaders/beckmann.wgsl (erfinv_unit); u = 0 or 1 give -+INF_SLOPE64 ("infinity").
+// shaders/lib/beckmann.wgsl (erfinv_unit); u = 0 or 1 give -+INF_SLOPE64 ("infinity").
 fn erfinv_unit64(u: f32) -> f64 {
     if (u <= 0.0) {
         return -INF_SLOPE64;

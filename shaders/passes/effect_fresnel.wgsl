@@ -1,6 +1,6 @@
 // F at cos th = wi.h for a weighted case with a Fresnel term: the form fresnel_mode() names
 // (FRESNEL_* of the composed header, src/reference/fresnel.rs Fresnel::mode), its parameters
-// from the effect uniform (shaders/weighted.wgsl). fresnel_mode() is generated: an override
+// from the effect uniform (shaders/passes/weighted.wgsl). fresnel_mode() is generated: an override
 // constant in a specialised module, effect.modes.y in the uber-kernel.
 
 fn effect_fresnel(c: f32) -> f32 {
