@@ -5,6 +5,7 @@ use super::context::GpuError;
 use super::layout;
 use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
+use crate::reference::LobeKind;
 use crate::reference::sampler::{self, SamplerSpec};
 
 /// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
@@ -106,7 +107,7 @@ pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precis
             src.push_str(&sampler_call_site(&[spec]));
             push_all(&mut src, &[sources::LOBE_KERNEL]);
             match precision {
-                Precision::F64 => src.push_str(&precision::f64_draw(job)),
+                Precision::F64 => src.push_str(&f64_draw(job)),
                 _ => src.push_str(sources::LOBE_DRAW),
             }
         }
@@ -145,7 +146,7 @@ pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision:
         layout::consts_wgsl()
     );
     let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
-    push_all(&mut src, &[sources::RNG, precision.math(), sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
+    push_all(&mut src, &[sources::RNG, math_module(precision), sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
     src
 }
 
@@ -154,6 +155,44 @@ pub(crate) fn push_all(src: &mut String, parts: &[&str]) {
         src.push_str(part);
         src.push('\n');
     }
+}
+
+/// The math module of a kernel's f32 code (the f64 kernels' f32 parts, such as the erf⁻¹
+/// guess that seeds their Newton steps, use the accurate one).
+fn math_module(precision: Precision) -> &'static str {
+    match precision {
+        Precision::F32Fast => sources::FASTMATH,
+        Precision::F32Accurate | Precision::F64 => sources::MATH_F32,
+    }
+}
+
+/// The f64 draw of a lobe job: the job's α and ωi as f64 constants, the call site
+/// `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64 erfc and
+/// erf⁻¹).
+///
+/// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
+pub(crate) fn f64_draw(job: &Job) -> String {
+    let Job::Lobe { lobe, incident, .. } = job else { panic!("f64 kernels exist for lobes only") };
+    let spec = sampler::find(lobe.kind, lobe.method);
+    let Some(sample64) = spec.wgsl.sample64 else { panic!("no f64 sampler for {}", spec.name()) };
+    let mut s = format!(
+        "// the job's alpha and incident direction in f64\n\
+         const A64: vec2<f64> = vec2<f64>({}, {});\nconst WI64: vec3<f64> = vec3<f64>({}, {}, {});\n",
+        precision::lit(lobe.alpha_x),
+        precision::lit(lobe.alpha_y),
+        precision::lit(incident.x),
+        precision::lit(incident.y),
+        precision::lit(incident.z)
+    );
+    s += &call_site("sampler_sample64", "a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>", "LobeSample64", &[spec], |_| {
+        format!("{sample64}(a, wi, u)")
+    });
+    s += sources::F64;
+    if lobe.kind == LobeKind::Beckmann {
+        s += sources::F64_BECKMANN;
+        s += &precision::erfc_straight_line();
+    }
+    s
 }
 
 /// "ggx vndf", "discrete cdf (10 items)".

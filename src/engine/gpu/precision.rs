@@ -1,5 +1,5 @@
-//! The arithmetic of a kernel ([`Precision`]), chosen when its module is composed: the math
-//! module of the f32 kernels (`shaders/math/f32.wgsl`, or the approximations of
+//! The arithmetic of a kernel ([`Precision`]), chosen when its module is composed
+//! (`compose::math_module`, `compose::f64_draw`): the math module of the f32 kernels (`shaders/math/f32.wgsl`, or the approximations of
 //! `shaders/math/f32_fast.wgsl` under the same names), and for f64 the draw of `shaders/math/f64.wgsl` in
 //! place of `shaders/passes/lobe_draw.wgsl`. `lobes tradeoff` compares the three.
 //!
@@ -10,9 +10,6 @@
 //!   plus `shaders/math/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann), with the job's α and
 //!   ωi as f64 constants (the kernel's uniform block carries them in f32 only).
 
-use super::compose::{self, sources};
-use crate::engine::job::Job;
-use crate::reference::{LobeKind, sampler};
 use serde::Serialize;
 
 /// The arithmetic of a sampling kernel.
@@ -44,19 +41,8 @@ impl Precision {
     }
 }
 
-impl Precision {
-    /// The math module of the kernel's f32 code (the f64 kernels' f32 parts, such as the
-    /// erf⁻¹ guess that seeds their Newton steps, use the accurate one).
-    pub(crate) fn math(self) -> &'static str {
-        match self {
-            Precision::F32Fast => sources::FASTMATH,
-            Precision::F32Accurate | Precision::F64 => sources::MATH_F32,
-        }
-    }
-}
-
 /// An f64 literal that round-trips (17 significant digits).
-fn lit(x: f64) -> String {
+pub(crate) fn lit(x: f64) -> String {
     format!("{x:.16e}lf")
 }
 
@@ -86,35 +72,6 @@ pub fn erfc_straight_line() -> String {
     }
     out += "    return k;\n}\n";
     out
-}
-
-/// The f64 draw of a lobe job: the job's α and ωi as f64 constants, the call site
-/// `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64 erfc and
-/// erf⁻¹).
-///
-/// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
-pub(crate) fn f64_draw(job: &Job) -> String {
-    let Job::Lobe { lobe, incident, .. } = job else { panic!("f64 kernels exist for lobes only") };
-    let spec = sampler::find(lobe.kind, lobe.method);
-    let Some(sample64) = spec.wgsl.sample64 else { panic!("no f64 sampler for {}", spec.name()) };
-    let mut s = format!(
-        "// the job's alpha and incident direction in f64\n\
-         const A64: vec2<f64> = vec2<f64>({}, {});\nconst WI64: vec3<f64> = vec3<f64>({}, {}, {});\n",
-        lit(lobe.alpha_x),
-        lit(lobe.alpha_y),
-        lit(incident.x),
-        lit(incident.y),
-        lit(incident.z)
-    );
-    s += &compose::call_site("sampler_sample64", "a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>", "LobeSample64", &[spec], |_| {
-        format!("{sample64}(a, wi, u)")
-    });
-    s += sources::F64;
-    if lobe.kind == LobeKind::Beckmann {
-        s += sources::F64_BECKMANN;
-        s += &erfc_straight_line();
-    }
-    s
 }
 
 #[cfg(test)]
