@@ -28,7 +28,7 @@ fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> compare::Ang
 /// The f64 kernels reproduce the f64 reference to far below f32 resolution (f32 kernels: ~1e-7
 /// rad), with no validity disagreement. Measured on lavapipe: ≤ 1.9e-15 rad, except Beckmann's
 /// visible normals at 5.8e-14 rad, where the kernel's own straight-line erfc (within 1.3e-12 of
-/// the exact value, `variants::erfc_straight_line`) moves the visible-slope root; the
+/// the exact value, `engine::gpu::precision::erfc_straight_line`) moves the visible-slope root; the
 /// reference's erfc is libm's (~1 ulp). With statrs 0.18's erfc (off by up to 1e-10) the
 /// reference itself was off, and Beckmann's visible normals differed by 3.9e-11 rad.
 #[test]
