@@ -14,7 +14,7 @@ const RNG: &str = include_str!("../../shaders/lib/rng.wgsl");
 const WG: u32 = 64;
 
 /// The passes' uniform block (`LobesCheckParams` in user_passes.wgsl).
-#[repr(C)]
+#[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(super) struct Params {
     pub user: [[f32; 4]; 4],
@@ -27,7 +27,9 @@ pub(super) struct Params {
     pub samples_per_thread: u32,
     pub rows: u32,
     pub cols: u32,
-    pub _pad: [u32; 3],
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// The compiled passes of one user sampler.
@@ -163,4 +165,44 @@ impl<'g> Passes<'g> {
 /// A 64-bit value as the (lo, hi) pair the kernels take.
 pub(super) fn split(v: u64) -> [u32; 2] {
     [v as u32, (v >> 32) as u32]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::mem::{align_of, offset_of, size_of};
+
+    /// `Params` has the layout of `LobesCheckParams` (naga's layouter, WGSL's rules).
+    #[test]
+    fn params_layout() {
+        let members = [
+            ("user", offset_of!(Params, user)),
+            ("wi", offset_of!(Params, wi)),
+            ("bounds", offset_of!(Params, bounds)),
+            ("seed", offset_of!(Params, seed)),
+            ("base", offset_of!(Params, base)),
+            ("count", offset_of!(Params, count)),
+            ("eps", offset_of!(Params, eps)),
+            ("samples_per_thread", offset_of!(Params, samples_per_thread)),
+            ("rows", offset_of!(Params, rows)),
+            ("cols", offset_of!(Params, cols)),
+            ("_pad0", offset_of!(Params, _pad0)),
+            ("_pad1", offset_of!(Params, _pad1)),
+            ("_pad2", offset_of!(Params, _pad2)),
+        ];
+        let s = UserSampler {
+            sources: vec![super::super::Source {
+                name: "t.wgsl".into(),
+                text: "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { return u; }\n\
+                       fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 1.0; }"
+                    .into(),
+            }],
+            sample: "s".into(),
+            pdf: "p".into(),
+            eval: None,
+            domain: Domain::Sphere,
+        };
+        let source = compose(&s).unwrap().text;
+        crate::engine::gpu::layout::check_struct(&source, "LobesCheckParams", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
+    }
 }
