@@ -238,7 +238,7 @@ pub fn dfg_reference() -> Vec<[f64; 2]> {
 pub fn write_outputs(dir: &Path, lut: &[[f32; 2]]) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let raw: Vec<u8> = lut.iter().flat_map(|t| t.iter().flat_map(|x| x.to_le_bytes())).collect();
-    lobes::report::output::write_atomic(&dir.join("dfg.f32"), &raw)?;
+    lobes::report::atomic::write_atomic(&dir.join("dfg.f32"), &raw)?;
     let to8 = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     let rgb: Vec<u8> = lut.iter().flat_map(|t| [to8(t[0]), to8(t[1]), 0]).collect();
     let mut png = Vec::new();
@@ -249,7 +249,7 @@ pub fn write_outputs(dir: &Path, lut: &[[f32; 2]]) -> anyhow::Result<()> {
         SIZE,
         image::ExtendedColorType::Rgb8,
     )?;
-    lobes::report::output::write_atomic(&dir.join("dfg.png"), &png)?;
+    lobes::report::atomic::write_atomic(&dir.join("dfg.png"), &png)?;
     Ok(())
 }
 

@@ -115,8 +115,8 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--out {}: {e}", dir.display()))?;
-        crate::report::output::write_atomic(&dir.join("composed.wgsl"), sampler.composed().map_err(input)?.as_bytes())?;
-        crate::report::output::write_atomic(&dir.join("report.json"), serde_json::to_string(&report)?.as_bytes())?;
+        crate::report::atomic::write_atomic(&dir.join("composed.wgsl"), sampler.composed().map_err(input)?.as_bytes())?;
+        crate::report::atomic::write_atomic(&dir.join("report.json"), serde_json::to_string(&report)?.as_bytes())?;
     }
     if args.output.json {
         emit_json(&report)?;

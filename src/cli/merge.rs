@@ -201,7 +201,7 @@ pub fn run_shard(args: &super::run::RunArgs, shard: Shard) -> anyhow::Result<()>
         let folder = args.out.join(&case.name);
         std::fs::create_dir_all(&folder)?;
         let file = folder.join(shard.file_name());
-        output::write_atomic(&file, serde_json::to_string(&doc)?.as_bytes())
+        crate::report::atomic::write_atomic(&file, serde_json::to_string(&doc)?.as_bytes())
             .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", file.display()))?;
         rows.push((case.name.clone(), range, gpu_seconds, wall_seconds, file));
     }

@@ -5,7 +5,7 @@
 //! colour bar with min/mid/max tick labels on the right, the title on top and the axis range
 //! labels. Text uses an embedded 5×7 bitmap font drawn at 2×; characters it lacks become a
 //! hollow box, so any `&str` is safe to draw. [`write_png`] writes the image atomically
-//! (temporary file in the same directory, then rename).
+//! ([`super::atomic`]).
 //!
 //! Colour scales:
 //! - [`Scale::Sequential`]: viridis-like, from `min(0, min v)` to `max v`. When every value
@@ -18,9 +18,8 @@
 //! Non-finite values (NaN, ±inf) are drawn grey and ignored when fitting the scale; an
 //! all-zero or empty map renders without dividing by zero.
 
-use std::io::{self, BufWriter};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::io;
+use std::path::Path;
 
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
@@ -130,40 +129,22 @@ pub fn render(h: &Heatmap) -> RgbImage {
     img
 }
 
-/// Renders `h` and writes it as a PNG to `path`, atomically: the image goes to a temporary
-/// file in the same directory, which is then renamed over `path`.
+/// Renders `h` and writes it as a PNG to `path`, atomically ([`super::atomic`]).
 pub fn write_png(h: &Heatmap, path: &Path) -> io::Result<()> {
     let img = render(h);
-    let tmp = temp_path(path);
-    let result = encode_png(&img, &tmp).and_then(|()| std::fs::rename(&tmp, path));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
+    super::atomic::write_atomic_with(path, |out| encode_png(&img, out))
 }
 
-/// A hidden, unique sibling of `path` to write into before renaming.
-fn temp_path(path: &Path) -> PathBuf {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path
-        .file_name()
-        .map_or("heatmap".into(), |n| n.to_string_lossy());
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
-}
-
-/// Encodes `img` as PNG into a new file at `path` and syncs it to disk.
-fn encode_png(img: &RgbImage, path: &Path) -> io::Result<()> {
-    let mut out = BufWriter::new(std::fs::File::create(path)?);
-    PngEncoder::new(&mut out)
+/// Encodes `img` as PNG into `out`.
+fn encode_png(img: &RgbImage, out: &mut dyn io::Write) -> io::Result<()> {
+    PngEncoder::new(out)
         .write_image(
             img.as_raw(),
             img.width(),
             img.height(),
             ExtendedColorType::Rgb8,
         )
-        .map_err(io::Error::other)?;
-    out.into_inner().map_err(|e| e.into_error())?.sync_all()
+        .map_err(io::Error::other)
 }
 
 /// Value of cell `i` (row-major); missing cells read as NaN.

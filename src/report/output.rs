@@ -1,23 +1,15 @@
 //! Per-case outputs: `histogram.json` and PNG heat maps of the measured histogram, the
 //! expected one and the signed residual (measured − expected)/√expected. Every file is
-//! written to a temporary name and renamed into place, and `histogram.json` is written last,
+//! written atomically ([`super::atomic`]), and `histogram.json` is written last,
 //! so a case folder with a `histogram.json` is complete.
 
+use super::atomic::write_atomic;
 use super::heatmap::{self, Heatmap, Scale};
 use crate::engine::job::Job;
 use crate::reference::Invalid;
 use crate::run::CaseResult;
 use serde_json::{Value, json};
 use std::path::Path;
-
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension(format!("tmp{}", std::process::id()));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
-}
 
 /// Rows of a row-major grid as nested arrays.
 fn nested<T: Copy + Into<Value>>(values: &[T], cols: usize) -> Value {

@@ -3,7 +3,7 @@
 //! `tradeoff.json`; each written under a temporary name and renamed into place.
 
 use super::heatmap::{draw_text, fill_rect, text_width};
-use super::output::write_atomic;
+use super::atomic::write_atomic;
 use crate::experiments::tradeoff::{MethodPoint, Precision, QuadraturePoint, Sweep, SweepPoint};
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};

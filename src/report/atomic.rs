@@ -1,0 +1,87 @@
+//! The one way lobes writes a file: into a temporary file in the target folder, synced to disk,
+//! then renamed over the target (`tempfile`'s `NamedTempFile::persist`), and the folder synced.
+//! A reader sees the old file or the complete new one, never a part; a failed write leaves no
+//! temporary file behind (it is removed when dropped).
+
+use std::io::{self, Write};
+use std::path::Path;
+
+/// Writes `bytes` to `path` atomically.
+///
+/// ```
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.txt");
+/// lobes::report::atomic::write_atomic(&path, b"hello").unwrap();
+/// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
+/// ```
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomic_with(path, |out| out.write_all(bytes))
+}
+
+/// Writes `path` atomically with `write`, which gets the temporary file (buffered).
+pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".lobes-").suffix(".tmp").tempfile_in(folder)?;
+    {
+        let mut out = io::BufWriter::new(tmp.as_file_mut());
+        write(&mut out)?;
+        out.flush()?;
+    }
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    sync_folder(folder)
+}
+
+/// Makes the rename durable (POSIX: the folder's entry is synced separately from the file).
+#[cfg(unix)]
+fn sync_folder(folder: &Path) -> io::Result<()> {
+    std::fs::File::open(folder)?.sync_all()
+}
+
+#[cfg(not(unix))]
+fn sync_folder(_: &Path) -> io::Result<()> {
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn replaces_the_file_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.json");
+        write_atomic(&path, b"first").unwrap();
+        write_atomic(&path, b"second, longer").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"second, longer");
+        assert_eq!(names(dir.path()), ["x.json"]);
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_old_file_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.json");
+        write_atomic(&path, b"old").unwrap();
+        let err = write_atomic_with(&path, |out| {
+            out.write_all(b"half")?;
+            Err(io::Error::other("the encoder failed"))
+        })
+        .unwrap_err();
+        assert_eq!(err.to_string(), "the encoder failed");
+        assert_eq!(std::fs::read(&path).unwrap(), b"old");
+        // a target that is a folder cannot be replaced by a file
+        std::fs::create_dir(dir.path().join("blocked")).unwrap();
+        assert!(write_atomic(&dir.path().join("blocked"), b"x").is_err());
+        assert_eq!(names(dir.path()), ["blocked", "x.json"]);
+        assert!(write_atomic(&dir.path().join("no/such/folder/x"), b"x").is_err());
+    }
+}
