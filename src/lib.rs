@@ -13,7 +13,8 @@
 //!   one ([`engine::cpu`]).
 //! - [`stats`]: binning, expected counts by quadrature, the χ² test, weighted sums.
 //! - [`scene`]: scene files and their cases.
-//! - [`run`](mod@run): a case end to end: histogram, expected counts, verdicts.
+//! - [`run`](mod@run): a case end to end: histogram, expected counts, verdicts; shards of it
+//!   and their merge.
 //! - [`experiments`]: the stress suite and the accuracy-against-time sweep.
 //! - [`check`]: judging a user's own WGSL sampler (`lobes check`).
 //! - [`report`]: heat maps, plots, tables and output files.

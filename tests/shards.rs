@@ -2,7 +2,8 @@
 //! counts (and verdicts) of the unsharded run; gaps, overlaps and mixed scenes are refused.
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
-use serde_json::Value;
+use lobes::report::output::{HistogramFile, RunSummary, ShardSummary};
+use lobes::run::shard::ShardFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -33,8 +34,8 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))).unwrap()
+fn histogram(path: &Path) -> HistogramFile {
+    HistogramFile::read(path).unwrap()
 }
 
 const SCENE: &str = r#"
@@ -77,38 +78,53 @@ fn three_shards_merge_to_exactly_the_unsharded_run() {
         // each shard into its own folder, as separate machines would write them
         let o = lobes(&dir, &["run", "scene.toml", "--shard", &format!("{i}/3"), "--out", &format!("part{i}"), "--json"]);
         assert!(o.status.success(), "shard {i}: {}", stderr(&o));
-        let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
-        assert_eq!(doc["backend"], "gpu", "the shards must run on the GPU");
+        let doc: ShardSummary = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(doc.backend, "gpu", "the shards must run on the GPU");
     }
     let ranges: Vec<(u64, u64)> = (0..3)
         .map(|i| {
-            let s = json(&dir.join(format!("part{i}/beckmann-ndf/shard-{i}-of-3.json")));
-            assert_eq!(s["format"], "lobes-shard");
-            assert_eq!(s["samples"], 999_999);
-            (s["first"].as_u64().unwrap(), s["end"].as_u64().unwrap())
+            let s = ShardFile::read(&dir.join(format!("part{i}/beckmann-ndf/shard-{i}-of-3.json"))).unwrap();
+            assert_eq!(s.format, "lobes-shard");
+            assert_eq!(s.samples, 999_999);
+            (s.first, s.end)
         })
         .collect();
     assert_eq!(ranges, [(0, 333_333), (333_333, 666_666), (666_666, 999_999)]);
 
     let merged = lobes(&dir, &["merge", "part0", "part1", "part2", "--out", "merged", "--json"]);
     assert_eq!(merged.status.code(), full.status.code(), "same verdicts, same exit code: {}", stderr(&merged));
+    let (full_summary, merged_summary): (RunSummary, RunSummary) =
+        (serde_json::from_slice(&full.stdout).unwrap(), serde_json::from_slice(&merged.stdout).unwrap());
+    for (a, b) in full_summary.cases.iter().zip(&merged_summary.cases) {
+        assert_eq!((&a.case, a.passed), (&b.case, b.passed), "the same verdict per case");
+    }
     for case in ["ggx-vndf", "beckmann-ndf", "alias"] {
-        let a = json(&dir.join("full").join(case).join("histogram.json"));
-        let b = json(&dir.join("merged").join(case).join("histogram.json"));
-        assert_eq!(a["backend"], "gpu");
-        for key in ["counts", "invalid", "samples", "seed", "expected", "expected_invalid", "chi2", "per_sample_check", "params", "adapter", "backend", "rows", "cols"] {
-            assert_eq!(a[key], b[key], "{case}: '{key}' differs between the unsharded run and the merged shards");
-        }
-        let total: u64 = b["counts"].as_array().unwrap().iter().flat_map(|r| r.as_array().unwrap()).map(|c| c.as_u64().unwrap()).sum::<u64>()
-            + b["invalid"].as_object().unwrap().values().map(|c| c.as_u64().unwrap()).sum::<u64>();
-        assert_eq!(total, a["samples"].as_u64().unwrap());
+        let a = histogram(&dir.join("full").join(case).join("histogram.json"));
+        let b = histogram(&dir.join("merged").join(case).join("histogram.json"));
+        assert_eq!(a.backend, "gpu");
+        let what = |key: &str| format!("{case}: '{key}' differs between the unsharded run and the merged shards");
+        assert_eq!(a.counts, b.counts, "{}", what("counts"));
+        assert_eq!(a.invalid, b.invalid, "{}", what("invalid"));
+        assert_eq!((a.samples, a.seed), (b.samples, b.seed), "{}", what("samples, seed"));
+        assert_eq!(a.expected, b.expected, "{}", what("expected"));
+        assert_eq!(a.expected_invalid, b.expected_invalid, "{}", what("expected_invalid"));
+        assert_eq!(a.chi2, b.chi2, "{}", what("chi2"));
+        assert_eq!(a.per_sample_check, b.per_sample_check, "{}", what("per_sample_check"));
+        assert_eq!(a.description, b.description, "{}", what("params, rows, cols"));
+        assert_eq!((&a.adapter, &a.backend), (&b.adapter, &b.backend), "{}", what("adapter, backend"));
+        let total: u64 = b.counts.iter().flatten().sum::<u64>() + <[u64; 4]>::from(b.invalid).iter().sum::<u64>();
+        assert_eq!(total, a.samples);
         for png in ["measured.png", "expected.png", "residual.png"] {
             assert!(dir.join("merged").join(case).join(png).is_file(), "{case}/{png}");
         }
         // the weighted case's fixed-point sums add up exactly too
-        assert_eq!(a["weighted"].is_null(), case != "beckmann-ndf", "{case}");
-        for key in ["sums", "check", "bin_albedo", "bin_max_weight_error", "effects"] {
-            assert_eq!(a["weighted"][key], b["weighted"][key], "{case}: weighted '{key}' differs");
+        assert_eq!(a.weighted.is_none(), case != "beckmann-ndf", "{case}");
+        if let (Some(a), Some(b)) = (&a.weighted, &b.weighted) {
+            assert_eq!(a.sums, b.sums, "{case}: weighted 'sums' differs");
+            assert_eq!(a.check, b.check, "{case}: weighted 'check' differs");
+            assert_eq!(a.bin_albedo, b.bin_albedo, "{case}: weighted 'bin_albedo' differs");
+            assert_eq!(a.bin_max_weight_error, b.bin_max_weight_error, "{case}: weighted 'bin_max_weight_error' differs");
+            assert_eq!(a.effects, b.effects, "{case}: weighted 'effects' differs");
         }
     }
     assert!(dir.join("merged/beckmann-ndf/albedo.png").is_file());
@@ -157,4 +173,41 @@ fn merge_refuses_gaps_overlaps_and_mixed_scenes() {
     // the same shard passed twice through two paths is read once
     let twice = lobes(&dir, &["merge", "p0", "p1", "p2", "p1/alias/shard-1-of-3.json", "--out", "ok"]);
     assert!(twice.status.code() != Some(2), "{}", stderr(&twice));
+}
+
+/// `lobes merge` judges a case as `lobes run` does: a weighted case whose χ² test passes but
+/// whose albedo check fails is a failed case (exit 1, `passed: false`). The shards run on the
+/// CPU engine; one shard's weighted sums are doubled, which doubles half the albedo estimate
+/// and leaves the counts alone.
+#[test]
+fn a_merged_case_that_fails_the_albedo_check_fails() {
+    let dir = scratch("albedo-fails");
+    let scene = "[[case]]\nname = \"w\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = 20.0\nsamples = 20_000\nbins = [8, 16]\nfresnel = \"schlick\"\nf0 = 0.5\nmasking = \"separable\"\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    for i in 0..2 {
+        assert!(lobes(&dir, &["run", "scene.toml", "--cpu", "--shard", &format!("{i}/2"), "--out", "parts"]).status.success());
+    }
+    let honest = lobes(&dir, &["merge", "parts", "--out", "honest", "--json"]);
+    assert_eq!(honest.status.code(), Some(0), "{}", stderr(&honest));
+
+    let path = dir.join("parts/w/shard-1-of-2.json");
+    let mut shard = ShardFile::read(&path).unwrap();
+    let sums = shard.weighted.as_mut().unwrap();
+    sums.bins.iter_mut().for_each(|b| *b *= 2);
+    std::fs::write(&path, serde_json::to_string(&shard).unwrap()).unwrap();
+
+    let merged = lobes(&dir, &["merge", "parts", "--out", "merged", "--json"]);
+    assert_eq!(merged.status.code(), Some(1), "{}", stderr(&merged));
+    assert!(stderr(&merged).contains("1 of 1 cases failed the χ² test or the albedo checks"), "{}", stderr(&merged));
+    let summary: RunSummary = serde_json::from_slice(&merged.stdout).unwrap();
+    assert_eq!(summary.failed, 1);
+    let case = &summary.cases[0];
+    assert!(!case.passed, "the summary reports the failed albedo check");
+    let measured = case.measured.as_ref().unwrap();
+    assert!(!measured.albedo.unwrap().passed);
+    assert!(measured.p_value >= summary.per_case_significance, "the χ² test alone passes: p = {}", measured.p_value);
+    let h = histogram(&dir.join("merged/w/histogram.json"));
+    assert!(h.chi2.passed && !h.weighted.unwrap().check.passed);
+    let table = lobes(&dir, &["merge", "parts", "--out", "merged"]);
+    assert!(String::from_utf8_lossy(&table.stdout).lines().any(|l| l.starts_with("w ") && l.contains("FAIL")));
 }

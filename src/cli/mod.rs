@@ -22,10 +22,12 @@ pub mod tradeoff;
 pub mod tutorial;
 
 use crate::reference::{LobeKind, Method};
+use crate::run::shard::ShardError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
 use std::fmt;
 use std::io::Write;
+use std::path::Path;
 
 /// Exit code for bad input: usage and validation errors (clap's own code for usage errors).
 pub const EXIT_USAGE: u8 = 2;
@@ -114,11 +116,27 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
 }
 
-/// The process exit code for an error: [`EXIT_USAGE`] if a [`UsageError`] or a clap error is
-/// anywhere in its chain, else [`EXIT_FAILURE`].
+/// The process exit code for an error: [`EXIT_USAGE`] if a [`UsageError`], a clap error or bad
+/// shards ([`ShardError`]) are anywhere in its chain, else [`EXIT_FAILURE`].
 pub fn exit_code(err: &anyhow::Error) -> u8 {
-    let bad_input = err.chain().any(|e| e.is::<UsageError>() || e.is::<clap::Error>());
+    let bad_input = err.chain().any(|e| e.is::<UsageError>() || e.is::<clap::Error>() || e.is::<ShardError>());
     if bad_input { EXIT_USAGE } else { EXIT_FAILURE }
+}
+
+/// Creates the `--out` folder; a path that is not a folder or cannot be created is bad input.
+pub fn prepare_out(out: &Path) -> anyhow::Result<()> {
+    if out.exists() && !out.is_dir() {
+        return Err(usage(format!("--out {}: exists and is not a folder; give a folder (created if missing)", out.display())));
+    }
+    std::fs::create_dir_all(out).map_err(|e| usage(format!("--out {}: cannot create the output folder: {e}", out.display())))
+}
+
+/// A significance level strictly between 0 and 1 (`--significance` of run and merge).
+pub fn parse_level(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x > 0.0 && x < 1.0 => Ok(x),
+        _ => Err(format!("'{s}' is not a significance level; give a number strictly between 0 and 1")),
+    }
 }
 
 /// Output selection shared by the subcommands.
@@ -350,4 +368,17 @@ pub fn parse_polar_180(s: &str) -> Result<f64, String> {
 /// Parses an azimuth in degrees, [-360, 360].
 pub fn parse_azimuth(s: &str) -> Result<f64, String> {
     parse_degrees_in(s, -360.0, 360.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_shards_are_bad_input() {
+        let err = anyhow::Error::from(ShardError("case 'c': samples 3..6 are missing".into())).context("lobes merge");
+        assert_eq!(exit_code(&err), EXIT_USAGE);
+        assert_eq!(exit_code(&usage("x")), EXIT_USAGE);
+        assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_FAILURE);
+    }
 }

@@ -1,14 +1,15 @@
 //! `lobes run`: every case of a scene, sampled and histogrammed on the GPU, judged against
-//! the f64 reference, with per-case outputs and a table.
+//! the f64 reference, with per-case outputs and a table; with `--shard I/N`, one shard of every
+//! case, written as raw results for `lobes merge`.
 
-use super::{OutputArgs, emit, emit_json, usage};
-use crate::report::output;
-use crate::run::{Backend, device_lost, run_case};
-use crate::scene::{DEFAULT_SCENE, Scene};
+use super::{OutputArgs, emit, emit_json, parse_level, prepare_out, usage};
+use crate::report::output::{self, CaseSummary, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
+use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
+use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
+use crate::scene::{Case, DEFAULT_SCENE, Scene};
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use serde_json::json;
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Args)]
@@ -26,25 +27,22 @@ pub struct RunArgs {
     pub cpu: bool,
     /// Run only shard I of N (0 ≤ I < N) of every case: its contiguous range of sample indices,
     /// written as raw counts to `OUT/<case>/shard-I-of-N.json` for `lobes merge`.
-    #[arg(long, value_name = "I/N", value_parser = super::merge::parse_shard)]
-    pub shard: Option<super::merge::Shard>,
+    #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
+    pub shard: Option<Shard>,
     #[command(flatten)]
     pub output: OutputArgs,
-}
-
-/// A significance level strictly between 0 and 1 (`--significance` of run and merge).
-pub(super) fn parse_level(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x > 0.0 && x < 1.0 => Ok(x),
-        _ => Err(format!("'{s}' is not a significance level; give a number strictly between 0 and 1")),
-    }
 }
 
 /// Reads and validates a scene (the embedded default when `path` is None). A file that cannot
 /// be read, is not UTF-8 or is not a valid scene is a [`super::UsageError`] naming the file (and
 /// the line and column).
 pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
-    let scene = match path {
+    read_scene(path).map(|(_, scene)| scene)
+}
+
+/// [`load_scene`], with the scene's name and text (for shard files).
+fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(SceneSource, Scene)> {
+    let (name, text) = match path {
         Some(p) => {
             let bytes = std::fs::read(p).map_err(|e| {
                 usage(format!(
@@ -52,19 +50,15 @@ pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
                     p.display()
                 ))
             })?;
-            Scene::from_bytes(&p.display().to_string(), &bytes)
+            let name = p.display().to_string();
+            let scene = Scene::from_bytes(&name, &bytes).map_err(|e| usage(e.to_string()))?;
+            // from_bytes has checked that the file is UTF-8
+            return Ok((SceneSource { name, text: String::from_utf8_lossy(&bytes).into_owned() }, scene));
         }
-        None => Scene::parse("<embedded scenes/all-lobes.toml>", DEFAULT_SCENE),
+        None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.to_string()),
     };
-    scene.map_err(|e| usage(e.to_string()))
-}
-
-/// Creates the `--out` folder; a path that is not a folder or cannot be created is bad input.
-fn prepare_out(out: &Path) -> anyhow::Result<()> {
-    if out.exists() && !out.is_dir() {
-        return Err(usage(format!("--out {}: exists and is not a folder; give a folder (created if missing)", out.display())));
-    }
-    std::fs::create_dir_all(out).map_err(|e| usage(format!("--out {}: cannot create the output folder: {e}", out.display())))
+    let scene = Scene::parse(&name, &text).map_err(|e| usage(e.to_string()))?;
+    Ok((SceneSource { name, text }, scene))
 }
 
 /// Checks, before anything runs, that every case fits the GPU adapter (histograms larger than a
@@ -91,20 +85,15 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
 
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
 /// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
-fn run_and_write(
-    backend: &mut Backend,
-    case: &crate::scene::Case,
-    level: f64,
-    out: &Path,
-    bar: &ProgressBar,
-) -> anyhow::Result<crate::run::CaseResult> {
+fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, bar: &ProgressBar) -> anyhow::Result<CaseResult> {
     let stale = out.join(&case.name).join("histogram.json");
     match std::fs::remove_file(&stale) {
         Ok(()) => {}
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
         Err(e) => anyhow::bail!("cannot remove the earlier {}: {e}", stale.display()),
     }
-    let result = run_case(backend, case, level, &mut |done| bar.set_position(done))?;
+    let sampled = run_case(backend, case, 0..case.samples, &mut |done| bar.set_position(done))?;
+    let result = judge(case, sampled, level)?;
     let adapter = backend.adapter();
     output::write_case(out, &result, &adapter, backend.name())
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
@@ -120,7 +109,7 @@ fn progress_bar(samples: u64, name: &str) -> ProgressBar {
 
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     if let Some(shard) = args.shard {
-        return super::merge::run_shard(args, shard);
+        return run_shard(args, shard);
     }
     let scene = load_scene(args.scene.as_ref())?;
     prepare_out(&args.out)?;
@@ -150,7 +139,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 }
                 let dash = || "-".to_string();
                 rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
-                summary.push(json!({"case": case.name, "samples": case.samples, "passed": false, "error": format!("{e:#}"), "output": null}));
+                summary.push(CaseSummary::error(case, format!("{e:#}")));
                 continue;
             }
         };
@@ -159,20 +148,20 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             if backend.name() == "cpu" { cpu_rows = true } else { wall_rows = true }
         }
         rows.push(output::table_row(&result));
-        summary.push(json!({
-            "case": case.name, "samples": case.samples, "backend": backend.name(), "gpu_seconds": result.gpu_seconds,
-            "wall_seconds": result.histogram_seconds, "chi2": result.chi2.statistic, "dof": result.chi2.dof,
-            "p_value": result.chi2.p_value, "passed": result.passed(),
-            "albedo": result.weighted.as_ref().map(|w| json!({"albedo": w.check.albedo, "reference": w.check.reference,
-                "relative_error": w.check.relative_error, "p_value": w.check.p_value, "max_weight_error": w.check.max_weight_error,
-                "passed": w.check.passed})),
-            "max_angle_rad": result.angle.as_ref().map(|a| a.max_angle_rad),
-            "output": args.out.join(&case.name),
-        }));
+        summary.push(CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) });
     }
     if args.output.json {
-        emit_json(&json!({"adapter": adapter, "backend": backend.name(), "significance": args.significance,
-                          "per_case_significance": level, "failed": failed, "errors": errors, "cases": summary}))?;
+        emit_json(&RunSummary {
+            format_version: SUMMARY_VERSION,
+            adapter,
+            backend: backend.name().into(),
+            significance: args.significance,
+            per_case_significance: level,
+            shard_files: None,
+            failed,
+            errors,
+            cases: summary,
+        })?;
     } else {
         let mut text = format!("adapter: {adapter}\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n", args.significance);
         text += &output::format_table(&rows);
@@ -191,4 +180,36 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         (e, 0) => anyhow::bail!("{e} of {n} cases could not run (see the errors above)"),
         (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test or the albedo checks"),
     }
+}
+
+/// `lobes run SCENE --shard I/N --out DIR`: samples shard I of every case and writes
+/// `DIR/<case>/shard-I-of-N.json` for `lobes merge`.
+fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
+    let (source, scene) = read_scene(args.scene.as_ref())?;
+    let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
+    let adapter = backend.adapter();
+    prepare_out(&args.out)?;
+    let origin = ShardOrigin { scene: &source, cases: scene.cases.len(), shard, adapter: &adapter, backend: backend.name() };
+    let mut cases = Vec::new();
+    for (case_index, case) in scene.cases.iter().enumerate() {
+        let sampled = run_case(&mut backend, case, shard.range(case.samples), &mut |_| {})?;
+        let file = ShardFile::new(&origin, case_index, case, &sampled);
+        let path = output::write_shard(&args.out, &file)?;
+        cases.push(ShardCaseSummary::of(&file, path));
+    }
+    let hash = fnv1a64(&source.text);
+    if args.output.json {
+        emit_json(&ShardSummary { format_version: SUMMARY_VERSION, shard, adapter, backend: backend.name().into(), scene_fnv1a64: hash, cases })?;
+    } else {
+        let mut t = format!("adapter: {adapter}\nshard {shard} of scene {} ({hash})\n\n", source.name);
+        let w = cases.iter().map(|c| c.case.len()).max().unwrap_or(4).max(4);
+        t += &format!("{:<w$}  {:>25}  {:>10}\n", "case", "samples", "time");
+        for c in &cases {
+            let time = c.gpu_seconds.map_or(format!("{:.3} s*", c.wall_seconds), |g| format!("{g:.3} s"));
+            t += &format!("{:<w$}  {:>25}  {time:>10}\n", c.case, format!("{}..{}", c.first, c.end));
+        }
+        t += &format!("\nshard files in {}/<case>/{}; add them up with `lobes merge`\n", args.out.display(), shard.file_name());
+        emit(&t)?;
+    }
+    Ok(())
 }

@@ -97,10 +97,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         return Err(usage(format!("--min-log2 {} is above --max-log2 {}; give min ≤ max", args.min_log2, args.max_log2)));
     }
     if let Some(out) = &args.out {
-        if out.exists() && !out.is_dir() {
-            return Err(usage(format!("--out {}: exists and is not a folder; give a folder (created if missing)", out.display())));
-        }
-        std::fs::create_dir_all(out).map_err(|e| usage(format!("--out {}: cannot create the output folder: {e}", out.display())))?;
+        super::prepare_out(out)?;
     }
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();

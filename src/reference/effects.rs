@@ -34,7 +34,7 @@ use serde::Serialize;
 /// let direct = e.eval(&lobe, wi, s.omega_r) * s.omega_r.z / lobe.pdf_r(wi, s.omega_r);
 /// assert!((e.weight(&lobe, wi, &s) - direct).abs() < 1e-12);
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize, schemars::JsonSchema)]
 pub struct Effects {
     pub fresnel: Fresnel,
     pub masking: Masking,

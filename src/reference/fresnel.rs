@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 /// Which Fresnel term multiplies the BRDF.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Fresnel {
     /// F = 1: a lossless mirror-like microsurface.

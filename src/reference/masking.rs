@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 /// Which masking-shadowing term multiplies the microfacet BRDF.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, serde::Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum Masking {
     /// G = 1: no masking (the BRDF is D / (4 cos θi cos θr)).

@@ -1,96 +1,160 @@
 //! Per-case outputs: `histogram.json` and PNG heat maps of the measured histogram, the
-//! expected one and the signed residual (measured − expected)/√expected. Every file is
-//! written atomically ([`super::atomic`]), and `histogram.json` is written last,
-//! so a case folder with a `histogram.json` is complete.
+//! expected one and the signed residual (measured − expected)/√expected; shard files; and the
+//! `--json` summaries of `lobes run` and `lobes merge`. Each is a serde struct that writer and
+//! reader share, with a `format_version`. Every file is written atomically ([`super::atomic`]), and
+//! `histogram.json` last, so a case folder with a `histogram.json` is complete.
 
 use super::atomic::write_atomic;
 use super::heatmap::{self, Heatmap, Scale};
 use crate::engine::job::Job;
-use crate::reference::Invalid;
-use crate::run::CaseResult;
-use serde_json::{Value, json};
-use std::path::Path;
+use crate::reference::effects::Effects;
+use crate::run::record::{ByReason, CaseDescription, Timing, WeightedTiming};
+use crate::run::shard::ShardFile;
+use crate::run::{CaseResult, WeightedResult};
+use crate::stats::chi2::Chi2;
+use crate::stats::compare::AngleCheck;
+use crate::stats::weighted::{AlbedoCheck, WeightedSums};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
-/// Rows of a row-major grid as nested arrays.
-fn nested<T: Copy + Into<Value>>(values: &[T], cols: usize) -> Value {
-    Value::Array(values.chunks(cols.max(1)).map(|r| Value::Array(r.iter().map(|&v| v.into()).collect())).collect())
+/// The version of the layout of `histogram.json`.
+pub const HISTOGRAM_VERSION: u32 = 1;
+/// The version of the layout of the `--json` summaries of `lobes run` and `lobes merge`.
+pub const SUMMARY_VERSION: u32 = 1;
+
+/// `histogram.json`: a case's measured and expected histograms and its verdicts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct HistogramFile {
+    /// [`HISTOGRAM_VERSION`].
+    pub format_version: u32,
+    pub case: String,
+    #[serde(flatten)]
+    pub description: CaseDescription,
+    /// ωi as a unit vector, normal on +z (null for a discrete case).
+    pub incident: Option<[f64; 3]>,
+    pub samples: u64,
+    pub seed: u64,
+    pub adapter: String,
+    /// `gpu` or `cpu` (shards from both, merged: `cpu + gpu`).
+    pub backend: String,
+    /// Bin edges over cos θ (rows) and φ (columns); null for a discrete case.
+    pub cos_theta_edges: Option<Vec<f64>>,
+    pub phi_edges: Option<Vec<f64>>,
+    /// Counts, rows × cols (one row of items for a discrete case).
+    pub counts: Vec<Vec<u64>>,
+    /// Expected counts, rows × cols.
+    pub expected: Vec<Vec<f64>>,
+    pub invalid: ByReason<u64>,
+    pub expected_invalid: ByReason<f64>,
+    pub chi2: Chi2,
+    pub timing: Timing,
+    /// GPU directions of the first samples against f64 (GPU lobe cases).
+    pub per_sample_check: Option<AngleCheck>,
+    /// The expected histogram's quadrature (lobe cases).
+    pub quadrature: Option<QuadratureRecord>,
+    /// Whether bins were counted in workgroup memory (GPU only).
+    pub workgroup_counting: Option<bool>,
+    /// The weighted histogram of a case with effects.
+    pub weighted: Option<WeightedRecord>,
 }
 
-fn reasons<T: Copy + Into<Value>>(values: &[T; 4]) -> Value {
-    Value::Object(Invalid::ALL.iter().zip(values).map(|(r, &v)| (r.name().to_string(), v.into())).collect())
-}
-
-/// The `histogram.json` document of a case.
-pub fn histogram_json(r: &CaseResult, adapter: &str, backend: &str) -> Value {
-    let case = &r.case;
-    let (lobe, method, params, incident, rows, cols, edges) = match &case.job {
-        Job::Lobe { lobe, incident, grid } => (
-            lobe.kind.name().to_string(),
-            lobe.method.name().to_string(),
-            json!({"alpha_x": lobe.alpha_x, "alpha_y": lobe.alpha_y,
-                   "incident_theta_deg": case.incident_deg.0, "incident_phi_deg": case.incident_deg.1}),
-            json!([incident.x, incident.y, incident.z]),
-            grid.rows as usize,
-            grid.cols as usize,
-            (json!(grid.cos_theta_edges()), json!(grid.phi_edges())),
-        ),
-        Job::Discrete { dist, method } => (
-            "discrete".to_string(),
-            format!("{method:?}").to_lowercase(),
-            json!({"weights": dist.weights()}),
-            Value::Null,
-            1,
-            dist.len(),
-            (Value::Null, Value::Null),
-        ),
-    };
-    let quadrature = r.expected.quadrature.as_ref().map(|q| {
-        json!({"error_estimate": q.error_estimate, "max_error_sigma_at_1e8": q.max_error_sigma,
-               "below_horizon_probability": q.below_horizon, "seconds": r.quadrature_seconds})
-    });
-    json!({
-        "case": case.name,
-        "lobe": lobe,
-        "method": method,
-        "params": params,
-        "incident": incident,
-        "samples": case.samples,
-        "seed": case.seed,
-        "adapter": adapter,
-        "backend": backend,
-        "cos_theta_edges": edges.0,
-        "phi_edges": edges.1,
-        "rows": rows,
-        "cols": cols,
-        "counts": nested(&r.counts.bins, cols),
-        "expected": nested(&r.expected.bins, cols),
-        "invalid": reasons(&r.counts.invalid),
-        "expected_invalid": reasons(&r.expected.invalid),
-        "chi2": {"statistic": r.chi2.statistic, "dof": r.chi2.dof, "p_value": r.chi2.p_value,
-                 "significance": r.chi2.significance, "passed": r.chi2.passed,
-                 "samples_in_zero_probability_cells": r.chi2.in_impossible_cells},
-        "timing": {"gpu_seconds": r.gpu_seconds, "histogram_wall_seconds": r.histogram_seconds},
-        "per_sample_check": r.angle,
-        "quadrature": quadrature,
-        "workgroup_counting": r.workgroup_counting,
-        "weighted": r.weighted.as_ref().map(|w| weighted_json(r, w, cols)),
-    })
+/// The accuracy and time of the expected histogram's quadrature.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct QuadratureRecord {
+    pub error_estimate: f64,
+    pub max_error_sigma_at_1e8: f64,
+    pub below_horizon_probability: f64,
+    pub seconds: f64,
 }
 
 /// The `weighted` section: the effects, the verdict, and per bin the albedo estimate, its f64
 /// quadrature and the largest weight difference.
-fn weighted_json(r: &CaseResult, w: &crate::run::WeightedResult, cols: usize) -> Value {
-    let n = r.case.samples;
-    let estimate: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, n)).collect();
-    json!({
-        "effects": r.case.effects,
-        "check": w.check,
-        "timing": {"gpu_seconds": w.gpu_seconds, "wall_seconds": w.wall_seconds},
-        "bin_albedo": nested(&estimate, cols),
-        "bin_albedo_reference": nested(&w.check.reference_bins, cols),
-        "bin_max_weight_error": nested(&w.sums.max_error, cols),
-        "sums": w.sums,
-    })
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct WeightedRecord {
+    pub effects: Effects,
+    pub check: AlbedoCheck,
+    pub timing: WeightedTiming,
+    pub bin_albedo: Vec<Vec<f64>>,
+    pub bin_albedo_reference: Vec<Vec<f64>>,
+    pub bin_max_weight_error: Vec<Vec<f32>>,
+    pub sums: WeightedSums,
+}
+
+/// Rows of a row-major grid.
+fn nested<T: Copy>(values: &[T], cols: usize) -> Vec<Vec<T>> {
+    values.chunks(cols.max(1)).map(<[T]>::to_vec).collect()
+}
+
+impl HistogramFile {
+    /// The `histogram.json` of a case.
+    pub fn new(r: &CaseResult, adapter: &str, backend: &str) -> Self {
+        let case = &r.case;
+        let description = CaseDescription::of(case);
+        let cols = description.cols;
+        let (incident, cos_theta_edges, phi_edges) = match &case.job {
+            Job::Lobe { incident, grid, .. } => (Some(incident.to_array()), Some(grid.cos_theta_edges()), Some(grid.phi_edges())),
+            Job::Discrete { .. } => (None, None, None),
+        };
+        HistogramFile {
+            format_version: HISTOGRAM_VERSION,
+            case: case.name.clone(),
+            description,
+            incident,
+            samples: case.samples,
+            seed: case.seed,
+            adapter: adapter.into(),
+            backend: backend.into(),
+            cos_theta_edges,
+            phi_edges,
+            counts: nested(&r.counts.bins, cols),
+            expected: nested(&r.expected.bins, cols),
+            invalid: r.counts.invalid.into(),
+            expected_invalid: r.expected.invalid.into(),
+            chi2: r.chi2.clone(),
+            timing: Timing { gpu_seconds: r.gpu_seconds, histogram_wall_seconds: r.histogram_seconds },
+            per_sample_check: r.angle.clone(),
+            quadrature: r.expected.quadrature.as_ref().map(|q| QuadratureRecord {
+                error_estimate: q.error_estimate,
+                max_error_sigma_at_1e8: q.max_error_sigma,
+                below_horizon_probability: q.below_horizon,
+                seconds: r.quadrature_seconds,
+            }),
+            workgroup_counting: r.workgroup_counting,
+            weighted: r.weighted.as_ref().map(|w| WeightedRecord::new(r, w, cols)),
+        }
+    }
+
+    /// Reads a `histogram.json`.
+    pub fn read(path: &Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
+        serde_json::from_str(&text).map_err(|e| anyhow::anyhow!("{}: not a lobes histogram.json: {e}", path.display()))
+    }
+}
+
+impl WeightedRecord {
+    fn new(r: &CaseResult, w: &WeightedResult, cols: usize) -> Self {
+        let n = r.case.samples;
+        let estimate: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, n)).collect();
+        WeightedRecord {
+            effects: r.case.effects.expect("a weighted case has effects"),
+            check: w.check.clone(),
+            timing: WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds },
+            bin_albedo: nested(&estimate, cols),
+            bin_albedo_reference: nested(&w.check.reference_bins, cols),
+            bin_max_weight_error: nested(&w.sums.max_error, cols),
+            sums: w.sums.clone(),
+        }
+    }
+}
+
+/// Writes a shard file to `dir/<case>/shard-I-of-N.json` and returns its path.
+pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
+    let folder = dir.join(&shard.case);
+    std::fs::create_dir_all(&folder)?;
+    let file = folder.join(shard.shard.file_name());
+    write_atomic(&file, serde_json::to_string(shard)?.as_bytes()).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", file.display()))?;
+    Ok(file)
 }
 
 /// Writes the heat maps and then `histogram.json` into `dir/<case>/`.
@@ -123,9 +187,160 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> a
         let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label, col_label, row_range, col_range };
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
-    let doc = histogram_json(r, adapter, backend);
+    let doc = HistogramFile::new(r, adapter, backend);
     write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
     Ok(())
+}
+
+/// The `--json` summary of `lobes run` and `lobes merge`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct RunSummary {
+    /// [`SUMMARY_VERSION`].
+    pub format_version: u32,
+    pub adapter: String,
+    pub backend: String,
+    /// The family-wise level, and the Šidák-corrected level of each case.
+    pub significance: f64,
+    pub per_case_significance: f64,
+    /// The shard files added up (`lobes merge` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard_files: Option<usize>,
+    /// Cases that ran and failed a check.
+    pub failed: usize,
+    /// Cases that could not run (always 0 for `lobes merge`, which stops at the first error).
+    pub errors: usize,
+    pub cases: Vec<CaseSummary>,
+}
+
+/// One case of a [`RunSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CaseSummary {
+    pub case: String,
+    pub samples: u64,
+    /// The shards added up (`lobes merge` only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shards: Option<usize>,
+    /// The backend the case ran on (`lobes run` only: it may move to the CPU mid-run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backend: Option<String>,
+    /// The case's verdict ([`CaseResult::passed`]): χ² and, where weighted, the albedo checks.
+    pub passed: bool,
+    /// What the case measured (absent where it could not run).
+    #[serde(flatten)]
+    pub measured: Option<CaseMeasured>,
+    /// Why the case could not run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+    /// The case's output folder (null where it could not run).
+    pub output: Option<PathBuf>,
+}
+
+/// What a case measured, in a [`CaseSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CaseMeasured {
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+    pub chi2: f64,
+    pub dof: u64,
+    pub p_value: f64,
+    pub albedo: Option<AlbedoSummary>,
+    pub max_angle_rad: Option<f64>,
+}
+
+/// The albedo checks of a weighted case, in a [`CaseSummary`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct AlbedoSummary {
+    pub albedo: f64,
+    pub reference: f64,
+    pub relative_error: f64,
+    pub p_value: f64,
+    pub max_weight_error: f32,
+    pub passed: bool,
+}
+
+impl CaseSummary {
+    /// The summary of a case that ran, with its outputs in `out/<case>`.
+    pub fn of(r: &CaseResult, out: &Path) -> Self {
+        CaseSummary {
+            case: r.case.name.clone(),
+            samples: r.case.samples,
+            shards: None,
+            backend: None,
+            passed: r.passed(),
+            measured: Some(CaseMeasured {
+                gpu_seconds: r.gpu_seconds,
+                wall_seconds: r.histogram_seconds,
+                chi2: r.chi2.statistic,
+                dof: r.chi2.dof,
+                p_value: r.chi2.p_value,
+                albedo: r.weighted.as_ref().map(|w| AlbedoSummary {
+                    albedo: w.check.albedo,
+                    reference: w.check.reference,
+                    relative_error: w.check.relative_error,
+                    p_value: w.check.p_value,
+                    max_weight_error: w.check.max_weight_error,
+                    passed: w.check.passed,
+                }),
+                max_angle_rad: r.angle.as_ref().map(|a| a.max_angle_rad),
+            }),
+            error: None,
+            output: Some(out.join(&r.case.name)),
+        }
+    }
+
+    /// The summary of a case that could not run.
+    pub fn error(case: &crate::scene::Case, error: String) -> Self {
+        CaseSummary {
+            case: case.name.clone(),
+            samples: case.samples,
+            shards: None,
+            backend: None,
+            passed: false,
+            measured: None,
+            error: Some(error),
+            output: None,
+        }
+    }
+}
+
+/// The `--json` summary of `lobes run --shard I/N`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ShardSummary {
+    /// [`SUMMARY_VERSION`].
+    pub format_version: u32,
+    pub shard: crate::run::shard::Shard,
+    pub adapter: String,
+    pub backend: String,
+    pub scene_fnv1a64: String,
+    pub cases: Vec<ShardCaseSummary>,
+}
+
+/// One case of a [`ShardSummary`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ShardCaseSummary {
+    pub case: String,
+    /// The shard's sample range `first .. end`, and its length.
+    pub first: u64,
+    pub end: u64,
+    pub samples: u64,
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+    /// The shard file written.
+    pub file: PathBuf,
+}
+
+impl ShardCaseSummary {
+    pub fn of(shard: &ShardFile, file: PathBuf) -> Self {
+        ShardCaseSummary {
+            case: shard.case.clone(),
+            first: shard.first,
+            end: shard.end,
+            samples: shard.end - shard.first,
+            gpu_seconds: shard.timing.gpu_seconds,
+            wall_seconds: shard.timing.histogram_wall_seconds,
+            file,
+        }
+    }
 }
 
 /// One line of the run table.

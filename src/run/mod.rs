@@ -1,7 +1,14 @@
-//! Running a case end to end: histogram on the GPU (or the CPU engine), expected counts in f64,
-//! the χ² verdict and the per-sample check.
+//! Running a case end to end: [`run_case`] samples a range of it on the GPU (or the CPU engine),
+//! [`judge`] computes the expected counts in f64 and the verdicts. A whole run is one range;
+//! scale-out runs shards of it ([`shard`]) and adds them up ([`merge`]) before judging.
+//! [`record`] holds the parts of the output files that shard files and `histogram.json` share.
+
+pub mod merge;
+pub mod record;
+pub mod shard;
 
 use crate::engine::cpu;
+use crate::engine::gpu::effects::Specialisation;
 use crate::engine::gpu::{GpuEngine, GpuError, WeightedRun};
 use crate::engine::job::{Counts, Job, SampleRange};
 use crate::scene::Case;
@@ -9,7 +16,7 @@ use crate::stats::chi2::Chi2;
 use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::Quadrature;
 use crate::stats::weighted::{self, AlbedoCheck, WeightedSums};
-use crate::engine::gpu::effects::Specialisation;
+use std::ops::Range;
 use std::time::Instant;
 
 /// Samples regenerated on the CPU for the per-sample check.
@@ -81,92 +88,89 @@ impl CaseResult {
     }
 }
 
-/// The samples `first .. first + count` of a case.
-fn samples(case: &Case, first: u64, count: u64) -> SampleRange {
-    SampleRange { seed: case.seed, first, count }
-}
-
-/// The weighted sums of samples `first .. first + samples` of a case with effects, with the
-/// specialised module on the GPU.
-pub fn weighted_sums(backend: &mut Backend, case: &Case, first: u64, count: u64) -> anyhow::Result<WeightedRun> {
-    let effects = case.effects.as_ref().expect("a weighted case");
-    let range = samples(case, first, count);
-    Ok(match backend {
-        Backend::Gpu(engine) => engine.weighted(&case.job, effects, range, Specialisation::Specialised)?,
-        Backend::Cpu => {
-            let t = Instant::now();
-            let sums = cpu::weighted(&case.job, effects, range);
-            WeightedRun { sums, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64() }
-        }
-    })
-}
-
-/// Judges the weighted sums of a whole case.
-pub fn judge_weighted(case: &Case, run: WeightedRun, significance: f64) -> WeightedResult {
-    let effects = case.effects.as_ref().expect("a weighted case");
-    let check = weighted::albedo_check(&case.job, effects, &run.sums, case.samples, significance, &Quadrature::default());
-    WeightedResult { sums: run.sums, check, gpu_seconds: run.gpu_seconds, wall_seconds: run.wall_seconds }
-}
-
-/// The histogram of some samples of a case, and its times.
+/// What samples `range` of a case produced, before any verdict: the raw material of a shard
+/// file and, added over shards ([`Sampled::add`]), of a merged case.
 #[derive(Debug, Clone)]
-pub struct HistogramRun {
+pub struct Sampled {
     pub counts: Counts,
-    /// GPU time of the sampling passes (timestamp queries), where there are any.
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
-    /// Whether the GPU counted bins in workgroup memory (None on the CPU engine).
     pub workgroup_counting: Option<bool>,
+    /// The per-sample check: only for a range that starts at sample 0, on the GPU.
+    pub angle: Option<AngleCheck>,
+    /// The weighted pass of a case with effects.
+    pub weighted: Option<WeightedRun>,
 }
 
-/// Histograms samples `first .. first + count` of a case on `backend`.
-pub fn histogram(backend: &mut Backend, case: &Case, first: u64, count: u64, progress: &mut dyn FnMut(u64)) -> anyhow::Result<HistogramRun> {
-    let range = samples(case, first, count);
-    Ok(match backend {
+impl Sampled {
+    /// Adds the results of another range of the same case (shards add exactly): counts and
+    /// sums add, times add (GPU time only where both have it), workgroup counting is kept
+    /// where both agree, and the per-sample check is whichever range has one.
+    pub fn add(&mut self, other: &Sampled) {
+        self.counts.add(&other.counts);
+        self.gpu_seconds = self.gpu_seconds.zip(other.gpu_seconds).map(|(a, b)| a + b);
+        self.wall_seconds += other.wall_seconds;
+        if self.workgroup_counting != other.workgroup_counting {
+            self.workgroup_counting = None;
+        }
+        if self.angle.is_none() {
+            self.angle.clone_from(&other.angle);
+        }
+        if let (Some(a), Some(b)) = (&mut self.weighted, &other.weighted) {
+            a.sums.add(&b.sums);
+            a.gpu_seconds = a.gpu_seconds.zip(b.gpu_seconds).map(|(x, y)| x + y);
+            a.wall_seconds += b.wall_seconds;
+        }
+    }
+}
+
+/// Samples `range` of a case on `backend`: the histogram, the per-sample check where the
+/// range starts at sample 0 (GPU only: the first [`ANGLE_CHECK_SAMPLES`] directions against
+/// f64), and the weighted sums of a case with effects. `lobes run` runs `0 .. samples`,
+/// `lobes run --shard I/N` its shard's range.
+pub fn run_case(backend: &mut Backend, case: &Case, range: Range<u64>, progress: &mut dyn FnMut(u64)) -> anyhow::Result<Sampled> {
+    let (first, n) = (range.start, range.end - range.start);
+    let samples = SampleRange { seed: case.seed, first, count: n };
+    let mut sampled = match backend {
         Backend::Gpu(engine) => {
-            let r = engine.histogram(&case.job, range, progress)?;
-            HistogramRun { counts: r.counts, gpu_seconds: r.gpu_seconds, wall_seconds: r.wall_seconds, workgroup_counting: Some(r.workgroup_counting) }
+            let r = engine.histogram(&case.job, samples, progress)?;
+            let workgroup_counting = Some(r.workgroup_counting);
+            Sampled { counts: r.counts, gpu_seconds: r.gpu_seconds, wall_seconds: r.wall_seconds, workgroup_counting, angle: None, weighted: None }
         }
         Backend::Cpu => {
             let t = Instant::now();
-            let counts = cpu::histogram(&case.job, range);
-            progress(count);
-            HistogramRun { counts, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64(), workgroup_counting: None }
+            let counts = cpu::histogram(&case.job, samples);
+            progress(n);
+            Sampled { counts, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64(), workgroup_counting: None, angle: None, weighted: None }
         }
-    })
-}
-
-/// The verdict on the counts of a whole case.
-#[derive(Debug, Clone)]
-pub struct Verdict {
-    pub expected: ExpectedCounts,
-    pub chi2: Chi2,
-    /// Time of the f64 quadrature of the expected counts.
-    pub quadrature_seconds: f64,
-    /// The per-sample check, on the GPU for a lobe.
-    pub angle: Option<AngleCheck>,
-}
-
-/// Judges counts of a whole case: expected counts, χ² at `significance`, per-sample check.
-pub fn judge(backend: &mut Backend, case: &Case, counts: Counts, significance: f64) -> anyhow::Result<Verdict> {
-    let t = Instant::now();
-    let expected = compare::expected_counts(&case.job, case.samples, &Quadrature::default());
-    let quadrature_seconds = t.elapsed().as_secs_f64();
-    let chi2 = compare::chi2_test(&counts, &expected, significance);
-    let angle = match (backend, &case.job) {
-        (Backend::Gpu(engine), Job::Lobe { .. }) => {
-            let n = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
-            let dirs = engine.directions(&case.job, samples(case, 0, n as u64))?;
-            Some(compare::angle_check(&case.job, case.seed, 0, &dirs))
-        }
-        _ => None,
     };
-    Ok(Verdict { expected, chi2, quadrature_seconds, angle })
+    let total = sampled.counts.total();
+    anyhow::ensure!(total == n, "case '{}': {total} samples counted for {n} requested", case.name);
+    if let (Backend::Gpu(engine), Job::Lobe { .. }) = (&mut *backend, &case.job) {
+        if first == 0 {
+            let k = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
+            let dirs = engine.directions(&case.job, SampleRange::whole(case.seed, k as u64))?;
+            sampled.angle = Some(compare::angle_check(&case.job, case.seed, 0, &dirs));
+        }
+    }
+    if let Some(effects) = &case.effects {
+        sampled.weighted = Some(match backend {
+            Backend::Gpu(engine) => engine.weighted(&case.job, effects, samples, Specialisation::Specialised)?,
+            Backend::Cpu => {
+                let t = Instant::now();
+                let sums = cpu::weighted(&case.job, effects, samples);
+                WeightedRun { sums, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64() }
+            }
+        });
+    }
+    Ok(sampled)
 }
 
-/// Runs one case: all its samples, then the verdict.
-pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
-    let HistogramRun { counts, gpu_seconds, wall_seconds: histogram_seconds, workgroup_counting } = histogram(backend, case, 0, case.samples, progress)?;
+/// Judges all samples of a case (one range `0 .. samples`, or its shards added up): the
+/// expected counts in f64, the χ² test at per-case `significance`, and the albedo checks of a
+/// weighted case.
+pub fn judge(case: &Case, sampled: Sampled, significance: f64) -> anyhow::Result<CaseResult> {
+    let Sampled { counts, gpu_seconds, wall_seconds, workgroup_counting, angle, weighted } = sampled;
     anyhow::ensure!(
         counts.total() == case.samples,
         "case '{}': {} samples counted for {} requested",
@@ -174,12 +178,30 @@ pub fn run_case(backend: &mut Backend, case: &Case, significance: f64, progress:
         counts.total(),
         case.samples
     );
-    let Verdict { expected, chi2, quadrature_seconds, angle } = judge(backend, case, counts.clone(), significance)?;
-    let weighted = match &case.effects {
-        Some(_) => Some(judge_weighted(case, weighted_sums(backend, case, 0, case.samples)?, significance)),
-        None => None,
+    let t = Instant::now();
+    let expected = compare::expected_counts(&case.job, case.samples, &Quadrature::default());
+    let quadrature_seconds = t.elapsed().as_secs_f64();
+    let chi2 = compare::chi2_test(&counts, &expected, significance);
+    let weighted = match (&case.effects, weighted) {
+        (None, _) => None,
+        (Some(effects), Some(w)) => {
+            let check = weighted::albedo_check(&case.job, effects, &w.sums, case.samples, significance, &Quadrature::default());
+            Some(WeightedResult { sums: w.sums, check, gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds })
+        }
+        (Some(_), None) => anyhow::bail!("case '{}' is weighted but has no weighted sums", case.name),
     };
-    Ok(CaseResult { case: case.clone(), counts, expected, chi2, gpu_seconds, histogram_seconds, quadrature_seconds, angle, workgroup_counting, weighted })
+    Ok(CaseResult {
+        case: case.clone(),
+        counts,
+        expected,
+        chi2,
+        gpu_seconds,
+        histogram_seconds: wall_seconds,
+        quadrature_seconds,
+        angle,
+        workgroup_counting,
+        weighted,
+    })
 }
 
 /// Whether `err` left the GPU device unusable, so that `lobes run` moves the remaining cases

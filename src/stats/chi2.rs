@@ -9,7 +9,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 pub const MIN_EXPECTED: f64 = 5.0;
 
 /// The outcome of a χ² test.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Chi2 {
     pub statistic: f64,
     pub dof: u64,
@@ -18,6 +18,7 @@ pub struct Chi2 {
     pub significance: f64,
     pub passed: bool,
     /// Observed samples in cells whose expected count is exactly 0 (any rejects the sampler).
+    #[serde(rename = "samples_in_zero_probability_cells")]
     pub in_impossible_cells: u64,
 }
 

@@ -44,7 +44,7 @@ pub fn chi2_test(counts: &Counts, expected: &ExpectedCounts, significance: f64) 
 
 /// GPU directions against the f64 reference, sample by sample: `lobes run`'s per-sample check
 /// and `lobes tradeoff`'s angle per precision.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize, schemars::JsonSchema)]
 pub struct AngleCheck {
     /// Samples compared (valid on both sides).
     pub compared: u64,

@@ -13,7 +13,7 @@ pub const SQUARE_SCALE: f64 = 65536.0;
 pub const WEIGHT_LIMIT: f64 = (1u64 << 23) as f64;
 
 /// The raw result of a weighted run, exactly as summed (shards add exactly).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct WeightedSums {
     /// Σ w per bin, in units of 2⁻²⁰.
     pub bins: Vec<u64>,
@@ -138,7 +138,7 @@ mod tests {
 }
 
 /// The verdict on a weighted histogram.
-#[derive(Clone, Serialize)]
+#[derive(Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct AlbedoCheck {
     /// Σ w / N over the bins.
     pub albedo: f64,

@@ -1,0 +1,125 @@
+//! The parts of lobes' output files that shard files ([`super::shard::ShardFile`]) and
+//! `histogram.json` ([`crate::report::output::HistogramFile`]) share: what a case samples,
+//! counts by invalid reason, and the histogram's timing. Writers and readers use the same
+//! structs.
+
+use crate::engine::job::Job;
+use crate::reference::Invalid;
+use crate::scene::Case;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// What a case samples: `lobe`, `method`, `params`, and the histogram's `rows` × `cols`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CaseDescription {
+    /// `ward`, `beckmann`, `ggx` or `discrete`.
+    pub lobe: String,
+    /// `ndf`, `vndf`, `bounded`, or for a discrete case `cdf` or `alias`.
+    pub method: String,
+    pub params: Params,
+    /// Rows over cos θ (1 for a discrete case).
+    pub rows: usize,
+    /// Columns over φ (the items of a discrete case).
+    pub cols: usize,
+}
+
+/// A case's parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(untagged)]
+pub enum Params {
+    Lobe { alpha_x: f64, alpha_y: f64, incident_theta_deg: f64, incident_phi_deg: f64 },
+    Discrete { weights: Vec<f64> },
+}
+
+impl CaseDescription {
+    pub fn of(case: &Case) -> Self {
+        match &case.job {
+            Job::Lobe { lobe, grid, .. } => CaseDescription {
+                lobe: lobe.kind.name().into(),
+                method: lobe.method.name().into(),
+                params: Params::Lobe {
+                    alpha_x: lobe.alpha_x,
+                    alpha_y: lobe.alpha_y,
+                    incident_theta_deg: case.incident_deg.0,
+                    incident_phi_deg: case.incident_deg.1,
+                },
+                rows: grid.rows as usize,
+                cols: grid.cols as usize,
+            },
+            Job::Discrete { dist, method } => CaseDescription {
+                lobe: "discrete".into(),
+                method: format!("{method:?}").to_lowercase(),
+                params: Params::Discrete { weights: dist.weights().to_vec() },
+                rows: 1,
+                cols: dist.len(),
+            },
+        }
+    }
+}
+
+/// One value per invalid reason ([`Invalid::ALL`], whose names are the keys).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ByReason<T> {
+    pub non_finite_direction: T,
+    pub below_horizon: T,
+    pub non_finite_pdf: T,
+    pub zero_pdf: T,
+}
+
+impl<T: Copy> From<[T; 4]> for ByReason<T> {
+    /// From values in the order of [`Invalid::ALL`].
+    fn from([non_finite_direction, below_horizon, non_finite_pdf, zero_pdf]: [T; 4]) -> Self {
+        ByReason { non_finite_direction, below_horizon, non_finite_pdf, zero_pdf }
+    }
+}
+
+impl<T: Copy> From<ByReason<T>> for [T; 4] {
+    /// To values in the order of [`Invalid::ALL`].
+    fn from(r: ByReason<T>) -> Self {
+        [r.non_finite_direction, r.below_horizon, r.non_finite_pdf, r.zero_pdf]
+    }
+}
+
+impl<T> ByReason<T> {
+    /// The value for `reason`.
+    pub fn get(&self, reason: Invalid) -> &T {
+        match reason {
+            Invalid::NonFiniteDirection => &self.non_finite_direction,
+            Invalid::BelowHorizon => &self.below_horizon,
+            Invalid::NonFinitePdf => &self.non_finite_pdf,
+            Invalid::ZeroPdf => &self.zero_pdf,
+        }
+    }
+}
+
+/// The histogram pass's time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Timing {
+    /// From GPU timestamp queries; null where the adapter has none (and on the CPU engine).
+    pub gpu_seconds: Option<f64>,
+    pub histogram_wall_seconds: f64,
+}
+
+/// The weighted pass's time.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct WeightedTiming {
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reasons_are_keyed_by_their_names_in_order() {
+        let v = serde_json::to_value(ByReason::from([10u64, 11, 12, 13])).unwrap();
+        for (i, r) in Invalid::ALL.into_iter().enumerate() {
+            assert_eq!(v[r.name()], 10 + i as u64, "{}", r.name());
+            assert_eq!(*ByReason::from([10u64, 11, 12, 13]).get(r), 10 + i as u64);
+        }
+        assert_eq!(v.as_object().unwrap().len(), 4);
+        let back: [u64; 4] = serde_json::from_value::<ByReason<u64>>(v).unwrap().into();
+        assert_eq!(back, [10, 11, 12, 13]);
+    }
+}
