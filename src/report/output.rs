@@ -1,7 +1,8 @@
 //! Per-case outputs: `histogram.json` and PNG heat maps of the measured histogram, the
 //! expected one and the signed residual (measured − expected)/√expected; shard files; and the
 //! `--json` summaries of `lobes run` and `lobes merge`. Each is a serde struct that writer and
-//! reader share, with a `format_version`. Every file is written atomically ([`super::atomic`]), and
+//! reader share, with a `format_version`; `docs/schema/` holds their JSON Schema
+//! ([`super::schema`]). Every file is written atomically ([`super::atomic`]), and
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
 
 use super::atomic::write_atomic;

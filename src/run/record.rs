@@ -1,7 +1,7 @@
 //! The parts of lobes' output files that shard files ([`super::shard::ShardFile`]) and
 //! `histogram.json` ([`crate::report::output::HistogramFile`]) share: what a case samples,
 //! counts by invalid reason, and the histogram's timing. Writers and readers use the same
-//! structs.
+//! structs; `docs/schema/` holds their JSON Schema ([`crate::report::schema`]).
 
 use crate::engine::job::Job;
 use crate::reference::Invalid;

@@ -1,0 +1,154 @@
+//! The JSON Schemas in `docs/schema/` are those generated from the output structs, and every
+//! JSON file lobes writes validates against its schema: `histogram.json` of a run and of a
+//! merge, shard files, and the `--json` summaries of `lobes run`, `lobes run --shard` and
+//! `lobes merge`. The files read back through the same structs that wrote them.
+//! GPU test: it needs a wgpu adapter (lavapipe in CI) and fails without one.
+//!
+//! After a change to an output struct, regenerate the schemas with
+//! `LOBES_WRITE_SCHEMA=1 cargo test --release --test schema`.
+
+use lobes::report::output::{CaseSummary, HistogramFile, RunSummary, SUMMARY_VERSION, ShardSummary};
+use lobes::report::schema::{schemas, to_text};
+use lobes::run::shard::ShardFile;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
+
+fn docs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/schema")
+}
+
+#[test]
+fn published_schemas_are_up_to_date() {
+    let write = std::env::var_os("LOBES_WRITE_SCHEMA").is_some();
+    for (name, schema) in schemas() {
+        let path = docs().join(name);
+        let text = to_text(&schema);
+        if write {
+            std::fs::create_dir_all(docs()).unwrap();
+            std::fs::write(&path, &text).unwrap();
+        }
+        let stored = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            stored == text,
+            "{} is not the schema generated from the structs; regenerate it with \
+             `LOBES_WRITE_SCHEMA=1 cargo test --release --test schema`",
+            path.display()
+        );
+    }
+}
+
+/// Validates `instance` against the published schema `name`; the errors name the JSON paths.
+fn validate(name: &str, instance: &Value, what: &str) {
+    let schema: Value = serde_json::from_str(&std::fs::read_to_string(docs().join(name)).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap_or_else(|e| panic!("{name} is not a valid schema: {e}"));
+    let errors: Vec<String> = validator.iter_errors(instance).map(|e| format!("{}: {e}", e.instance_path())).collect();
+    assert!(errors.is_empty(), "{what} does not validate against {name}:\n{}", errors.join("\n"));
+}
+
+fn file(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))).unwrap()
+}
+
+fn lobes(dir: &Path, args: &[&str]) -> Value {
+    let out = Command::new(LOBES).current_dir(dir).args(args).output().expect("run lobes");
+    assert!(out.status.success(), "lobes {}: {}", args.join(" "), String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+/// A lobe case, a weighted lobe case and a discrete case: every optional section appears.
+const SCENE: &str = r#"
+[defaults]
+samples = 40_000
+bins = [8, 16]
+seed = 3
+
+[[case]]
+name = "ggx"
+lobe = "ggx"
+method = "vndf"
+alpha = 0.4
+incident_theta = 30.0
+
+[[case]]
+name = "weighted"
+lobe = "beckmann"
+alpha = 0.5
+incident_theta = 60.0
+fresnel = "schlick"
+f0 = 0.04
+masking = "height-correlated"
+
+[[case]]
+name = "alias"
+lobe = "discrete"
+method = "alias"
+weights = [1, 2, 3, 4]
+"#;
+
+#[test]
+fn every_file_lobes_writes_validates_against_its_schema() {
+    if let Err(e) = lobes::engine::gpu::GpuEngine::open() {
+        panic!("GPU tests need a wgpu adapter: {e}");
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("schema-outputs");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("scene.toml"), SCENE).unwrap();
+    let cases = ["ggx", "weighted", "alias"];
+
+    let run = lobes(&dir, &["run", "scene.toml", "--out", "full", "--json"]);
+    validate("run-summary.schema.json", &run, "the summary of lobes run");
+    let summary: RunSummary = serde_json::from_value(run).unwrap();
+    assert_eq!(summary.format_version, SUMMARY_VERSION);
+    assert_eq!(summary.cases.iter().map(|c| c.case.as_str()).collect::<Vec<_>>(), cases);
+
+    for i in 0..2 {
+        let shard = lobes(&dir, &["run", "scene.toml", "--shard", &format!("{i}/2"), "--out", "parts", "--json"]);
+        validate("shard-summary.schema.json", &shard, "the summary of lobes run --shard");
+        let shard: ShardSummary = serde_json::from_value(shard).unwrap();
+        for c in &shard.cases {
+            let path = dir.join(&c.file);
+            validate("shard.schema.json", &file(&path), &path.display().to_string());
+            let back = ShardFile::read(&path).unwrap();
+            assert_eq!((back.first, back.end), (c.first, c.end));
+        }
+    }
+    let merge = lobes(&dir, &["merge", "parts", "--out", "merged", "--json"]);
+    validate("run-summary.schema.json", &merge, "the summary of lobes merge");
+    let merged: RunSummary = serde_json::from_value(merge).unwrap();
+    assert_eq!(merged.shard_files, Some(6));
+
+    for out in ["full", "merged"] {
+        for case in cases {
+            let path = dir.join(out).join(case).join("histogram.json");
+            validate("histogram.schema.json", &file(&path), &path.display().to_string());
+            let h = HistogramFile::read(&path).unwrap();
+            // what the struct reads is all the file holds: written again, it is the same text
+            assert!(serde_json::to_string_pretty(&h).unwrap() == std::fs::read_to_string(&path).unwrap(), "{}", path.display());
+            assert_eq!(h.weighted.is_some(), case == "weighted");
+            assert_eq!(h.per_sample_check.is_some(), case != "alias", "{}", path.display());
+        }
+    }
+
+    // the schemas are not vacuous: a damaged file does not validate
+    let schema: Value = serde_json::from_str(&std::fs::read_to_string(docs().join("histogram.schema.json")).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    let mut damaged = file(&dir.join("full/ggx/histogram.json"));
+    damaged["counts"][0][0] = (-1).into();
+    assert!(!validator.is_valid(&damaged));
+    damaged.as_object_mut().unwrap().remove("chi2");
+    assert!(validator.iter_errors(&damaged).any(|e| e.to_string().contains("\"chi2\" is a required property")));
+
+    // a case that could not run: the error row of a summary
+    let mut with_error = summary.clone();
+    let scene = lobes::scene::Scene::parse("scene.toml", SCENE).unwrap();
+    with_error.cases.push(CaseSummary::error(&scene.cases[0], "the GPU device was lost".into()));
+    with_error.errors = 1;
+    let v = serde_json::to_value(&with_error).unwrap();
+    validate("run-summary.schema.json", &v, "a summary with an error row");
+    assert_eq!(serde_json::from_value::<RunSummary>(v).unwrap(), with_error);
+    let _ = std::fs::remove_dir_all(&dir);
+}
