@@ -2,4 +2,5 @@
 
 pub mod heatmap;
 pub mod output;
+pub mod table;
 pub mod tradeoff;
