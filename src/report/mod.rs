@@ -1,6 +1,13 @@
-//! Reports: per-case JSON and PNG heat maps, and the run table.
+//! Reports: per-case JSON and PNG heat maps, the run table, and `lobes tradeoff`'s outputs.
+//!
+//! [`heatmap`] lays out a heat map from a [`colour`] scale, [`label`]s and [`text`], and
+//! [`png`] encodes it; [`table`] prints terminal tables; [`output`] writes a case's files.
 
+pub mod colour;
 pub mod heatmap;
+pub mod label;
 pub mod output;
+pub mod png;
 pub mod table;
+pub mod text;
 pub mod tradeoff;

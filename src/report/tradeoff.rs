@@ -2,11 +2,11 @@
 //! against time, one panel per sampler, one curve per precision, with the 1/√N line) and
 //! `tradeoff.json`; each written under a temporary name and renamed into place.
 
-use super::heatmap::{draw_text, fill_rect, text_width};
+use super::heatmap::fill_rect;
+use super::text::{draw_text, text_width};
 use super::output::write_atomic;
 use crate::experiments::tradeoff::{MethodPoint, Precision, QuadraturePoint, Sweep, SweepPoint};
-use image::codecs::png::PngEncoder;
-use image::{ExtendedColorType, ImageEncoder, Rgb, RgbImage};
+use image::{Rgb, RgbImage};
 use serde::Serialize;
 use std::path::Path;
 
@@ -315,16 +315,10 @@ pub fn plot(sweep: &Sweep) -> RgbImage {
     img
 }
 
-fn png_bytes(img: &RgbImage) -> anyhow::Result<Vec<u8>> {
-    let mut buf = Vec::new();
-    PngEncoder::new(&mut buf).write_image(img.as_raw(), img.width(), img.height(), ExtendedColorType::Rgb8)?;
-    Ok(buf)
-}
-
 /// Writes tradeoff.png, tradeoff.json and tradeoff.md into `dir` (created if missing).
 pub fn write(dir: &Path, r: &Report) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir)?;
-    write_atomic(&dir.join("tradeoff.png"), &png_bytes(&plot(&r.sweep))?)?;
+    write_atomic(&dir.join("tradeoff.png"), &super::png::encode(&plot(&r.sweep))?)?;
     write_atomic(&dir.join("tradeoff.json"), serde_json::to_string_pretty(r)?.as_bytes())?;
     write_atomic(&dir.join("tradeoff.md"), markdown(r).as_bytes())?;
     Ok(())
