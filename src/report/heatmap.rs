@@ -236,7 +236,7 @@ fn draw_axis_labels(img: &mut RgbImage, h: &Heatmap, lay: &Layout) {
 }
 
 /// Fills a rectangle, clipped to the image.
-pub(crate) fn fill_rect(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, rgb: Rgb<u8>) {
+fn fill_rect(img: &mut RgbImage, x: u32, y: u32, w: u32, h: u32, rgb: Rgb<u8>) {
     let (x1, y1) = (
         x.saturating_add(w).min(img.width()),
         y.saturating_add(h).min(img.height()),
