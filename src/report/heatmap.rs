@@ -10,8 +10,9 @@ use super::colour::{Mapping, NAN_GREY, colour, value_colour};
 use super::label::{axis_text, compact};
 use super::text::{LINE_H, draw_text, text_width};
 use image::{Rgb, RgbImage};
-use std::io;
-use std::path::Path;
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use super::colour::Scale;
 
@@ -81,10 +82,33 @@ pub fn render(h: &Heatmap) -> RgbImage {
     img
 }
 
-/// Renders `h` and writes it as a PNG to `path`, atomically.
+/// Renders `h` and writes it as a PNG to `path`, atomically: the file goes to a temporary
+/// name in the same directory, is synced, and is then renamed over `path`.
 pub fn write_png(h: &Heatmap, path: &Path) -> io::Result<()> {
     let png = super::png::encode(&render(h)).map_err(io::Error::other)?;
-    super::output::write_atomic(path, &png)
+    let tmp = temp_path(path);
+    let result = write_synced(&tmp, &png).and_then(|()| std::fs::rename(&tmp, path));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// A hidden, unique sibling of `path` to write into before renaming.
+fn temp_path(path: &Path) -> PathBuf {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let name = path
+        .file_name()
+        .map_or("heatmap".into(), |n| n.to_string_lossy());
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
+}
+
+/// Writes `bytes` into a new file at `path` and syncs it to disk.
+fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = std::fs::File::create(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()
 }
 
 /// Value of cell `i` (row-major); missing cells read as NaN.
