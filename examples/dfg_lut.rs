@@ -241,15 +241,8 @@ pub fn write_outputs(dir: &Path, lut: &[[f32; 2]]) -> anyhow::Result<()> {
     lobes::report::atomic::write_atomic(&dir.join("dfg.f32"), &raw)?;
     let to8 = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     let rgb: Vec<u8> = lut.iter().flat_map(|t| [to8(t[0]), to8(t[1]), 0]).collect();
-    let mut png = Vec::new();
-    image::ImageEncoder::write_image(
-        image::codecs::png::PngEncoder::new(&mut png),
-        &rgb,
-        SIZE,
-        SIZE,
-        image::ExtendedColorType::Rgb8,
-    )?;
-    lobes::report::atomic::write_atomic(&dir.join("dfg.png"), &png)?;
+    let img = image::RgbImage::from_raw(SIZE, SIZE, rgb).expect("SIZE × SIZE RGB texels");
+    lobes::report::atomic::write_atomic(&dir.join("dfg.png"), &lobes::report::png::encode(&img)?)?;
     Ok(())
 }
 

@@ -6,6 +6,7 @@ use crate::engine::cpu;
 use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Job, SampleRange};
 use crate::reference::{Lobe, SAMPLERS, reflect};
+use crate::report::table;
 use crate::stats::histogram::SphereGrid;
 use crate::stats::median::median;
 use clap::Args;
@@ -126,12 +127,18 @@ fn run_effects(args: &BenchArgs, scene: &std::path::PathBuf) -> anyhow::Result<(
 weighted pass, median of {runs} runs; ratio = uber-kernel time / specialised time (median of per-run ratios)
 
 ");
-    text += &format!("{:<28} {:>10} {:>14} {:>14} {:>7}
-", "case", "samples", "specialised s", "uber s", "ratio");
-    for r in &results {
-        text += &format!("{:<28} {:>10} {:>14.4} {:>14.4} {:>7.2}
-", r.case, r.samples, r.specialised_seconds, r.uber_seconds, r.ratio);
-    }
+    text += &table::render(
+        &["case", "samples", "specialised s", "uber s", "ratio"],
+        results.iter().map(|r| {
+            vec![
+                r.case.clone(),
+                r.samples.to_string(),
+                format!("{:.4}", r.specialised_seconds),
+                format!("{:.4}", r.uber_seconds),
+                format!("{:.2}", r.ratio),
+            ]
+        }),
+    );
     let geo = (results.iter().map(|r| r.ratio.ln()).sum::<f64>() / results.len() as f64).exp();
     text += &format!("
 geometric mean of the ratios: {geo:.2}
@@ -173,9 +180,18 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         return emit_json(&serde_json::json!({"adapter": adapter, "runs": runs, "results": results}));
     }
     let mut text = format!("adapter: {adapter}\nmedian of {runs} runs, 64 x 128 bins, alpha {}, 45 deg incidence\n\n", args.alpha);
-    text += &format!("{:<10} {:<8} {:<22} {:>12} {:>10} {:>14}\n", "lobe", "method", "backend", "samples", "seconds", "samples/s");
-    for r in &results {
-        text += &format!("{:<10} {:<8} {:<22} {:>12} {:>10.4} {:>14.3e}\n", r.lobe, r.method, r.backend, r.samples, r.seconds, r.samples_per_second);
-    }
+    text += &table::render(
+        &["lobe", "method", "backend", "samples", "seconds", "samples/s"],
+        results.iter().map(|r| {
+            vec![
+                r.lobe.clone(),
+                r.method.clone(),
+                r.backend.clone(),
+                r.samples.to_string(),
+                format!("{:.4}", r.seconds),
+                format!("{:.3e}", r.samples_per_second),
+            ]
+        }),
+    );
     emit(&text)
 }

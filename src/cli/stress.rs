@@ -4,6 +4,7 @@
 use super::{OutputArgs, emit, emit_json};
 use crate::engine::gpu::GpuEngine;
 use crate::experiments::stress;
+use crate::report::table;
 use clap::Args;
 
 #[derive(Debug, Clone, Args)]
@@ -36,14 +37,23 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
         emit_json(&serde_json::json!({"rows": rows, "failed": failed,
             "direction_bound_rad": stress::DIRECTION_BOUND, "unit_bound_f32": stress::UNIT_BOUND_F32}))?;
     } else {
-        let mut t = format!("{:<34} {:<8} {:>5} {:>5} {:>10} {:>5} {:>5} {:>10}  verdict\n", "case", "kernel", "n", "valid", "unit err", "bad", "mism", "angle rad");
-        for r in rows.iter().filter(|r| !args.failures || !r.passed) {
-            t += &format!(
-                "{:<34} {:<8} {:>5} {:>5} {:>10.2e} {:>5} {:>5} {:>10.2e}  {}\n",
-                r.case, r.kernel, r.samples, r.valid, r.worst_unit_error, r.bad_values, r.validity_mismatches, r.worst_angle_rad,
-                if r.passed { "pass" } else { "FAIL" }
-            );
-        }
+        let shown = rows.iter().filter(|r| !args.failures || !r.passed);
+        let mut t = table::render(
+            &["case", "kernel", "n", "valid", "unit err", "bad", "mism", "angle rad", "verdict"],
+            shown.map(|r| {
+                vec![
+                    r.case.clone(),
+                    r.kernel.to_string(),
+                    r.samples.to_string(),
+                    r.valid.to_string(),
+                    format!("{:.2e}", r.worst_unit_error),
+                    r.bad_values.to_string(),
+                    r.validity_mismatches.to_string(),
+                    format!("{:.2e}", r.worst_angle_rad),
+                    if r.passed { "pass" } else { "FAIL" }.to_string(),
+                ]
+            }),
+        );
         t += &format!("\n{} rows, {failed} failed\n", rows.len());
         emit(&t)?;
     }

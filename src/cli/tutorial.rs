@@ -9,11 +9,11 @@ use super::{
 use crate::engine::job::DiscreteMethod;
 use crate::reference::discrete::{AliasTable, DiscreteSample, Distribution};
 use crate::reference::{Invalid, reflect};
+use crate::report::table;
 use clap::builder::PossibleValue;
 use clap::{Args, ValueEnum};
 use glam::DVec3;
 use serde::Serialize;
-use std::fmt::Write as _;
 
 /// `--method` takes the library's [`DiscreteMethod`] by its names; clap stays inside `cli/`.
 impl ValueEnum for DiscreteMethod {
@@ -116,21 +116,24 @@ pub fn discrete(args: &DiscreteArgs) -> anyhow::Result<()> {
     if args.output.json {
         return emit_json(&r);
     }
-    let mut t = String::new();
-    writeln!(t, "distribution ({} entries)", r.weights.len())?;
-    writeln!(t, "{:>6}  {:>12}  {:>10}  {:>10}", "index", "weight", "pmf", "cdf")?;
-    for (i, ((w, p), c)) in r.weights.iter().zip(&r.pmf).zip(&r.cdf).enumerate() {
-        writeln!(t, "{i:>6}  {w:>12}  {p:>10.6}  {c:>10.6}")?;
-    }
+    let mut t = format!("distribution ({} entries)\n", r.weights.len());
+    t += &table::render(
+        &["index", "weight", "pmf", "cdf"],
+        r.weights.iter().zip(&r.pmf).zip(&r.cdf).enumerate().map(|(i, ((w, p), c))| {
+            vec![i.to_string(), w.to_string(), format!("{p:.6}"), format!("{c:.6}")]
+        }),
+    );
     let method = match r.method {
         DiscreteMethod::Cdf => "cdf (first CDF entry ≥ u)",
         DiscreteMethod::Alias => "alias (Walker/Vose, one uniform)",
     };
-    writeln!(t, "\ndraws, method {method}")?;
-    writeln!(t, "{:>10}  {:>6}  {:>12}  {:>11}  {:>10}", "u", "index", "value", "probability", "cdf")?;
-    for s in &r.samples {
-        writeln!(t, "{:>10}  {:>6}  {:>12}  {:>11.6}  {:>10.6}", s.u, s.index, s.value, s.probability, s.cdf)?;
-    }
+    t += &format!("\ndraws, method {method}\n");
+    t += &table::render(
+        &["u", "index", "value", "probability", "cdf"],
+        r.samples.iter().map(|s| {
+            vec![s.u.to_string(), s.index.to_string(), s.value.to_string(), format!("{:.6}", s.probability), format!("{:.6}", s.cdf)]
+        }),
+    );
     emit(&t)
 }
 
@@ -206,16 +209,21 @@ pub fn pdf_convert(args: &PdfConvertArgs) -> anyhow::Result<()> {
     if args.output.json {
         return emit_json(&r);
     }
-    let mut t = String::new();
-    writeln!(t, "{:<24}{}", "p(ωh)", r.pdf_h)?;
-    writeln!(t, "{:<24}{}°, {}° (in plane, same side)", "θh, θi", r.theta_h_deg, r.theta_i_deg)?;
-    writeln!(t, "{:<24}{}", "ωi", vec3(r.omega_i))?;
-    writeln!(t, "{:<24}{}", "h", vec3(r.h))?;
-    writeln!(t, "{:<24}{}", "ωr = 2(ωi·h)h − ωi", vec3(r.omega_r))?;
-    writeln!(t, "{:<24}{:.6}", "ωi·h", r.cos_ih)?;
-    writeln!(t, "{:<24}{:.6}", "dωh/dωr = 1/(4|ωr·h|)", r.jacobian)?;
-    writeln!(t, "{:<24}{:.6}", "p(ωr)", r.pdf_r)?;
-    writeln!(t, "{:<24}{}", "valid", validity(r.invalid_reason))?;
+    let t = table::render(
+        &[],
+        [
+            ["p(ωh)".into(), r.pdf_h.to_string()],
+            ["θh, θi".into(), format!("{}°, {}° (in plane, same side)", r.theta_h_deg, r.theta_i_deg)],
+            ["ωi".into(), vec3(r.omega_i)],
+            ["h".into(), vec3(r.h)],
+            ["ωr = 2(ωi·h)h − ωi".into(), vec3(r.omega_r)],
+            ["ωi·h".into(), format!("{:.6}", r.cos_ih)],
+            ["dωh/dωr = 1/(4|ωr·h|)".into(), format!("{:.6}", r.jacobian)],
+            ["p(ωr)".into(), format!("{:.6}", r.pdf_r)],
+            ["valid".into(), validity(r.invalid_reason)],
+        ]
+        .map(Vec::from),
+    );
     emit(&t)
 }
 
@@ -295,23 +303,22 @@ pub fn sample(args: &SampleArgs) -> anyhow::Result<()> {
     if args.output.json {
         return emit_json(&r);
     }
-    let mut t = String::new();
-    writeln!(t, "{:<10}{} ({}), αx = {}, αy = {}", "lobe", r.lobe, r.method, r.alpha_x, r.alpha_y)?;
-    writeln!(t, "{:<10}{}, {}", "u", r.u[0], r.u[1])?;
-    writeln!(
-        t,
-        "{:<10}{}  (θ {}°, φ {}°)",
-        "ωi",
-        vec3(r.omega_i),
-        args.incident.incident_theta,
-        args.incident.incident_phi
-    )?;
-    writeln!(t, "{:<10}{:.6}°, {:.6}°", "θh, φh", r.theta_h_deg, r.phi_h_deg)?;
-    writeln!(t, "{:<10}{}", "h", vec3(r.h))?;
-    writeln!(t, "{:<10}{}", "ωr", vec3(r.omega_r))?;
-    writeln!(t, "{:<10}{:.6}", "p(h)", r.pdf_h)?;
-    writeln!(t, "{:<10}{:.6}", "p(ωr)", r.pdf_r)?;
-    writeln!(t, "{:<10}{}", "valid", validity(r.invalid_reason))?;
+    let i = &args.incident;
+    let t = table::render(
+        &[],
+        [
+            ["lobe".into(), format!("{} ({}), αx = {}, αy = {}", r.lobe, r.method, r.alpha_x, r.alpha_y)],
+            ["u".into(), format!("{}, {}", r.u[0], r.u[1])],
+            ["ωi".into(), format!("{}  (θ {}°, φ {}°)", vec3(r.omega_i), i.incident_theta, i.incident_phi)],
+            ["θh, φh".into(), format!("{:.6}°, {:.6}°", r.theta_h_deg, r.phi_h_deg)],
+            ["h".into(), vec3(r.h)],
+            ["ωr".into(), vec3(r.omega_r)],
+            ["p(h)".into(), format!("{:.6}", r.pdf_h)],
+            ["p(ωr)".into(), format!("{:.6}", r.pdf_r)],
+            ["valid".into(), validity(r.invalid_reason)],
+        ]
+        .map(Vec::<String>::from),
+    );
     emit(&t)
 }
 

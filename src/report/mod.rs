@@ -1,8 +1,16 @@
 //! Reports: per-case JSON and PNG heat maps, the run table, the JSON Schema of every output,
-//! and the one atomic file writer.
+//! the one atomic file writer, and `lobes tradeoff`'s outputs.
+//!
+//! [`heatmap`] lays out a heat map from a [`colour`] scale, [`label`]s and [`text`], and
+//! [`png`] encodes it; [`table`] prints terminal tables; [`output`] writes a case's files.
 
 pub mod atomic;
+pub mod colour;
 pub mod heatmap;
+pub mod label;
 pub mod output;
 pub mod schema;
+pub mod png;
+pub mod table;
+pub mod text;
 pub mod tradeoff;

@@ -366,20 +366,7 @@ pub fn table_row(r: &CaseResult) -> [String; 9] {
 
 pub const TABLE_HEADER: [&str; 9] = ["case", "samples", "GPU time", "chi2", "dof", "p-value", "verdict", "max angle err", "albedo (rel err)"];
 
-/// A plain-text table with aligned columns.
+/// The run table (`lobes run`, `lobes merge`).
 pub fn format_table(rows: &[[String; 9]]) -> String {
-    let mut widths = TABLE_HEADER.map(|h| h.chars().count());
-    for r in rows {
-        for (w, c) in widths.iter_mut().zip(r) {
-            *w = (*w).max(c.chars().count());
-        }
-    }
-    let line = |cells: Vec<String>| {
-        cells.iter().zip(&widths).map(|(c, w)| format!("{c:<w$}")).collect::<Vec<_>>().join("  ").trim_end().to_string() + "\n"
-    };
-    let mut out = line(TABLE_HEADER.iter().map(|s| s.to_string()).collect());
-    for r in rows {
-        out += &line(r.to_vec());
-    }
-    out
+    super::table::render(&TABLE_HEADER, rows.iter().map(|r| r.to_vec()))
 }
