@@ -138,20 +138,17 @@ impl Module {
         }
     }
 
-    /// The modules this one uses directly (each earlier in [`Module::ALL`]).
+    /// The modules this one uses directly (each earlier in [`Module::ALL`]), from the `#import`
+    /// lines of its files.
     ///
     /// ```
     /// use lobes::embed::Module;
     /// assert_eq!(Module::Beckmann.dependencies(), [Module::Reflect, Module::Microfacet]);
     /// assert!(Module::Rng.dependencies().is_empty());
     /// ```
-    pub fn dependencies(self) -> &'static [Module] {
-        match self {
-            Module::Rng | Module::Reflect | Module::Discrete => &[],
-            Module::Microfacet => &[],
-            Module::Ward => &[Module::Reflect],
-            Module::Ggx | Module::Beckmann => &[Module::Reflect, Module::Microfacet],
-        }
+    pub fn dependencies(self) -> Vec<Module> {
+        let imported: Vec<&str> = self.parts().iter().flat_map(|p| library::imports(p)).collect();
+        Module::ALL.into_iter().filter(|&m| m != self && m.parts().iter().any(|p| imported.contains(p))).collect()
     }
 
     /// The import paths of the module's files (`#define_import_path` in `shaders/lib`).
@@ -229,7 +226,7 @@ pub fn resolve(modules: &[Module]) -> Vec<Module> {
     fn mark(m: Module, wanted: &mut [bool; Module::ALL.len()]) {
         if !wanted[m as usize] {
             wanted[m as usize] = true;
-            for &d in m.dependencies() {
+            for d in m.dependencies() {
                 mark(d, wanted);
             }
         }
@@ -343,7 +340,7 @@ mod tests {
     #[test]
     fn dependencies_come_earlier() {
         for m in Module::ALL {
-            for &d in m.dependencies() {
+            for d in m.dependencies() {
                 assert!(d < m, "{m:?} depends on {d:?}");
             }
         }

@@ -110,19 +110,37 @@ fn in_import_order(modules: &[&str], math: Math) -> Vec<(&'static str, &'static 
         if out.contains(&file) {
             return;
         }
-        let (_, imports, _) = naga_oil::compose::get_preprocessor_data(file.1);
-        for import in imports {
-            // `#import lobes::ggx::ggx_d` names an item of `lobes::ggx`
-            let target = files(math).filter_map(|(_, s)| import_path(s)).find(|p| import.import == *p || import.import.starts_with(&format!("{p}::")));
-            if let Some(target) = target {
-                visit(target, math, out);
-            }
+        for target in imports_of(file.1) {
+            visit(target, math, out);
         }
         out.push(file);
     }
     let mut out = Vec::new();
     for m in modules {
         visit(m, math, &mut out);
+    }
+    out
+}
+
+/// The library modules that library module `module` imports (`#import` lines of its file),
+/// each once, in the file's order.
+pub fn imports(module: &str) -> Vec<&'static str> {
+    source(module).map(imports_of).unwrap_or_default()
+}
+
+fn imports_of(source: &str) -> Vec<&'static str> {
+    let (_, imports, _) = naga_oil::compose::get_preprocessor_data(source);
+    let mut out: Vec<&'static str> = Vec::new();
+    for import in imports {
+        // `#import lobes::ggx::ggx_d` names an item of `lobes::ggx`
+        let target = files(Math::Accurate)
+            .filter_map(|(_, s)| import_path(s))
+            .find(|p| import.import == *p || import.import.starts_with(&format!("{p}::")));
+        if let Some(target) = target
+            && !out.contains(&target)
+        {
+            out.push(target);
+        }
     }
     out
 }
