@@ -1,3 +1,8 @@
+#define_import_path lobes::beckmann
+#import lobes::math::{math_cos, math_exp, math_log, math_sin, neg_ln}
+#import lobes::reflect::{LobeSample, PI, from_tan_theta, lobe_sample, reflect_about, reflect_sample}
+#import lobes::microfacet::stretch
+
 // Beckmann; CPU twin: src/reference/beckmann.rs.
 // D(h) = exp(-(hx^2/ax^2 + hy^2/ay^2)/hz^2) / (pi ax ay hz^4)                 (Heitz 2014, eq. 71)
 // Lambda(w) = -erfc(a)/2 + exp(-a^2)/(2 a sqrt(pi)), a = wz/|(ax wx, ay wy)|  (Heitz 2014, eq. 72)

@@ -1,3 +1,8 @@
+#define_import_path lobes::beckmann_eval
+#import lobes::math::math_exp
+#import lobes::reflect::reflection_half_vector
+#import lobes::beckmann::{INV_SQRT_PI, beckmann_d, beckmann_g1_over_cos, erfc_approx}
+
 // Beckmann densities and BRDF for renderers that embed lobes' samplers (lobes::embed,
 // Module::Beckmann); CPU twins: src/reference/beckmann.rs and src/reference/microfacet.rs.
 // a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.

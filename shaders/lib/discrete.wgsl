@@ -1,3 +1,5 @@
+#define_import_path lobes::discrete
+
 // Discrete 1D sampling; CPU twin: src/reference/discrete.rs.
 // The CDF (f64 prefix sums / total, rounded to f32 on the host) is inverted by binary search for the
 // first entry with cdf >= u and cdf > 0 (pbrt-v4 SampleDiscrete; the "> 0" keeps u = 0 off leading

@@ -1,3 +1,5 @@
+#define_import_path lobes::fresnel
+
 // Fresnel reflectance of the microfacet (or Ward half-vector) at cos th = wi.h; CPU twin:
 // src/reference/fresnel.rs. Every form returns a reflectance in [0, 1].
 

@@ -1,3 +1,8 @@
+#define_import_path lobes::ggx
+#import lobes::math::{math_cos, math_sin}
+#import lobes::reflect::{LobeSample, PI, lobe_sample, reflect_about, reflect_sample}
+#import lobes::microfacet::stretch
+
 // GGX (Trowbridge-Reitz); CPU twin: src/reference/ggx.rs.
 // D(h) = 1 / (pi ax ay (hx^2/ax^2 + hy^2/ay^2 + hz^2)^2)                (Heitz 2014, eq. 85)
 // G1(w) = 2|wz| / (|wz| + |(ax wx, ay wy, wz)|)                       (Heitz 2014, eq. 86)

@@ -1,3 +1,7 @@
+#define_import_path lobes::ggx_eval
+#import lobes::reflect::reflection_half_vector
+#import lobes::ggx::{ggx_bounded_one_minus_k, ggx_d}
+
 // GGX densities and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ggx);
 // CPU twins: src/reference/ggx.rs and src/reference/microfacet.rs (Lobe::pdf_r, Lobe::eval).
 // a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.

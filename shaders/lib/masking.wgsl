@@ -1,3 +1,5 @@
+#define_import_path lobes::masking
+
 // Smith masking-shadowing from the two directions' masking terms G1(wi), G1(wr) (each in [0, 1]);
 // CPU twin: src/reference/masking.rs. Written with G1 = 1 / (1 + Lambda) rather than Lambda,
 // so that grazing directions (Lambda -> inf, G1 -> 0) stay finite.

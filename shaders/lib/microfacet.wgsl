@@ -1,3 +1,5 @@
+#define_import_path lobes::microfacet
+
 // Shared microfacet helpers; CPU twin: src/reference/microfacet.rs.
 
 // normalize(ax wx, ay wy, wz): w stretched to the alpha = 1 configuration (Heitz 2018, listing 1).

@@ -1,3 +1,5 @@
+#define_import_path lobes::reflect
+
 // The half-vector -> reflected-direction change of variables; CPU twin: src/reference/reflect.rs.
 // wr = 2 (wi.h) h - wi and p(wr) = p(h) / (4 |wr.h|) (tutorial part 2; Walter et al. 2007, eq. 14).
 

@@ -1,3 +1,5 @@
+#define_import_path lobes::rng
+
 // Counter-based uniforms; the CPU twin is src/reference/rng.rs.
 // pcg4d: Jarzynski & Olano, "Hash Functions for GPU Rendering", JCGT 9(3), 2020.
 // Sample `index` (a 64-bit counter as lo, hi) of the run keyed by the 64-bit `seed`

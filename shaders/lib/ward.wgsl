@@ -1,3 +1,7 @@
+#define_import_path lobes::ward
+#import lobes::math::{math_cos, math_exp, math_sin, neg_ln}
+#import lobes::reflect::{LobeSample, PI, from_tan_theta, reflect_sample}
+
 // The Ward lobe, Walter 2005 "Notes on the Ward BRDF"; CPU twin: src/reference/ward.rs.
 // Sampling (his eqs. 6-8) in slope form: (tan th cos ph, tan th sin ph) = sqrt(-ln u1) (ax cos 2pi u2, ay sin 2pi u2).
 // p(h) = exp(-(hx^2/ax^2 + hy^2/ay^2)/hz^2) / (pi ax ay hz^3) (his eq. 9, Cartesian form).

@@ -1,3 +1,8 @@
+#define_import_path lobes::ward_eval
+#import lobes::math::math_exp
+#import lobes::reflect::{PI, reflection_half_vector}
+#import lobes::ward::ward_pdf_h
+
 // Ward's density and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ward);
 // CPU twin: src/reference/ward.rs (pdf_h through the reflection Jacobian, eval).
 // a = (alpha_x, alpha_y); wi, wr unit vectors in the local frame (normal +z), pointing away.

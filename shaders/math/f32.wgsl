@@ -1,3 +1,5 @@
+#define_import_path lobes::math
+
 // The f32 math of the samplers and the binning: the transcendental functions they call, as
 // math_log, math_exp, math_sin, math_cos, math_atan2 and neg_ln. This module is the f32 one (the
 // WGSL builtins, plus an accurate -ln u); shaders/math/f32_fast.wgsl defines the same names with cheap

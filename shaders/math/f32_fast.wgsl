@@ -1,3 +1,5 @@
+#define_import_path lobes::math
+
 // Cheap f32 approximations of the transcendental functions the samplers and the binning call,
 // for `lobes tradeoff`'s "f32-fast" kernels: the math module that the composing host
 // (src/engine/gpu/compose.rs) includes in place of shaders/math/f32.wgsl, with the same names

@@ -64,7 +64,8 @@ pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
         c.push(&s.name, &s.text);
     }
     c.push("<lobes check glue>", &glue(sampler));
-    c.push("shaders/lib/rng.wgsl", RNG);
+    // lobes' RNG as plain WGSL (its naga_oil directives blanked, its line numbers kept)
+    c.push("shaders/lib/rng.wgsl", &crate::engine::gpu::library::plain(RNG));
     c.push("shaders/check/user_passes.wgsl", PASSES);
     c.validate()?;
     Ok(c)

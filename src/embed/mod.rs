@@ -25,15 +25,18 @@
 //!            [Module::Rng, Module::Reflect, Module::Microfacet, Module::Ggx]);
 //! ```
 //!
-//! Why plain WGSL and a Rust call, rather than naga_oil's `#import` or WESL modules: WGSL has
-//! no modules of its own, and every wgpu renderer can take a `String`; naga_oil had no release
-//! for naga 30 (the naga of wgpu 30) when this was written, and the `wesl` crate from 0.4.1 on
-//! needs a newer rustc than this crate's toolchain. The files are small, their names do not
-//! collide with each other, and declarations at WGSL module scope may come in any order, so a
-//! composed string is all that is needed. It is also exactly the code the χ² tests judge:
-//! [`Module::source`] returns the same `shaders/*.wgsl` text that the test kernels are built
-//! from (`crate::engine::gpu::compose::sources`), plus the pdf, BRDF and estimator-weight functions of `shaders/*_eval.wgsl`,
-//! which `tests/embed.rs` checks against the f64 reference on the GPU.
+//! The library files are naga_oil modules: each names its import path (`#define_import_path
+//! lobes::ggx`) and what it imports from the others (`#import lobes::reflect::{LobeSample, PI}`),
+//! and lobes composes them with naga_oil, Bevy's shader composer (chosen over a resolver of our
+//! own: it resolves the imports, validates every file and reports errors at the file and line,
+//! and it is what Bevy renderers already use; see `crate::engine::gpu::library`). What [`wgsl`]
+//! returns is still plain WGSL, since a `String` is what every wgpu renderer can take: the files
+//! in import order with their directive lines blanked. Their names do not collide with each
+//! other and WGSL declarations at module scope may come in any order, so no namespaces are
+//! needed. It is exactly the code the χ² tests judge (the test kernels are built from the same
+//! composition), plus the pdf, BRDF and estimator-weight functions of `shaders/lib/*_eval.wgsl`,
+//! which `tests/embed.rs` checks against the f64 reference on the GPU. A renderer that composes
+//! with naga_oil itself can take the files as they are from [`Module::source`].
 //!
 //! The composed code defines, at module scope, the names listed on each [`Module`] (and a few
 //! helpers: everything it defines is in [`Module::symbols`]); your shader must not define them
@@ -50,8 +53,8 @@ mod discrete;
 
 pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable};
 
-use crate::engine::gpu::compose::sources;
 use crate::engine::gpu::GpuError;
+use crate::engine::gpu::library::{self, Math};
 
 
 /// A WGSL module of lobes, as embedded by [`wgsl`]. The listed functions are the ones meant for
@@ -135,44 +138,45 @@ impl Module {
         }
     }
 
-    /// The modules this one uses directly (each earlier in [`Module::ALL`]).
+    /// The modules this one uses directly (each earlier in [`Module::ALL`]), from the `#import`
+    /// lines of its files.
     ///
     /// ```
     /// use lobes::embed::Module;
     /// assert_eq!(Module::Beckmann.dependencies(), [Module::Reflect, Module::Microfacet]);
     /// assert!(Module::Rng.dependencies().is_empty());
     /// ```
-    pub fn dependencies(self) -> &'static [Module] {
-        match self {
-            Module::Rng | Module::Reflect | Module::Discrete => &[],
-            Module::Microfacet => &[],
-            Module::Ward => &[Module::Reflect],
-            Module::Ggx | Module::Beckmann => &[Module::Reflect, Module::Microfacet],
-        }
+    pub fn dependencies(self) -> Vec<Module> {
+        let imported: Vec<&str> = self.parts().iter().flat_map(|p| library::imports(p)).collect();
+        Module::ALL.into_iter().filter(|&m| m != self && m.parts().iter().any(|p| imported.contains(p))).collect()
     }
 
+    /// The import paths of the module's files (`#define_import_path` in `shaders/lib`).
     fn parts(self) -> &'static [&'static str] {
         match self {
-            Module::Rng => &[sources::RNG],
-            Module::Reflect => &[sources::MATH_F32, sources::REFLECT],
-            Module::Microfacet => &[sources::MICROFACET],
-            Module::Ward => &[sources::WARD, sources::WARD_EVAL],
-            Module::Ggx => &[sources::GGX, sources::GGX_EVAL],
-            Module::Beckmann => &[sources::BECKMANN, sources::BECKMANN_EVAL],
-            Module::Discrete => &[sources::DISCRETE],
+            Module::Rng => &["lobes::rng"],
+            Module::Reflect => &["lobes::math", "lobes::reflect"],
+            Module::Microfacet => &["lobes::microfacet"],
+            Module::Ward => &["lobes::ward", "lobes::ward_eval"],
+            Module::Ggx => &["lobes::ggx", "lobes::ggx_eval"],
+            Module::Beckmann => &["lobes::beckmann", "lobes::beckmann_eval"],
+            Module::Discrete => &["lobes::discrete"],
         }
     }
 
-    /// The module's WGSL on its own (without its dependencies; [`wgsl`] adds those).
-    /// [`Module::Discrete`] comes with its bindings at group 0, bindings 3 and 4.
+    /// The module's files as they are in `shaders/` (without its dependencies; [`wgsl`] adds
+    /// those): naga_oil modules, WGSL with `#define_import_path` and `#import` directives, for a
+    /// renderer that composes its shaders with naga_oil. [`Module::Discrete`] comes with its
+    /// bindings at group 0, bindings 3 and 4.
     ///
     /// ```
     /// use lobes::embed::Module;
     /// assert!(Module::Ggx.source().contains("fn ggx_sample_vndf("));
     /// assert!(Module::Ggx.source().contains("fn ggx_pdf_vndf("));
+    /// assert!(Module::Ggx.source().contains("#define_import_path lobes::ggx_eval"));
     /// ```
     pub fn source(self) -> String {
-        self.parts().join("\n")
+        self.parts().iter().map(|p| library::source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
     }
 
     /// Every name the module declares at module scope (functions, constants, structs, globals),
@@ -222,7 +226,7 @@ pub fn resolve(modules: &[Module]) -> Vec<Module> {
     fn mark(m: Module, wanted: &mut [bool; Module::ALL.len()]) {
         if !wanted[m as usize] {
             wanted[m as usize] = true;
-            for &d in m.dependencies() {
+            for d in m.dependencies() {
                 mark(d, wanted);
             }
         }
@@ -266,15 +270,14 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
         env!("CARGO_PKG_VERSION"),
         names.join(", ")
     );
-    for m in resolved {
-        out.push_str(&format!("\n// ---- lobes: {} ----\n", m.name()));
-        match m {
-            Module::Discrete => out.push_str(&discrete_wgsl(discrete)),
-            _ => out.push_str(&m.source()),
-        }
-        if !out.ends_with('\n') {
-            out.push('\n');
-        }
+    // the library composes every module but Discrete, whose bindings are the caller's
+    let paths: Vec<&str> = resolved.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.parts().iter().copied()).collect();
+    if !paths.is_empty() {
+        out.push_str(&library::wgsl(&paths, Math::Accurate).unwrap_or_else(|e| panic!("{e}")));
+    }
+    if resolved.contains(&Module::Discrete) {
+        out.push_str("// ---- shaders/lib/discrete.wgsl ----\n");
+        out.push_str(&discrete_wgsl(discrete));
     }
     out
 }
@@ -292,8 +295,9 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
 /// ```
 pub fn discrete_wgsl(bindings: DiscreteBindings) -> String {
     let mut found = [false; 2];
-    let mut out = String::with_capacity(sources::DISCRETE.len() + 16);
-    for line in sources::DISCRETE.lines() {
+    let file = library::plain(library::source("lobes::discrete").expect("shaders/lib/discrete.wgsl"));
+    let mut out = String::with_capacity(file.len() + 16);
+    for line in file.lines() {
         let var = line.find("var<storage");
         let which = [("discrete_f", bindings.table, 0), ("discrete_u", bindings.alias, 1)]
             .into_iter()
@@ -336,7 +340,7 @@ mod tests {
     #[test]
     fn dependencies_come_earlier() {
         for m in Module::ALL {
-            for &d in m.dependencies() {
+            for d in m.dependencies() {
                 assert!(d < m, "{m:?} depends on {d:?}");
             }
         }
@@ -377,6 +381,7 @@ mod tests {
 
     #[test]
     fn default_discrete_bindings_leave_the_file_unchanged() {
-        assert_eq!(discrete_wgsl(DiscreteBindings::default()).trim_end(), sources::DISCRETE.trim_end());
+        let file = library::plain(library::source("lobes::discrete").unwrap());
+        assert_eq!(discrete_wgsl(DiscreteBindings::default()).trim_end(), file.trim_end());
     }
 }

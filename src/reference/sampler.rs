@@ -2,7 +2,7 @@
 //! list of samplers comes from (the uber-kernel's ids, `lobes bench`, `lobes tradeoff`, the
 //! stress suite, the WGSL call sites of the counting and weighted kernels).
 //!
-//! An entry names the sampler, the `shaders/` files that define its WGSL functions, the call
+//! An entry names the sampler, the library modules that define its WGSL functions, the call
 //! sites of those functions, and its f64 twins: the Rust reference ([`Reference`], `None` for a
 //! sampler known only as WGSL) and the f64 WGSL sampler of `lobes tradeoff` (`sample64`).
 //! Adding a sampler is one entry here plus its files.
@@ -26,11 +26,11 @@ pub struct SamplerSpec {
 /// `wr: vec3<f32>`, `h = normalize(wi + wr)`, `u: vec2<f32>` and a drawn `s: LobeSample`.
 #[derive(Debug, Clone, Copy)]
 pub struct Wgsl {
-    /// The `shaders/` files (without `.wgsl`) that define the sampler, in order, after the
-    /// `rng` and `reflect` every kernel has.
-    pub sample_files: &'static [&'static str],
-    /// The files that define its density, BRDF and weight (after `sample_files`).
-    pub eval_files: &'static [&'static str],
+    /// The library module (`#define_import_path` of its `shaders/lib` file) that defines the
+    /// sampler.
+    pub module: &'static str,
+    /// The library module that defines its density, BRDF and weight (it imports `module`).
+    pub eval_module: &'static str,
     /// `fn (a, wi, u) -> LobeSample`.
     pub sample: &'static str,
     /// p(ωr), the sampler's density, in terms of `a`, `wi`, `wr`.
@@ -63,8 +63,6 @@ pub struct Reference {
 const MICROFACET_NDF_WEIGHT: &str = "microfacet_ndf_weight(wi, s.h)";
 const GGX_EVAL: &str = "ggx_d(a, h) / (4.0 * wi.z * wr.z)";
 const BECKMANN_EVAL: &str = "beckmann_d(a, h) / (4.0 * wi.z * wr.z)";
-const GGX_FILES: &[&str] = &["microfacet", "ggx"];
-const BECKMANN_FILES: &[&str] = &["microfacet", "beckmann"];
 
 /// Every sampler; an uber-kernel's sampler id is its index here.
 pub const REGISTRY: [SamplerSpec; 6] = [
@@ -72,8 +70,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Ward,
         method: Method::Ndf,
         wgsl: Wgsl {
-            sample_files: &["ward"],
-            eval_files: &["ward_eval"],
+            module: "lobes::ward",
+            eval_module: "lobes::ward_eval",
             sample: "ward_sample",
             pdf: "ward_pdf(a, wi, wr)",
             eval: "ward_eval(a, wi, wr)",
@@ -91,8 +89,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Beckmann,
         method: Method::Ndf,
         wgsl: Wgsl {
-            sample_files: BECKMANN_FILES,
-            eval_files: &["beckmann_eval"],
+            module: "lobes::beckmann",
+            eval_module: "lobes::beckmann_eval",
             sample: "beckmann_sample_ndf",
             pdf: "beckmann_pdf_ndf(a, wi, wr)",
             eval: BECKMANN_EVAL,
@@ -110,8 +108,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Beckmann,
         method: Method::Vndf,
         wgsl: Wgsl {
-            sample_files: BECKMANN_FILES,
-            eval_files: &["beckmann_eval"],
+            module: "lobes::beckmann",
+            eval_module: "lobes::beckmann_eval",
             sample: "beckmann_sample_vndf",
             pdf: "beckmann_pdf_vndf(a, wi, wr)",
             eval: BECKMANN_EVAL,
@@ -129,8 +127,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Ggx,
         method: Method::Ndf,
         wgsl: Wgsl {
-            sample_files: GGX_FILES,
-            eval_files: &["ggx_eval"],
+            module: "lobes::ggx",
+            eval_module: "lobes::ggx_eval",
             sample: "ggx_sample_ndf",
             pdf: "ggx_pdf_ndf(a, wi, wr)",
             eval: GGX_EVAL,
@@ -148,8 +146,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Ggx,
         method: Method::Vndf,
         wgsl: Wgsl {
-            sample_files: GGX_FILES,
-            eval_files: &["ggx_eval"],
+            module: "lobes::ggx",
+            eval_module: "lobes::ggx_eval",
             sample: "ggx_sample_vndf",
             pdf: "ggx_pdf_vndf(a, wi, wr)",
             eval: GGX_EVAL,
@@ -167,8 +165,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
         kind: LobeKind::Ggx,
         method: Method::Bounded,
         wgsl: Wgsl {
-            sample_files: GGX_FILES,
-            eval_files: &["ggx_eval"],
+            module: "lobes::ggx",
+            eval_module: "lobes::ggx_eval",
             sample: "ggx_sample_bounded",
             pdf: "ggx_pdf_bounded(a, wi, wr)",
             eval: GGX_EVAL,

@@ -1,66 +1,54 @@
 //! Composes the WGSL module of a job from the files in `shaders/`, holding only the code the
 //! job needs, and validates it with naga before any pipeline is made.
+//!
+//! A module is: the job's constants (a generated header), the library modules it needs
+//! (`shaders/lib`, `shaders/math`: the RNG, the math of its precision, reflection, its sampler's
+//! module and, for weighted modules, the density, Fresnel and masking modules), composed by
+//! naga_oil from the files' own `#import`s ([`super::library`], which says why naga_oil), then the
+//! passes (`shaders/passes`, binning) and the generated call sites that pick the sampler. The
+//! passes are still joined as text after the library: they use the header's names, which are
+//! not a module of their own yet.
 
 use super::context::GpuError;
 use super::layout;
+use super::library::{self, Math};
 use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::LobeKind;
 use crate::reference::sampler::{self, SamplerSpec};
 
-/// The WGSL sources, one file per concept (each the twin of a module in `src/reference` or
-/// `src/stats`).
+/// The WGSL of the passes and of the f64 kernels, which use the names the composed header
+/// defines (the library files, `shaders/lib` and `shaders/math`, are composed by
+/// [`super::library`]).
 pub mod sources {
-    pub const RNG: &str = include_str!("../../../shaders/lib/rng.wgsl");
-    pub const REFLECT: &str = include_str!("../../../shaders/lib/reflect.wgsl");
-    pub const WARD: &str = include_str!("../../../shaders/lib/ward.wgsl");
-    pub const MICROFACET: &str = include_str!("../../../shaders/lib/microfacet.wgsl");
-    pub const GGX: &str = include_str!("../../../shaders/lib/ggx.wgsl");
-    pub const BECKMANN: &str = include_str!("../../../shaders/lib/beckmann.wgsl");
-    pub const DISCRETE: &str = include_str!("../../../shaders/lib/discrete.wgsl");
     pub const HISTOGRAM: &str = include_str!("../../../shaders/lib/histogram.wgsl");
     pub const KERNEL: &str = include_str!("../../../shaders/passes/kernel.wgsl");
     pub const COUNTING_WORKGROUP: &str = include_str!("../../../shaders/passes/counting_workgroup.wgsl");
     pub const COUNTING_GLOBAL: &str = include_str!("../../../shaders/passes/counting_global.wgsl");
     pub const LOBE_KERNEL: &str = include_str!("../../../shaders/passes/lobe_kernel.wgsl");
-    pub const WARD_EVAL: &str = include_str!("../../../shaders/lib/ward_eval.wgsl");
-    pub const GGX_EVAL: &str = include_str!("../../../shaders/lib/ggx_eval.wgsl");
-    pub const BECKMANN_EVAL: &str = include_str!("../../../shaders/lib/beckmann_eval.wgsl");
-    pub const FRESNEL: &str = include_str!("../../../shaders/lib/fresnel.wgsl");
-    pub const MASKING: &str = include_str!("../../../shaders/lib/masking.wgsl");
     pub const WEIGHTED: &str = include_str!("../../../shaders/passes/weighted.wgsl");
     pub const LOBE_DRAW: &str = include_str!("../../../shaders/passes/lobe_draw.wgsl");
-    pub const MATH_F32: &str = include_str!("../../../shaders/math/f32.wgsl");
-    pub const FASTMATH: &str = include_str!("../../../shaders/math/f32_fast.wgsl");
     pub const F64: &str = include_str!("../../../shaders/math/f64.wgsl");
     pub const F64_BECKMANN: &str = include_str!("../../../shaders/math/f64_beckmann.wgsl");
     pub const EFFECT: &str = include_str!("../../../shaders/passes/effect.wgsl");
     pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/passes/effect_fresnel.wgsl");
     pub const EFFECT_MASKING: &str = include_str!("../../../shaders/passes/effect_masking.wgsl");
-
-    /// The file `shaders/{stem}.wgsl` of a sampler or lobe (as named in
-    /// [`crate::reference::sampler::Wgsl`]).
-    pub fn file(stem: &str) -> &'static str {
-        match stem {
-            "ward" => WARD,
-            "microfacet" => MICROFACET,
-            "ggx" => GGX,
-            "beckmann" => BECKMANN,
-            "ward_eval" => WARD_EVAL,
-            "ggx_eval" => GGX_EVAL,
-            "beckmann_eval" => BECKMANN_EVAL,
-            other => panic!("no shader file shaders/{other}.wgsl"),
-        }
-    }
 }
 
 pub use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 
-/// The files of a sampler, then those of its density and weight: `eval` false for the counting
-/// kernels, which only draw.
-pub(crate) fn sampler_files(spec: &SamplerSpec, eval: bool) -> Vec<&'static str> {
-    let stems = spec.wgsl.sample_files.iter().chain(if eval { spec.wgsl.eval_files } else { &[] });
-    stems.map(|s| sources::file(s)).collect()
+/// The library module of a sampler, or with `eval` that of its density and weight (which
+/// imports the sampler's): `eval` false for the counting kernels, which only draw.
+pub(crate) fn sampler_module(spec: &SamplerSpec, eval: bool) -> &'static str {
+    if eval { spec.wgsl.eval_module } else { spec.wgsl.module }
+}
+
+/// The plain WGSL of the library `modules` with the math of `precision` (see [`library::wgsl`]).
+///
+/// Panics if the library does not compose: its files are built in, and the tests compose every
+/// module.
+pub(crate) fn library(modules: &[&str], precision: Precision) -> String {
+    library::wgsl(modules, math_module(precision)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
@@ -99,11 +87,21 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
 /// As [`compose_tile`], in the arithmetic of `precision` (`lobes tradeoff`; see
 /// [`super::precision`]).
 pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
-    let mut src = header(job, workgroup_words, tile_bins, precision);
+    compose_with(job, workgroup_words, tile_bins, precision, &[])
+}
+
+/// As [`compose_precision`], with the library modules `extra` too (a weighted module's density,
+/// Fresnel and masking).
+pub(crate) fn compose_with(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, extra: &[&str]) -> String {
+    let mut modules = extra.to_vec();
+    modules.push(match job {
+        Job::Lobe { lobe, .. } => sampler_module(sampler::find(lobe.kind, lobe.method), false),
+        Job::Discrete { .. } => "lobes::discrete",
+    });
+    let mut src = header(job, workgroup_words, tile_bins, precision, &modules);
     match job {
         Job::Lobe { lobe, .. } => {
             let spec = sampler::find(lobe.kind, lobe.method);
-            push_all(&mut src, &sampler_files(spec, false));
             src.push_str(&sampler_call_site(&[spec]));
             push_all(&mut src, &[sources::LOBE_KERNEL]);
             match precision {
@@ -112,7 +110,6 @@ pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precis
             }
         }
         Job::Discrete { method, .. } => {
-            src.push_str(sources::DISCRETE);
             let call = match method {
                 DiscreteMethod::Cdf if job.bins() > crate::reference::discrete::BLOCK => {
                     "discrete_sample_cdf_blocks(u.xy, params.n_items, params.last_positive)"
@@ -129,8 +126,8 @@ pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precis
 }
 
 /// The constants, the RNG, the math of `precision`, binning and counting kernels every job's
-/// module starts with.
-pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
+/// module starts with, and the library `modules` it draws with.
+pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, modules: &[&str]) -> String {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
@@ -146,7 +143,10 @@ pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision:
         layout::consts_wgsl()
     );
     let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
-    push_all(&mut src, &[sources::RNG, math_module(precision), sources::REFLECT, sources::HISTOGRAM, sources::KERNEL, counting]);
+    let mut library_modules = vec!["lobes::rng", "lobes::math", "lobes::reflect"];
+    library_modules.extend(modules);
+    src.push_str(&library(&library_modules, precision));
+    push_all(&mut src, &[sources::HISTOGRAM, sources::KERNEL, counting]);
     src
 }
 
@@ -159,10 +159,10 @@ pub(crate) fn push_all(src: &mut String, parts: &[&str]) {
 
 /// The math module of a kernel's f32 code (the f64 kernels' f32 parts, such as the erf⁻¹
 /// guess that seeds their Newton steps, use the accurate one).
-fn math_module(precision: Precision) -> &'static str {
+fn math_module(precision: Precision) -> Math {
     match precision {
-        Precision::F32Fast => sources::FASTMATH,
-        Precision::F32Accurate | Precision::F64 => sources::MATH_F32,
+        Precision::F32Fast => Math::Fast,
+        Precision::F32Accurate | Precision::F64 => Math::Accurate,
     }
 }
 

@@ -96,18 +96,23 @@ fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
     src
 }
 
-/// The effect files of a module with (or without) Fresnel and masking, then the estimator and
+/// The effect glue of a module with (or without) Fresnel and masking, then the estimator and
 /// the weighted pass.
 fn effect_files(fresnel: bool, masking: bool) -> Vec<&'static str> {
     let mut files = Vec::new();
     if fresnel {
-        files.extend([sources::FRESNEL, sources::EFFECT_FRESNEL]);
+        files.push(sources::EFFECT_FRESNEL);
     }
     if masking {
-        files.extend([sources::MASKING, sources::EFFECT_MASKING]);
+        files.push(sources::EFFECT_MASKING);
     }
     files.extend([sources::EFFECT, sources::WEIGHTED]);
     files
+}
+
+/// The library modules of Fresnel and masking that [`effect_files`] call.
+fn effect_modules(fresnel: bool, masking: bool) -> Vec<&'static str> {
+    [(fresnel, "lobes::fresnel"), (masking, "lobes::masking")].into_iter().filter_map(|(on, m)| on.then_some(m)).collect()
 }
 
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
@@ -118,13 +123,14 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
     match how {
         Specialisation::Specialised => {
             let spec = sampler::find(lobe.kind, lobe.method);
-            let mut source = compose::compose(job, workgroup_words);
-            source.push('\n');
-            compose::push_all(&mut source, &spec.wgsl.eval_files.iter().map(|f| sources::file(f)).collect::<Vec<_>>());
-            let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
-            source.push_str("override ANISOTROPIC: bool = true;\n");
             let fresnel = effects.fresnel != Fresnel::None;
             let masking = effects.masking != Masking::None && lobe.kind != LobeKind::Ward;
+            let mut modules = vec![compose::sampler_module(spec, true)];
+            modules.extend(effect_modules(fresnel, masking));
+            let mut source = compose::compose_with(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &modules);
+            source.push('\n');
+            let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
+            source.push_str("override ANISOTROPIC: bool = true;\n");
             if fresnel {
                 source.push_str("override FRESNEL: u32 = 1u;\n");
                 constants.push(("FRESNEL", effects.fresnel.mode() as f64));
@@ -154,17 +160,16 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
-    let mut source = compose::header(job, workgroup_words, job.bins() as u32, Precision::F32Accurate);
-    source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
-    let mut files: Vec<&str> = Vec::new();
+    let mut modules: Vec<&str> = Vec::new();
     for spec in &REGISTRY {
-        for f in compose::sampler_files(spec, true) {
-            if !files.contains(&f) {
-                files.push(f);
-            }
+        let m = compose::sampler_module(spec, true);
+        if !modules.contains(&m) {
+            modules.push(m);
         }
     }
-    compose::push_all(&mut source, &files);
+    modules.extend(effect_modules(true, true));
+    let mut source = compose::header(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &modules);
+    source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
     source.push_str(&compose::sampler_call_site(&REGISTRY.iter().collect::<Vec<_>>()));
     compose::push_all(&mut source, &[sources::LOBE_KERNEL, sources::LOBE_DRAW]);
     source.push_str(&samplers_glue(&REGISTRY.iter().collect::<Vec<_>>(), true));

@@ -103,8 +103,8 @@ mod tests {
     /// header (`lobes::embed`) is checked against the host's instead.
     #[test]
     fn embedded_constants_match_the_host() {
-        let discrete = include_str!("../../../shaders/lib/discrete.wgsl");
-        assert_eq!(u32_const(discrete, "DISCRETE_BLOCK") as usize, crate::reference::discrete::BLOCK);
+        let discrete = super::super::library::plain(include_str!("../../../shaders/lib/discrete.wgsl"));
+        assert_eq!(u32_const(&discrete, "DISCRETE_BLOCK") as usize, crate::reference::discrete::BLOCK);
     }
 
     #[test]

@@ -6,6 +6,7 @@ pub mod dispatch;
 pub mod effects;
 pub mod engine;
 pub mod layout;
+pub mod library;
 pub mod params;
 pub mod precision;
 pub mod weighted;

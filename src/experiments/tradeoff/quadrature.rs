@@ -4,6 +4,7 @@
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
 use crate::engine::gpu::dispatch::{Pass, Step};
+use crate::engine::gpu::precision::Precision;
 use crate::engine::gpu::{GpuEngine, GpuError, compose};
 use crate::reference::{Lobe, sampler};
 use crate::stats::expected::direction;
@@ -41,8 +42,7 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
 pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     let spec = sampler::find(lobe.kind, lobe.method);
     let mut src = format!("const ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n", grid.rows, grid.cols);
-    compose::push_all(&mut src, &[compose::sources::MATH_F32, compose::sources::REFLECT]);
-    compose::push_all(&mut src, &compose::sampler_files(spec, true));
+    src += &compose::library(&["lobes::math", "lobes::reflect", compose::sampler_module(spec, true)], Precision::F32Accurate);
     src += &format!("fn sampler_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {{\n    return {};\n}}\n", spec.wgsl.pdf);
     src + QUADRATURE_WGSL
 }
