@@ -108,13 +108,15 @@ impl CheckArgs {
 pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let sampler = args.sampler()?;
     let settings = args.settings()?;
+    if let Some(dir) = &args.out {
+        super::prepare_out(dir)?;
+    }
     let gpu = Gpu::new()?;
     if args.power {
         return power(&gpu, &sampler, &settings, args.output.json);
     }
     let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("--out {}: {e}", dir.display()))?;
         crate::report::atomic::write_atomic(&dir.join("composed.wgsl"), sampler.composed().map_err(input)?.as_bytes())?;
         crate::report::atomic::write_atomic(&dir.join("report.json"), serde_json::to_string(&report)?.as_bytes())?;
     }
