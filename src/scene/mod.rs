@@ -19,6 +19,13 @@
 //! f0 = 0.04
 //! masking = "g1"        # none | g1 | separable | height-correlated (not for ward)
 //! # weighted = true     # a weighted histogram without Fresnel or masking
+//!
+//! [[case]]               # a sampler of your own, in WGSL, judged by `lobes check`'s checks
+//! name = "my-ggx"
+//! sampler = { wgsl = ["ggx.wgsl"], sample = "ggx_sample", pdf = "ggx_pdf", eval = "ggx_eval" }
+//! params = [0.3, 0.3]    # up to 16 numbers, `params` of the WGSL functions
+//! domain = "sphere"      # sphere | plane (then bounds = [x0, y0, x1, y1])
+//! incident_theta = [0, 45, 80]  # an array sweeps: one case per value, named my-ggx-theta0 …
 //! ```
 //!
 //! Every value is read as a TOML value first and checked here, so a wrong type, a value out
@@ -26,6 +33,11 @@
 //! is a [`SceneError`] pointing at the value (a value set in `[defaults]` is reported where
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
+
+mod sweep;
+mod user;
+
+pub use user::UserCase;
 
 use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::discrete::{Distribution, WeightsError};
@@ -36,6 +48,7 @@ use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use serde::Deserialize;
 use std::collections::HashMap;
+use sweep::{Point, Sweep};
 use std::ops::Range;
 use toml::{Spanned, Value};
 
@@ -93,8 +106,8 @@ struct RawCase {
     alpha: Option<Val>,
     alpha_x: Option<Val>,
     alpha_y: Option<Val>,
-    incident_theta: Option<Val>,
-    incident_phi: Option<Val>,
+    incident_theta: Option<Sweep>,
+    incident_phi: Option<Sweep>,
     weights: Option<Spanned<Weights>>,
     samples: Option<Val>,
     bins: Option<Val>,
@@ -105,6 +118,10 @@ struct RawCase {
     eta: Option<Val>,
     k: Option<Val>,
     masking: Option<Val>,
+    sampler: Option<Spanned<user::RawSampler>>,
+    params: Option<Sweep>,
+    domain: Option<Val>,
+    bounds: Option<Val>,
 }
 
 /// `weights = [...]`, each item with its own span (so an error points at the bad weight).
@@ -119,16 +136,21 @@ impl<'de> Deserialize<'de> for Weights {
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str("an array of weights such as [15, 5, 25]")
             }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Weights, A::Error> {
-                let mut items = Vec::new();
-                while let Some(item) = seq.next_element::<Val>()? {
-                    items.push(item);
-                }
-                Ok(Weights(items))
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Weights, A::Error> {
+                spanned_items(seq).map(Weights)
             }
         }
         d.deserialize_seq(V)
     }
+}
+
+/// The items of a TOML array, each with its span.
+fn spanned_items<'de, A: serde::de::SeqAccess<'de>>(mut seq: A) -> Result<Vec<Val>, A::Error> {
+    let mut items = Vec::new();
+    while let Some(item) = seq.next_element::<Val>()? {
+        items.push(item);
+    }
+    Ok(items)
 }
 
 /// One validated case.
@@ -148,11 +170,49 @@ pub struct Case {
 /// A validated scene.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// The cases of lobes' own samplers (lobes and discrete distributions).
     pub cases: Vec<Case>,
+    /// The cases of users' WGSL samplers (`sampler = { wgsl = [...], ... }`).
+    pub user_cases: Vec<UserCase>,
     /// The file name used in messages.
     pub file: String,
-    /// Line and column of each case's `[[case]]` table.
-    locations: Vec<(usize, usize)>,
+    /// Every case in the file's order, with the line and column of its `[[case]]` table.
+    order: Vec<(Slot, (usize, usize))>,
+}
+
+/// Where a case of [`Scene::entries`] is held.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Slot {
+    Lobe(usize),
+    User(usize),
+}
+
+/// A case of a scene: one of lobes' samplers, or a user's.
+#[derive(Debug, Clone, Copy)]
+pub enum Entry<'a> {
+    Lobe(&'a Case),
+    User(&'a UserCase),
+}
+
+impl<'a> Entry<'a> {
+    pub fn name(&self) -> &'a str {
+        match self {
+            Entry::Lobe(c) => &c.name,
+            Entry::User(c) => &c.name,
+        }
+    }
+    pub fn samples(&self) -> u64 {
+        match self {
+            Entry::Lobe(c) => c.samples,
+            Entry::User(c) => c.settings.samples,
+        }
+    }
+}
+
+/// A case as validated, before it takes its place in the scene.
+enum Parsed {
+    Lobe(Case),
+    User(UserCase),
 }
 
 struct Ctx<'a> {
@@ -236,7 +296,12 @@ fn seed(ctx: &Ctx, v: &Val) -> Result<u64, SceneError> {
 }
 
 fn bins(ctx: &Ctx, v: &Val) -> Result<SphereGrid, SceneError> {
-    let bad = |what: String| ctx.err(v.span(), format!("bins {what}; {BINS_ALLOWED}"));
+    grid(ctx, v, true, BINS_ALLOWED)
+}
+
+/// `[rows, cols]` with at most [`MAX_BINS`] bins (and an even number of rows where `even_rows`).
+fn grid(ctx: &Ctx, v: &Val, even_rows: bool, allowed: &str) -> Result<SphereGrid, SceneError> {
+    let bad = |what: String| ctx.err(v.span(), format!("bins {what}; {allowed}"));
     let Value::Array(items) = v.get_ref() else { return Err(bad(format!("must be an array, got {}", kind_of(v.get_ref())))) };
     let [rows, cols] = items.as_slice() else { return Err(bad(format!("has {} items, not 2", items.len()))) };
     let dim = |x: &Value| match x {
@@ -245,7 +310,7 @@ fn bins(ctx: &Ctx, v: &Val) -> Result<SphereGrid, SceneError> {
         other => Err(bad(format!("must hold whole numbers, got {}", kind_of(other)))),
     };
     let (r, c) = (dim(rows)?, dim(cols)?);
-    if r % 2 == 1 {
+    if even_rows && r % 2 == 1 {
         return Err(bad(format!("= [{r}, {c}] is not allowed: {r} rows is odd")));
     }
     if r as u64 * c as u64 > MAX_BINS {
@@ -288,25 +353,37 @@ impl Scene {
         }
         // Names are compared ignoring case: they name folders, and some file systems ignore case.
         let mut names: HashMap<String, (usize, usize)> = HashMap::new();
-        let mut cases = Vec::new();
-        let mut locations = Vec::new();
+        let mut scene = Scene { cases: Vec::new(), user_cases: Vec::new(), file: file.to_string(), order: Vec::new() };
         for c in &raw.case {
-            let case = validate_case(&ctx, c, &defaults)?;
             let here = line_column(text, c.span().start);
-            if let Some((line, column)) = names.insert(case.name.to_lowercase(), here) {
-                let span = c.get_ref().name.as_ref().map_or(c.span(), |n| n.span());
-                return Err(ctx.err(
-                    span,
-                    format!(
-                        "duplicate case name '{}' (the case at {line}:{column} has it too, ignoring case); names must be unique, they name the output folders",
-                        case.name
-                    ),
-                ));
+            let name_span = c.get_ref().name.as_ref().map_or(c.span(), |n| n.span());
+            for parsed in validate_table(&ctx, c, &defaults)? {
+                let name = match &parsed {
+                    Parsed::Lobe(case) => &case.name,
+                    Parsed::User(case) => &case.name,
+                };
+                if let Some((line, column)) = names.insert(name.to_lowercase(), here) {
+                    return Err(ctx.err(
+                        name_span,
+                        format!(
+                            "duplicate case name '{name}' (the case at {line}:{column} has it too, ignoring case); names must be unique, they name the output folders"
+                        ),
+                    ));
+                }
+                let slot = match parsed {
+                    Parsed::Lobe(case) => {
+                        scene.cases.push(case);
+                        Slot::Lobe(scene.cases.len() - 1)
+                    }
+                    Parsed::User(case) => {
+                        scene.user_cases.push(case);
+                        Slot::User(scene.user_cases.len() - 1)
+                    }
+                };
+                scene.order.push((slot, here));
             }
-            cases.push(case);
-            locations.push(here);
         }
-        Ok(Scene { cases, file: file.to_string(), locations })
+        Ok(scene)
     }
 
     /// Parses a scene from raw bytes: text that is not UTF-8 is an error at the first bad byte.
@@ -326,10 +403,36 @@ impl Scene {
         }
     }
 
-    /// "file:line:column" of case `index`'s `[[case]]` table.
+    /// "file:line:column" of the `[[case]]` table of `cases[index]`.
     pub fn case_location(&self, index: usize) -> String {
-        let (line, column) = self.locations.get(index).copied().unwrap_or((1, 1));
+        let at = self.order.iter().find(|(s, _)| *s == Slot::Lobe(index)).map_or((1, 1), |o| o.1);
+        self.location(at)
+    }
+
+    fn location(&self, (line, column): (usize, usize)) -> String {
         format!("{}:{line}:{column}", self.file)
+    }
+
+    /// Every case, lobes' and users', in the file's order, with "file:line:column" of its
+    /// `[[case]]` table.
+    pub fn entries(&self) -> impl Iterator<Item = (Entry<'_>, String)> {
+        self.order.iter().map(|&(slot, at)| {
+            let entry = match slot {
+                Slot::Lobe(i) => Entry::Lobe(&self.cases[i]),
+                Slot::User(i) => Entry::User(&self.user_cases[i]),
+            };
+            (entry, self.location(at))
+        })
+    }
+
+    /// The number of cases (lobes' and users').
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Whether the scene has no cases (never, for a parsed scene).
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
     }
 }
 
@@ -357,9 +460,18 @@ fn reject_keys(ctx: &Ctx, keys: &[(&str, Option<&Val>)], why: &str) -> Result<()
     }
 }
 
-fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<Case, SceneError> {
+/// A case's name, sample count and seed (the name with its sweep suffix).
+struct Common {
+    name: String,
+    samples: u64,
+    seed: u64,
+}
+
+/// The cases of one `[[case]]` table: one, or one per point of its sweeps.
+fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<Vec<Parsed>, SceneError> {
     let c = spanned.get_ref();
     let name = check_name(ctx, spanned)?;
+    let name_span = c.name.as_ref().map_or(spanned.span(), |n| n.span());
     let samples = match &c.samples {
         Some(v) => samples(ctx, v)?,
         None => d.samples.map_or(10_000_000, |(n, _)| n),
@@ -368,9 +480,50 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
         Some(v) => seed(ctx, v)?,
         None => d.seed.unwrap_or(1),
     };
+    for (key, sweep) in [("incident_theta", &c.incident_theta), ("incident_phi", &c.incident_phi)] {
+        if let Some(s) = sweep
+            && s.is_empty_sweep()
+        {
+            return Err(ctx.err(s.span(), format!("{key} = [] sweeps over no values; give a number, or an array of numbers (one case each)")));
+        }
+    }
+    let sampler = match &c.sampler {
+        Some(raw) => Some(user::sampler(ctx, c, raw)?),
+        None => {
+            let user_keys = [("params", c.params.as_ref().map(Sweep::whole)), ("domain", c.domain.clone()), ("bounds", c.bounds.clone())];
+            let user_keys: Vec<(&str, Option<&Val>)> = user_keys.iter().map(|(k, v)| (*k, v.as_ref())).collect();
+            reject_keys(ctx, &user_keys, "only applies to a user sampler (sampler = { wgsl = [...], sample = ..., pdf = ... }); remove it")?;
+            None
+        }
+    };
+    sweep::points(c.incident_theta.as_ref(), c.incident_phi.as_ref(), c.params.as_ref())
+        .into_iter()
+        .map(|point| {
+            let name = format!("{name}{}", point.suffix);
+            if name.len() > MAX_NAME_LEN {
+                return Err(ctx.err(
+                    name_span.clone(),
+                    format!("the sweep makes the case name '{name}', longer than {MAX_NAME_LEN} characters (it names a folder); shorten the name"),
+                ));
+            }
+            let common = Common { name, samples, seed };
+            match &sampler {
+                Some(s) => user::case(ctx, spanned, d, &point, common, s).map(Parsed::User),
+                None => validate_case(ctx, spanned, d, &point, common).map(Parsed::Lobe),
+            }
+        })
+        .collect()
+}
+
+fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common) -> Result<Case, SceneError> {
+    let c = spanned.get_ref();
+    let Common { name, samples, seed } = common;
     let lobes_allowed = "use ward, beckmann, ggx or discrete";
     let Some(lobe_v) = &c.lobe else {
-        return Err(ctx.err(spanned.span(), format!("case '{name}' has no lobe; add lobe = \"...\" ({lobes_allowed})")));
+        return Err(ctx.err(
+            spanned.span(),
+            format!("case '{name}' has no lobe; add lobe = \"...\" ({lobes_allowed}), or sampler = {{ wgsl = [...], sample = ..., pdf = ... }} for a sampler of your own"),
+        ));
     };
     let lobe_name = string(ctx, lobe_v, "lobe", lobes_allowed)?;
     let method = c.method.as_ref().map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
@@ -381,14 +534,12 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
             Some(("alias", _)) => DiscreteMethod::Alias,
             Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias"))),
         };
+        reject_keys(ctx, &roughness_keys(c), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
         reject_keys(
             ctx,
             &[
-                ("alpha", c.alpha.as_ref()),
-                ("alpha_x", c.alpha_x.as_ref()),
-                ("alpha_y", c.alpha_y.as_ref()),
-                ("incident_theta", c.incident_theta.as_ref()),
-                ("incident_phi", c.incident_phi.as_ref()),
+                ("incident_theta", point.incident_theta.as_ref()),
+                ("incident_phi", point.incident_phi.as_ref()),
                 ("bins", c.bins.as_ref()),
             ],
             "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
@@ -455,14 +606,11 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
             return Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})")));
         }
     };
-    let theta = match &c.incident_theta {
+    let theta = match &point.incident_theta {
         Some(t) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
         None => 0.0,
     };
-    let phi = match &c.incident_phi {
-        Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360")?,
-        None => 0.0,
-    };
+    let phi = incident_phi(ctx, point)?;
     let grid = match &c.bins {
         Some(v) => bins(ctx, v)?,
         None => d.bins.unwrap_or(SphereGrid { rows: 64, cols: 128 }),
@@ -475,6 +623,18 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<
         return Err(ctx.err(span, format!("samples = {samples} is too many for a weighted case; at most 2^32 (4294967296)")));
     }
     Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi), effects })
+}
+
+/// `incident_phi` of a case (0 unless given).
+fn incident_phi(ctx: &Ctx, point: &Point) -> Result<f64, SceneError> {
+    match &point.incident_phi {
+        Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360"),
+        None => Ok(0.0),
+    }
+}
+
+fn roughness_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 3] {
+    [("alpha", c.alpha.as_ref()), ("alpha_x", c.alpha_x.as_ref()), ("alpha_y", c.alpha_y.as_ref())]
 }
 
 fn effect_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 6] {
@@ -567,6 +727,45 @@ mod tests {
     fn embedded_scenes_parse() {
         assert!(Scene::parse("all-lobes.toml", DEFAULT_SCENE).unwrap().cases.len() > 10);
         assert_eq!(Scene::parse("tutorial.toml", TUTORIAL_SCENE).unwrap().cases.len(), 3);
+    }
+
+    #[test]
+    fn an_array_of_incident_angles_sweeps_a_lobe_case() {
+        let text = "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0, 60]\nincident_phi = [-30, 90]\n\n[[case]]\nname = \"w\"\nlobe = \"ward\"\nalpha = 0.2\n";
+        let scene = Scene::parse("s.toml", text).unwrap();
+        let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
+        assert_eq!(names, ["g-theta0-phi-30", "g-theta0-phi90", "g-theta60-phi-30", "g-theta60-phi90", "w"]);
+        assert_eq!(scene.cases[3].incident_deg, (60.0, 90.0));
+        // (sin 60° cos 90°, sin 60° sin 90°, cos 60°)
+        let Job::Lobe { incident, .. } = &scene.cases[3].job else { panic!("a lobe") };
+        assert!((incident.y - 0.75f64.sqrt()).abs() < 1e-12 && incident.x.abs() < 1e-12 && (incident.z - 0.5).abs() < 1e-12);
+        assert_eq!(scene.case_location(4), "s.toml:8:1");
+        assert!(scene.entries().all(|(_, at)| at.starts_with("s.toml:")));
+        let err = Scene::parse("s.toml", "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0, 95]\n").unwrap_err();
+        assert_eq!((err.line, err.column), (5, 22), "{err}");
+        let err = Scene::parse("s.toml", "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = []\n").unwrap_err();
+        assert!(err.message.contains("sweeps over no values"), "{err}");
+        let dup = "[[case]]\nname = \"g-theta0\"\nlobe = \"ward\"\nalpha = 0.2\n[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0]\n";
+        assert!(Scene::parse("s.toml", dup).unwrap_err().message.contains("duplicate case name 'g-theta0'"));
+    }
+
+    #[test]
+    fn a_user_sampler_case_reads_its_files_relative_to_the_scene() {
+        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/user-samplers.toml");
+        let scene = Scene::parse(file, &std::fs::read_to_string(file).unwrap()).unwrap();
+        assert!(scene.cases.is_empty());
+        assert_eq!(scene.len(), 6);
+        let hg = &scene.user_cases[4];
+        assert_eq!((hg.name.as_str(), hg.settings.params.as_slice()), ("henyey-greenstein-params-0.3", &[-0.3][..]));
+        assert_eq!(hg.settings.samples, 1_000_000);
+        let plane = &scene.user_cases[5];
+        assert_eq!(plane.sampler.domain, crate::check::Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] });
+        // the three θi of one sampler share its files
+        assert!(std::sync::Arc::ptr_eq(&scene.user_cases[0].sampler, &scene.user_cases[2].sampler));
+        assert_eq!(scene.user_cases[2].settings.incident_theta, 80.0);
+        // elsewhere, the same relative path names no file
+        let err = Scene::parse("elsewhere/s.toml", &std::fs::read_to_string(file).unwrap()).unwrap_err();
+        assert!(err.message.contains("elsewhere/../examples/samplers/ggx_vndf.wgsl: cannot read"), "{err}");
     }
 
     #[test]

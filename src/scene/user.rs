@@ -1,0 +1,138 @@
+//! Cases of a user's WGSL sampler: `sampler = { wgsl = [...], sample = "...", pdf = "...",
+//! eval = "..." }` with `params`, `domain` (and `bounds` on the plane), judged by the checks of
+//! `lobes check` ([`crate::check`]). The WGSL files are read relative to the scene file and
+//! checked against the contract while the scene is parsed, so that a missing file, function or
+//! signature is a [`SceneError`] at the case's `sampler` before any case runs.
+
+use super::sweep::Point;
+use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
+use crate::check::{Domain, MAX_PARAMS, Settings, UserSampler};
+use serde::Deserialize;
+use std::path::Path;
+use std::sync::Arc;
+use toml::{Spanned, Value};
+
+/// `sampler = { ... }` as written.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawSampler {
+    wgsl: Option<Val>,
+    sample: Option<Val>,
+    pdf: Option<Val>,
+    eval: Option<Val>,
+}
+
+/// One validated case of a user's sampler: the sampler (shared by the cases of a sweep) and the
+/// settings of its check (the significance is the run's, per case).
+#[derive(Debug, Clone)]
+pub struct UserCase {
+    pub name: String,
+    pub sampler: Arc<UserSampler>,
+    pub settings: Settings,
+}
+
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name\", pdf = \"fn name\", eval = \"fn name\" } (eval optional; paths relative to the scene file)";
+const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
+const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
+
+/// The sampler of a `[[case]]` table: its files read and checked against the contract.
+pub(super) fn sampler(ctx: &Ctx, c: &RawCase, raw: &Spanned<RawSampler>) -> Result<Arc<UserSampler>, SceneError> {
+    let not_here = "does not apply to a user sampler (its WGSL is the whole sampler); remove it";
+    reject_keys(ctx, &[("lobe", c.lobe.as_ref()), ("method", c.method.as_ref())], not_here)?;
+    reject_keys(ctx, &roughness_keys(c), not_here)?;
+    if let Some(w) = &c.weights {
+        return Err(ctx.err(w.span(), format!("weights {not_here}")));
+    }
+    reject_keys(ctx, &effect_keys(c), "does not apply to a user sampler (give an eval function for the weight and albedo checks); remove it")?;
+    let r = raw.get_ref();
+    let name = |v: &Option<Val>, key: &str| -> Result<Option<String>, SceneError> {
+        v.as_ref().map(|v| string(ctx, v, &format!("sampler.{key}"), SAMPLER_ALLOWED).map(String::from)).transpose()
+    };
+    let missing = |key: &str| ctx.err(raw.span(), format!("the sampler has no {key}; {SAMPLER_ALLOWED}"));
+    let Some(wgsl) = &r.wgsl else { return Err(missing("wgsl")) };
+    let sample = name(&r.sample, "sample")?.ok_or_else(|| missing("sample"))?;
+    let pdf = name(&r.pdf, "pdf")?.ok_or_else(|| missing("pdf"))?;
+    let eval = name(&r.eval, "eval")?;
+    let files = match wgsl.get_ref() {
+        Value::Array(items) if !items.is_empty() => items
+            .iter()
+            .map(|i| match i {
+                Value::String(s) => Ok(s.as_str()),
+                other => Err(ctx.err(wgsl.span(), format!("sampler.wgsl must hold file names (strings), got {}; {SAMPLER_ALLOWED}", kind_of(other)))),
+            })
+            .collect::<Result<Vec<_>, _>>()?,
+        Value::Array(_) => return Err(ctx.err(wgsl.span(), format!("sampler.wgsl is empty; {SAMPLER_ALLOWED}"))),
+        other => return Err(ctx.err(wgsl.span(), format!("sampler.wgsl must be an array of file names, got {}; {SAMPLER_ALLOWED}", kind_of(other)))),
+    };
+    let base = Path::new(ctx.file).parent().unwrap_or(Path::new(""));
+    let paths: Vec<_> = files.iter().map(|f| base.join(f)).collect();
+    let domain = domain(ctx, c)?;
+    UserSampler::from_files(&paths, &sample, &pdf, eval.as_deref(), domain).map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
+    .map(Arc::new)
+}
+
+/// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no
+/// incident direction.
+fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
+    let allowed = "use sphere (unit directions) or plane (points of the box given by bounds)";
+    let plane = match &c.domain {
+        None => false,
+        Some(v) => match string(ctx, v, "domain", allowed)? {
+            "sphere" => false,
+            "plane" => true,
+            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}"))),
+        },
+    };
+    if !plane {
+        reject_keys(ctx, &[("bounds", c.bounds.as_ref())], "only applies to domain = \"plane\"; remove it (or set domain = \"plane\")")?;
+        return Ok(Domain::Sphere);
+    }
+    let angles = [("incident_theta", c.incident_theta.as_ref().map(|s| s.whole())), ("incident_phi", c.incident_phi.as_ref().map(|s| s.whole()))];
+    let angles: Vec<(&str, Option<&Val>)> = angles.iter().map(|(k, v)| (*k, v.as_ref())).collect();
+    reject_keys(ctx, &angles, "does not apply to domain = \"plane\" (a point of the plane has no incident direction); remove it")?;
+    let domain_v = c.domain.as_ref().expect("domain = \"plane\" is written");
+    let Some(b) = &c.bounds else { return Err(ctx.err(domain_v.span(), format!("domain = \"plane\" needs bounds; {BOUNDS_ALLOWED}"))) };
+    let Value::Array(items) = b.get_ref() else {
+        return Err(ctx.err(b.span(), format!("bounds must be an array, got {}; {BOUNDS_ALLOWED}", kind_of(b.get_ref()))));
+    };
+    let numbers = items.iter().map(|i| number(ctx, &Spanned::new(b.span(), i.clone()), "bounds", |_| true, BOUNDS_ALLOWED)).collect::<Result<Vec<_>, _>>()?;
+    match numbers[..] {
+        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok(Domain::Plane { bounds: [x0, y0, x1, y1] }),
+        _ => Err(ctx.err(b.span(), format!("bounds = {} is not a box; {BOUNDS_ALLOWED}", b.get_ref()))),
+    }
+}
+
+/// One case of a user's sampler at one point of its sweeps.
+pub(super) fn case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>) -> Result<UserCase, SceneError> {
+    let c = spanned.get_ref();
+    let defaults = Settings::default();
+    let incident_theta = match &point.incident_theta {
+        Some(t) => number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?,
+        None => defaults.incident_theta,
+    };
+    let incident_phi = incident_phi(ctx, point)?;
+    let params = match &point.params {
+        None => Vec::new(),
+        Some(p) => params(ctx, p)?,
+    };
+    let bins = match (&c.bins, &d.bins) {
+        (Some(v), _) => Some(grid(ctx, v, false, GRID_ALLOWED)?),
+        (None, Some(g)) => Some(*g),
+        (None, None) => None,
+    };
+    let Common { name, samples, seed } = common;
+    let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, ..defaults };
+    Ok(UserCase { name, sampler: sampler.clone(), settings })
+}
+
+/// `params = [p1, p2, ...]`: at most [`MAX_PARAMS`] finite numbers.
+fn params(ctx: &Ctx, v: &Val) -> Result<Vec<f64>, SceneError> {
+    let allowed = format!("params is a list of at most {MAX_PARAMS} finite numbers, params[i / 4][i % 4] in WGSL (an array of such lists sweeps)");
+    let Value::Array(items) = v.get_ref() else {
+        return Err(ctx.err(v.span(), format!("params must be an array, got {}; {allowed}", kind_of(v.get_ref()))));
+    };
+    if items.len() > MAX_PARAMS {
+        return Err(ctx.err(v.span(), format!("params has {} numbers; {allowed}", items.len())));
+    }
+    items.iter().map(|i| number(ctx, &Spanned::new(v.span(), i.clone()), "params", |_| true, &allowed)).collect()
+}
