@@ -133,6 +133,22 @@ fn every_file_lobes_writes_validates_against_its_schema() {
         }
     }
 
+    // a scene of users' WGSL samplers (sphere and plane; with and without an eval), with fewer samples
+    let user_scene = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/user-samplers.toml"))
+        .unwrap()
+        .replace("samples = 1_000_000", "samples = 50_000")
+        .replace("../examples", &Path::new(env!("CARGO_MANIFEST_DIR")).join("examples").display().to_string());
+    std::fs::write(dir.join("user.toml"), user_scene).unwrap();
+    let run = lobes(&dir, &["run", "user.toml", "--out", "user", "--json"]);
+    validate("run-summary.schema.json", &run, "the summary of lobes run on users' samplers");
+    for case in ["ggx-vndf-theta45", "piecewise-2d"] {
+        let path = dir.join("user").join(case).join("histogram.json");
+        validate("histogram.schema.json", &file(&path), &path.display().to_string());
+        let h = HistogramFile::read(&path).unwrap();
+        assert!(serde_json::to_string_pretty(&h).unwrap() == std::fs::read_to_string(&path).unwrap(), "{}", path.display());
+        assert!(h.user_sampler.is_some() && h.invalid.is_none());
+    }
+
     // the schemas are not vacuous: a damaged file does not validate
     let schema: Value = serde_json::from_str(&std::fs::read_to_string(docs().join("histogram.schema.json")).unwrap()).unwrap();
     let validator = jsonschema::validator_for(&schema).unwrap();
@@ -145,7 +161,7 @@ fn every_file_lobes_writes_validates_against_its_schema() {
     // a case that could not run: the error row of a summary
     let mut with_error = summary.clone();
     let scene = lobes::scene::Scene::parse("scene.toml", SCENE).unwrap();
-    with_error.cases.push(CaseSummary::error(&scene.cases[0], "the GPU device was lost".into()));
+    with_error.cases.push(CaseSummary::error(&lobes::scene::Entry::Lobe(&scene.cases[0]), "the GPU device was lost".into()));
     with_error.errors = 1;
     let v = serde_json::to_value(&with_error).unwrap();
     validate("run-summary.schema.json", &v, "a summary with an error row");

@@ -5,8 +5,9 @@
 use super::{OutputArgs, emit, emit_json, parse_level, prepare_out, usage};
 use crate::report::output::{self, CaseSummary, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
+use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
-use crate::scene::{Case, DEFAULT_SCENE, Scene};
+use crate::scene::{Case, DEFAULT_SCENE, Entry, Scene, UserCase};
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -83,21 +84,40 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Removes the `histogram.json` an earlier run left in the case's folder.
+fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
+    let stale = out.join(name).join("histogram.json");
+    match std::fs::remove_file(&stale) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => anyhow::bail!("cannot remove the earlier {}: {e}", stale.display()),
+    }
+}
+
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
 /// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
 fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, bar: &ProgressBar) -> anyhow::Result<CaseResult> {
-    let stale = out.join(&case.name).join("histogram.json");
-    match std::fs::remove_file(&stale) {
-        Ok(()) => {}
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => anyhow::bail!("cannot remove the earlier {}: {e}", stale.display()),
-    }
+    remove_stale(out, &case.name)?;
     let sampled = run_case(backend, case, 0..case.samples, &mut |done| bar.set_position(done))?;
     let result = judge(case, sampled, level)?;
     let adapter = backend.adapter();
     output::write_case(out, &result, &adapter, backend.name())
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok(result)
+}
+
+/// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
+fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path) -> anyhow::Result<([String; 9], CaseSummary, bool)> {
+    remove_stale(out, &case.name)?;
+    let result = run_user(backend, case, level)?;
+    output::write_user_case(out, &result, backend.name())
+        .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
+    Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }, result.passed()))
+}
+
+/// The first user's sampler case of a scene and its location, if any.
+fn first_user_case(scene: &Scene) -> Option<(String, String)> {
+    scene.entries().find_map(|(e, at)| matches!(e, Entry::User(_)).then(|| (e.name().to_string(), at)))
 }
 
 fn progress_bar(samples: u64, name: &str) -> ProgressBar {
@@ -112,43 +132,60 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         return run_shard(args, shard);
     }
     let scene = load_scene(args.scene.as_ref())?;
+    if args.cpu
+        && let Some((name, at)) = first_user_case(&scene)
+    {
+        return Err(usage(format!("{at}: case '{name}' is a WGSL sampler, which runs on a GPU adapter only; run without --cpu")));
+    }
     prepare_out(&args.out)?;
     let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
     check_fits(&backend, &scene)?;
     let adapter = backend.adapter();
-    let n = scene.cases.len();
+    let n = scene.len();
     let level = sidak(args.significance, n);
     let mut rows = Vec::new();
     let mut summary = Vec::new();
     let (mut failed, mut errors) = (0, 0);
-    let (mut cpu_rows, mut wall_rows) = (false, false);
+    let (mut cpu_rows, mut wall_rows, mut user_rows) = (false, false, false);
     // A case that cannot run (device lost, a write that fails) is reported and skipped; the
     // others still run. After a lost device the remaining cases run on the CPU engine.
-    for (i, case) in scene.cases.iter().enumerate() {
-        let bar = progress_bar(case.samples, &case.name);
-        let outcome = run_and_write(&mut backend, case, level, &args.out, &bar);
-        bar.finish_and_clear();
-        let result = match outcome {
-            Ok(result) => result,
+    for (i, (entry, at)) in scene.entries().enumerate() {
+        let outcome = match entry {
+            Entry::Lobe(case) => {
+                let bar = progress_bar(case.samples, &case.name);
+                let outcome = run_and_write(&mut backend, case, level, &args.out, &bar);
+                bar.finish_and_clear();
+                outcome.map(|result| {
+                    if result.gpu_seconds.is_none() {
+                        if backend.name() == "cpu" { cpu_rows = true } else { wall_rows = true }
+                    }
+                    let row = output::table_row(&result);
+                    (row, CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) }, result.passed())
+                })
+            }
+            Entry::User(case) => {
+                user_rows = true;
+                run_user_and_write(&backend, case, level, &args.out)
+            }
+        };
+        match outcome {
+            Ok((row, case_summary, passed)) => {
+                failed += usize::from(!passed);
+                rows.push(row);
+                summary.push(case_summary);
+            }
             Err(e) => {
                 errors += 1;
-                eprintln!("error: case '{}' ({}): {e:#}; no histogram.json was written for it", case.name, scene.case_location(i));
+                eprintln!("error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
                 if device_lost(&e) && matches!(backend, Backend::Gpu(_)) && i + 1 < n {
                     eprintln!("warning: the GPU device is unusable; the remaining cases run on the CPU reference engine (f64, all cores)");
                     backend = Backend::Cpu;
                 }
                 let dash = || "-".to_string();
-                rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
-                summary.push(CaseSummary::error(case, format!("{e:#}")));
-                continue;
+                rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
+                summary.push(CaseSummary::error(&entry, format!("{e:#}")));
             }
-        };
-        failed += usize::from(!result.passed());
-        if result.gpu_seconds.is_none() {
-            if backend.name() == "cpu" { cpu_rows = true } else { wall_rows = true }
         }
-        rows.push(output::table_row(&result));
-        summary.push(CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) });
     }
     if args.output.json {
         emit_json(&RunSummary {
@@ -171,12 +208,15 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         if wall_rows {
             text += "\n* wall time: the adapter has no timestamp queries\n";
         }
+        if user_rows {
+            text += "\n† a WGSL sampler of your own: wall time of all its checks (lobes check); FAIL names the checks that failed\n";
+        }
         text += &format!("\noutputs in {}\n", args.out.display());
         emit(&text)?;
     }
     match (errors, failed) {
         (0, 0) => Ok(()),
-        (0, f) => anyhow::bail!("{f} of {n} cases failed the χ² test or the albedo checks"),
+        (0, f) => anyhow::bail!("{f} of {n} cases failed the χ² test or the albedo checks (or, for a WGSL sampler, one of its checks)"),
         (e, 0) => anyhow::bail!("{e} of {n} cases could not run (see the errors above)"),
         (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test or the albedo checks"),
     }
@@ -186,6 +226,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
 /// `DIR/<case>/shard-I-of-N.json` for `lobes merge`.
 fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
     let (source, scene) = read_scene(args.scene.as_ref())?;
+    if let Some((name, at)) = first_user_case(&scene) {
+        return Err(usage(format!(
+            "{at}: case '{name}' is a WGSL sampler of your own, which --shard does not split: its checks (the Jacobian probe, \
+             the quadrature of its pdf, the hard cases) judge the whole case, not sums over sample ranges; \
+             run it without --shard, or put it in a scene of its own"
+        )));
+    }
     let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
     let adapter = backend.adapter();
     prepare_out(&args.out)?;

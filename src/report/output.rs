@@ -7,10 +7,13 @@
 
 use super::atomic::write_atomic;
 use super::heatmap::{self, Heatmap, Scale};
+use crate::check::Domain;
 use crate::engine::job::Job;
+use crate::stats::histogram::SphereGrid;
 use crate::reference::effects::Effects;
 use crate::run::record::{ByReason, CaseDescription, Timing, WeightedTiming};
 use crate::run::shard::ShardFile;
+use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
 use crate::stats::chi2::Chi2;
 use crate::stats::compare::AngleCheck;
@@ -46,8 +49,9 @@ pub struct HistogramFile {
     pub counts: Vec<Vec<u64>>,
     /// Expected counts, rows × cols.
     pub expected: Vec<Vec<f64>>,
-    pub invalid: ByReason<u64>,
-    pub expected_invalid: ByReason<f64>,
+    /// Invalid samples by reason (null for a user's sampler: see `user_sampler.invalid`).
+    pub invalid: Option<ByReason<u64>>,
+    pub expected_invalid: Option<ByReason<f64>>,
     pub chi2: Chi2,
     pub timing: Timing,
     /// GPU directions of the first samples against f64 (GPU lobe cases).
@@ -58,6 +62,41 @@ pub struct HistogramFile {
     pub workgroup_counting: Option<bool>,
     /// The weighted histogram of a case with effects.
     pub weighted: Option<WeightedRecord>,
+    /// The checks of a user's WGSL sampler (`lobes check`); absent for lobes' own samplers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub user_sampler: Option<UserSamplerRecord>,
+}
+
+/// The `user_sampler` section: every check of `lobes check` and the invalid samples by the
+/// check's reasons ([`crate::check::REASONS`]), pooled into one cell of the χ² test.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct UserSamplerRecord {
+    /// Whether every check passed (the case's verdict).
+    pub passed: bool,
+    pub checks: Vec<CheckRecord>,
+    pub invalid: UserInvalid,
+    /// The expected count of the pooled invalid cell.
+    pub expected_invalid: f64,
+    /// Wall time of all the checks.
+    pub wall_seconds: f64,
+}
+
+/// One check of a user's sampler: its name, verdict, one line a person reads, and its figures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct CheckRecord {
+    pub name: String,
+    pub passed: bool,
+    pub summary: String,
+    pub figures: serde_json::Value,
+}
+
+/// Invalid samples of a user's sampler by reason.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct UserInvalid {
+    pub non_finite_point: u64,
+    pub outside_domain: u64,
+    pub non_finite_pdf: u64,
+    pub zero_pdf: u64,
 }
 
 /// The accuracy and time of the expected histogram's quadrature.
@@ -110,8 +149,8 @@ impl HistogramFile {
             phi_edges,
             counts: nested(&r.counts.bins, cols),
             expected: nested(&r.expected.bins, cols),
-            invalid: r.counts.invalid.into(),
-            expected_invalid: r.expected.invalid.into(),
+            invalid: Some(r.counts.invalid.into()),
+            expected_invalid: Some(r.expected.invalid.into()),
             chi2: r.chi2.clone(),
             timing: Timing { gpu_seconds: r.gpu_seconds, histogram_wall_seconds: r.histogram_seconds },
             per_sample_check: r.angle.clone(),
@@ -123,6 +162,51 @@ impl HistogramFile {
             }),
             workgroup_counting: r.workgroup_counting,
             weighted: r.weighted.as_ref().map(|w| WeightedRecord::new(r, w, cols)),
+            user_sampler: None,
+        }
+    }
+
+    /// The `histogram.json` of a user's sampler case.
+    pub fn of_user(r: &UserResult, backend: &str) -> Self {
+        let (case, report) = (&r.case, &r.report);
+        let description = CaseDescription::of_user(case, report.rows, report.cols);
+        let cols = description.cols;
+        let sphere = report.domain == Domain::Sphere;
+        let grid = SphereGrid { rows: report.rows, cols: report.cols };
+        let wi = crate::reference::reflect::spherical(case.settings.incident_theta.to_radians(), case.settings.incident_phi.to_radians());
+        let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = report.invalid;
+        HistogramFile {
+            format_version: HISTOGRAM_VERSION,
+            case: case.name.clone(),
+            description,
+            incident: sphere.then(|| wi.to_array()),
+            samples: case.settings.samples,
+            seed: case.settings.seed,
+            adapter: report.adapter.clone(),
+            backend: backend.into(),
+            cos_theta_edges: sphere.then(|| grid.cos_theta_edges()),
+            phi_edges: sphere.then(|| grid.phi_edges()),
+            counts: nested(&report.counts, cols),
+            expected: nested(&report.expected, cols),
+            invalid: None,
+            expected_invalid: None,
+            chi2: r.chi2.clone(),
+            timing: Timing { gpu_seconds: None, histogram_wall_seconds: r.wall_seconds },
+            per_sample_check: None,
+            quadrature: None,
+            workgroup_counting: None,
+            weighted: None,
+            user_sampler: Some(UserSamplerRecord {
+                passed: report.passed,
+                checks: report
+                    .checks
+                    .iter()
+                    .map(|c| CheckRecord { name: c.name.clone(), passed: c.passed, summary: c.summary.clone(), figures: c.figures.clone() })
+                    .collect(),
+                invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
+                expected_invalid: r.expected_invalid,
+                wall_seconds: r.wall_seconds,
+            }),
         }
     }
 
@@ -158,33 +242,75 @@ pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     Ok(file)
 }
 
+/// A histogram's grid and the labels and ranges of its axes.
+#[derive(Clone, Copy)]
+struct Axes {
+    rows: usize,
+    cols: usize,
+    row_label: &'static str,
+    col_label: &'static str,
+    row_range: (f64, f64),
+    col_range: (f64, f64),
+}
+
+impl Axes {
+    /// Rows over cos θ in [−1, 1], columns over φ in [−π, π) (as lobes bins directions).
+    fn sphere(rows: usize, cols: usize) -> Self {
+        Axes { rows, cols, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-std::f64::consts::PI, std::f64::consts::PI) }
+    }
+}
+
+/// Writes the heat maps of the measured and expected counts and the signed residual
+/// (measured − expected)/√expected into `folder`.
+fn write_maps(folder: &Path, name: &str, a: &Axes, measured: &[f64], expected: &[f64]) -> anyhow::Result<()> {
+    let residual: Vec<f64> = measured
+        .iter()
+        .zip(expected)
+        .map(|(&o, &e)| if e > 0.0 { (o - e) / e.sqrt() } else if o > 0.0 { f64::NAN } else { 0.0 })
+        .collect();
+    let maps = [
+        ("measured.png", format!("{name}: measured counts"), measured, Scale::Sequential),
+        ("expected.png", format!("{name}: expected counts"), expected, Scale::Sequential),
+        ("residual.png", format!("{name}: (measured - expected)/sqrt(expected)"), &residual[..], Scale::Diverging),
+    ];
+    for (file, title, values, scale) in maps {
+        let (rows, cols, row_label, col_label, row_range, col_range) = (a.rows, a.cols, a.row_label, a.col_label, a.row_range, a.col_range);
+        let map = Heatmap { title: &title, rows, cols, values, scale, row_label, col_label, row_range, col_range };
+        heatmap::write_png(&map, &folder.join(file))?;
+    }
+    Ok(())
+}
+
+/// Writes the heat maps and then `histogram.json` of a user's sampler case into `dir/<case>/`.
+pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str) -> anyhow::Result<()> {
+    let folder = dir.join(&r.case.name);
+    std::fs::create_dir_all(&folder)?;
+    let (rows, cols) = (r.report.rows as usize, r.report.cols as usize);
+    let axes = match r.report.domain {
+        Domain::Sphere => Axes::sphere(rows, cols),
+        Domain::Plane { bounds: [x0, y0, x1, y1] } => Axes { rows, cols, row_label: "y", col_label: "x", row_range: (y0, y1), col_range: (x0, x1) },
+    };
+    let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
+    write_maps(&folder, &r.case.name, &axes, &measured, &r.report.expected)?;
+    let doc = HistogramFile::of_user(r, backend);
+    write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
+    Ok(())
+}
+
 /// Writes the heat maps and then `histogram.json` into `dir/<case>/`.
 pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
-    let (rows, cols, row_range, col_range) = match &r.case.job {
-        Job::Lobe { grid, .. } => (grid.rows as usize, grid.cols as usize, (-1.0, 1.0), (-std::f64::consts::PI, std::f64::consts::PI)),
-        Job::Discrete { dist, .. } => (1, dist.len(), (0.0, 1.0), (0.0, dist.len() as f64)),
+    let axes = match &r.case.job {
+        Job::Lobe { grid, .. } => Axes::sphere(grid.rows as usize, grid.cols as usize),
+        Job::Discrete { dist, .. } => Axes { rows: 1, cols: dist.len(), row_label: "", col_label: "index", row_range: (0.0, 1.0), col_range: (0.0, dist.len() as f64) },
     };
-    let (row_label, col_label) = if rows == 1 { ("", "index") } else { ("cos θ", "φ") };
     let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();
-    let residual: Vec<f64> = measured
-        .iter()
-        .zip(&r.expected.bins)
-        .map(|(&o, &e)| if e > 0.0 { (o - e) / e.sqrt() } else if o > 0.0 { f64::NAN } else { 0.0 })
-        .collect();
-    let maps = [
-        ("measured.png", format!("{}: measured counts", r.case.name), &measured, Scale::Sequential),
-        ("expected.png", format!("{}: expected counts", r.case.name), &r.expected.bins, Scale::Sequential),
-        ("residual.png", format!("{}: (measured - expected)/sqrt(expected)", r.case.name), &residual, Scale::Diverging),
-    ];
-    for (file, title, values, scale) in maps {
-        let map = Heatmap { title: &title, rows, cols, values, scale, row_label, col_label, row_range, col_range };
-        heatmap::write_png(&map, &folder.join(file))?;
-    }
+    write_maps(&folder, &r.case.name, &axes, &measured, &r.expected.bins)?;
     if let Some(w) = &r.weighted {
         let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
         let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
+        let Axes { rows, cols, row_label, col_label, row_range, col_range } = axes;
         let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label, col_label, row_range, col_range };
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
@@ -224,8 +350,12 @@ pub struct CaseSummary {
     /// The backend the case ran on (`lobes run` only: it may move to the CPU mid-run).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<String>,
-    /// The case's verdict ([`CaseResult::passed`]): χ² and, where weighted, the albedo checks.
+    /// The case's verdict ([`CaseResult::passed`]): χ² and, where weighted, the albedo checks;
+    /// for a user's sampler, every check of `lobes check`.
     pub passed: bool,
+    /// The checks a user's sampler failed, by name (absent for lobes' own samplers).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failed_checks: Option<Vec<String>>,
     /// What the case measured (absent where it could not run).
     #[serde(flatten)]
     pub measured: Option<CaseMeasured>,
@@ -268,6 +398,7 @@ impl CaseSummary {
             shards: None,
             backend: None,
             passed: r.passed(),
+            failed_checks: None,
             measured: Some(CaseMeasured {
                 gpu_seconds: r.gpu_seconds,
                 wall_seconds: r.histogram_seconds,
@@ -289,14 +420,45 @@ impl CaseSummary {
         }
     }
 
-    /// The summary of a case that could not run.
-    pub fn error(case: &crate::scene::Case, error: String) -> Self {
+    /// The summary of a user's sampler case, with its outputs in `out/<case>`.
+    pub fn of_user(r: &UserResult, out: &Path) -> Self {
         CaseSummary {
-            case: case.name.clone(),
-            samples: case.samples,
+            case: r.case.name.clone(),
+            samples: r.case.settings.samples,
+            shards: None,
+            backend: None,
+            passed: r.passed(),
+            failed_checks: Some(r.failed_checks().into_iter().map(String::from).collect()),
+            measured: Some(CaseMeasured {
+                gpu_seconds: None,
+                wall_seconds: r.wall_seconds,
+                chi2: r.chi2.statistic,
+                dof: r.chi2.dof,
+                p_value: r.chi2.p_value,
+                albedo: r.albedo.map(|a| AlbedoSummary {
+                    albedo: a.mean_weight,
+                    reference: a.quadrature,
+                    relative_error: a.relative_error(),
+                    p_value: a.p_value,
+                    max_weight_error: a.max_weight_error as f32,
+                    passed: a.passed,
+                }),
+                max_angle_rad: None,
+            }),
+            error: None,
+            output: Some(out.join(&r.case.name)),
+        }
+    }
+
+    /// The summary of a case that could not run.
+    pub fn error(case: &crate::scene::Entry, error: String) -> Self {
+        CaseSummary {
+            case: case.name().to_string(),
+            samples: case.samples(),
             shards: None,
             backend: None,
             passed: false,
+            failed_checks: None,
             measured: None,
             error: Some(error),
             output: None,
@@ -361,6 +523,23 @@ pub fn table_row(r: &CaseResult) -> [String; 9] {
         if r.passed() { "pass".into() } else { "FAIL".into() },
         angle,
         r.weighted.as_ref().map_or("-".into(), |w| format!("{:.5} ({:+.1e})", w.check.albedo, w.check.relative_error)),
+    ]
+}
+
+/// One line of the run table for a user's sampler: its time is the wall time of all its checks
+/// (marked †), its verdict names the checks that failed.
+pub fn user_table_row(r: &UserResult) -> [String; 9] {
+    let failed = r.failed_checks();
+    [
+        r.case.name.clone(),
+        r.case.settings.samples.to_string(),
+        format!("{:.3} s†", r.wall_seconds),
+        format!("{:.1}", r.chi2.statistic),
+        r.chi2.dof.to_string(),
+        format!("{:.4}", r.chi2.p_value),
+        if failed.is_empty() { "pass".into() } else { format!("FAIL ({})", failed.join(", ")) },
+        "-".into(),
+        r.albedo.map_or("-".into(), |a| format!("{:.5} ({:+.1e})", a.mean_weight, a.relative_error())),
     ]
 }
 

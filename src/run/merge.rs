@@ -139,6 +139,10 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
     }
     let scene = Scene::parse(&first.file.scene_name, &first.file.scene)
         .map_err(|e| ShardError(format!("{}: the scene stored in the shard does not parse: {e}", first.path.display())))?;
+    if let Some(user) = scene.user_cases.first() {
+        // `lobes run --shard` refuses such scenes, so no shard of one is ever written
+        return Err(ShardError(format!("{}: case '{}' is a WGSL sampler, which is never sharded; run it with `lobes run`", first.path.display(), user.name)));
+    }
     let mut by_case: BTreeMap<&str, Vec<&ShardOnDisk>> = BTreeMap::new();
     for s in shards {
         let f = &s.file;

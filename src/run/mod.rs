@@ -6,6 +6,7 @@
 pub mod merge;
 pub mod record;
 pub mod shard;
+pub mod user;
 
 use crate::engine::cpu;
 use crate::engine::gpu::effects::Specialisation;

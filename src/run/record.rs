@@ -5,21 +5,22 @@
 
 use crate::engine::job::Job;
 use crate::reference::Invalid;
-use crate::scene::Case;
+use crate::check::Domain;
+use crate::scene::{Case, UserCase};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// What a case samples: `lobe`, `method`, `params`, and the histogram's `rows` × `cols`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct CaseDescription {
-    /// `ward`, `beckmann`, `ggx` or `discrete`.
+    /// `ward`, `beckmann`, `ggx`, `discrete`, or `user` for a user's WGSL sampler.
     pub lobe: String,
-    /// `ndf`, `vndf`, `bounded`, or for a discrete case `cdf` or `alias`.
+    /// `ndf`, `vndf`, `bounded`, for a discrete case `cdf` or `alias`, for a user's sampler `wgsl`.
     pub method: String,
     pub params: Params,
-    /// Rows over cos θ (1 for a discrete case).
+    /// Rows over cos θ (1 for a discrete case, over y on the plane).
     pub rows: usize,
-    /// Columns over φ (the items of a discrete case).
+    /// Columns over φ (the items of a discrete case, over x on the plane).
     pub cols: usize,
 }
 
@@ -29,6 +30,23 @@ pub struct CaseDescription {
 pub enum Params {
     Lobe { alpha_x: f64, alpha_y: f64, incident_theta_deg: f64, incident_phi_deg: f64 },
     Discrete { weights: Vec<f64> },
+    /// A user's WGSL sampler ([`crate::check`]).
+    User {
+        /// The WGSL files, in order, as the scene resolves them.
+        wgsl: Vec<String>,
+        sample: String,
+        pdf: String,
+        eval: Option<String>,
+        /// The numbers passed as `params` (before zero-padding).
+        params: Vec<f64>,
+        /// `sphere` or `plane`.
+        domain: String,
+        /// The plane's box `[x0, y0, x1, y1]` (null on the sphere).
+        bounds: Option<[f64; 4]>,
+        /// The incident direction (null on the plane, where there is none).
+        incident_theta_deg: Option<f64>,
+        incident_phi_deg: Option<f64>,
+    },
 }
 
 impl CaseDescription {
@@ -53,6 +71,34 @@ impl CaseDescription {
                 rows: 1,
                 cols: dist.len(),
             },
+        }
+    }
+}
+
+impl CaseDescription {
+    /// The description of a user's sampler case.
+    pub fn of_user(case: &UserCase, rows: u32, cols: u32) -> Self {
+        let (s, set) = (&case.sampler, &case.settings);
+        let (domain, bounds, sphere) = match s.domain {
+            Domain::Sphere => ("sphere", None, true),
+            Domain::Plane { bounds } => ("plane", Some(bounds), false),
+        };
+        CaseDescription {
+            lobe: "user".into(),
+            method: "wgsl".into(),
+            params: Params::User {
+                wgsl: s.sources.iter().map(|f| f.name.clone()).collect(),
+                sample: s.sample.clone(),
+                pdf: s.pdf.clone(),
+                eval: s.eval.clone(),
+                params: set.params.clone(),
+                domain: domain.into(),
+                bounds,
+                incident_theta_deg: sphere.then_some(set.incident_theta),
+                incident_phi_deg: sphere.then_some(set.incident_phi),
+            },
+            rows: rows as usize,
+            cols: cols as usize,
         }
     }
 }

@@ -1,0 +1,113 @@
+//! A user's WGSL sampler as a case of `lobes run`: every check of `lobes check`
+//! ([`crate::check::check`]) at the case's samples, bins, seed and incident direction, at the
+//! run's per-case (Šidák) significance, so that its χ² test is one of the run's family of tests.
+//! The case passes when every check passes.
+//!
+//! A user's case runs whole: its checks (the Jacobian probe, the quadrature of the pdf, the hard
+//! cases) are not sums over sample ranges, so `lobes run --shard` refuses scenes that have one.
+
+use super::Backend;
+use crate::check::{self, Report, Settings};
+use crate::scene::UserCase;
+use crate::stats::chi2::Chi2;
+use serde::Deserialize;
+use std::time::Instant;
+
+/// What the checks of a user's case found.
+#[derive(Debug, Clone)]
+pub struct UserResult {
+    pub case: UserCase,
+    pub report: Report,
+    /// The χ² test of the histogram against the quadrature of the user's pdf.
+    pub chi2: Chi2,
+    /// The expected count of the invalid-sample cell (the pdf's missing mass, [`check::check`]).
+    pub expected_invalid: f64,
+    /// The albedo check, where the sampler has an eval.
+    pub albedo: Option<Albedo>,
+    /// Wall time of all the checks.
+    pub wall_seconds: f64,
+}
+
+/// The weights and albedo checks of a sampler with an eval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Albedo {
+    /// The mean weight eval/pdf of the samples, and ∫eval by quadrature.
+    pub mean_weight: f64,
+    pub quadrature: f64,
+    pub p_value: f64,
+    pub max_weight_error: f64,
+    /// Both the weights and the albedo checks passed.
+    pub passed: bool,
+}
+
+impl Albedo {
+    /// mean weight / ∫eval − 1.
+    pub fn relative_error(&self) -> f64 {
+        self.mean_weight / self.quadrature - 1.0
+    }
+}
+
+/// The figures of the `chi2` check that a run reads besides the test itself.
+#[derive(Deserialize)]
+struct Chi2Extra {
+    expected_invalid: f64,
+}
+
+#[derive(Deserialize)]
+struct AlbedoFigures {
+    mean_weight: f64,
+    quadrature: f64,
+    p_value: f64,
+}
+
+#[derive(Deserialize)]
+struct WeightFigures {
+    max_weight_error: f64,
+}
+
+/// The figures of check `name` of `report`, read as `T`.
+fn figures<T: serde::de::DeserializeOwned>(report: &Report, name: &str) -> anyhow::Result<Option<(T, bool)>> {
+    report
+        .get(name)
+        .map(|c| {
+            let f = serde_json::from_value(c.figures.clone()).map_err(|e| anyhow::anyhow!("the {name} check's figures: {e}"))?;
+            Ok((f, c.passed))
+        })
+        .transpose()
+}
+
+impl UserResult {
+    pub fn passed(&self) -> bool {
+        self.report.passed
+    }
+
+    /// The checks that failed, by name.
+    pub fn failed_checks(&self) -> Vec<&str> {
+        self.report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect()
+    }
+}
+
+/// Runs the checks of a user's case at per-case `significance`: on the GPU only (the sampler is
+/// WGSL), so on the CPU backend it is an error.
+pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow::Result<UserResult> {
+    let Backend::Gpu(engine) = backend else {
+        anyhow::bail!("case '{}' is a WGSL sampler and runs on a GPU adapter only; none is in use (CPU engine)", case.name);
+    };
+    let t = Instant::now();
+    let settings = Settings { significance, ..case.settings.clone() };
+    let report = check::check(&engine.gpu, &case.sampler, &settings)?;
+    let wall_seconds = t.elapsed().as_secs_f64();
+    let (chi2, _) = figures::<Chi2>(&report, "chi2")?.ok_or_else(|| anyhow::anyhow!("the check report has no chi2 check"))?;
+    let (extra, _) = figures::<Chi2Extra>(&report, "chi2")?.expect("read above");
+    let albedo = match (figures::<AlbedoFigures>(&report, "albedo")?, figures::<WeightFigures>(&report, "weights")?) {
+        (Some((a, a_ok)), Some((w, w_ok))) => Some(Albedo {
+            mean_weight: a.mean_weight,
+            quadrature: a.quadrature,
+            p_value: a.p_value,
+            max_weight_error: w.max_weight_error,
+            passed: a_ok && w_ok,
+        }),
+        _ => None,
+    };
+    Ok(UserResult { case: case.clone(), report, chi2, expected_invalid: extra.expected_invalid, albedo, wall_seconds })
+}

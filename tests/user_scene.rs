@@ -1,0 +1,175 @@
+//! A user's WGSL sampler as a case of `lobes run`: the shipped scene of example samplers passes,
+//! a broken sampler fails the run with exit 1 naming the checks it failed, and bad scenes are
+//! refused with exit 2 at the scene's line before any case runs.
+//! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
+
+use lobes::report::output::{HistogramFile, RunSummary};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh, empty folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("user-scene-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn lobes(args: &[&str]) -> Output {
+    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
+    out
+}
+
+fn summary(out: &Output) -> RunSummary {
+    serde_json::from_slice(&out.stdout).expect("one JSON summary on stdout")
+}
+
+/// The shipped scene: GGX visible normals swept over θi, Henyey–Greenstein swept over g, a
+/// piecewise-constant 2-D distribution on the plane; every case passes every check.
+#[test]
+fn the_example_scene_of_user_samplers_passes() {
+    let dir = scratch("example");
+    let out = lobes(&["run", "scenes/user-samplers.toml", "--out", dir.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(&out);
+    let names: Vec<&str> = s.cases.iter().map(|c| c.case.as_str()).collect();
+    assert_eq!(
+        names,
+        ["ggx-vndf-theta0", "ggx-vndf-theta45", "ggx-vndf-theta80", "henyey-greenstein-params0.7", "henyey-greenstein-params-0.3", "piecewise-2d"]
+    );
+    // Šidák over the six cases: 1 − (1 − 0.01)^(1/6)
+    assert!((s.per_case_significance - 1.673_653_852e-3).abs() < 1e-9, "{}", s.per_case_significance);
+    for c in &s.cases {
+        assert!(c.passed, "{c:?}");
+        assert_eq!(c.failed_checks.as_deref(), Some(&[][..]));
+    }
+    // Every case has its folder: heat maps and a histogram.json judged at the per-case level.
+    for c in &s.cases {
+        let folder = dir.join(&c.case);
+        for png in ["measured.png", "expected.png", "residual.png"] {
+            assert!(folder.join(png).is_file(), "{}/{png}", folder.display());
+        }
+        let h = HistogramFile::read(&folder.join("histogram.json")).unwrap();
+        assert_eq!((h.description.lobe.as_str(), h.samples, h.seed), ("user", 1_000_000, 7));
+        assert_eq!(h.chi2.significance, s.per_case_significance);
+        let record = h.user_sampler.expect("a user sampler's checks");
+        assert!(record.passed && record.checks.iter().any(|c| c.name == "jacobian"));
+    }
+    // Independent values on the plane (piecewise_2d.wgsl's table): its second row of cells,
+    // y in [0.25, 0.5), has weight 0, and its first row holds 1+2+3+4+4+3+2+1 = 20 of Σw = 60.
+    let h = HistogramFile::read(&dir.join("piecewise-2d/histogram.json")).unwrap();
+    assert_eq!((h.description.rows, h.description.cols), (64, 64));
+    assert_eq!(h.counts[16..32].iter().flatten().sum::<u64>(), 0);
+    let first = h.counts[..16].iter().flatten().sum::<u64>() as f64 / 1e6;
+    let p = 20.0 / 60.0;
+    assert!((first - p).abs() < 4.0 * (p * (1.0 - p) / 1e6).sqrt(), "{first}");
+    // On the sphere the incident direction is recorded: θi = 45° in the x-z plane.
+    let h = HistogramFile::read(&dir.join("ggx-vndf-theta45/histogram.json")).unwrap();
+    let wi = h.incident.unwrap();
+    assert!((wi[0] - 0.5f64.sqrt()).abs() < 1e-12 && wi[1].abs() < 1e-12 && (wi[2] - 0.5f64.sqrt()).abs() < 1e-12, "{wi:?}");
+}
+
+/// A scene with a lobe case and a user's sampler without its reflection Jacobian: the lobe
+/// passes, the broken sampler fails (the Jacobian and χ² checks), the run exits 1.
+#[test]
+fn a_broken_user_sampler_fails_the_run() {
+    let dir = scratch("broken");
+    let scene = dir.join("broken.toml");
+    let samplers = root().join("examples/samplers");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"
+[defaults]
+samples = 200_000
+bins = [16, 32]
+
+[[case]]
+name = "ggx-lobe"
+lobe = "ggx"
+method = "vndf"
+alpha = 0.3
+incident_theta = 30
+
+[[case]]
+name = "no-jacobian"
+sampler = {{ wgsl = ["{0}/ggx_vndf.wgsl", "{0}/broken_no_jacobian.wgsl"], sample = "broken_sample_no_jacobian", pdf = "broken_pdf_no_jacobian" }}
+params = [0.3, 0.3]
+incident_theta = 30
+"#,
+            samplers.display()
+        ),
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(&out);
+    assert_eq!((s.failed, s.errors), (1, 0));
+    assert!(s.cases[0].passed && s.cases[0].case == "ggx-lobe");
+    let broken = &s.cases[1];
+    assert!(!broken.passed);
+    let failed = broken.failed_checks.clone().unwrap();
+    assert!(failed.iter().any(|c| c == "jacobian") && failed.iter().any(|c| c == "chi2"), "{failed:?}");
+    assert!(out_dir.join("no-jacobian/histogram.json").is_file());
+    // The table names the failed checks.
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("FAIL (jacobian"), "{table}");
+}
+
+/// Writes a scene whose case uses ggx_vndf.wgsl through a path relative to the scene file.
+fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
+    let scene = dir.join("bad.toml");
+    std::fs::copy(root().join("examples/samplers/ggx_vndf.wgsl"), dir.join("ggx.wgsl")).unwrap();
+    std::fs::write(&scene, format!("[defaults]\nsamples = 1000\n\n[[case]]\nname = \"mine\"\n{case_lines}")).unwrap();
+    scene
+}
+
+/// Bad user-sampler cases: exit 2, the message at the scene's file:line, and no case runs.
+#[test]
+fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
+    let dir = scratch("bad");
+    let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
+    let cases: [(&str, &[&str]); 9] = [
+        ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_d\" }\n", &["bad.toml:6:", "ggx.wgsl:", "wrong signature"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\" }\n", &["bad.toml:6:", "no pdf"]),
+        (&format!("{good}domain = \"plane\"\n"), &["bad.toml:7:", "needs bounds"]),
+        (&format!("{good}bounds = [0, 0, 1, 1]\n"), &["bad.toml:7:", "only applies to domain = \"plane\""]),
+        (&format!("{good}alpha = 0.3\n"), &["bad.toml:7:", "alpha does not apply to a user sampler"]),
+        (&format!("{good}params = [[0.3, 0.3], [0.1, \"x\"]]\n"), &["bad.toml:7:", "params must be a number"]),
+        ("lobe = \"ggx\"\nalpha = 0.3\nparams = [0.3]\n", &["bad.toml:8:", "params only applies to a user sampler"]),
+    ];
+    for (lines, want) in cases {
+        let scene = bad_scene(&dir, lines);
+        let out_dir = dir.join("out");
+        let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{lines}: {stderr}");
+        for w in want {
+            assert!(stderr.contains(w), "{lines}: want {w:?} in: {stderr}");
+        }
+        assert!(!out_dir.join("mine").exists(), "{lines}: a case ran");
+    }
+    // A user's sampler needs the GPU, and runs whole: --cpu and --shard refuse it.
+    let scene = bad_scene(&dir, good);
+    for flags in [&["--cpu"][..], &["--shard", "0/2"]] {
+        let mut args = vec!["run", scene.to_str().unwrap(), "--out", dir.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let out = lobes(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flags:?}: {stderr}");
+        assert!(stderr.contains("bad.toml:4:1: case 'mine'"), "{flags:?}: {stderr}");
+    }
+}
