@@ -165,7 +165,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             }
             Entry::User(case) => {
                 user_rows = true;
-                run_user_and_write(&backend, case, level, &args.out)
+                let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
+                bar.enable_steady_tick(std::time::Duration::from_millis(200));
+                let outcome = run_user_and_write(&backend, case, level, &args.out);
+                bar.finish_and_clear();
+                outcome
             }
         };
         match outcome {

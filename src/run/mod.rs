@@ -2,6 +2,7 @@
 //! [`judge`] computes the expected counts in f64 and the verdicts. A whole run is one range;
 //! scale-out runs shards of it ([`shard`]) and adds them up ([`merge`]) before judging.
 //! [`record`] holds the parts of the output files that shard files and `histogram.json` share.
+//! A user's WGSL sampler runs whole through the checks of `lobes check` ([`user`]).
 
 pub mod merge;
 pub mod record;

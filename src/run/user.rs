@@ -7,7 +7,7 @@
 //! cases) are not sums over sample ranges, so `lobes run --shard` refuses scenes that have one.
 
 use super::Backend;
-use crate::check::{self, Report, Settings};
+use crate::check::{self, CheckError, Report, Settings};
 use crate::scene::UserCase;
 use crate::stats::chi2::Chi2;
 use serde::Deserialize;
@@ -65,6 +65,15 @@ struct WeightFigures {
     max_weight_error: f64,
 }
 
+/// A check's error as a run's: a GPU error keeps its type, so that a lost device moves the run's
+/// remaining cases to the CPU ([`super::device_lost`]).
+fn run_error(e: CheckError) -> anyhow::Error {
+    match e {
+        CheckError::Gpu(g) => anyhow::Error::new(g),
+        other => other.into(),
+    }
+}
+
 /// The figures of check `name` of `report`, read as `T`.
 fn figures<T: serde::de::DeserializeOwned>(report: &Report, name: &str) -> anyhow::Result<Option<(T, bool)>> {
     report
@@ -95,7 +104,7 @@ pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow
     };
     let t = Instant::now();
     let settings = Settings { significance, ..case.settings.clone() };
-    let report = check::check(&engine.gpu, &case.sampler, &settings)?;
+    let report = check::check(&engine.gpu, &case.sampler, &settings).map_err(run_error)?;
     let wall_seconds = t.elapsed().as_secs_f64();
     let (chi2, _) = figures::<Chi2>(&report, "chi2")?.ok_or_else(|| anyhow::anyhow!("the check report has no chi2 check"))?;
     let (extra, _) = figures::<Chi2Extra>(&report, "chi2")?.expect("read above");
@@ -110,4 +119,17 @@ pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow
         _ => None,
     };
     Ok(UserResult { case: case.clone(), report, chi2, expected_invalid: extra.expected_invalid, albedo, wall_seconds })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::gpu::GpuError;
+
+    #[test]
+    fn a_lost_device_in_a_users_check_is_seen_as_one() {
+        let lost = run_error(CheckError::Gpu(GpuError::Lost("Parent device is lost".into())));
+        assert!(super::super::device_lost(&lost));
+        assert!(!super::super::device_lost(&run_error(CheckError::Device("out of memory".into()))));
+    }
 }

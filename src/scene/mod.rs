@@ -1,5 +1,5 @@
-//! Scene files: a TOML list of cases, each one lobe (or discrete distribution) to sample,
-//! histogram and judge. Errors name the file, line and column and what is allowed.
+//! Scene files: a TOML list of cases, each one lobe (or discrete distribution, or a user's WGSL
+//! sampler) to sample, histogram and judge. Errors name the file, line and column and what is allowed.
 //!
 //! ```toml
 //! [defaults]            # optional; every case may override these
