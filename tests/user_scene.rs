@@ -140,7 +140,8 @@ fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
 fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let dir = scratch("bad");
     let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
-    let cases: [(&str, &[&str]); 9] = [
+    let cases: [(&str, &[&str]); 10] = [
+        ("sampler = \"ggx.wgsl\"\n", &["bad.toml:6:", "expected a sampler table { wgsl = [\"file.wgsl\"]"]),
         ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_d\" }\n", &["bad.toml:6:", "ggx.wgsl:", "wrong signature"]),

@@ -338,6 +338,7 @@ impl Scene {
                 .replace("struct RawScene", "[defaults] and [[case]] tables")
                 .replace("struct RawDefaults", "a [defaults] table")
                 .replace("struct RawCase", "a [[case]] table")
+                .replace("struct RawSampler", "a sampler table { wgsl = [\"file.wgsl\"], sample = \"...\", pdf = \"...\" }")
                 // `case` is the only plain sequence (weights say what they expect themselves)
                 .replace("expected a sequence", "expected [[case]] tables (write [[case]] for each case, not [case])");
             ctx.err(span, message)
