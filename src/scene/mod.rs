@@ -746,6 +746,9 @@ mod tests {
         assert_eq!((err.line, err.column), (5, 22), "{err}");
         let err = Scene::parse("s.toml", "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = []\n").unwrap_err();
         assert!(err.message.contains("sweeps over no values"), "{err}");
+        let long = format!("[[case]]\nname = \"{}\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [45]\n", "n".repeat(95));
+        let err = Scene::parse("s.toml", &long).unwrap_err();
+        assert!(err.message.contains("longer than 100 characters") && err.line == 2, "{err}");
         let dup = "[[case]]\nname = \"g-theta0\"\nlobe = \"ward\"\nalpha = 0.2\n[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0]\n";
         assert!(Scene::parse("s.toml", dup).unwrap_err().message.contains("duplicate case name 'g-theta0'"));
     }
