@@ -88,7 +88,7 @@ fn pipelines_are_made_once_per_effect_set() {
 fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&Composed>, level: f64) -> AlbedoCheck {
     let composed = module.cloned().unwrap_or_else(|| e.weighted_module(job, effects, Specialisation::Specialised));
     let run = e.weighted_with(job, effects, &composed, SampleRange::whole(7, N)).expect("weighted run");
-    weighted::albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
+    lobes::run::compare::albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
 }
 
 /// Every sampler with every Fresnel form and masking term somewhere: the albedo agrees with
