@@ -87,6 +87,11 @@ fn temp_wgsl(name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// A uniform direction on the sphere from u.xy (z = 1 − 2u.x, φ = 2π u.y), for inline samplers.
+const UNIFORM_DIRECTION: &str = "fn uniform_direction(u: vec4<f32>) -> vec3<f32> {\n\
+     let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
+     return vec3<f32>(r * cos(phi), r * sin(phi), z);\n}\n";
+
 const GOOD_SAMPLE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n    return vec4<f32>(0.0, 0.0, 1.0, 1.0);\n}\n";
 
 /// WGSL errors point at the user's file, line and column; a missing function or a wrong
@@ -123,13 +128,14 @@ fn broken_input_is_reported_at_the_users_file() {
 fn bad_pdf_values_are_counted_by_reason() {
     let src = temp_wgsl(
         "nan.wgsl",
-        "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
-         let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
-         let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
-         var pdf = 0.0795775;\n if (z > 0.9) { pdf = sqrt(-z); }\n if (z < -0.9) { pdf = -1.0; }\n\
-         return vec4<f32>(d, pdf);\n}\n\
-         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
-         if (d.z < -0.9) { return -1.0; }\n return 0.0795775;\n}\n",
+        &format!(
+            "{UNIFORM_DIRECTION}fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         let d = uniform_direction(u);\n\
+         var pdf = 0.0795775;\n if (d.z > 0.9) {{ pdf = sqrt(-d.z); }}\n if (d.z < -0.9) {{ pdf = -1.0; }}\n\
+         return vec4<f32>(d, pdf);\n}}\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         if (d.z < -0.9) {{ return -1.0; }}\n return 0.0795775;\n}}\n"
+        ),
     );
     let s = UserSampler::from_files(&[src], "s", "p", None, Domain::Sphere).unwrap();
     let r = check(&gpu(), &s, &Settings { samples: 1 << 20, ..Settings::default() }).unwrap();
@@ -265,13 +271,14 @@ fn a_nan_at_u_equal_to_one_is_caught_by_the_hard_cases_alone() {
 fn a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo() {
     let src = temp_wgsl(
         "double.wgsl",
-        "fn twice_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
-         let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
-         return vec4<f32>(r * cos(phi), r * sin(phi), z, 2.0 * 0.07957747);\n}\n\
-         fn uniform_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
-         return 0.07957747;\n}\n\
-         fn uniform_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
-         return 0.3 * 0.07957747 * (1.0 + d.z);\n}\n",
+        &format!(
+            "{UNIFORM_DIRECTION}fn twice_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         return vec4<f32>(uniform_direction(u), 2.0 * 0.07957747);\n}}\n\
+         fn uniform_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         return 0.07957747;\n}}\n\
+         fn uniform_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         return 0.3 * 0.07957747 * (1.0 + d.z);\n}}\n"
+        ),
     );
     let s = UserSampler::from_files(&[src], "twice_sample", "uniform_pdf", Some("uniform_eval"), Domain::Sphere).unwrap();
     let r = check(&gpu(), &s, &Settings { samples: 1 << 18, bins: Some((32, 64)), ..Settings::default() }).unwrap();

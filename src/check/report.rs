@@ -55,20 +55,6 @@ pub struct Check {
     pub summary: String,
 }
 
-/// Each check's figures, named by the check (`"name"` in JSON, its figures under `"figures"`).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(tag = "name", content = "figures", rename_all = "snake_case")]
-pub enum Figures {
-    PdfConsistency(ConsistencyFigures),
-    Jacobian(JacobianCheck),
-    PdfValues(PdfValuesFigures),
-    Normalization(NormalizationFigures),
-    Chi2(Chi2Figures),
-    Weights(WeightFigures),
-    Albedo(AlbedoFigures),
-    HardCases(Vec<HardRow>),
-}
-
 /// The reported pdf against the pdf function at the probe samples.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct ConsistencyFigures {
@@ -137,45 +123,48 @@ pub trait FiguresOf: Sized {
     fn of(figures: &Figures) -> Option<&Self>;
 }
 
-macro_rules! figures_of {
-    ($($variant:ident($ty:ty)),* $(,)?) => {$(
-        impl FiguresOf for $ty {
+/// [`Figures`] with a variant per check, its name (in JSON and [`Figures::name`]) and the
+/// [`FiguresOf`] impl of its type, from one list.
+macro_rules! figures {
+    ($($variant:ident($ty:ty) = $name:literal),* $(,)?) => {
+        /// Each check's figures, named by the check (`"name"` in JSON, its figures under
+        /// `"figures"`).
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+        #[serde(tag = "name", content = "figures")]
+        pub enum Figures {
+            $(#[serde(rename = $name)] $variant($ty),)*
+        }
+
+        impl Figures {
+            /// The check's name, as in JSON.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Figures::$variant(_) => $name,)*
+                }
+            }
+        }
+
+        $(impl FiguresOf for $ty {
             fn of(figures: &Figures) -> Option<&Self> {
                 match figures {
                     Figures::$variant(f) => Some(f),
                     _ => None,
                 }
             }
-        }
-    )*};
+        })*
+    };
 }
 
-figures_of!(
-    PdfConsistency(ConsistencyFigures),
-    Jacobian(JacobianCheck),
-    PdfValues(PdfValuesFigures),
-    Normalization(NormalizationFigures),
-    Chi2(Chi2Figures),
-    Weights(WeightFigures),
-    Albedo(AlbedoFigures),
-    HardCases(Vec<HardRow>),
+figures!(
+    PdfConsistency(ConsistencyFigures) = "pdf_consistency",
+    Jacobian(JacobianCheck) = "jacobian",
+    PdfValues(PdfValuesFigures) = "pdf_values",
+    Normalization(NormalizationFigures) = "normalization",
+    Chi2(Chi2Figures) = "chi2",
+    Weights(WeightFigures) = "weights",
+    Albedo(AlbedoFigures) = "albedo",
+    HardCases(Vec<HardRow>) = "hard_cases",
 );
-
-impl Figures {
-    /// The check's name, as in JSON.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Figures::PdfConsistency(_) => "pdf_consistency",
-            Figures::Jacobian(_) => "jacobian",
-            Figures::PdfValues(_) => "pdf_values",
-            Figures::Normalization(_) => "normalization",
-            Figures::Chi2(_) => "chi2",
-            Figures::Weights(_) => "weights",
-            Figures::Albedo(_) => "albedo",
-            Figures::HardCases(_) => "hard_cases",
-        }
-    }
-}
 
 impl Check {
     /// The check's name: `pdf_consistency`, `jacobian`, `pdf_values`, `normalization`, `chi2`,
