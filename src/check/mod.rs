@@ -22,6 +22,9 @@
 //! 7. `normalization`: ∫pdf over the domain against the fraction of valid samples: a pdf off by a
 //!    constant factor (a wrong normalisation, an approximated G1) shows here at any sample count.
 //!
+//! It returns a [`Report`] with each check's typed figures ([`report`]); [`power`] runs it at
+//! growing sample counts. `lobes check --out` draws the histogram with `crate::report::check`.
+//!
 //! ```no_run
 //! use lobes::check::{check, Settings, UserSampler, Domain};
 //! let sampler = UserSampler::from_files(&["my_ggx.wgsl".into()], "my_sample", "my_pdf", None, Domain::Sphere)?;
