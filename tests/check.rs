@@ -325,3 +325,31 @@ fn power_sweep_exits_1_and_says_from_which_count_an_error_is_caught() {
     let (code, _, stderr) = lobes(&["--samples", "0"]);
     assert_eq!(code, Some(2), "{stderr}");
 }
+
+/// Bad flags of `lobes check` exit 2 with a message naming the flag, before any GPU work.
+#[test]
+fn bad_flags_exit_2_naming_the_flag() {
+    let hg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers/henyey_greenstein.wgsl");
+    let seventeen = vec!["0.1"; 17].join(",");
+    for (extra, flag) in [
+        (vec!["--bins", "0,4"], "--bins"),
+        (vec!["--bins", "5000,5000"], "--bins"),
+        (vec!["--bins", "4.5,8"], "--bins"),
+        (vec!["--params", seventeen.as_str()], "--params"),
+        (vec!["--samples", "0"], "--samples"),
+        (vec!["--significance", "1.5"], "--significance"),
+        (vec!["--domain", "plane"], "--bounds"),
+        (vec!["--bounds", "0,0,1,1"], "--bounds"),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lobes"))
+            .arg("check")
+            .arg(&hg)
+            .args(["--sample", "hg_sample", "--pdf", "hg_pdf"])
+            .args(&extra)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(flag), "{extra:?} should name {flag}: {stderr}");
+    }
+}

@@ -209,7 +209,9 @@ impl Settings {
             Domain::Plane { .. } => (64, 64),
         })
     }
-    fn validate(&self) -> Result<(), CheckError> {
+    /// Bad input, named by its command-line flag: more than 16 params, an incident θ outside
+    /// [0, 180], no samples, an empty or too large grid, a significance outside (0, 1).
+    pub fn validate(&self) -> Result<(), CheckError> {
         let bad = |flag: &str, what: String| Err(CheckError::Input(format!("{flag}: {what}")));
         if self.params.len() > MAX_PARAMS {
             return bad("--params", format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));

@@ -90,9 +90,10 @@ impl CheckArgs {
     fn settings(&self) -> anyhow::Result<Settings> {
         let bins = match &self.bins {
             None => None,
+            // the grid's limits are Settings::validate's
             Some(b) => match b.0[..] {
-                [r, c] if r >= 1.0 && c >= 1.0 && r.fract() == 0.0 && c.fract() == 0.0 && r * c <= (1u64 << 24) as f64 => Some((r as u32, c as u32)),
-                _ => return Err(usage("--bins: expected ROWS,COLS, two whole numbers ≥ 1 with at most 2^24 bins, e.g. 64,128")),
+                [r, c] if [r, c].iter().all(|v| v.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(v)) => Some((r as u32, c as u32)),
+                _ => return Err(usage("--bins: expected ROWS,COLS, two whole numbers, e.g. 64,128")),
             },
         };
         Ok(Settings {
@@ -111,6 +112,7 @@ impl CheckArgs {
 pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let sampler = args.sampler()?;
     let settings = args.settings()?;
+    settings.validate().map_err(input)?;
     if let Some(dir) = &args.out {
         super::prepare_out(dir)?;
     }
