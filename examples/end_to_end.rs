@@ -14,7 +14,7 @@ use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::chi2::sidak;
-use lobes::stats::compare;
+use lobes::run::compare;
 use lobes::stats::expected::Quadrature;
 use lobes::stats::histogram::SphereGrid;
 

@@ -1,6 +1,21 @@
 //! `lobes check` on shipped example samplers: correct ones pass, broken ones are rejected by the
-//! check that should catch them.
+//! check that should catch them. Each check is shown to reject a deliberately broken sampler:
+//!
+//! | check | rejects | test |
+//! |---|---|---|
+//! | `pdf_consistency` | a pdf function that forgot the table of a 2-D warp | `piecewise_constant_2d_warp_on_the_plane` |
+//! | `jacobian` | a pdf without the reflection Jacobian 1/(4\|d·h\|) | `missing_reflection_jacobian_is_rejected` |
+//! | `pdf_values` | a pdf that is negative on a cap | `bad_pdf_values_are_counted_by_reason` |
+//! | `normalization` | Mitsuba's rational Beckmann G1 (0.3 % off) | `mitsuba_rational_g1_is_rejected` |
+//! | `chi2` | the missing Jacobian; a wrong g in an f64 reference | `missing_reflection_jacobian_is_rejected`, `an_f64_reference_pdf_from_rust` |
+//! | `weights`, `albedo` | a sampler that reports twice its pdf | `a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo` |
+//! | `hard_cases` | a pdf that is 0/0 at u.x = 1 only | `a_nan_at_u_equal_to_one_is_caught_by_the_hard_cases_alone` |
+//!
+//! and the correct samplers (GGX and Beckmann visible normals, Henyey–Greenstein, the 2-D warp)
+//! pass all of them.
 
+use lobes::check::hard::HardRow;
+use lobes::check::report::{AlbedoFigures, NormalizationFigures, WeightFigures};
 use lobes::check::{Domain, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 use std::path::PathBuf;
@@ -20,7 +35,7 @@ fn henyey_greenstein_passes() {
     for g in [0.7, -0.3, 0.0] {
         let r = check(&gpu, &s, &Settings { params: vec![g], ..Settings::default() }).unwrap();
         for c in &r.checks {
-            eprintln!("g {g}: {} {} {}", c.name, c.passed, c.summary);
+            eprintln!("g {g}: {} {} {}", c.name(), c.passed, c.summary);
         }
         r.assert_passed();
     }
@@ -34,7 +49,7 @@ fn ggx(extra: &[&str], sample: &str, pdf: &str, eval: Option<&str>) -> UserSampl
 
 fn show(r: &lobes::check::Report) {
     for c in &r.checks {
-        eprintln!("{}: {} {} {}", r.sampler, c.name, c.passed, c.summary);
+        eprintln!("{}: {} {} {}", r.sampler, c.name(), c.passed, c.summary);
     }
 }
 
@@ -72,6 +87,11 @@ fn temp_wgsl(name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// A uniform direction on the sphere from u.xy (z = 1 − 2u.x, φ = 2π u.y), for inline samplers.
+const UNIFORM_DIRECTION: &str = "fn uniform_direction(u: vec4<f32>) -> vec3<f32> {\n\
+     let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
+     return vec3<f32>(r * cos(phi), r * sin(phi), z);\n}\n";
+
 const GOOD_SAMPLE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n    return vec4<f32>(0.0, 0.0, 1.0, 1.0);\n}\n";
 
 /// WGSL errors point at the user's file, line and column; a missing function or a wrong
@@ -108,13 +128,14 @@ fn broken_input_is_reported_at_the_users_file() {
 fn bad_pdf_values_are_counted_by_reason() {
     let src = temp_wgsl(
         "nan.wgsl",
-        "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
-         let z = 1.0 - 2.0 * u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
-         let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
-         var pdf = 0.0795775;\n if (z > 0.9) { pdf = sqrt(-z); }\n if (z < -0.9) { pdf = -1.0; }\n\
-         return vec4<f32>(d, pdf);\n}\n\
-         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
-         if (d.z < -0.9) { return -1.0; }\n return 0.0795775;\n}\n",
+        &format!(
+            "{UNIFORM_DIRECTION}fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         let d = uniform_direction(u);\n\
+         var pdf = 0.0795775;\n if (d.z > 0.9) {{ pdf = sqrt(-d.z); }}\n if (d.z < -0.9) {{ pdf = -1.0; }}\n\
+         return vec4<f32>(d, pdf);\n}}\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         if (d.z < -0.9) {{ return -1.0; }}\n return 0.0795775;\n}}\n"
+        ),
     );
     let s = UserSampler::from_files(&[src], "s", "p", None, Domain::Sphere).unwrap();
     let r = check(&gpu(), &s, &Settings { samples: 1 << 20, ..Settings::default() }).unwrap();
@@ -188,7 +209,7 @@ fn mitsuba_rational_g1_is_rejected() {
     let lambda = 0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
     let exact = 1.0 / (1.0 + lambda);
     let approx = (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a);
-    let integral = norm.figures["pdf_integral"].as_f64().unwrap();
+    let integral = r.figures::<NormalizationFigures>().unwrap().pdf_integral;
     assert!((integral - approx / exact).abs() < 2e-4, "∫pdf {integral} against G1 ratio {}", approx / exact);
     let r = check(&gpu, &s, &Settings { samples: 1 << 26, ..settings }).unwrap();
     show(&r);
@@ -214,4 +235,121 @@ fn an_f64_reference_pdf_from_rust() {
     r.assert_passed();
     let r = check(&gpu, &s, &settings(0.45)).unwrap();
     assert!(!r.get("chi2").unwrap().passed);
+}
+
+/// A uniform sampler of the upper hemisphere, correct everywhere but at u.x = 1 exactly: its
+/// pdf is written (1/2π) · r/sin θ, a factor that cancels analytically but is 0/0 at the pole.
+/// lobes' RNG never draws u = 1, so the histogram, the probes and every statistic pass: only the
+/// hard cases see the NaN.
+#[test]
+fn a_nan_at_u_equal_to_one_is_caught_by_the_hard_cases_alone() {
+    let src = temp_wgsl(
+        "pole.wgsl",
+        "fn pole_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
+         let z = u.x;\n let r = sqrt(max(0.0, 1.0 - z * z));\n let phi = 6.2831853 * u.y;\n\
+         let pdf = 0.15915494 * r / sqrt(1.0 - z * z);\n\
+         return vec4<f32>(r * cos(phi), r * sin(phi), z, pdf);\n}\n\
+         fn pole_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
+         return select(0.0, 0.15915494, d.z >= 0.0);\n}\n\
+         fn pole_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
+         return 0.5 * pole_pdf(wi, d, params);\n}\n",
+    );
+    let s = UserSampler::from_files(&[src], "pole_sample", "pole_pdf", Some("pole_eval"), Domain::Sphere).unwrap();
+    let r = check(&gpu(), &s, &Settings { samples: 1 << 18, bins: Some((32, 64)), ..Settings::default() }).unwrap();
+    show(&r);
+    assert_eq!(r.failed(), ["hard_cases"]);
+    let rows = r.figures::<Vec<HardRow>>().unwrap();
+    for row in rows {
+        assert!(row.bad_pdf > 0 && row.first_failure.is_some_and(|u| u[0] == 1.0), "{row:?}");
+    }
+}
+
+/// A sampler that reports twice its pdf (the pdf function is right): the weights eval/pdf a
+/// renderer forms come out half of eval/pdf(d), and their mean half the albedo. The histogram,
+/// the normalisation and the Jacobian judge the pdf function and pass.
+#[test]
+fn a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo() {
+    let src = temp_wgsl(
+        "double.wgsl",
+        &format!(
+            "{UNIFORM_DIRECTION}fn twice_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         return vec4<f32>(uniform_direction(u), 2.0 * 0.07957747);\n}}\n\
+         fn uniform_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         return 0.07957747;\n}}\n\
+         fn uniform_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+         return 0.3 * 0.07957747 * (1.0 + d.z);\n}}\n"
+        ),
+    );
+    let s = UserSampler::from_files(&[src], "twice_sample", "uniform_pdf", Some("uniform_eval"), Domain::Sphere).unwrap();
+    let r = check(&gpu(), &s, &Settings { samples: 1 << 18, bins: Some((32, 64)), ..Settings::default() }).unwrap();
+    show(&r);
+    assert_eq!(r.failed(), ["pdf_consistency", "weights", "albedo"]);
+    let weights = r.figures::<WeightFigures>().unwrap();
+    assert!((weights.max_weight_error - 0.5).abs() < 1e-3, "{weights:?}");
+    // independent value: ∫eval = 0.3/(4π) ∫(1 + cos θ) dω = 0.3; the weights average half of it
+    let albedo = r.figures::<AlbedoFigures>().unwrap();
+    assert!((albedo.quadrature - 0.3).abs() < 1e-4 && (albedo.mean_weight - 0.15).abs() < 5.0 * albedo.std_error, "{albedo:?}");
+}
+
+/// `lobes check --power` exits 1 when some count fails and says from which count, and after
+/// how much GPU time, the error is caught: Mitsuba's rational G1 fails the normalisation at
+/// every count (the χ² test alone would need about 2²⁶ samples). Bad input exits 2.
+#[test]
+fn power_sweep_exits_1_and_says_from_which_count_an_error_is_caught() {
+    let samplers = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers");
+    let (beckmann, broken) = (samplers.join("beckmann_vndf.wgsl"), samplers.join("broken_mitsuba_g1.wgsl"));
+    let lobes = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lobes"))
+            .arg("check")
+            .args([&beckmann, &broken])
+            .args(["--sample", "mitsuba_sample", "--pdf", "mitsuba_pdf", "--params", "0.8,0.8", "--incident-theta", "85", "--bins", "32,64", "--power"])
+            .args(extra)
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    let (code, stdout, stderr) = lobes(&["--samples", "262144"]);
+    assert_eq!(code, Some(1), "{stdout}{stderr}");
+    let verdict = stdout.lines().last().unwrap();
+    assert!(verdict.starts_with("caught from 65536 samples (normalization failing), after "), "{stdout}");
+    assert!(verdict.contains(" s of GPU time") || verdict.contains("no GPU timestamps"), "{verdict}");
+    assert!(stdout.lines().any(|l| l.starts_with("262144 ")), "a row per count: {stdout}");
+    assert!(stderr.contains("caught from 65536 samples"), "{stderr}");
+
+    let (code, stdout, _) = lobes(&["--samples", "262144", "--json"]);
+    assert_eq!(code, Some(1));
+    let sweep: lobes::check::power::PowerSweep = serde_json::from_str(&stdout).unwrap();
+    assert!(!sweep.passed && sweep.points.iter().all(|p| !p.normalization_passed));
+    assert_eq!(sweep.caught.map(|c| (c.samples, c.failed)), Some((65536, vec!["normalization".to_string()])));
+
+    let (code, _, stderr) = lobes(&["--samples", "0"]);
+    assert_eq!(code, Some(2), "{stderr}");
+}
+
+/// Bad flags of `lobes check` exit 2 with a message naming the flag, before any GPU work.
+#[test]
+fn bad_flags_exit_2_naming_the_flag() {
+    let hg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers/henyey_greenstein.wgsl");
+    let seventeen = vec!["0.1"; 17].join(",");
+    for (extra, flag) in [
+        (vec!["--bins", "0,4"], "--bins"),
+        (vec!["--bins", "5000,5000"], "--bins"),
+        (vec!["--bins", "4.5,8"], "--bins"),
+        (vec!["--params", seventeen.as_str()], "--params"),
+        (vec!["--samples", "0"], "--samples"),
+        (vec!["--significance", "1.5"], "--significance"),
+        (vec!["--domain", "plane"], "--bounds"),
+        (vec!["--bounds", "0,0,1,1"], "--bounds"),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lobes"))
+            .arg("check")
+            .arg(&hg)
+            .args(["--sample", "hg_sample", "--pdf", "hg_pdf"])
+            .args(&extra)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(flag), "{extra:?} should name {flag}: {stderr}");
+    }
 }

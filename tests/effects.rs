@@ -13,7 +13,8 @@ use lobes::scene::Scene;
 use lobes::stats::chi2::sidak;
 use lobes::stats::expected::Quadrature;
 use lobes::stats::histogram::SphereGrid;
-use lobes::stats::weighted::{self, AlbedoCheck, WEIGHT_ERROR_LIMIT};
+use lobes::run::compare::albedo_check;
+use lobes::stats::weighted::{AlbedoCheck, WEIGHT_ERROR_LIMIT};
 
 fn engine() -> GpuEngine {
     GpuEngine::open().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"))
@@ -88,7 +89,7 @@ fn pipelines_are_made_once_per_effect_set() {
 fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&Composed>, level: f64) -> AlbedoCheck {
     let composed = module.cloned().unwrap_or_else(|| e.weighted_module(job, effects, Specialisation::Specialised));
     let run = e.weighted_with(job, effects, &composed, SampleRange::whole(7, N)).expect("weighted run");
-    weighted::albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
+    albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
 }
 
 /// Every sampler with every Fresnel form and masking term somewhere: the albedo agrees with

@@ -179,7 +179,7 @@ fn embedded_samplers_densities_and_brdfs_match_the_f64_reference() {
                     continue;
                 }
                 compared += 1;
-                max_angle = max_angle.max(lobes::stats::compare::angle_between(wr.normalize(), reference.omega_r));
+                max_angle = max_angle.max(lobes::run::compare::angle_between(wr.normalize(), reference.omega_r));
                 // the pdf function against the sampler's own density, both on the GPU, and both
                 // functions against f64 at the GPU's direction
                 let wr64 = wr.normalize();

@@ -7,7 +7,7 @@ use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect, ward};
 use lobes::stats::chi2::{self, sidak};
-use lobes::stats::compare::{self, ExpectedCounts};
+use lobes::run::compare::{self, ExpectedCounts};
 use lobes::stats::expected::{self, Quadrature};
 use lobes::stats::histogram::SphereGrid;
 

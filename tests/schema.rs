@@ -168,3 +168,98 @@ fn every_file_lobes_writes_validates_against_its_schema() {
     assert_eq!(serde_json::from_value::<RunSummary>(v).unwrap(), with_error);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Runs lobes in `dir`, expecting the exit status `code`; its stdout as JSON.
+fn lobes_exit(dir: &Path, args: &[&str], code: i32) -> Value {
+    let out = Command::new(LOBES).current_dir(dir).args(args).output().expect("run lobes");
+    assert_eq!(out.status.code(), Some(code), "lobes {}: {}", args.join(" "), String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).expect("one JSON object on stdout")
+}
+
+/// A uniform sampler of the sphere whose reported pdf is NaN above z = 0.9 and negative below
+/// z = −0.9, with a pdf function negative there too: every figure that can go wrong does.
+const BROKEN: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {
+    let z = 1.0 - 2.0 * u.x;
+    let r = sqrt(max(0.0, 1.0 - z * z));
+    let d = vec3<f32>(r * cos(6.2831853 * u.y), r * sin(6.2831853 * u.y), z);
+    var pdf = 0.0795775;
+    if (z > 0.9) { pdf = sqrt(-z); }
+    if (z < -0.9) { pdf = -1.0; }
+    return vec4<f32>(d, pdf);
+}
+fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {
+    if (d.z < -0.9) { return -1.0; }
+    if (d.z > 0.95) { return sqrt(-d.z); }
+    return 0.0795775;
+}
+fn e(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {
+    return 0.5 * p(wi, d, params);
+}
+";
+
+/// `lobes check --json`, its `report.json` and `lobes check --power --json` validate against
+/// their schemas, for a passing sampler on the sphere, a failing one whose figures hold NaN
+/// sources, and a warp on the plane; the report reads back through `lobes::check::Report`.
+#[test]
+fn check_reports_validate_against_their_schema() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("schema-check");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("broken.wgsl"), BROKEN).unwrap();
+    let samplers = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/samplers");
+    let hg = samplers.join("henyey_greenstein.wgsl");
+    let plane = samplers.join("piecewise_2d.wgsl");
+    let hg_args = [hg.to_str().unwrap(), "--sample", "hg_sample", "--pdf", "hg_pdf", "--eval", "hg_eval", "--params", "0.6"];
+    let runs: [(Vec<&str>, i32); 3] = [
+        ([&hg_args[..], &["--samples", "65536", "--bins", "16,32", "--out", "hg", "--json"]].concat(), 0),
+        (vec!["broken.wgsl", "--sample", "s", "--pdf", "p", "--eval", "e", "--samples", "65536", "--bins", "16,32", "--out", "broken", "--json"], 1),
+        (
+            vec![plane.to_str().unwrap(), "--sample", "env_sample", "--pdf", "env_pdf", "--domain", "plane", "--bounds", "0,0,1,1", "--samples", "65536"]
+                .into_iter()
+                .chain(["--bins", "16,16", "--out", "plane", "--json"])
+                .collect(),
+            0,
+        ),
+    ];
+    for (args, code) in runs {
+        let mut full = vec!["check"];
+        full.extend(&args);
+        let printed = lobes_exit(&dir, &full, code);
+        validate("check-report.schema.json", &printed, &format!("lobes {}", full.join(" ")));
+        let out = dir.join(args[args.len() - 2]);
+        let written = file(&out.join("report.json"));
+        validate("check-report.schema.json", &written, &out.join("report.json").display().to_string());
+        let report: lobes::check::Report = serde_json::from_value(written).unwrap();
+        assert_eq!(report.format_version, lobes::check::report::REPORT_VERSION);
+        assert_eq!(report.passed, code == 0);
+        let from_stdout: lobes::check::Report = serde_json::from_value(printed).unwrap();
+        assert!(report == from_stdout, "report.json holds what --json prints");
+        for png in ["measured.png", "expected.png", "residual.png"] {
+            let img = image::open(out.join(png)).unwrap_or_else(|e| panic!("{}: {e}", out.join(png).display()));
+            assert!(img.width() > 300 && img.height() > 200, "{png}: {}×{}", img.width(), img.height());
+        }
+    }
+
+    // the schema holds the contract: each check names its figures, and a check's figures must
+    // be those of its name
+    let schema: Value = serde_json::from_str(&std::fs::read_to_string(docs().join("check-report.schema.json")).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).unwrap();
+    let mut damaged = file(&dir.join("hg/report.json"));
+    assert_eq!(damaged["checks"][4]["name"], "chi2");
+    damaged["checks"][4]["name"] = "normalization".into();
+    assert!(!validator.is_valid(&damaged), "chi2's figures under the name normalization");
+    let mut damaged = file(&dir.join("hg/report.json"));
+    damaged.as_object_mut().unwrap().remove("format_version");
+    assert!(!validator.is_valid(&damaged));
+
+    let mut power = vec!["check"];
+    power.extend(&hg_args);
+    power.extend(["--samples", "131072", "--bins", "16,32", "--power", "--out", "power", "--json"]);
+    let sweep = lobes_exit(&dir, &power, 0);
+    validate("check-power.schema.json", &sweep, "lobes check --power --json");
+    validate("check-power.schema.json", &file(&dir.join("power/power.json")), "power.json");
+    let sweep: lobes::check::power::PowerSweep = serde_json::from_value(sweep).unwrap();
+    assert_eq!(sweep.points.iter().map(|p| p.samples).collect::<Vec<_>>(), [65536, 131072]);
+    assert!(sweep.passed && sweep.caught.is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}

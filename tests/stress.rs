@@ -4,7 +4,7 @@
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
 use lobes::reference::discrete::Distribution;
-use lobes::stats::compare;
+use lobes::run::compare;
 use lobes::stats::expected::Quadrature;
 
 fn engine() -> GpuEngine {

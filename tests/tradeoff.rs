@@ -6,7 +6,7 @@ use lobes::engine::gpu::GpuEngine;
 use lobes::engine::job::SampleRange;
 use lobes::reference::{LobeKind, Method, reflect};
 use lobes::stats::chi2;
-use lobes::stats::compare;
+use lobes::run::compare;
 use lobes::stats::expected::Quadrature;
 use lobes::experiments::tradeoff::{self, Precision, Sampler, quadrature};
 use std::process::Command;

@@ -36,6 +36,8 @@ pub(super) struct Params {
 pub(super) struct Passes<'g> {
     gpu: &'g Gpu,
     module: wgpu::ShaderModule,
+    /// GPU time of the passes run so far (timestamp queries; `None` without them).
+    gpu_seconds: std::cell::Cell<Option<f64>>,
 }
 
 /// The generated file that calls the user's functions under the names the passes use.
@@ -86,7 +88,12 @@ impl<'g> Passes<'g> {
             source: wgpu::ShaderSource::Wgsl(composed.text.as_str().into()),
         });
         gpu.check_errors()?;
-        Ok(Self { gpu, module })
+        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)) })
+    }
+
+    /// GPU time of the passes run so far, where the adapter has timestamp queries.
+    pub fn gpu_seconds(&self) -> Option<f64> {
+        self.gpu_seconds.get()
     }
 
     /// Runs `entry` over `invocations` invocations through the engine's dispatcher and reads back
@@ -118,7 +125,8 @@ impl<'g> Passes<'g> {
         }
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(entry), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
         let step = Step { pipeline: &pipeline, groups: invocations.div_ceil(WG) as u64 };
-        gpu.dispatch(&[Pass { label: entry, bind: &bind, offset: None, steps: vec![step] }])?;
+        let seconds = gpu.dispatch(&[Pass { label: entry, bind: &bind, offset: None, steps: vec![step] }])?;
+        self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));
         Ok(gpu.read(&out, out_bytes)?)
     }
 

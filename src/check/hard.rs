@@ -29,7 +29,7 @@ pub fn uniforms() -> Vec<[f32; 4]> {
 }
 
 /// One incident direction's row of the table.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, schemars::JsonSchema)]
 pub struct HardRow {
     /// Incident θ in degrees (on the plane: the run's).
     pub incident_theta: f64,

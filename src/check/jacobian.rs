@@ -24,7 +24,7 @@ pub const MAX_SHARE_OFF: f64 = 1e-2;
 pub const MIN_COMPARED: u64 = 100;
 
 /// What the comparison found.
-#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq, schemars::JsonSchema)]
 pub struct JacobianCheck {
     pub probed: u64,
     pub compared: u64,
@@ -37,8 +37,9 @@ pub struct JacobianCheck {
     /// Compared samples with |p · |J| − 1| > TOLERANCE.
     pub off: u64,
     pub share_off: f64,
-    /// Median and worst p · |J| over the compared samples (1 for a correct pdf).
-    pub median_ratio: f64,
+    /// Median and worst p · |J| over the compared samples (1 for a correct pdf; no median
+    /// without compared samples).
+    pub median_ratio: Option<f64>,
     pub worst_ratio: f64,
     /// The u of the worst sample.
     pub worst_u: [f32; 4],
@@ -104,7 +105,7 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], plane: bool) -> JacobianC
         skipped_invalid: 0,
         off: 0,
         share_off: 0.0,
-        median_ratio: f64::NAN,
+        median_ratio: None,
         worst_ratio: 1.0,
         worst_u: [0.0; 4],
         tolerance: TOLERANCE,
@@ -133,7 +134,7 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], plane: bool) -> JacobianC
     c.compared = ratios.len() as u64;
     if !ratios.is_empty() {
         ratios.sort_by(f64::total_cmp);
-        c.median_ratio = ratios[ratios.len() / 2];
+        c.median_ratio = Some(ratios[ratios.len() / 2]);
         c.share_off = c.off as f64 / c.compared as f64;
     }
     c.applicable = c.compared >= MIN_COMPARED;
@@ -155,7 +156,7 @@ mod tests {
         };
         let u = vec![[0.3, 0.6, 0.0, 0.0]; MIN_COMPARED as usize];
         let good = judge(&vec![probe(1.0); MIN_COMPARED as usize], &u, true);
-        assert!(good.applicable && good.passed && (good.median_ratio - 1.0).abs() < 1e-3, "{good:?}");
+        assert!(good.applicable && good.passed && (good.median_ratio.unwrap() - 1.0).abs() < 1e-3, "{good:?}");
         let bad = judge(&vec![probe(2.0); MIN_COMPARED as usize], &u, true);
         assert!(bad.applicable && !bad.passed && (bad.worst_ratio - 2.0).abs() < 1e-3, "{bad:?}");
     }

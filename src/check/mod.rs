@@ -22,6 +22,9 @@
 //! 7. `normalization`: ∫pdf over the domain against the fraction of valid samples: a pdf off by a
 //!    constant factor (a wrong normalisation, an approximated G1) shows here at any sample count.
 //!
+//! It returns a [`Report`] with each check's typed figures ([`report`]); [`power`] runs it at
+//! growing sample counts. `lobes check --out` draws the histogram with `crate::report::check`.
+//!
 //! ```no_run
 //! use lobes::check::{check, Settings, UserSampler, Domain};
 //! let sampler = UserSampler::from_files(&["my_ggx.wgsl".into()], "my_sample", "my_pdf", None, Domain::Sphere)?;
@@ -35,15 +38,19 @@ pub mod compose;
 mod gpu;
 pub mod hard;
 pub mod jacobian;
+pub mod power;
 pub mod quadrature;
+pub mod report;
 
 pub use compose::Source;
+pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
 use crate::reference::rng;
-use crate::stats::chi2::{self, Chi2};
+use crate::stats::chi2;
+use report::{AlbedoFigures, Chi2Figures, ConsistencyFigures, NormalizationFigures, PdfValuesFigures, REPORT_VERSION, WeightFigures};
 use serde::{Deserialize, Serialize};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Why a check could not be run (as opposed to a check that ran and failed).
 #[derive(Debug, thiserror::Error)]
@@ -72,7 +79,7 @@ impl CheckError {
 }
 
 /// Where the sampled points live.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "lowercase", tag = "kind")]
 pub enum Domain {
     /// Unit directions anywhere on the sphere, binned in (cos θ, φ) as lobes bins its lobes.
@@ -202,7 +209,9 @@ impl Settings {
             Domain::Plane { .. } => (64, 64),
         })
     }
-    fn validate(&self) -> Result<(), CheckError> {
+    /// Bad input, named by its command-line flag: more than 16 params, an incident θ outside
+    /// [0, 180], no samples, an empty or too large grid, a significance outside (0, 1).
+    pub fn validate(&self) -> Result<(), CheckError> {
         let bad = |flag: &str, what: String| Err(CheckError::Input(format!("{flag}: {what}")));
         if self.params.len() > MAX_PARAMS {
             return bad("--params", format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
@@ -231,115 +240,10 @@ impl Settings {
     }
 }
 
-/// One check's verdict and figures.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Check {
-    pub name: String,
-    pub passed: bool,
-    /// One line a person reads.
-    pub summary: String,
-    /// The check's numbers (its own typed struct, serialised).
-    pub figures: serde_json::Value,
-}
-
-/// Names of the invalid-sample reasons, in the order of their cells after the bins.
-pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
-
-/// Everything a check of a user's sampler found.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Report {
-    pub passed: bool,
-    pub checks: Vec<Check>,
-    pub sampler: String,
-    pub domain: Domain,
-    pub samples: u64,
-    pub rows: u32,
-    pub cols: u32,
-    pub adapter: String,
-    /// Counts per bin (row-major), and per reason of [`REASONS`].
-    pub counts: Vec<u64>,
-    pub invalid: [u64; 4],
-    /// Expected counts per bin from the quadrature of the pdf.
-    pub expected: Vec<f64>,
-}
-
-impl Report {
-    /// The check called `name`.
-    pub fn get(&self, name: &str) -> Option<&Check> {
-        self.checks.iter().find(|c| c.name == name)
-    }
-
-    /// Panics, naming every failed check and its summary, unless every check passed.
-    pub fn assert_passed(&self) {
-        self.assert_passed_with(None)
-    }
-
-    /// As [`Report::assert_passed`], naming where the outputs were written.
-    pub fn assert_passed_with(&self, outputs: Option<&Path>) {
-        if self.passed {
-            return;
-        }
-        let failed: Vec<String> = self.checks.iter().filter(|c| !c.passed).map(|c| format!("  {}: {}", c.name, c.summary)).collect();
-        let out = outputs.map(|p| format!("\noutputs: {}", p.display())).unwrap_or_default();
-        panic!("lobes check: {} failed {} of {} checks:\n{}{out}", self.sampler, failed.len(), self.checks.len(), failed.join("\n"));
-    }
-}
-
-fn check_of<T: Serialize>(name: &str, passed: bool, summary: String, figures: &T) -> Check {
-    Check { name: name.into(), passed, summary, figures: serde_json::to_value(figures).expect("figures serialise") }
-}
-
 /// The incident direction at θ, φ in degrees.
 fn incident(theta: f64, phi: f64) -> [f32; 3] {
     let w = crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians());
     [w.x as f32, w.y as f32, w.z as f32]
-}
-
-/// The χ² figures with the pdf's total integral.
-#[derive(Serialize)]
-struct Chi2Figures<'a> {
-    #[serde(flatten)]
-    chi2: &'a Chi2,
-    /// Σ over bins of ∫ pdf: 1 for a pdf that is normalised over the domain.
-    pdf_integral: f64,
-    invalid: [u64; 4],
-    expected_invalid: f64,
-    quadrature: &'a quadrature::Integrals,
-}
-
-/// The weights figures.
-#[derive(Serialize)]
-struct NormalizationFigures {
-    pdf_integral: f64,
-    valid_fraction: f64,
-    /// The quadrature's resolution of ∫pdf: its error estimate plus the f32 rounding of the sum.
-    resolution: f64,
-    tolerance: f64,
-}
-
-#[derive(Serialize)]
-struct WeightFigures {
-    max_weight_error: f64,
-    limit: f64,
-}
-
-#[derive(Serialize)]
-struct AlbedoFigures {
-    mean_weight: f64,
-    std_error: f64,
-    quadrature: f64,
-    quadrature_error: f64,
-    z: f64,
-    p_value: f64,
-    significance: f64,
-}
-
-#[derive(Serialize)]
-struct ConsistencyFigures {
-    compared: u64,
-    max_relative_difference: f64,
-    worst_u: [f32; 4],
-    limit: f64,
 }
 
 /// Largest relative difference allowed between the reported pdf and the pdf function (f32
@@ -349,6 +253,7 @@ pub const PDF_CONSISTENCY_LIMIT: f64 = 1e-3;
 
 /// Runs every check of `sampler` on `gpu`.
 pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
+    let started = std::time::Instant::now();
     settings.validate()?;
     sampler.validate()?;
     let (rows, cols) = settings.grid(&sampler.domain);
@@ -407,37 +312,51 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let probes = passes.probe(&params, &items)?;
 
     // pdf consistency: the reported pdf against the pdf function, at valid samples.
-    let mut consistency = ConsistencyFigures { compared: 0, max_relative_difference: 0.0, worst_u: [0.0; 4], limit: PDF_CONSISTENCY_LIMIT };
+    let mut consistency =
+        ConsistencyFigures { compared: 0, max_relative_difference: 0.0, pdf_function_not_finite: 0, worst_u: [0.0; 4], limit: PDF_CONSISTENCY_LIMIT };
     let mut p_max: f64 = 0.0;
     for (p, u) in probes.iter().zip(&probe_u) {
         let (rep, fun) = (p[0][3] as f64, p[6][0] as f64);
         if rep > 0.0 && rep.is_finite() && p[0][..3].iter().all(|x| x.is_finite()) {
             consistency.compared += 1;
-            let diff = if fun.is_finite() { (rep - fun).abs() / rep.max(fun) } else { f64::INFINITY };
-            if diff > consistency.max_relative_difference {
-                consistency.max_relative_difference = diff;
-                consistency.worst_u = *u;
+            if !fun.is_finite() {
+                // the worst of all: the first such sample is the one shown
+                if consistency.pdf_function_not_finite == 0 {
+                    consistency.worst_u = *u;
+                }
+                consistency.pdf_function_not_finite += 1;
+            } else {
+                let diff = (rep - fun).abs() / rep.max(fun);
+                if diff > consistency.max_relative_difference {
+                    consistency.max_relative_difference = diff;
+                    if consistency.pdf_function_not_finite == 0 {
+                        consistency.worst_u = *u;
+                    }
+                }
             }
             p_max = p_max.max(rep);
         }
     }
-    let consistent = consistency.max_relative_difference <= PDF_CONSISTENCY_LIMIT;
-    checks.push(check_of(
-        "pdf_consistency",
-        consistent,
-        format!(
-            "the pdf the sampler reports and {}(d) differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e}) over {} samples",
+    let consistent = consistency.max_relative_difference <= PDF_CONSISTENCY_LIMIT && consistency.pdf_function_not_finite == 0;
+    let not_finite = match consistency.pdf_function_not_finite {
+        0 => String::new(),
+        k => format!("; {}(d) NaN or ∞ at {k} of them", sampler.pdf),
+    };
+    checks.push(Check {
+        passed: consistent,
+        summary: format!(
+            "the pdf the sampler reports and {}(d) differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e}) over {} samples{not_finite}",
             sampler.pdf, consistency.max_relative_difference, consistency.compared
         ),
-        &consistency,
-    ));
+        figures: Figures::PdfConsistency(consistency),
+    });
 
     // The Jacobian.
     let jac = jacobian::judge(&probes, &probe_u, plane);
     let summary = if jac.applicable {
         format!(
             "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%)",
-            jac.median_ratio,
+            jac.median_ratio.unwrap_or(f64::NAN),
             jac.worst_ratio,
             100.0 * jac.share_off,
             jac.compared,
@@ -450,7 +369,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
             jac.compared, jac.probed, jac.skipped_selection, jac.skipped_not_smooth, jac.skipped_invalid
         )
     };
-    checks.push(check_of("jacobian", jac.passed, summary, &jac));
+    checks.push(Check { passed: jac.passed, summary, figures: Figures::Jacobian(jac) });
 
     // The expected histogram.
     let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
@@ -471,16 +390,15 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     };
     let n = settings.samples as f64;
     let pdf_total: f64 = integrals.probabilities.iter().sum();
-    checks.push(check_of(
-        "pdf_values",
-        integrals.bad_parts == 0,
-        if integrals.bad_parts == 0 {
+    checks.push(Check {
+        passed: integrals.bad_parts == 0,
+        summary: if integrals.bad_parts == 0 {
             format!("{}(d) finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf, integrals.parts)
         } else {
             format!("{}(d) returned NaN, ∞ or a negative value in {} of {} quadrature parts", sampler.pdf, integrals.bad_parts, integrals.parts)
         },
-        &integrals.bad_parts,
-    ));
+        figures: Figures::PdfValues(PdfValuesFigures { bad_parts: integrals.bad_parts, parts: integrals.parts }),
+    });
     let expected: Vec<f64> = integrals.probabilities.iter().map(|p| n * p).collect();
     let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
     // The mass the pdf leaves to invalid samples, 1 − ∫pdf, is known no better than the
@@ -498,15 +416,14 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let valid = 1.0 - observed_invalid;
     let norm_tolerance = 2.0 * resolution + 4.0 * (valid * (1.0 - valid) / n).sqrt();
     let norm = NormalizationFigures { pdf_integral: pdf_total, valid_fraction: valid, resolution, tolerance: norm_tolerance };
-    checks.push(check_of(
-        "normalization",
-        (pdf_total - valid).abs() <= norm_tolerance,
-        format!(
+    checks.push(Check {
+        passed: (pdf_total - valid).abs() <= norm_tolerance,
+        summary: format!(
             "∫{}(d) over the domain = {pdf_total:.6} against the valid fraction {valid:.6} of the samples (tolerance {norm_tolerance:.1e})",
             sampler.pdf
         ),
-        &norm,
-    ));
+        figures: Figures::Normalization(norm),
+    });
     let observed: Vec<u64> = totals[..bins].iter().copied().chain([invalid.iter().sum()]).collect();
     let exp: Vec<f64> = expected.iter().copied().chain([expected_invalid]).collect();
     let chi2 = chi2::test(&observed, &exp, settings.significance);
@@ -514,8 +431,9 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         "χ² = {:.1} on {} dof, p = {:.3e} (significance {}); ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
         chi2.statistic, chi2.dof, chi2.p_value, settings.significance, pdf_total, chi2.in_impossible_cells, integrals.max_error_sigma
     );
-    let figures = Chi2Figures { chi2: &chi2, pdf_integral: pdf_total, invalid, expected_invalid, quadrature: &integrals };
-    checks.push(check_of("chi2", chi2.passed, summary, &figures));
+    let passed = chi2.passed;
+    let figures = Chi2Figures { chi2, pdf_integral: pdf_total, invalid, expected_invalid, quadrature: integrals.clone() };
+    checks.push(Check { passed, summary, figures: Figures::Chi2(figures) });
 
     // Weights and albedo, with an eval.
     if sampler.eval.is_some() {
@@ -532,12 +450,11 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         }
         let limit = crate::stats::weighted::WEIGHT_ERROR_LIMIT as f64;
         let wf = WeightFigures { max_weight_error: max_err, limit };
-        checks.push(check_of(
-            "weights",
-            max_err <= limit,
-            format!("eval/pdf from the sampler and eval/{}(d) differ by at most {max_err:.2e} (limit {limit:.0e})", sampler.pdf),
-            &wf,
-        ));
+        checks.push(Check {
+            passed: max_err <= limit,
+            summary: format!("eval/pdf from the sampler and eval/{}(d) differ by at most {max_err:.2e} (limit {limit:.0e})", sampler.pdf),
+            figures: Figures::Weights(wf),
+        });
         let mean = sw / n;
         let var = (sw2 / n - mean * mean).max(0.0);
         let se = (var / n).sqrt();
@@ -546,12 +463,11 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         let z = (mean - quad) / (se * se + quad_err * quad_err).sqrt().max(f64::MIN_POSITIVE);
         let p = libm::erfc(z.abs() / std::f64::consts::SQRT_2);
         let af = AlbedoFigures { mean_weight: mean, std_error: se, quadrature: quad, quadrature_error: quad_err, z, p_value: p, significance: settings.significance };
-        checks.push(check_of(
-            "albedo",
-            p >= settings.significance,
-            format!("mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6}: z = {z:.2}, p = {p:.3e}"),
-            &af,
-        ));
+        checks.push(Check {
+            passed: p >= settings.significance,
+            summary: format!("mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6}: z = {z:.2}, p = {p:.3e}"),
+            figures: Figures::Albedo(af),
+        });
     }
 
     // Hard cases.
@@ -567,19 +483,19 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let table: Vec<hard::HardRow> =
         thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
     let failing: Vec<String> = table.iter().filter(|r| !r.passed).map(|r| format!("θi {}° (first at u = {:?})", r.incident_theta, r.first_failure.unwrap_or_default())).collect();
-    checks.push(check_of(
-        "hard_cases",
-        failing.is_empty(),
-        if failing.is_empty() {
+    checks.push(Check {
+        passed: failing.is_empty(),
+        summary: if failing.is_empty() {
             format!("{} inputs at u ∈ {{0, 2⁻²⁴, ½, 1 − 2⁻²⁴, 1}}⁴ × {} incident angles: every sample valid or rejected with pdf 0", items.len(), thetas.len())
         } else {
             format!("NaN, ∞, a negative pdf or a bad point at {}", failing.join(", "))
         },
-        &table,
-    ));
+        figures: Figures::HardCases(table),
+    });
 
     let passed = checks.iter().all(|c| c.passed);
     Ok(Report {
+        format_version: REPORT_VERSION,
         passed,
         checks,
         sampler: describe(sampler),
@@ -588,6 +504,8 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         rows,
         cols,
         adapter: gpu.adapter_name(),
+        gpu_seconds: passes.gpu_seconds(),
+        wall_seconds: started.elapsed().as_secs_f64(),
         counts: totals[..bins].to_vec(),
         invalid,
         expected,
@@ -600,40 +518,3 @@ fn describe(s: &UserSampler) -> String {
     format!("{}/{} in {}", s.sample, s.pdf, files.join(", "))
 }
 
-/// One sample count of a power sweep.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct PowerPoint {
-    pub samples: u64,
-    /// The χ² test's p-value and verdict at this count.
-    pub p_value: f64,
-    pub chi2_passed: bool,
-    /// The normalisation check's verdict at this count.
-    pub normalization_passed: bool,
-    /// Whether every check passed.
-    pub passed: bool,
-    /// Wall time of the whole check at this count.
-    pub seconds: f64,
-}
-
-/// The sample counts of a power sweep up to `max`: 2¹⁶, 2¹⁸, … (×4), ending at `max`.
-pub fn power_counts(max: u64) -> Vec<u64> {
-    let mut v: Vec<u64> = std::iter::successors(Some(1u64 << 16), |n| n.checked_mul(4)).take_while(|&n| n < max).collect();
-    v.push(max);
-    v
-}
-
-/// From which sample count a check catches an error: the whole check at each count of
-/// [`power_counts`]`(settings.samples)`, with its χ² p-value and wall time.
-pub fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Vec<PowerPoint>, CheckError> {
-    power_counts(settings.samples)
-        .into_iter()
-        .map(|samples| {
-            let t = std::time::Instant::now();
-            let r = check(gpu, sampler, &Settings { samples, ..settings.clone() })?;
-            let chi2 = r.get("chi2").expect("every check has chi2");
-            let p_value = chi2.figures["p_value"].as_f64().unwrap_or(f64::NAN);
-            let normalization_passed = r.get("normalization").expect("every check has normalization").passed;
-            Ok(PowerPoint { samples, p_value, chi2_passed: chi2.passed, normalization_passed, passed: r.passed, seconds: t.elapsed().as_secs_f64() })
-        })
-        .collect()
-}

@@ -28,7 +28,7 @@ pub const MAX_INITIAL_SPLIT: u32 = 16;
 const MAX_PARTS: usize = 1 << 22;
 
 /// Per-bin integrals and what their accuracy is.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct Integrals {
     /// ∫ pdf over each bin (row-major).
     pub probabilities: Vec<f64>,

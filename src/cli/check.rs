@@ -1,6 +1,7 @@
 //! `lobes check`: judge a user's WGSL sampler (see [`crate::check`]).
 
 use super::{NumberList, OutputArgs, emit, emit_json, parse_azimuth, parse_number_list, parse_polar_180, usage};
+use crate::report::table;
 use crate::check::{self, CheckError, Domain, Settings, UserSampler};
 use crate::engine::gpu::Gpu;
 use clap::{Args, ValueEnum};
@@ -56,10 +57,12 @@ pub struct CheckArgs {
     #[arg(long, value_name = "A", default_value_t = 0.01)]
     pub significance: f64,
     /// Run the whole check at 2^16, 2^18, … samples up to --samples and print the χ² p-value and
-    /// time at each: from which sample count is an error caught?
+    /// time at each, and from which count (after how much GPU time) an error is caught; exit 1
+    /// when some count fails.
     #[arg(long)]
     pub power: bool,
-    /// Write report.json (and the composed WGSL) to this folder.
+    /// Write report.json, heat maps of the histogram (measured.png, expected.png, residual.png)
+    /// and the composed WGSL to this folder (power.json with --power).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     #[command(flatten)]
@@ -87,9 +90,10 @@ impl CheckArgs {
     fn settings(&self) -> anyhow::Result<Settings> {
         let bins = match &self.bins {
             None => None,
+            // the grid's limits are Settings::validate's
             Some(b) => match b.0[..] {
-                [r, c] if r >= 1.0 && c >= 1.0 && r.fract() == 0.0 && c.fract() == 0.0 && r * c <= (1u64 << 24) as f64 => Some((r as u32, c as u32)),
-                _ => return Err(usage("--bins: expected ROWS,COLS, two whole numbers ≥ 1 with at most 2^24 bins, e.g. 64,128")),
+                [r, c] if [r, c].iter().all(|v| v.fract() == 0.0 && (0.0..=u32::MAX as f64).contains(v)) => Some((r as u32, c as u32)),
+                _ => return Err(usage("--bins: expected ROWS,COLS, two whole numbers, e.g. 64,128")),
             },
         };
         Ok(Settings {
@@ -108,46 +112,63 @@ impl CheckArgs {
 pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let sampler = args.sampler()?;
     let settings = args.settings()?;
+    settings.validate().map_err(input)?;
     if let Some(dir) = &args.out {
         super::prepare_out(dir)?;
     }
     let gpu = Gpu::new()?;
     if args.power {
-        return power(&gpu, &sampler, &settings, args.output.json);
+        return power(&gpu, &sampler, &settings, args);
     }
     let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
     if let Some(dir) = &args.out {
-        crate::report::atomic::write_atomic(&dir.join("composed.wgsl"), sampler.composed().map_err(input)?.as_bytes())?;
-        crate::report::atomic::write_atomic(&dir.join("report.json"), serde_json::to_string(&report)?.as_bytes())?;
+        crate::report::check::write(dir, &report, &sampler.composed().map_err(input)?)?;
     }
     if args.output.json {
         emit_json(&report)?;
     } else {
         let mut t = format!("{} on {} ({} samples, {}×{} bins)\n", report.sampler, report.adapter, report.samples, report.rows, report.cols);
-        for c in &report.checks {
-            t += &format!("  {:<16} {:<4}  {}\n", c.name, if c.passed { "ok" } else { "FAIL" }, c.summary);
-        }
+        t += &table::render(&["check", "result", "summary"], report.checks.iter().map(|c| vec![c.name(), verdict(c.passed), &c.summary]));
         t += if report.passed { "passed\n" } else { "FAILED\n" };
         emit(&t)?;
     }
-    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect();
-    anyhow::ensure!(failed.is_empty(), "{} failed: {}", report.sampler, failed.join(", "));
+    anyhow::ensure!(report.passed, "{} failed: {}", report.sampler, report.failed().join(", "));
     Ok(())
 }
 
-fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, json: bool) -> anyhow::Result<()> {
-    let points = check::power(gpu, sampler, settings).map_err(input)?;
-    if json {
-        return emit_json(&serde_json::json!({ "sampler": sampler_name(sampler), "points": points }));
-    }
-    let mut t = format!("{}\n{:>12}  {:>10}  {:>5}  {:>13}  {:>5}  {:>8}\n", sampler_name(sampler), "samples", "chi2 p", "chi2", "normalization", "all", "seconds");
-    for p in &points {
-        let v = |b: bool| if b { "ok" } else { "FAIL" };
-        t += &format!("{:>12}  {:>10.3e}  {:>5}  {:>13}  {:>5}  {:>8.2}\n", p.samples, p.p_value, v(p.chi2_passed), v(p.normalization_passed), v(p.passed), p.seconds);
-    }
-    emit(&t)
+fn verdict(passed: bool) -> &'static str {
+    if passed { "ok" } else { "FAIL" }
 }
 
-fn sampler_name(s: &UserSampler) -> String {
-    format!("{}/{}", s.sample, s.pdf)
+/// `--power`: exits 0 when every check passes at every count, 1 when some count fails.
+fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs) -> anyhow::Result<()> {
+    let sweep = check::power::power(gpu, sampler, settings).map_err(input)?;
+    if let Some(dir) = &args.out {
+        crate::report::check::write_power(dir, &sweep)?;
+    }
+    if args.output.json {
+        emit_json(&sweep)?;
+    } else {
+        let seconds = |s: Option<f64>| s.map_or("-".to_string(), |s| format!("{s:.3}"));
+        let mut t = format!("{}\n", sweep.sampler);
+        t += &table::render(
+            &["samples", "chi2 p", "chi2", "normalization", "all", "GPU s", "wall s"],
+            sweep.points.iter().map(|p| {
+                vec![
+                    p.samples.to_string(),
+                    format!("{:.3e}", p.p_value),
+                    verdict(p.chi2_passed).into(),
+                    verdict(p.normalization_passed).into(),
+                    verdict(p.passed).into(),
+                    seconds(p.gpu_seconds),
+                    format!("{:.2}", p.seconds),
+                ]
+            }),
+        );
+        t += &sweep.verdict();
+        t.push('\n');
+        emit(&t)?;
+    }
+    anyhow::ensure!(sweep.passed, "{}: {}", sweep.sampler, sweep.verdict());
+    Ok(())
 }

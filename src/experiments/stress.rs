@@ -10,7 +10,7 @@
 use crate::engine::gpu::GpuEngine;
 use crate::engine::job::Job;
 use crate::reference::{Invalid, Lobe, reflect, rng};
-use crate::stats::compare::angle_between;
+use crate::run::compare::angle_between;
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
 use serde::Serialize;

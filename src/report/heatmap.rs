@@ -6,14 +6,14 @@
 //! [`super::colour`]), a grey "nan" key when some cells are not finite, the title on top and
 //! the axis range labels. [`write_png`] writes the image atomically ([`super::atomic`]).
 
-use super::colour::{Mapping, NAN_GREY, colour, value_colour};
+use super::colour::{NAN_GREY, colour, value_colour};
 use super::label::{axis_text, compact};
 use super::text::{LINE_H, draw_text, text_width};
 use image::{Rgb, RgbImage};
 use std::io;
 use std::path::Path;
 
-pub use super::colour::Scale;
+pub use super::colour::{Mapping, Scale};
 
 /// A 2-D histogram to draw.
 #[derive(Debug, Clone, Copy)]
@@ -65,7 +65,12 @@ const MAX_WIDTH: u32 = 4096;
 
 /// Renders the heat map, colour bar, title and axis labels into an RGB image.
 pub fn render(h: &Heatmap) -> RgbImage {
-    let mapping = Mapping::fit(h.scale, cell_values(h));
+    render_scaled(h, Mapping::fit(h.scale, cell_values(h)))
+}
+
+/// As [`render`], on a colour scale fitted elsewhere: maps drawn on one [`Mapping`] (fitted to
+/// all their values) can be compared colour for colour.
+pub fn render_scaled(h: &Heatmap, mapping: Mapping) -> RgbImage {
     let ticks = tick_labels(&mapping);
     let has_bad = (0..h.rows * h.cols).any(|i| !cell(h, i).is_finite());
     let lay = Layout::new(h, &ticks, has_bad);
@@ -84,7 +89,16 @@ pub fn render(h: &Heatmap) -> RgbImage {
 /// Renders `h` and writes it as a PNG to `path`, atomically: the file goes to a temporary
 /// name in the same directory, is synced, and is then renamed over `path`.
 pub fn write_png(h: &Heatmap, path: &Path) -> io::Result<()> {
-    let png = super::png::encode(&render(h)).map_err(io::Error::other)?;
+    write_image(&render(h), path)
+}
+
+/// As [`write_png`], on the colour scale `mapping` ([`render_scaled`]).
+pub fn write_png_scaled(h: &Heatmap, mapping: Mapping, path: &Path) -> io::Result<()> {
+    write_image(&render_scaled(h, mapping), path)
+}
+
+fn write_image(img: &RgbImage, path: &Path) -> io::Result<()> {
+    let png = super::png::encode(img).map_err(io::Error::other)?;
     super::atomic::write_atomic(path, &png)
 }
 

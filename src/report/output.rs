@@ -16,7 +16,7 @@ use crate::run::shard::ShardFile;
 use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
 use crate::stats::chi2::Chi2;
-use crate::stats::compare::AngleCheck;
+use crate::run::compare::AngleCheck;
 use crate::stats::weighted::{AlbedoCheck, WeightedSums};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

@@ -1,8 +1,10 @@
 //! JSON Schemas (draft 2020-12) of every JSON file lobes writes, generated from the serde
 //! structs that write and read them. `docs/schema/` holds them; `tests/schema.rs` checks that
-//! they are up to date and that the files of a run, a shard run and a merge validate.
+//! they are up to date and that the files of a run, a shard run, a merge and a check validate.
 
 use super::output::{HistogramFile, RunSummary, ShardSummary};
+use crate::check::Report as CheckReport;
+use crate::check::power::PowerSweep;
 use crate::run::shard::ShardFile;
 use schemars::{JsonSchema, schema_for};
 
@@ -20,6 +22,10 @@ pub fn schemas() -> Vec<(&'static str, serde_json::Value)> {
         one::<RunSummary>("run-summary.schema.json"),
         // stdout of `lobes run --shard I/N --json`
         one::<ShardSummary>("shard-summary.schema.json"),
+        // stdout of `lobes check --json`, and DIR/report.json of `lobes check --out DIR`
+        one::<CheckReport>("check-report.schema.json"),
+        // stdout of `lobes check --power --json`, and DIR/power.json with --out DIR
+        one::<PowerSweep>("check-power.schema.json"),
     ]
 }
 

@@ -4,6 +4,7 @@
 //! [`record`] holds the parts of the output files that shard files and `histogram.json` share.
 //! A user's WGSL sampler runs whole through the checks of `lobes check` ([`user`]).
 
+pub mod compare;
 pub mod merge;
 pub mod record;
 pub mod shard;
@@ -15,9 +16,9 @@ use crate::engine::gpu::{GpuEngine, GpuError, WeightedRun};
 use crate::engine::job::{Counts, Job, SampleRange};
 use crate::scene::Case;
 use crate::stats::chi2::Chi2;
-use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
+use compare::{AngleCheck, ExpectedCounts};
 use crate::stats::expected::Quadrature;
-use crate::stats::weighted::{self, AlbedoCheck, WeightedSums};
+use crate::stats::weighted::{AlbedoCheck, WeightedSums};
 use std::ops::Range;
 use std::time::Instant;
 
@@ -187,7 +188,7 @@ pub fn judge(case: &Case, sampled: Sampled, significance: f64) -> anyhow::Result
     let weighted = match (&case.effects, weighted) {
         (None, _) => None,
         (Some(effects), Some(w)) => {
-            let check = weighted::albedo_check(&case.job, effects, &w.sums, case.samples, significance, &Quadrature::default());
+            let check = compare::albedo_check(&case.job, effects, &w.sums, case.samples, significance, &Quadrature::default());
             Some(WeightedResult { sums: w.sums, check, gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds })
         }
         (Some(_), None) => anyhow::bail!("case '{}' is weighted but has no weighted sums", case.name),

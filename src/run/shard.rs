@@ -16,7 +16,7 @@ use super::Sampled;
 use crate::engine::gpu::WeightedRun;
 use crate::engine::job::Counts;
 use crate::scene::Case;
-use crate::stats::compare::AngleCheck;
+use crate::run::compare::AngleCheck;
 use crate::stats::weighted::WeightedSums;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

@@ -1,7 +1,6 @@
 //! Statistics: binning, Gauss–Legendre quadrature, expected counts, and the χ² test.
 
 pub mod chi2;
-pub mod compare;
 pub mod expected;
 pub mod gauss_legendre;
 pub mod histogram;

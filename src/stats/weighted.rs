@@ -198,7 +198,7 @@ pub const WEIGHT_ERROR_LIMIT: f32 = 1e-3;
 pub const F32_FLOOR: f64 = 1e-6;
 
 /// z = diff / σ and its two-sided p-value, with σ² = std_error² + (F32_FLOOR · value)².
-fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
+pub fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
     let sigma = std_error.hypot(F32_FLOOR * value.abs());
     if diff == 0.0 {
         return (0.0, 1.0);
@@ -207,63 +207,3 @@ fn two_sided(diff: f64, std_error: f64, value: f64) -> (f64, f64) {
     (z, libm::erfc(z.abs() / std::f64::consts::SQRT_2))
 }
 
-/// Judges `sums` of `n` samples of a lobe case with `effects` at per-case `significance`:
-/// the albedo against the f64 quadrature of f cos θr, the sphere total against the furnace
-/// value where there is one, the per-bin weight check, and no overflow.
-///
-/// ```
-/// use lobes::{engine::job::{Job, SampleRange}, stats::{histogram::SphereGrid, expected::Quadrature, weighted::albedo_check}};
-/// use lobes::reference::{Lobe, LobeKind, Method, effects::Effects, masking::Masking, fresnel::Fresnel, reflect::spherical};
-/// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
-/// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 } };
-/// let effects = Effects { fresnel: Fresnel::None, masking: Masking::G1 };
-/// let sums = lobes::engine::cpu::weighted(&job, &effects, SampleRange::whole(1, 200_000));
-/// let check = albedo_check(&job, &effects, &sums, 200_000, 0.01, &Quadrature::default());
-/// assert!(check.passed, "{check:?}");
-/// assert_eq!(check.furnace, Some(1.0)); // F = 1, G = G1(ωi): the weak white furnace
-/// ```
-pub fn albedo_check(
-    job: &crate::engine::job::Job,
-    effects: &crate::reference::effects::Effects,
-    sums: &WeightedSums,
-    n: u64,
-    significance: f64,
-    q: &crate::stats::expected::Quadrature,
-) -> AlbedoCheck {
-    let crate::engine::job::Job::Lobe { lobe, incident, grid } = job else { panic!("albedo of a lobe job") };
-    let wi = *incident;
-    let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
-    let f_cos = |w: glam::DVec3| effects.eval(lobe, wi, w) * w.z;
-    let reference_bins = crate::stats::expected::probabilities(&f_cos, *grid, width, q).probabilities;
-    let reference: f64 = reference_bins.iter().sum();
-    let albedo = sums.albedo(n);
-    let std_error = sums.std_error(n, true);
-    let (z, p_value) = two_sided(albedo - reference, std_error, reference);
-    let sphere_total = sums.sphere_total(n);
-    let sphere_std_error = sums.std_error(n, false);
-    let furnace = effects.furnace(lobe, wi);
-    let furnace_p_value = furnace.map(|f| two_sided(sphere_total - f, sphere_std_error, f).1);
-    let max_weight_error = sums.max_weight_error();
-    let passed = p_value >= significance
-        && furnace_p_value.is_none_or(|p| p >= significance)
-        && max_weight_error <= WEIGHT_ERROR_LIMIT
-        && sums.overflow == 0;
-    AlbedoCheck {
-        albedo,
-        std_error,
-        reference,
-        relative_error: (albedo - reference) / reference,
-        z,
-        p_value,
-        sphere_total,
-        sphere_std_error,
-        furnace,
-        furnace_p_value,
-        max_weight_error,
-        weight_error_limit: WEIGHT_ERROR_LIMIT,
-        overflow: sums.overflow,
-        significance,
-        passed,
-        reference_bins,
-    }
-}

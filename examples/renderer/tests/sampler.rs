@@ -1,6 +1,8 @@
 //! The renderer's diffuse sampler, judged by lobes on the GPU (lavapipe in CI).
 
+use lobes::check::report::{AlbedoFigures, Chi2Figures, NormalizationFigures};
 use lobes::check::{Domain, Reference, Report, Settings, Source, UserSampler, check};
+use lobes::check::jacobian::JacobianCheck;
 use lobes::engine::gpu::Gpu;
 
 fn gpu() -> Gpu {
@@ -18,7 +20,7 @@ fn sampler(extra: &[(&str, &str)], sample: &str, pdf: &str, eval: Option<&str>) 
 
 fn print(label: &str, report: &Report) {
     for c in &report.checks {
-        eprintln!("{label}: {} {} {}", c.name, if c.passed { "passed" } else { "FAILED" }, c.summary);
+        eprintln!("{label}: {} {} {}", c.name(), if c.passed { "passed" } else { "FAILED" }, c.summary);
     }
 }
 
@@ -35,7 +37,7 @@ fn diffuse_lobe_passes() {
         for name in ["chi2", "normalization", "pdf_values", "pdf_consistency", "jacobian", "weights", "albedo", "hard_cases"] {
             assert!(report.get(name).is_some_and(|c| c.passed), "check `{name}` missing or failed");
         }
-        let mean = report.get("albedo").unwrap().figures["mean_weight"].as_f64().unwrap();
+        let mean = report.figures::<AlbedoFigures>().unwrap().mean_weight;
         assert!((mean - albedo).abs() < 1e-5 * albedo, "mean weight {mean} for albedo {albedo}");
         // Samples from above are rejected only where f32 rounding puts them on the rim of the
         // disk (z = 0): u within a few ulps of the square's edge, a few in 2²² samples at most.
@@ -57,7 +59,7 @@ fn diffuse_lobe_passes_against_an_f64_reference_pdf() {
     print("f64 reference", &report);
     report.assert_passed();
     // In f64 the cosine lobe integrates to 1 far below f32 rounding (2·10⁻⁶ of the GPU's sum).
-    let integral = report.get("normalization").unwrap().figures["pdf_integral"].as_f64().unwrap();
+    let integral = report.figures::<NormalizationFigures>().unwrap().pdf_integral;
     assert!((integral - 1.0).abs() < 1e-9, "∫pdf = {integral}");
 }
 
@@ -71,7 +73,7 @@ fn incident_direction_from_below_is_rejected() {
     report.assert_passed();
     // every sample is rejected with pdf 0 (lobes' reason "zero_pdf"), and the pdf integrates to 0
     assert_eq!(report.invalid, [0, 0, 0, 1 << 16]);
-    let integral = report.get("chi2").unwrap().figures["pdf_integral"].as_f64().unwrap();
+    let integral = report.figures::<Chi2Figures>().unwrap().pdf_integral;
     assert_eq!(integral, 0.0);
 }
 
@@ -86,20 +88,20 @@ fn a_pdf_off_by_a_factor_of_two_is_caught() {
     assert!(!chi2.passed, "{}", chi2.summary);
     // The expected histogram holds half the samples: the other half is expected among the
     // invalid samples, and none are there.
-    let integral = chi2.figures["pdf_integral"].as_f64().unwrap();
+    let integral = report.figures::<Chi2Figures>().unwrap().pdf_integral;
     assert!((integral - 0.5).abs() < 1e-4, "∫pdf = {integral}");
     // ... which the normalisation check compares with the valid fraction of the samples, 1.
     let normalization = report.get("normalization").expect("a normalization check");
-    assert!(!normalization.passed && normalization.figures["valid_fraction"].as_f64().unwrap() > 0.999_99, "{}", normalization.summary);
+    assert!(!normalization.passed && report.figures::<NormalizationFigures>().unwrap().valid_fraction > 0.999_99, "{}", normalization.summary);
     // The map's density is cos θ/π, twice the pdf: pdf · |J| = ½ at every smooth sample.
     let jacobian = report.get("jacobian").unwrap();
-    let median = jacobian.figures["median_ratio"].as_f64().unwrap();
+    let median = report.figures::<JacobianCheck>().unwrap().median_ratio.unwrap();
     assert!(!jacobian.passed && (median - 0.5).abs() < 0.01, "{}", jacobian.summary);
     // The sampler reports the same wrong pdf as the pdf function, so those agree ...
     assert!(report.get("pdf_consistency").unwrap().passed);
     // ... and the weights eval/pdf come out twice the albedo: the mean weight is off too.
     let albedo = report.get("albedo").unwrap();
-    let mean = albedo.figures["mean_weight"].as_f64().unwrap();
+    let mean = report.figures::<AlbedoFigures>().unwrap().mean_weight;
     assert!(!albedo.passed && (mean - 1.6).abs() < 1e-4, "{}", albedo.summary);
     // The panic message of assert_passed names the failed checks.
     let message = std::panic::catch_unwind(|| report.assert_passed()).unwrap_err();
@@ -117,9 +119,8 @@ fn an_error_of_a_fraction_of_a_percent_is_caught_by_chi2_with_many_samples() {
     let settings = Settings { params: vec![0.8], samples: 1 << 26, bins: Some((32, 64)), ..Settings::default() };
     let report = check(&gpu, &skewed, &settings).unwrap_or_else(|e| panic!("{e}"));
     print("skewed by ±0.4 %", &report);
-    let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect();
-    assert_eq!(failed, ["chi2"], "only the χ² test sees an error this small");
-    let p = report.get("chi2").unwrap().figures["p_value"].as_f64().unwrap();
+    assert_eq!(report.failed(), ["chi2"], "only the χ² test sees an error this small");
+    let p = report.figures::<Chi2Figures>().unwrap().chi2.p_value;
     assert!(p < 1e-4, "χ² p = {p}");
 }
 
@@ -138,6 +139,6 @@ fn a_reported_pdf_that_differs_from_the_pdf_function_is_caught() {
     for name in ["pdf_consistency", "weights", "albedo"] {
         assert!(!report.get(name).unwrap().passed, "{name} passed");
     }
-    let mean = report.get("albedo").unwrap().figures["mean_weight"].as_f64().unwrap();
+    let mean = report.figures::<AlbedoFigures>().unwrap().mean_weight;
     assert!((mean - 1.6).abs() < 0.05, "mean weight {mean}");
 }

@@ -14,7 +14,7 @@ use crate::engine::gpu::GpuEngine;
 use crate::engine::job::{Counts, Job, SampleRange};
 use crate::reference::{Invalid, Lobe, LobeKind, Method, SAMPLERS, reflect, rng, sampler};
 use crate::stats::chi2;
-use crate::stats::compare::{self, AngleCheck, ExpectedCounts};
+use crate::run::compare::{self, AngleCheck, ExpectedCounts};
 use crate::stats::expected::{self, Quadrature, REFERENCE_SAMPLES};
 use crate::stats::histogram::SphereGrid;
 use crate::stats::median::median;

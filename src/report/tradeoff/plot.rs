@@ -143,7 +143,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::compare::AngleCheck;
+    use crate::run::compare::AngleCheck;
 
     fn point(sampler: &str, precision: Precision, samples: u64, seconds: f64) -> SweepPoint {
         SweepPoint {

@@ -1,10 +1,14 @@
-//! Judging a histogram: the expected count of every cell (bins and invalid reasons), the χ²
-//! test over them, and the per-sample angular check of GPU directions against f64.
+//! Judging a job's histogram: the expected count of every cell (bins and invalid reasons), the
+//! χ² test over them, the per-sample angular check of GPU directions against f64, and the albedo
+//! check of a weighted histogram. (Here, above the engine, because they take its [`Job`]; the
+//! statistics they use, in [`crate::stats`], know nothing of jobs.)
 
 use crate::engine::job::{Counts, Job};
 use crate::reference::Invalid;
+use crate::reference::effects::Effects;
 use crate::stats::chi2::{self, Chi2};
 use crate::stats::expected::{self, Expected, Quadrature};
+use crate::stats::weighted::{AlbedoCheck, WEIGHT_ERROR_LIMIT, WeightedSums, two_sided};
 use glam::DVec3;
 use serde::Serialize;
 
@@ -60,7 +64,7 @@ impl AngleCheck {
     ///
     /// ```
     /// use glam::DVec3;
-    /// use lobes::stats::compare::AngleCheck;
+    /// use lobes::run::compare::AngleCheck;
     /// let tilted = DVec3::new(1e-3, 0.0, 1.0); // 1e-3 rad (to 3e-7) off the normal
     /// let a = AngleCheck::from_pairs([(Some(tilted), Some(DVec3::Z)), (None, None), (Some(DVec3::Z), None)]);
     /// assert_eq!((a.compared, a.validity_mismatches), (1, 1));
@@ -100,4 +104,65 @@ pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleC
         let gpu = (g[3] == 0.0).then(|| DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64));
         (gpu, s.invalid.is_none().then_some(s.omega_r))
     }))
+}
+
+/// Judges `sums` of `n` samples of a lobe case with `effects` at per-case `significance`:
+/// the albedo against the f64 quadrature of f cos θr, the sphere total against the furnace
+/// value where there is one, the per-bin weight check, and no overflow.
+///
+/// ```
+/// use lobes::{engine::job::{Job, SampleRange}, run::compare::albedo_check, stats::{histogram::SphereGrid, expected::Quadrature}};
+/// use lobes::reference::{Lobe, LobeKind, Method, effects::Effects, masking::Masking, fresnel::Fresnel, reflect::spherical};
+/// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
+/// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 } };
+/// let effects = Effects { fresnel: Fresnel::None, masking: Masking::G1 };
+/// let sums = lobes::engine::cpu::weighted(&job, &effects, SampleRange::whole(1, 200_000));
+/// let check = albedo_check(&job, &effects, &sums, 200_000, 0.01, &Quadrature::default());
+/// assert!(check.passed, "{check:?}");
+/// assert_eq!(check.furnace, Some(1.0)); // F = 1, G = G1(ωi): the weak white furnace
+/// ```
+pub fn albedo_check(
+    job: &Job,
+    effects: &Effects,
+    sums: &WeightedSums,
+    n: u64,
+    significance: f64,
+    q: &Quadrature,
+) -> AlbedoCheck {
+    let Job::Lobe { lobe, incident, grid } = job else { panic!("albedo of a lobe job") };
+    let wi = *incident;
+    let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
+    let f_cos = |w: glam::DVec3| effects.eval(lobe, wi, w) * w.z;
+    let reference_bins = expected::probabilities(&f_cos, *grid, width, q).probabilities;
+    let reference: f64 = reference_bins.iter().sum();
+    let albedo = sums.albedo(n);
+    let std_error = sums.std_error(n, true);
+    let (z, p_value) = two_sided(albedo - reference, std_error, reference);
+    let sphere_total = sums.sphere_total(n);
+    let sphere_std_error = sums.std_error(n, false);
+    let furnace = effects.furnace(lobe, wi);
+    let furnace_p_value = furnace.map(|f| two_sided(sphere_total - f, sphere_std_error, f).1);
+    let max_weight_error = sums.max_weight_error();
+    let passed = p_value >= significance
+        && furnace_p_value.is_none_or(|p| p >= significance)
+        && max_weight_error <= WEIGHT_ERROR_LIMIT
+        && sums.overflow == 0;
+    AlbedoCheck {
+        albedo,
+        std_error,
+        reference,
+        relative_error: (albedo - reference) / reference,
+        z,
+        p_value,
+        sphere_total,
+        sphere_std_error,
+        furnace,
+        furnace_p_value,
+        max_weight_error,
+        weight_error_limit: WEIGHT_ERROR_LIMIT,
+        overflow: sums.overflow,
+        significance,
+        passed,
+        reference_bins,
+    }
 }

@@ -1,0 +1,208 @@
+//! What `lobes check` found: the [`Report`] that `--json` prints and `--out` writes as
+//! `report.json`, and the typed figures of each check. `docs/schema/check-report.schema.json`
+//! is its JSON Schema ([`crate::report::schema`]).
+
+use super::Domain;
+use super::hard::HardRow;
+use super::jacobian::JacobianCheck;
+use super::quadrature::Integrals;
+use crate::stats::chi2::Chi2;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The version of the layout of [`Report`] (and of [`super::power::PowerSweep`]).
+pub const REPORT_VERSION: u32 = 1;
+
+/// Names of the invalid-sample reasons, in the order of their cells after the bins.
+pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
+
+/// Everything a check of a user's sampler found.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Report {
+    /// [`REPORT_VERSION`].
+    pub format_version: u32,
+    /// Whether every check passed.
+    pub passed: bool,
+    pub checks: Vec<Check>,
+    /// "sample/pdf in file.wgsl, …".
+    pub sampler: String,
+    pub domain: Domain,
+    pub samples: u64,
+    /// The histogram's grid: rows over cos θ (sphere) or y (plane), columns over φ or x.
+    pub rows: u32,
+    pub cols: u32,
+    pub adapter: String,
+    /// GPU time of every pass of the check, from timestamp queries (null where the adapter has
+    /// none), and the wall time of the whole check.
+    pub gpu_seconds: Option<f64>,
+    pub wall_seconds: f64,
+    /// Counts per bin (row-major), and per reason of [`REASONS`].
+    pub counts: Vec<u64>,
+    pub invalid: [u64; 4],
+    /// Expected counts per bin from the quadrature of the pdf.
+    pub expected: Vec<f64>,
+}
+
+/// One check's verdict and figures; in JSON `{"name", "figures", "passed", "summary"}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Check {
+    /// The check's name and its numbers.
+    #[serde(flatten)]
+    pub figures: Figures,
+    pub passed: bool,
+    /// One line a person reads.
+    pub summary: String,
+}
+
+/// The reported pdf against the pdf function at the probe samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ConsistencyFigures {
+    /// Valid probe samples compared.
+    pub compared: u64,
+    /// The largest |reported − pdf(d)| / max(reported, pdf(d)) where pdf(d) is finite.
+    pub max_relative_difference: f64,
+    /// Samples where pdf(d) is NaN or ∞ while the sampler reports a valid pdf (each fails).
+    pub pdf_function_not_finite: u64,
+    pub worst_u: [f32; 4],
+    pub limit: f64,
+}
+
+/// The pdf function's values at the quadrature's nodes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct PdfValuesFigures {
+    /// Quadrature parts whose integral of the pdf came out NaN, ∞ or negative.
+    pub bad_parts: u64,
+    pub parts: u64,
+}
+
+/// ∫pdf over the domain against the valid fraction of the samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct NormalizationFigures {
+    pub pdf_integral: f64,
+    pub valid_fraction: f64,
+    /// The quadrature's resolution of ∫pdf: its error estimate plus the f32 rounding of the sum.
+    pub resolution: f64,
+    pub tolerance: f64,
+}
+
+/// The χ² test with the pdf's total integral and the quadrature behind the expected counts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Chi2Figures {
+    #[serde(flatten)]
+    pub chi2: Chi2,
+    /// Σ over bins of ∫ pdf: 1 for a pdf that is normalised over the domain.
+    pub pdf_integral: f64,
+    /// Invalid samples by reason (the order of [`REASONS`]), and the invalid cell's expectation.
+    pub invalid: [u64; 4],
+    pub expected_invalid: f64,
+    pub quadrature: Integrals,
+}
+
+/// eval/pdf from the sampler against eval/pdf(d).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct WeightFigures {
+    pub max_weight_error: f64,
+    pub limit: f64,
+}
+
+/// The mean weight against the quadrature of eval.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct AlbedoFigures {
+    pub mean_weight: f64,
+    pub std_error: f64,
+    pub quadrature: f64,
+    pub quadrature_error: f64,
+    pub z: f64,
+    pub p_value: f64,
+    pub significance: f64,
+}
+
+/// A type of figures, to read one check's figures typed: `report.figures::<Chi2Figures>()`.
+pub trait FiguresOf: Sized {
+    fn of(figures: &Figures) -> Option<&Self>;
+}
+
+/// [`Figures`] with a variant per check, its name (in JSON and [`Figures::name`]) and the
+/// [`FiguresOf`] impl of its type, from one list.
+macro_rules! figures {
+    ($($variant:ident($ty:ty) = $name:literal),* $(,)?) => {
+        /// Each check's figures, named by the check (`"name"` in JSON, its figures under
+        /// `"figures"`).
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+        #[serde(tag = "name", content = "figures")]
+        pub enum Figures {
+            $(#[serde(rename = $name)] $variant($ty),)*
+        }
+
+        impl Figures {
+            /// The check's name, as in JSON.
+            pub fn name(&self) -> &'static str {
+                match self {
+                    $(Figures::$variant(_) => $name,)*
+                }
+            }
+        }
+
+        $(impl FiguresOf for $ty {
+            fn of(figures: &Figures) -> Option<&Self> {
+                match figures {
+                    Figures::$variant(f) => Some(f),
+                    _ => None,
+                }
+            }
+        })*
+    };
+}
+
+figures!(
+    PdfConsistency(ConsistencyFigures) = "pdf_consistency",
+    Jacobian(JacobianCheck) = "jacobian",
+    PdfValues(PdfValuesFigures) = "pdf_values",
+    Normalization(NormalizationFigures) = "normalization",
+    Chi2(Chi2Figures) = "chi2",
+    Weights(WeightFigures) = "weights",
+    Albedo(AlbedoFigures) = "albedo",
+    HardCases(Vec<HardRow>) = "hard_cases",
+);
+
+impl Check {
+    /// The check's name: `pdf_consistency`, `jacobian`, `pdf_values`, `normalization`, `chi2`,
+    /// `weights`, `albedo` or `hard_cases`.
+    pub fn name(&self) -> &'static str {
+        self.figures.name()
+    }
+}
+
+impl Report {
+    /// The check called `name`.
+    pub fn get(&self, name: &str) -> Option<&Check> {
+        self.checks.iter().find(|c| c.name() == name)
+    }
+
+    /// The figures of the check of type `T`, e.g. `report.figures::<Chi2Figures>()`; `None`
+    /// for a check that did not run (`weights` and `albedo` without an eval).
+    pub fn figures<T: FiguresOf>(&self) -> Option<&T> {
+        self.checks.iter().find_map(|c| T::of(&c.figures))
+    }
+
+    /// The names of the checks that failed.
+    pub fn failed(&self) -> Vec<&'static str> {
+        self.checks.iter().filter(|c| !c.passed).map(Check::name).collect()
+    }
+
+    /// Panics, naming every failed check and its summary, unless every check passed.
+    pub fn assert_passed(&self) {
+        self.assert_passed_with(None)
+    }
+
+    /// As [`Report::assert_passed`], naming where the outputs were written.
+    pub fn assert_passed_with(&self, outputs: Option<&Path>) {
+        if self.passed {
+            return;
+        }
+        let failed: Vec<String> = self.checks.iter().filter(|c| !c.passed).map(|c| format!("  {}: {}", c.name(), c.summary)).collect();
+        let out = outputs.map(|p| format!("\noutputs: {}", p.display())).unwrap_or_default();
+        panic!("lobes check: {} failed {} of {} checks:\n{}{out}", self.sampler, failed.len(), self.checks.len(), failed.join("\n"));
+    }
+}
