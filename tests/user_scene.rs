@@ -61,7 +61,7 @@ fn the_example_scene_of_user_samplers_passes() {
         assert_eq!((h.description.lobe.as_str(), h.samples, h.seed), ("user", 1_000_000, 7));
         assert_eq!(h.chi2.significance, s.per_case_significance);
         let record = h.user_sampler.expect("a user sampler's checks");
-        assert!(record.passed && record.checks.iter().any(|c| c.name == "jacobian"));
+        assert!(record.passed && record.checks.iter().any(|c| c.name() == "jacobian"));
     }
     // Independent values on the plane (piecewise_2d.wgsl's table): its second row of cells,
     // y in [0.25, 0.5), has weight 0, and its first row holds 1+2+3+4+4+3+2+1 = 20 of Σw = 60.

@@ -73,21 +73,13 @@ pub struct HistogramFile {
 pub struct UserSamplerRecord {
     /// Whether every check passed (the case's verdict).
     pub passed: bool,
-    pub checks: Vec<CheckRecord>,
+    /// Every check, as in `lobes check`'s report: `{"name", "figures", "passed", "summary"}`.
+    pub checks: Vec<crate::check::Check>,
     pub invalid: UserInvalid,
     /// The expected count of the pooled invalid cell.
     pub expected_invalid: f64,
     /// Wall time of all the checks.
     pub wall_seconds: f64,
-}
-
-/// One check of a user's sampler: its name, verdict, one line a person reads, and its figures.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct CheckRecord {
-    pub name: String,
-    pub passed: bool,
-    pub summary: String,
-    pub figures: serde_json::Value,
 }
 
 /// Invalid samples of a user's sampler by reason.
@@ -201,7 +193,7 @@ impl HistogramFile {
                 checks: report
                     .checks
                     .iter()
-                    .map(|c| CheckRecord { name: c.name.clone(), passed: c.passed, summary: c.summary.clone(), figures: c.figures.clone() })
+                    .cloned()
                     .collect(),
                 invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
                 expected_invalid: r.expected_invalid,

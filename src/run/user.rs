@@ -7,10 +7,10 @@
 //! cases) are not sums over sample ranges, so `lobes run --shard` refuses scenes that have one.
 
 use super::Backend;
+use crate::check::report::{AlbedoFigures, Chi2Figures, WeightFigures};
 use crate::check::{self, CheckError, Report, Settings};
 use crate::scene::UserCase;
 use crate::stats::chi2::Chi2;
-use serde::Deserialize;
 use std::time::Instant;
 
 /// What the checks of a user's case found.
@@ -47,24 +47,6 @@ impl Albedo {
     }
 }
 
-/// The figures of the `chi2` check that a run reads besides the test itself.
-#[derive(Deserialize)]
-struct Chi2Extra {
-    expected_invalid: f64,
-}
-
-#[derive(Deserialize)]
-struct AlbedoFigures {
-    mean_weight: f64,
-    quadrature: f64,
-    p_value: f64,
-}
-
-#[derive(Deserialize)]
-struct WeightFigures {
-    max_weight_error: f64,
-}
-
 /// A check's error as a run's: a GPU error keeps its type, so that a lost device moves the run's
 /// remaining cases to the CPU ([`super::device_lost`]).
 fn run_error(e: CheckError) -> anyhow::Error {
@@ -74,17 +56,6 @@ fn run_error(e: CheckError) -> anyhow::Error {
     }
 }
 
-/// The figures of check `name` of `report`, read as `T`.
-fn figures<T: serde::de::DeserializeOwned>(report: &Report, name: &str) -> anyhow::Result<Option<(T, bool)>> {
-    report
-        .get(name)
-        .map(|c| {
-            let f = serde_json::from_value(c.figures.clone()).map_err(|e| anyhow::anyhow!("the {name} check's figures: {e}"))?;
-            Ok((f, c.passed))
-        })
-        .transpose()
-}
-
 impl UserResult {
     pub fn passed(&self) -> bool {
         self.report.passed
@@ -92,7 +63,7 @@ impl UserResult {
 
     /// The checks that failed, by name.
     pub fn failed_checks(&self) -> Vec<&str> {
-        self.report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect()
+        self.report.checks.iter().filter(|c| !c.passed).map(|c| c.name()).collect()
     }
 }
 
@@ -106,19 +77,20 @@ pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow
     let settings = Settings { significance, ..case.settings.clone() };
     let report = check::check(&engine.gpu, &case.sampler, &settings).map_err(run_error)?;
     let wall_seconds = t.elapsed().as_secs_f64();
-    let (chi2, _) = figures::<Chi2>(&report, "chi2")?.ok_or_else(|| anyhow::anyhow!("the check report has no chi2 check"))?;
-    let (extra, _) = figures::<Chi2Extra>(&report, "chi2")?.expect("read above");
-    let albedo = match (figures::<AlbedoFigures>(&report, "albedo")?, figures::<WeightFigures>(&report, "weights")?) {
-        (Some((a, a_ok)), Some((w, w_ok))) => Some(Albedo {
+    let chi2_figures = report.figures::<Chi2Figures>().ok_or_else(|| anyhow::anyhow!("the check report has no chi2 check"))?;
+    let (chi2, expected_invalid) = (chi2_figures.chi2.clone(), chi2_figures.expected_invalid);
+    let passed = |name: &str| report.get(name).is_some_and(|c| c.passed);
+    let albedo = match (report.figures::<AlbedoFigures>(), report.figures::<WeightFigures>()) {
+        (Some(a), Some(w)) => Some(Albedo {
             mean_weight: a.mean_weight,
             quadrature: a.quadrature,
             p_value: a.p_value,
             max_weight_error: w.max_weight_error,
-            passed: a_ok && w_ok,
+            passed: passed("albedo") && passed("weights"),
         }),
         _ => None,
     };
-    Ok(UserResult { case: case.clone(), report, chi2, expected_invalid: extra.expected_invalid, albedo, wall_seconds })
+    Ok(UserResult { case: case.clone(), report, chi2, expected_invalid, albedo, wall_seconds })
 }
 
 #[cfg(test)]
