@@ -9,7 +9,6 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 const PASSES: &str = include_str!("../../shaders/check/user_passes.wgsl");
-const RNG: &str = include_str!("../../shaders/lib/rng.wgsl");
 /// Invocations per workgroup of every pass (`@workgroup_size(64)`).
 const WG: u32 = 64;
 
@@ -65,7 +64,8 @@ pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
     }
     c.push("<lobes check glue>", &glue(sampler));
     // lobes' RNG as plain WGSL (its naga_oil directives blanked, its line numbers kept)
-    c.push("shaders/lib/rng.wgsl", &crate::engine::gpu::library::plain(RNG));
+    let rng = crate::engine::gpu::library::source("lobes::rng").expect("shaders/lib/rng.wgsl is built in");
+    c.push("shaders/lib/rng.wgsl", &crate::engine::gpu::library::plain(rng));
     c.push("shaders/check/user_passes.wgsl", PASSES);
     c.validate()?;
     Ok(c)

@@ -1,19 +1,25 @@
-//! The WGSL library (`shaders/lib`, `shaders/math`) composed by naga_oil.
+//! lobes' WGSL files (`shaders/lib`, `shaders/math`, `shaders/passes`) composed by naga_oil.
 //!
-//! Each library file states its own import path (`#define_import_path lobes::ggx`) and what it
-//! uses from other files (`#import lobes::reflect::{LobeSample, reflect_sample}`); apart from those
-//! directives it is plain WGSL. [`wgsl`] has naga_oil (Bevy's shader composer) compose the wanted
-//! modules: it resolves the imports, validates every file and reports an error at the file and
+//! Each file states its own import path (`#define_import_path lobes::ggx`) and what it uses
+//! from other files (`#import lobes::reflect::{LobeSample, reflect_sample}`); apart from those
+//! directives it is plain WGSL, and opens on its own in a WGSL editor that knows naga_oil.
+//! [`compose`] has naga_oil (Bevy's shader composer) compose the wanted modules: it resolves the
+//! imports and validates every file as a root of its own, reporting an error at the file and
 //! line it is in. The WGSL handed on is then the files themselves, in import order (each after
 //! the files it imports), with the directive lines blanked: the same text, comments included, as
-//! the files, which is what the passes (`shaders/passes`, which use the names of the job's
-//! composed header), `lobes shader`, `lobes check` and renderers (`lobes::embed`) need.
+//! the files, which is what the GPU engine's kernels ([`super::compose`]), `lobes shader`,
+//! `lobes check` and renderers (`lobes::embed`) need.
+//!
+//! A composition may put files of its own in place of the built-in ones with the same import
+//! path: the alternatives below (the fast math, counting in global memory, ...) and generated
+//! files (a kernel's `lobes::job`, whose `#import`s [`imports_for`] finds from the names it uses).
 //!
 //! Why not naga_oil's composed module itself: it names every imported item with a module
 //! decoration (`ggx_dX_naga_oil_mod_X…X`), and naga's WGSL writer, which could write the module
 //! back with those cut, renames whatever ends in a digit (`add64` → `add64_`), so neither is the
-//! API the files define. No two library files declare the same name
-//! (`embed`'s `no_name_is_declared_by_two_modules`), so the plain text needs no namespaces.
+//! API the files define. No two files declare the same name (`embed`'s
+//! `no_name_is_declared_by_two_modules` for the library; naga rejects a composed kernel that
+//! does), so the plain text needs no namespaces.
 
 use super::context::GpuError;
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
