@@ -2,7 +2,7 @@
 //! composed into one WGSL module that holds only the code those effects need.
 //!
 //! Two levels of specialisation:
-//! - composition: the module is the case's counting kernel ([`compose::lobe_kernel`]) and
+//! - composition: the module is the case's counting kernel (`compose::lobe_kernel`) and
 //!   `shaders/passes/weighted.wgsl`, whose estimator (`shaders/passes/effect.wgsl`) imports
 //!   `lobes::effect_fresnel` and `lobes::effect_masking`: `shaders/passes/effect_fresnel.wgsl`
 //!   (with `shaders/lib/fresnel.wgsl`) only with a Fresnel term, else `no_fresnel.wgsl`, and
