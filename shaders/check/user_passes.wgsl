@@ -1,32 +1,17 @@
+#define_import_path lobes::check
+#import lobes::rng::{rng_uniforms, add64}
+#import lobes::check_params::lobes_check
+#import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval}
+
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
-// functions through three wrappers that the composing host generates (src/check/compose.rs):
+// functions through three wrappers of `lobes::user`, the module that the composing host
+// generates from the user's files (src/check/gpu.rs):
 //   fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32>   // (d, pdf the sampler reports)
 //   fn lobes_user_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32
 //   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
 // and `const LOBES_DOMAIN_PLANE: bool`. Every name here starts with `lobes_` so that it cannot
 // collide with the user's own.
 
-struct LobesCheckParams {
-    // the user's 16 numbers, zero-padded
-    user: array<vec4<f32>, 4>,
-    wi: vec4<f32>,
-    // plane: (x0, y0, x1, y1); sphere: unused
-    bounds: vec4<f32>,
-    seed: vec2<u32>,
-    base: vec2<u32>,
-    count: u32,
-    // finite-difference step of the probe pass
-    eps: f32,
-    samples_per_thread: u32,
-    // the histogram's grid
-    rows: u32,
-    cols: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> lobes_check: LobesCheckParams;
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;

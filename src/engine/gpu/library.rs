@@ -58,8 +58,8 @@ macro_rules! shader {
 }
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
-/// passes (`shaders/passes`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 26] = [
+/// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
+static FILES: [File; 28] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -86,6 +86,8 @@ static FILES: [File; 26] = [
     shader!("passes/effect_masking.wgsl"),
     shader!("passes/weighted.wgsl"),
     shader!("passes/quadrature.wgsl"),
+    shader!("check/check_params.wgsl"),
+    shader!("check/user_passes.wgsl"),
 ];
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
@@ -156,11 +158,22 @@ pub fn compose(roots: &[&str], chosen: &[File]) -> Result<String, GpuError> {
     if let Some(hit) = cache.lock().unwrap().get(&key) {
         return Ok(hit.clone());
     }
-    let order = in_import_order(roots, chosen)?;
-    validate(&order)?;
-    let out: String = order.iter().map(|f| format!("// ---- {} ----\n{}\n", f.path, plain(&f.source))).collect();
+    validate(&in_import_order(roots, chosen)?)?;
+    let out: String = pieces(roots, chosen)?.iter().map(|(path, text)| format!("// ---- {path} ----\n{text}\n")).collect();
     cache.lock().unwrap().insert(key, out.clone());
     Ok(out)
+}
+
+/// The files of [`compose`] as (path, plain WGSL) without validating them, for a caller that
+/// joins them itself (`lobes check`, which maps naga's diagnostics back to each part).
+pub fn pieces(roots: &[&str], chosen: &[File]) -> Result<Vec<(String, String)>, GpuError> {
+    Ok(in_import_order(roots, chosen)?.iter().map(|f| (f.path.to_string(), plain(&f.source))).collect())
+}
+
+/// Validates `roots` and all they import as [`compose`] does, each file a naga_oil root of its
+/// own: the first error, at its file and line.
+pub fn validate_files(roots: &[&str], chosen: &[File]) -> Result<(), GpuError> {
+    validate(&in_import_order(roots, chosen)?)
 }
 
 /// `roots` and every module they import, each after those it imports; an import that no file
@@ -227,16 +240,17 @@ pub fn plain(source: &str) -> String {
 fn validate(order: &[&File]) -> Result<(), GpuError> {
     let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
     let mut composer = Composer::default().with_capabilities(caps);
-    let error = |f: &File, e: naga_oil::compose::ComposerError, c: &Composer| GpuError::Shader { what: f.path.to_string(), message: e.emit_to_string(c) };
+    // `what`: the file the error is in (it may be one that the file being built imports)
+    let error = |e: naga_oil::compose::ComposerError, c: &Composer| GpuError::Shader { what: e.source.path(c).clone(), message: e.emit_to_string(c) };
     for f in order {
         let added = composer.add_composable_module(ComposableModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() });
         if let Err(e) = added {
-            return Err(error(f, e, &composer));
+            return Err(error(e, &composer));
         }
     }
     for f in order {
         if let Err(e) = composer.make_naga_module(NagaModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() }) {
-            return Err(error(f, e, &composer));
+            return Err(error(e, &composer));
         }
     }
     Ok(())
