@@ -1,32 +1,17 @@
+#define_import_path lobes::check
+#import lobes::rng::{rng_uniforms, add64}
+#import lobes::check_params::lobes_check
+#import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval}
+
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
-// functions through three wrappers that the composing host generates (src/check/compose.rs):
+// functions through three wrappers of `lobes::user`, the module that the composing host
+// generates from the user's files (src/check/gpu.rs):
 //   fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32>   // (d, pdf the sampler reports)
 //   fn lobes_user_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32
 //   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
 // and `const LOBES_DOMAIN_PLANE: bool`. Every name here starts with `lobes_` so that it cannot
 // collide with the user's own.
 
-struct LobesCheckParams {
-    // the user's 16 numbers, zero-padded
-    user: array<vec4<f32>, 4>,
-    wi: vec4<f32>,
-    // plane: (x0, y0, x1, y1); sphere: unused
-    bounds: vec4<f32>,
-    seed: vec2<u32>,
-    base: vec2<u32>,
-    count: u32,
-    // finite-difference step of the probe pass
-    eps: f32,
-    samples_per_thread: u32,
-    // the histogram's grid
-    rows: u32,
-    cols: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> lobes_check: LobesCheckParams;
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
@@ -52,11 +37,26 @@ fn lobes_domain_point(a: f32, b: f32, h: f32) -> vec3<f32> {
 }
 
 // 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30),
-// the pair the f64 quadrature (src/stats/expected.rs) uses.
-const LOBES_GL5_X = array<f32, 5>(-0.906179845938664, -0.538469310105683, 0.0, 0.538469310105683, 0.906179845938664);
-const LOBES_GL5_W = array<f32, 5>(0.236926885056189, 0.478628670499367, 0.568888888888889, 0.478628670499367, 0.236926885056189);
-const LOBES_GL3_X = array<f32, 3>(-0.774596669241483, 0.0, 0.774596669241483);
-const LOBES_GL3_W = array<f32, 3>(0.555555555555556, 0.888888888888889, 0.555555555555556);
+// the pair the f64 quadrature (src/stats/expected.rs) uses: the 5-point rule at 0 .. 5, the
+// 3-point rule at 5 .. 8.
+const LOBES_GL_X = array<f32, 8>(-0.906179845938664, -0.538469310105683, 0.0, 0.538469310105683, 0.906179845938664,
+                                 -0.774596669241483, 0.0, 0.774596669241483);
+const LOBES_GL_W = array<f32, 8>(0.236926885056189, 0.478628670499367, 0.568888888888889, 0.478628670499367, 0.236926885056189,
+                                 0.555555555555556, 0.888888888888889, 0.555555555555556);
+
+// (∫ pdf, ∫ eval) over the rectangle of centre c and half-widths hw in hemisphere h by the tensor
+// rule of nodes first .. first + n of LOBES_GL_*, without the area factor ha hb.
+fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, wi: vec3<f32>) -> vec2<f32> {
+    var sum = vec2<f32>(0.0);
+    for (var j = first; j < first + n; j++) {
+        for (var k = first; k < first + n; k++) {
+            let d = lobes_domain_point(c.x + hw.x * LOBES_GL_X[j], c.y + hw.y * LOBES_GL_X[k], h);
+            let w = LOBES_GL_W[j] * LOBES_GL_W[k];
+            sum += w * vec2<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d));
+        }
+    }
+    return sum;
+}
 
 // Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign in lobes_in[count + i].x,
 // integrated with the 5 × 5 and the 3 × 3 tensor
@@ -70,33 +70,12 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     }
     let r = lobes_in[i];
     let h = lobes_in[lobes_check.count + i].x;
-    let ha = 0.5 * (r.y - r.x);
-    let ca = 0.5 * (r.y + r.x);
-    let hb = 0.5 * (r.w - r.z);
-    let cb = 0.5 * (r.w + r.z);
+    let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
+    let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
     let wi = lobes_check.wi.xyz;
-    var p5 = 0.0;
-    var e5 = 0.0;
-    for (var j = 0; j < 5; j++) {
-        for (var k = 0; k < 5; k++) {
-            let d = lobes_domain_point(ca + ha * LOBES_GL5_X[j], cb + hb * LOBES_GL5_X[k], h);
-            let w = LOBES_GL5_W[j] * LOBES_GL5_W[k];
-            p5 += w * lobes_user_pdf(wi, d);
-            e5 += w * lobes_user_eval(wi, d);
-        }
-    }
-    var p3 = 0.0;
-    var e3 = 0.0;
-    for (var j = 0; j < 3; j++) {
-        for (var k = 0; k < 3; k++) {
-            let d = lobes_domain_point(ca + ha * LOBES_GL3_X[j], cb + hb * LOBES_GL3_X[k], h);
-            let w = LOBES_GL3_W[j] * LOBES_GL3_W[k];
-            p3 += w * lobes_user_pdf(wi, d);
-            e3 += w * lobes_user_eval(wi, d);
-        }
-    }
-    let area = ha * hb;
-    lobes_out[i] = vec4<f32>(p5, p3, e5, e3) * area;
+    let r5 = lobes_rule(0u, 5u, c, hw, h, wi);
+    let r3 = lobes_rule(5u, 3u, c, hw, h, wi);
+    lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (hw.x * hw.y);
 }
 
 // The sample map around item i of lobes_in = (u, wi): per item 7 vec4s,

@@ -2,6 +2,7 @@
 #import lobes::math::math_exp
 #import lobes::reflect::reflection_half_vector
 #import lobes::beckmann::{INV_SQRT_PI, beckmann_d, beckmann_g1_over_cos, erfc_approx}
+#import lobes::microfacet_eval::{microfacet_eval, microfacet_pdf_ndf, microfacet_pdf_vndf}
 
 // Beckmann densities and BRDF for renderers that embed lobes' samplers (lobes::embed,
 // Module::Beckmann); CPU twins: src/reference/beckmann.rs and src/reference/microfacet.rs.
@@ -26,36 +27,23 @@ fn beckmann_g2(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     return 1.0 / (1.0 + beckmann_lambda(a, wi) + beckmann_lambda(a, wr));
 }
 
-// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (Walter et al. 2007, eq. 20).
+// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (microfacet_eval).
 fn beckmann_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    if (wi.z <= 0.0 || wr.z <= 0.0) {
-        return 0.0;
-    }
     let h = normalize(wi + wr);
-    return beckmann_d(a, h) * beckmann_g2(a, wi, wr) / (4.0 * wi.z * wr.z);
+    return microfacet_eval(beckmann_d(a, h), beckmann_g2(a, wi, wr), wi, wr);
 }
 
-// The density of wr under beckmann_sample_ndf: D(h) cos th_h / (4 |wr.h|).
+// The density of wr under beckmann_sample_ndf: D(h) cos th_h / (4 |wr.h|) (microfacet_pdf_ndf).
 fn beckmann_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let h = reflection_half_vector(wi, wr);
-    if (h.z <= 0.0) {
-        return 0.0;
-    }
-    return beckmann_d(a, h) * h.z / (4.0 * abs(dot(wr, h)));
+    return microfacet_pdf_ndf(beckmann_d(a, h), wr, h);
 }
 
-// The density of wr under beckmann_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|),
-// with G1 / cos th_i in its grazing-stable form (beckmann_g1_over_cos).
+// The density of wr under beckmann_sample_vndf (microfacet_pdf_vndf), with G1 / cos th_i in its
+// grazing-stable form (beckmann_g1_over_cos).
 fn beckmann_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let h = reflection_half_vector(wi, wr);
-    if (h.z <= 0.0) {
-        return 0.0;
-    }
-    let cos_ih = dot(wi, h);
-    if (cos_ih <= 0.0) {
-        return 0.0;
-    }
-    return beckmann_g1_over_cos(a, wi) * cos_ih * beckmann_d(a, h) / (4.0 * abs(dot(wr, h)));
+    return microfacet_pdf_vndf(beckmann_g1_over_cos(a, wi), beckmann_d(a, h), wi, wr, h);
 }
 
 // Smith's G1(w) = cos th (G1 / cos th), in the form that stays finite at grazing angles.

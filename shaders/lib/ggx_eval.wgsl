@@ -1,6 +1,7 @@
 #define_import_path lobes::ggx_eval
 #import lobes::reflect::reflection_half_vector
 #import lobes::ggx::{ggx_bounded_one_minus_k, ggx_d}
+#import lobes::microfacet_eval::{microfacet_eval, microfacet_pdf_ndf, microfacet_pdf_vndf}
 
 // GGX densities and BRDF for renderers that embed lobes' samplers (lobes::embed, Module::Ggx);
 // CPU twins: src/reference/ggx.rs and src/reference/microfacet.rs (Lobe::pdf_r, Lobe::eval).
@@ -24,38 +25,24 @@ fn ggx_g2(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     return gi * gr / (gi + gr - gi * gr);
 }
 
-// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (Walter et al. 2007, eq. 20).
+// f(wi, wr) = D(h) G2(wi, wr) / (4 cos th_i cos th_r), without Fresnel (microfacet_eval).
 fn ggx_eval(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
-    if (wi.z <= 0.0 || wr.z <= 0.0) {
-        return 0.0;
-    }
     let h = normalize(wi + wr);
-    return ggx_d(a, h) * ggx_g2(a, wi, wr) / (4.0 * wi.z * wr.z);
+    return microfacet_eval(ggx_d(a, h), ggx_g2(a, wi, wr), wi, wr);
 }
 
-// The density of wr under ggx_sample_ndf: D(h) cos th_h / (4 |wr.h|).
+// The density of wr under ggx_sample_ndf: D(h) cos th_h / (4 |wr.h|) (microfacet_pdf_ndf).
 fn ggx_pdf_ndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let h = reflection_half_vector(wi, wr);
-    if (h.z <= 0.0) {
-        return 0.0;
-    }
-    return ggx_d(a, h) * h.z / (4.0 * abs(dot(wr, h)));
+    return microfacet_pdf_ndf(ggx_d(a, h), wr, h);
 }
 
-// The density of wr under ggx_sample_vndf: G1(wi) max(0, wi.h) D(h) / cos th_i / (4 |wr.h|)
-// (Heitz 2014, eq. 38, through the reflection Jacobian), with G1(wi) / cos th_i = 2 / (cos th_i + t),
-// t = |(ax wi.x, ay wi.y, wi.z)|, which stays finite at grazing incidence.
+// The density of wr under ggx_sample_vndf (microfacet_pdf_vndf), with G1(wi) / cos th_i =
+// 2 / (cos th_i + t), t = |(ax wi.x, ay wi.y, wi.z)|, which stays finite at grazing incidence.
 fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {
     let h = reflection_half_vector(wi, wr);
-    if (h.z <= 0.0) {
-        return 0.0;
-    }
-    let cos_ih = dot(wi, h);
-    if (cos_ih <= 0.0) {
-        return 0.0;
-    }
     let g1_over_cos = 2.0 / (wi.z + length(vec3<f32>(a * wi.xy, wi.z)));
-    return g1_over_cos * cos_ih * ggx_d(a, h) / (4.0 * abs(dot(wr, h)));
+    return microfacet_pdf_vndf(g1_over_cos, ggx_d(a, h), wi, wr, h);
 }
 
 // The density of wr under ggx_sample_bounded (Eto & Tokuyoshi 2023, listing 2):

@@ -1,6 +1,10 @@
-// Binning and exact counting; CPU twin: src/stats/histogram.rs.
-// The composing host prepends: ROWS, COLS, BINS (= ROWS * COLS, or the item count of a discrete
-// job), CELLS (= BINS + N_REASONS), and the reason codes REASON_* (src/engine/gpu/layout.rs).
+#define_import_path lobes::histogram
+#import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF}
+#import lobes::math::math_atan2
+#import lobes::reflect::PI
+
+// Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
+// grid and REASON_* the codes of src/engine/gpu/layout.rs, from the generated `lobes::job`.
 // Cell layout: BINS bins, then one counter per invalid reason (codes 1..N_REASONS, in the order of
 // reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
 const F32_MAX: f32 = 3.40282347e38;

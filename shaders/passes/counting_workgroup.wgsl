@@ -1,6 +1,10 @@
+#define_import_path lobes::counting
+#import lobes::job::{WG_SIZE, WG_WORDS}
+#import lobes::bindings::counts
+
 // Bin counting in workgroup memory: two 16-bit counters per u32 word (WG_WORDS = ceil(BINS / 2)),
 // flushed to the chunk's global counters once per workgroup. Used when WG_WORDS words fit the
-// adapter's workgroup storage.
+// adapter's workgroup storage (else shaders/passes/counting_global.wgsl).
 
 var<workgroup> wg_bins: array<atomic<u32>, WG_WORDS>;
 

@@ -1,12 +1,19 @@
+#define_import_path lobes::effect
+#import lobes::job::{effect_anisotropic, sampler_sample, sampler_weight, sampler_eval, sampler_pdf}
+#import lobes::bindings::params
+#import lobes::reflect::LobeSample
+#import lobes::effect_fresnel::effect_fresnel
+#import lobes::effect_masking::effect_masking
+
 // The estimator of a weighted histogram (shaders/passes/weighted.wgsl calls it): the sampler drawn with
 // the case's roughness, its weight with the case's Fresnel and masking, and the independent
 // check eval cos th_r / pdf. CPU twin: src/reference/effects.rs.
 //
-// What it calls is chosen by the composing host (src/engine/gpu/effects.rs), as a generated
-// call-site file of one-line functions: sampler_sample, sampler_weight, sampler_eval,
-// sampler_pdf (the registry's call sites, src/reference/sampler.rs); effect_anisotropic();
-// effect_fresnel and effect_masking (shaders/passes/effect_fresnel.wgsl and shaders/passes/effect_masking.wgsl
-// where the case has the effect, else 1).
+// What it calls is chosen by the composing host (src/engine/gpu/effects.rs): the call sites of
+// the generated `lobes::job` (sampler_sample, sampler_weight, sampler_eval, sampler_pdf: the
+// registry's, src/reference/sampler.rs; effect_anisotropic()), and effect_fresnel and
+// effect_masking from shaders/passes/effect_fresnel.wgsl and effect_masking.wgsl where the
+// case has the effect, else from no_fresnel.wgsl and no_masking.wgsl (1).
 
 fn effect_alpha() -> vec2<f32> {
     return select(params.alpha.xx, params.alpha, effect_anisotropic());

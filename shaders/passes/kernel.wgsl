@@ -1,49 +1,43 @@
-// The sampling-and-histogram kernels. The composing host (src/engine/gpu/compose.rs) prepends the
-// constants (ROWS, COLS, BINS, TILE_BINS, CELLS, WG_WORDS, and those of src/engine/gpu/layout.rs:
-// WG_SIZE, SAMPLES_PER_THREAD, N_REASONS, ...), the modules a job needs, and
-// `fn draw(index: vec2<u32>) -> u32`, which returns the bin of sample `index` or BINS + reason - 1.
+#define_import_path lobes::kernel
+#import lobes::job::{BINS, CELLS, N_REASONS, SAMPLES_PER_THREAD, TILE_BINS, WG_SIZE}
+#import lobes::bindings::{params, counts, totals}
+#import lobes::rng::add64
+#import lobes::counting::{count_bin, flush_bins}
+#import lobes::draw::draw
+
+// The sampling-and-histogram kernels of every job. `lobes::job` is the job's generated module
+// (src/engine/gpu/compose.rs: its grid, tile and the constants of src/engine/gpu/layout.rs);
+// `draw(index)` (shaders/passes/lobe_draw.wgsl or discrete_draw.wgsl) returns the bin of sample
+// `index` or BINS + reason - 1.
 //
 // Counting is exact: per workgroup, bins are packed two to a u32 word of workgroup atomics
 // (16 bits each; a workgroup draws WG_SIZE * SAMPLES_PER_THREAD <= 65535 samples), flushed into
 // per-chunk u32 global counters (a chunk holds < 2^32 samples), which `fold` adds into 64-bit
 // totals (lo, hi pairs with carry) after every chunk.
 
-// Params in src/engine/gpu/params.rs, whose layout a test checks against this one.
-struct Params {
-    seed: vec2<u32>,
-    base: vec2<u32>,
-    count: u32,
-    n_items: u32,
-    last_positive: u32,
-    tile_first: u32,
-    alpha: vec2<f32>,
-    _pad1: vec2<f32>,
-    wi: vec4<f32>,
-}
-
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read_write> counts: array<atomic<u32>>;
-@group(0) @binding(2) var<storage, read_write> totals: array<vec2<u32>>;
-@group(0) @binding(5) var<storage, read_write> directions_out: array<vec4<f32>>;
-
-fn flat_group(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
-    return wg.x + wg.y * nwg.x;
-}
-
-@compute @workgroup_size(WG_SIZE)
-fn sample_histogram(
+// Where an invocation of a sampling pass is (sample_histogram, and weighted_histogram in
+// shaders/passes/weighted.wgsl).
+struct Invocation {
     @builtin(local_invocation_index) lid: u32,
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let first = flat_group(wg, nwg) * (WG_SIZE * SAMPLES_PER_THREAD);
+}
+
+// The index within the dispatch of the k-th sample of invocation `at`: workgroups draw
+// consecutive blocks of WG_SIZE * SAMPLES_PER_THREAD samples, interleaved over their invocations.
+fn sample_of(at: Invocation, k: u32) -> u32 {
+    return (at.wg.x + at.wg.y * at.nwg.x) * (WG_SIZE * SAMPLES_PER_THREAD) + k * WG_SIZE + at.lid;
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn sample_histogram(at: Invocation) {
     // Per-reason counts in four registers, updated without branches (a dynamically indexed
     // private array costs a scatter per SIMD lane on CPU drivers).
     var invalid = vec4<u32>(0u);
     let count = params.count;
     let base = params.base;
     for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
-        let local = first + k * WG_SIZE + lid;
+        let local = sample_of(at, k);
         if (local < count) {
             let cell = draw(add64(base, local));
             if (cell < BINS) {
@@ -57,7 +51,7 @@ fn sample_histogram(
             }
         }
     }
-    flush_bins(lid);
+    flush_bins(at.lid);
     for (var r = 0u; r < N_REASONS; r++) {
         if (invalid[r] != 0u) {
             atomicAdd(&counts[TILE_BINS + r], invalid[r]);

@@ -1,5 +1,12 @@
-// The f32 draw of a lobe job (shaders/math/f64.wgsl has the f64 one): `draw`, which the counting kernel
-// (shaders/passes/kernel.wgsl) calls, and the per-sample entry point of the stability suite.
+#define_import_path lobes::draw
+#import lobes::job::{BINS, WG_SIZE, sampler_sample}
+#import lobes::bindings::{params, directions_out}
+#import lobes::histogram::{classify, bin_of}
+#import lobes::lobe_kernel::{explicit_u, lobe_sample_at}
+
+// The f32 draw of a lobe job (shaders/math/f64.wgsl has the f64 one, discrete_draw.wgsl a
+// discrete job's): `draw`, which the counting kernel (shaders/passes/kernel.wgsl) calls, and
+// the per-sample entry point of the stability suite.
 
 fn draw(index: vec2<u32>) -> u32 {
     let s = lobe_sample_at(index);

@@ -1,8 +1,15 @@
+#define_import_path lobes::lobe_kernel
+#import lobes::job::{WG_SIZE, sampler_sample}
+#import lobes::bindings::{params, directions_out}
+#import lobes::rng::{rng_uniforms, add64}
+#import lobes::reflect::LobeSample
+#import lobes::histogram::{classify, bin_of}
+
 // The draw of a lobe job: sampler_sample(alpha, wi, u) -> LobeSample is the generated call site
-// of the case's sampler (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs), or in the
-// uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site). The entry points
-// that draw in the kernel's precision, draw and explicit_samples, are in shaders/passes/lobe_draw.wgsl
-// (f32) or shaders/math/f64.wgsl (f64).
+// of the case's sampler in `lobes::job` (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs),
+// or in the uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site). The
+// entry points that draw in the kernel's precision, draw and explicit_samples, are in
+// shaders/passes/lobe_draw.wgsl (f32) or shaders/math/f64.wgsl (f64).
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
     let u = rng_uniforms(params.seed, index);

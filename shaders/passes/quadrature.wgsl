@@ -1,10 +1,14 @@
+#define_import_path lobes::quadrature
+#import lobes::job::{ROWS, COLS, N_NODES, sampler_pdf}
+#import lobes::reflect::PI
+
 // The expected histogram on the GPU in f32, for `lobes tradeoff`: one invocation per bin of a
 // ROWS x COLS grid (rows uniform in cos th over [-1, 1], columns uniform in phi over [-pi, pi),
 // as shaders/lib/histogram.wgsl), each integrating p(wr) over its bin by the fixed N_NODES x N_NODES
 // Gauss-Legendre product rule in (cos th, phi), where the solid-angle element is d cos th d phi
-// (the same rule as src/experiments/tradeoff/quadrature.rs fixed_probabilities in f64). The host
-// prepends ROWS, COLS and N_NODES, the lobe's files and `sampler_pdf(a, wi, wr) -> f32`, the
-// call site of the sampler's density (src/reference/sampler.rs).
+// (the same rule as src/experiments/tradeoff/quadrature.rs fixed_probabilities in f64). The
+// generated `lobes::job` (src/experiments/tradeoff/quadrature.rs) holds ROWS, COLS, N_NODES and
+// `sampler_pdf(a, wi, wr) -> f32`, the call site of the sampler's density (src/reference/sampler.rs).
 
 struct QuadParams {
     alpha: vec2<f32>,

@@ -1,26 +1,25 @@
+#define_import_path lobes::weighted
+#import lobes::job::{BINS, CELLS, SAMPLES_PER_THREAD, WG_SIZE, WEIGHT_LIMIT, WEIGHT_SCALE, SQUARE_SCALE}
+#import lobes::bindings::params
+#import lobes::rng::{rng_uniforms, add64}
+#import lobes::histogram::{classify, bin_of}
+#import lobes::kernel::{Invocation, sample_of}
+#import lobes::effect::{effect_sample, effect_weight, effect_check}
+
 // The weighted histogram: per cell, the sum of the estimator weights w = f(wi, wr) cos th_r / p(wr)
 // of the samples that land there, so that sum / N estimates the directional albedo the cell
 // receives; and, per bin, the largest relative difference between the sampler's own weight and
 // eval(wi, wr) cos th_r / pdf(wr) formed independently. CPU twin: src/stats/weighted.rs.
 //
-// The composing host (src/engine/gpu/effects.rs) prepends the effect glue: `effect_sample(u)`,
-// `effect_weight(s)` (the sampler's weight with the case's Fresnel and masking) and
-// `effect_check(wr)` (eval · cos th_r / pdf from the lobe's eval and pdf functions).
+// The estimator comes from shaders/passes/effect.wgsl: `effect_sample(u)`, `effect_weight(s)`
+// (the sampler's weight with the case's Fresnel and masking) and `effect_check(wr)`
+// (eval · cos th_r / pdf from the lobe's eval and pdf functions).
 //
 // Sums are exact and order-independent: each weight is rounded to a multiple of 2^-20 and added
 // into a 64-bit fixed-point cell (lo, hi) of global atomics, the carry taken from atomicAdd's
 // return value. A weight that is not finite or not below 2^23 is not summed but counted (cell
 // WEIGHT_OVERFLOW), so no sample is dropped silently.
 
-struct Effect {
-    // (sampler, fresnel, masking, anisotropic): read by the uber-kernel only; a specialised
-    // kernel has them as override constants.
-    modes: vec4<u32>,
-    // Fresnel parameters: (f0, _, _, _) for Schlick, (eta, k, _, _) otherwise.
-    fresnel: vec4<f32>,
-}
-
-@group(0) @binding(6) var<uniform> effect: Effect;
 // 2 words (lo, hi) per cell: CELLS cells of sum w, then sum w^2 over the bins, sum w^2 over all
 // samples, and the count of weights not summed.
 @group(0) @binding(7) var<storage, read_write> weight_sums: array<atomic<u32>>;
@@ -28,7 +27,7 @@ struct Effect {
 @group(0) @binding(8) var<storage, read_write> weight_error: array<atomic<u32>>;
 
 // WEIGHT_SCALE (2^20), SQUARE_SCALE (2^16) and WEIGHT_LIMIT (2^23) come from src/stats/weighted.rs
-// through the composed header (src/engine/gpu/layout.rs).
+// through the generated `lobes::job` (src/engine/gpu/layout.rs).
 const SQUARES_BINS: u32 = CELLS;
 const SQUARES_ALL: u32 = CELLS + 1u;
 const WEIGHT_OVERFLOW: u32 = CELLS + 2u;
@@ -69,19 +68,14 @@ fn relative_error_bits(w: f32, check: f32) -> u32 {
 }
 
 @compute @workgroup_size(WG_SIZE)
-fn weighted_histogram(
-    @builtin(local_invocation_index) lid: u32,
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let first = flat_group(wg, nwg) * (WG_SIZE * SAMPLES_PER_THREAD);
+fn weighted_histogram(at: Invocation) {
     // The sums of squares and the overflow count stay in registers until the end: one atomic
     // per invocation instead of one per sample.
     var squares_bins = vec2<u32>(0u);
     var squares_all = vec2<u32>(0u);
     var overflow = 0u;
     for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
-        let local = first + k * WG_SIZE + lid;
+        let local = sample_of(at, k);
         if (local >= params.count) {
             break;
         }

@@ -1,8 +1,9 @@
 //! A user's WGSL sampler, checked against the contract and composed with lobes' passes.
 //!
-//! The user's files come first, in the order given, then a small generated file that calls the
-//! user's functions under fixed names (`lobes_user_sample`, `lobes_user_pdf`, `lobes_user_eval`),
-//! then lobes' own code. Every part's first line in the composed text is remembered, so that a
+//! The composition (`gpu::compose`) holds lobes' own files (the RNG and the passes, naga_oil
+//! modules), the user's files in the order given, and a small generated file that calls the
+//! user's functions under fixed names (`lobes_user_sample`, `lobes_user_pdf`,
+//! `lobes_user_eval`). Every part's first line in the composed text is remembered, so that a
 //! naga diagnostic anywhere maps back to `file:line:column` of the part it came from.
 
 use super::CheckError;

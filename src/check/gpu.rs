@@ -3,17 +3,16 @@
 
 use super::compose::Composed;
 use super::{CheckError, Domain, UserSampler};
-use crate::engine::gpu::Gpu;
+use crate::engine::gpu::library::{self, File};
+use crate::engine::gpu::{Gpu, GpuError};
 use crate::engine::gpu::dispatch::{Pass, Step};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-const PASSES: &str = include_str!("../../shaders/check/user_passes.wgsl");
-const RNG: &str = include_str!("../../shaders/lib/rng.wgsl");
 /// Invocations per workgroup of every pass (`@workgroup_size(64)`).
 const WG: u32 = 64;
 
-/// The passes' uniform block (`LobesCheckParams` in user_passes.wgsl).
+/// The passes' uniform block (`LobesCheckParams` in `shaders/check/check_params.wgsl`).
 #[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub(super) struct Params {
@@ -27,9 +26,9 @@ pub(super) struct Params {
     pub samples_per_thread: u32,
     pub rows: u32,
     pub cols: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
+    pub _pad_a: u32,
+    pub _pad_b: u32,
+    pub _pad_c: u32,
 }
 
 /// The compiled passes of one user sampler.
@@ -40,7 +39,7 @@ pub(super) struct Passes<'g> {
     gpu_seconds: std::cell::Cell<Option<f64>>,
 }
 
-/// The generated file that calls the user's functions under the names the passes use.
+/// The generated wrappers that call the user's functions under the names the passes use.
 fn glue(sampler: &UserSampler) -> String {
     let eval = match &sampler.eval {
         Some(name) => format!("{name}(wi, d, lobes_check.user)"),
@@ -58,17 +57,38 @@ fn glue(sampler: &UserSampler) -> String {
     )
 }
 
+/// The path of the generated module `lobes::user` in messages.
+const USER_MODULE: &str = "<lobes check glue>";
+
 /// The user's files, the glue and lobes' passes as one module, validated by naga (errors at the
 /// user's file:line:column).
+///
+/// lobes' passes (`shaders/check/user_passes.wgsl`, `lobes::check`) are a naga_oil module like
+/// the engine's: it imports the RNG, the uniform block and `lobes::user`, the user's files with
+/// the glue, generated here. naga_oil validates lobes' files, each as its own root; the user's
+/// files are naga's to judge (alone in `check_user`, then in the whole composition), since
+/// naga_oil refuses some valid WGSL (a struct member whose name ends in a digit), so an error
+/// naga_oil finds in `lobes::user` itself is left to naga.
 pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
-    let mut c = Composed::default();
-    for s in &sampler.sources {
-        c.push(&s.name, &s.text);
+    let glue = glue(sampler);
+    let user: String = sampler.sources.iter().map(|s| format!("{}\n", s.text)).collect();
+    let module = format!("#define_import_path lobes::user\n#import lobes::check_params::lobes_check\n{user}{glue}");
+    let chosen = [File::generated(USER_MODULE, module)];
+    match library::validate_files(&["lobes::check"], &chosen) {
+        Err(GpuError::Shader { what, .. }) if what == USER_MODULE => {}
+        other => other?,
     }
-    c.push("<lobes check glue>", &glue(sampler));
-    // lobes' RNG as plain WGSL (its naga_oil directives blanked, its line numbers kept)
-    c.push("shaders/lib/rng.wgsl", &crate::engine::gpu::library::plain(RNG));
-    c.push("shaders/check/user_passes.wgsl", PASSES);
+    let mut c = Composed::default();
+    for (path, text) in library::pieces(&["lobes::check"], &chosen)? {
+        if path == USER_MODULE {
+            for s in &sampler.sources {
+                c.push(&s.name, &s.text);
+            }
+            c.push(USER_MODULE, &glue);
+        } else {
+            c.push(&path, &text);
+        }
+    }
     c.validate()?;
     Ok(c)
 }
@@ -195,9 +215,9 @@ mod tests {
             ("samples_per_thread", offset_of!(Params, samples_per_thread)),
             ("rows", offset_of!(Params, rows)),
             ("cols", offset_of!(Params, cols)),
-            ("_pad0", offset_of!(Params, _pad0)),
-            ("_pad1", offset_of!(Params, _pad1)),
-            ("_pad2", offset_of!(Params, _pad2)),
+            ("_pad_a", offset_of!(Params, _pad_a)),
+            ("_pad_b", offset_of!(Params, _pad_b)),
+            ("_pad_c", offset_of!(Params, _pad_c)),
         ];
         let s = UserSampler {
             sources: vec![super::super::Source {
@@ -213,5 +233,25 @@ mod tests {
         };
         let source = compose(&s).unwrap().text;
         crate::engine::gpu::layout::check_struct(&source, "LobesCheckParams", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
+    }
+
+    fn sampler(text: &str) -> UserSampler {
+        let sources = vec![super::super::Source { name: "t.wgsl".into(), text: text.into() }];
+        UserSampler { sources, sample: "s".into(), pdf: "p".into(), eval: None, domain: Domain::Sphere }
+    }
+
+    /// The user's lines keep their file's numbers in the composition, and valid WGSL that
+    /// naga_oil would refuse as a module of its own (a struct member ending in a digit) composes.
+    #[test]
+    fn user_files_keep_their_lines_and_need_not_suit_naga_oil() {
+        let text = "struct P { v0: f32 }\n\
+                    fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { let q = P(u.x); return vec4<f32>(wi, q.v0); }\n\
+                    fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 1.0; }\n";
+        let c = compose(&sampler(text)).unwrap();
+        let line = c.text.lines().position(|l| l.starts_with("fn s(")).unwrap() as u32 + 1;
+        assert_eq!(c.locate(line, 1), "t.wgsl:2:1");
+        for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn rng_uniforms(", "fn lobes_user_sample("] {
+            assert!(c.text.contains(entry), "{entry}");
+        }
     }
 }

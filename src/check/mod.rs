@@ -279,9 +279,9 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         samples_per_thread: 1,
         rows,
         cols,
-        _pad0: 0,
-        _pad1: 0,
-        _pad2: 0,
+        _pad_a: 0,
+        _pad_b: 0,
+        _pad_c: 0,
     };
     let plane = matches!(sampler.domain, Domain::Plane { .. });
     let mut checks = Vec::new();

@@ -78,7 +78,9 @@ pub enum Module {
     /// - `reflect_about(wi, h) -> vec3<f32>`, `reflect_sample(wi, h, pdf_h) -> LobeSample`
     ///   (p(ωr) = p(h) / (4 |ωr·h|)), `from_tan_theta`, `neg_ln`, `const PI: f32`.
     Reflect,
-    /// `shaders/lib/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz).
+    /// `shaders/lib/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz);
+    /// `shaders/lib/microfacet_eval.wgsl`: the BRDF and densities of every microfacet lobe from
+    /// its D and G terms (`microfacet_eval`, `microfacet_pdf_ndf`, `microfacet_pdf_vndf`).
     Microfacet,
     /// `shaders/lib/ward.wgsl` and `shaders/lib/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
     ///
@@ -147,8 +149,8 @@ impl Module {
     /// assert!(Module::Rng.dependencies().is_empty());
     /// ```
     pub fn dependencies(self) -> Vec<Module> {
-        let imported: Vec<&str> = self.parts().iter().flat_map(|p| library::imports(p)).collect();
-        Module::ALL.into_iter().filter(|&m| m != self && m.parts().iter().any(|p| imported.contains(p))).collect()
+        let imported: Vec<String> = self.parts().iter().flat_map(|p| library::imports(p)).collect();
+        Module::ALL.into_iter().filter(|&m| m != self && m.parts().iter().any(|p| imported.iter().any(|i| i == p))).collect()
     }
 
     /// The import paths of the module's files (`#define_import_path` in `shaders/lib`).
@@ -156,7 +158,7 @@ impl Module {
         match self {
             Module::Rng => &["lobes::rng"],
             Module::Reflect => &["lobes::math", "lobes::reflect"],
-            Module::Microfacet => &["lobes::microfacet"],
+            Module::Microfacet => &["lobes::microfacet", "lobes::microfacet_eval"],
             Module::Ward => &["lobes::ward", "lobes::ward_eval"],
             Module::Ggx => &["lobes::ggx", "lobes::ggx_eval"],
             Module::Beckmann => &["lobes::beckmann", "lobes::beckmann_eval"],

@@ -1,38 +1,44 @@
 //! Composes the WGSL module of a job from the files in `shaders/`, holding only the code the
 //! job needs, and validates it with naga before any pipeline is made.
 //!
-//! A module is: the job's constants (a generated header), the library modules it needs
-//! (`shaders/lib`, `shaders/math`: the RNG, the math of its precision, reflection, its sampler's
-//! module and, for weighted modules, the density, Fresnel and masking modules), composed by
-//! naga_oil from the files' own `#import`s ([`super::library`], which says why naga_oil), then the
-//! passes (`shaders/passes`, binning) and the generated call sites that pick the sampler. The
-//! passes are still joined as text after the library: they use the header's names, which are
-//! not a module of their own yet.
+//! Every file is a naga_oil module that says what it imports (`#import lobes::histogram::bin_of`),
+//! and a job's kernel is the passes it runs (`lobes::kernel`, `lobes::lobe_kernel`, and
+//! `lobes::weighted` for weighted cases, [`super::effects`]) with everything they import,
+//! composed by [`library::compose`]: each file validated as a root of its own (errors at its
+//! file and line), then the files in import order as plain WGSL. What differs between jobs is
+//! chosen in three ways, none of them by editing text:
+//! - the generated module `lobes::job` (`JobModule`, marked as generated in the composed
+//!   text): the job's constants (grid, tile, and those of [`layout::consts_wgsl`]) and its call
+//!   sites, one-line functions under fixed names that call the job's own sampler or discrete
+//!   method (`sampler_sample`, `discrete_sample`, ...), with the `#import`s they need;
+//! - a file in place of another with the same import path: the math (`shaders/math/f32.wgsl` or
+//!   `f32_fast.wgsl`), counting in workgroup or global memory, the draw of a lobe, a discrete
+//!   job or an f64 kernel, and a weighted case's effects or their absence;
+//! - `override` constants, fixed when a pipeline is made, for what is left to choose inside a file
+//!   (Fresnel form, masking term, anisotropy: [`super::effects`]).
+//!
+//! Why call sites rather than overrides for the sampler: an override can only switch between
+//! code that is all there, so every kernel would hold every sampler's files and a switch over
+//! them. That is the uber-kernel ([`super::effects::Specialisation::Uber`]): on lavapipe its
+//! weighted pass ran 1.34× as long as the specialised ones (geometric mean over
+//! `scenes/effects.toml`, `lobes bench --effects scenes/effects.toml --samples 4194304 --runs
+//! 3`, one measurement on a shared 2-core machine). And naga_oil cannot import an `override`
+//! from another module ("no definition in scope for identifier `lobes::job::X`"); a function
+//! that returns it, as `effect_anisotropic()`, can be imported, so the overrides of a weighted
+//! case live in `lobes::job` beside the call sites that read them.
 
 use super::context::GpuError;
 use super::layout;
-use super::library::{self, Math};
+use super::library::{self, File, Math};
 use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
 use crate::reference::LobeKind;
 use crate::reference::sampler::{self, SamplerSpec};
 
-/// The WGSL of the passes and of the f64 kernels, which use the names the composed header
-/// defines (the library files, `shaders/lib` and `shaders/math`, are composed by
-/// [`super::library`]).
+/// The f64 kernels' WGSL (`shaders/math`), which the f64 draw (`f64_draw`) holds.
 pub mod sources {
-    pub const HISTOGRAM: &str = include_str!("../../../shaders/lib/histogram.wgsl");
-    pub const KERNEL: &str = include_str!("../../../shaders/passes/kernel.wgsl");
-    pub const COUNTING_WORKGROUP: &str = include_str!("../../../shaders/passes/counting_workgroup.wgsl");
-    pub const COUNTING_GLOBAL: &str = include_str!("../../../shaders/passes/counting_global.wgsl");
-    pub const LOBE_KERNEL: &str = include_str!("../../../shaders/passes/lobe_kernel.wgsl");
-    pub const WEIGHTED: &str = include_str!("../../../shaders/passes/weighted.wgsl");
-    pub const LOBE_DRAW: &str = include_str!("../../../shaders/passes/lobe_draw.wgsl");
     pub const F64: &str = include_str!("../../../shaders/math/f64.wgsl");
     pub const F64_BECKMANN: &str = include_str!("../../../shaders/math/f64_beckmann.wgsl");
-    pub const EFFECT: &str = include_str!("../../../shaders/passes/effect.wgsl");
-    pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/passes/effect_fresnel.wgsl");
-    pub const EFFECT_MASKING: &str = include_str!("../../../shaders/passes/effect_masking.wgsl");
 }
 
 pub use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
@@ -43,17 +49,83 @@ pub(crate) fn sampler_module(spec: &SamplerSpec, eval: bool) -> &'static str {
     if eval { spec.wgsl.eval_module } else { spec.wgsl.module }
 }
 
-/// The plain WGSL of the library `modules` with the math of `precision` (see [`library::wgsl`]).
-///
-/// Panics if the library does not compose: its files are built in, and the tests compose every
-/// module.
-pub(crate) fn library(modules: &[&str], precision: Precision) -> String {
-    library::wgsl(modules, math_module(precision)).unwrap_or_else(|e| panic!("{e}"))
+/// The generated module `lobes::job` of a kernel: its declarations (constants, override
+/// constants, call sites) and the modules whose names those use.
+#[derive(Debug, Clone)]
+pub(crate) struct JobModule {
+    what: String,
+    declarations: String,
+    uses: Vec<&'static str>,
+}
+
+impl JobModule {
+    pub fn new(what: impl Into<String>) -> Self {
+        Self { what: what.into(), declarations: String::new(), uses: Vec::new() }
+    }
+
+    /// Adds declarations (WGSL text).
+    pub fn push(&mut self, declarations: &str) {
+        self.declarations.push_str(declarations);
+    }
+
+    /// Lets the declarations use names of `module` (and of what it imports).
+    pub fn uses(&mut self, module: &'static str) {
+        if !self.uses.contains(&module) {
+            self.uses.push(module);
+        }
+    }
+
+    /// The module as a file: a header saying what made it, the `#import`s of the names its
+    /// declarations use (from the files of `chosen` where they replace built-in ones), the
+    /// declarations.
+    fn file(&self, chosen: &[File]) -> Result<File, GpuError> {
+        let imports = library::imports_for(&self.declarations, &self.uses, chosen)?;
+        let source = format!(
+            "#define_import_path lobes::job\n{imports}\n// Generated by lobes (src/engine/gpu/compose.rs) for {}: the job's constants and call sites.\n{}",
+            self.what, self.declarations
+        );
+        Ok(File::generated(format!("lobes::job, generated for {}", self.what), source))
+    }
+}
+
+/// What a kernel is composed of: the modules it starts from, the files chosen in place of
+/// built-in ones, and its generated `lobes::job`.
+#[derive(Debug, Clone)]
+pub(crate) struct Kernel {
+    pub roots: Vec<&'static str>,
+    pub chosen: Vec<File>,
+    pub job: JobModule,
+    /// An f64 kernel's draw ([`f64_draw`]): its WGSL, which imports from `lobes::job`.
+    f64_draw: Option<String>,
+}
+
+impl Kernel {
+    /// The composed WGSL ([`library::compose`]).
+    ///
+    /// Panics if the files do not compose: they are built in, and the tests compose every kind
+    /// of kernel.
+    pub fn source(&self) -> String {
+        self.compose().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// The composed WGSL, or the first file that does not compose (at its line).
+    fn compose(&self) -> Result<String, GpuError> {
+        let mut chosen = self.chosen.clone();
+        chosen.push(self.job.file(&self.chosen)?);
+        if let Some(draw) = &self.f64_draw {
+            // the names it uses from the counting kernel's modules, as `lobes::draw`
+            let imports = library::imports_for(draw, &["lobes::lobe_kernel"], &chosen)?;
+            let what = format!("lobes::draw, f64, generated for {}", self.job.what);
+            chosen.push(File::generated(what, format!("#define_import_path lobes::draw\n{imports}{draw}")));
+        }
+        let composed = library::compose(&self.roots, &chosen)?;
+        Ok(format!("// Composed by lobes for {}\n{composed}", self.job.what))
+    }
 }
 
 /// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
 /// [`Wgsl`](crate::reference::sampler::Wgsl): directly for one sampler, for several by a
-/// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/passes/weighted.wgsl`).
+/// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/passes/effect_uniform.wgsl`).
 pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], expr: impl Fn(&sampler::Wgsl) -> String) -> String {
     if let [only] = samplers {
         return format!("fn {name}({args}) -> {ret} {{\n    return {};\n}}\n", expr(&only.wgsl));
@@ -64,11 +136,6 @@ pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerS
         body += &format!("        {label}: {{ r = {}; }}\n", expr(&s.wgsl));
     }
     body + "    }\n    return r;\n}\n"
-}
-
-/// `sampler_sample(a, wi, u) -> LobeSample`, what `shaders/passes/lobe_kernel.wgsl` draws with.
-pub(crate) fn sampler_call_site(samplers: &[&SamplerSpec]) -> String {
-    call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample))
 }
 
 /// The composed WGSL of `job`, counting all its bins.
@@ -87,74 +154,77 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
 /// As [`compose_tile`], in the arithmetic of `precision` (`lobes tradeoff`; see
 /// [`super::precision`]).
 pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
-    compose_with(job, workgroup_words, tile_bins, precision, &[])
+    kernel(job, workgroup_words, tile_bins, precision).source()
 }
 
-/// As [`compose_precision`], with the library modules `extra` too (a weighted module's density,
-/// Fresnel and masking).
-pub(crate) fn compose_with(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, extra: &[&str]) -> String {
-    let mut modules = extra.to_vec();
-    modules.push(match job {
-        Job::Lobe { lobe, .. } => sampler_module(sampler::find(lobe.kind, lobe.method), false),
-        Job::Discrete { .. } => "lobes::discrete",
-    });
-    let mut src = header(job, workgroup_words, tile_bins, precision, &modules);
+/// The counting kernel of `job`: `lobes::kernel` and, for a lobe, `lobes::lobe_kernel`, drawing
+/// with the job's sampler or discrete method.
+pub(crate) fn kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> Kernel {
     match job {
-        Job::Lobe { lobe, .. } => {
-            let spec = sampler::find(lobe.kind, lobe.method);
-            src.push_str(&sampler_call_site(&[spec]));
-            push_all(&mut src, &[sources::LOBE_KERNEL]);
-            match precision {
-                Precision::F64 => src.push_str(&f64_draw(job)),
-                _ => src.push_str(sources::LOBE_DRAW),
-            }
-        }
+        Job::Lobe { lobe, .. } => lobe_kernel(job, workgroup_words, tile_bins, precision, &[sampler::find(lobe.kind, lobe.method)]),
         Job::Discrete { method, .. } => {
+            let mut k = counting_kernel(job, workgroup_words, tile_bins, precision);
+            k.chosen.push(library::DISCRETE_DRAW);
             let call = match method {
-                DiscreteMethod::Cdf if job.bins() > crate::reference::discrete::BLOCK => {
-                    "discrete_sample_cdf_blocks(u.xy, params.n_items, params.last_positive)"
-                }
-                DiscreteMethod::Cdf => "discrete_sample_cdf(u.x, params.n_items, params.last_positive)",
-                DiscreteMethod::Alias => "discrete_sample_alias(u.xy, params.n_items)",
+                DiscreteMethod::Cdf if job.bins() > crate::reference::discrete::BLOCK => "discrete_sample_cdf_blocks(u.xy, n, last_positive)",
+                DiscreteMethod::Cdf => "discrete_sample_cdf(u.x, n, last_positive)",
+                DiscreteMethod::Alias => "discrete_sample_alias(u.xy, n)",
             };
-            src.push_str(&format!(
-                "\nfn draw(index: vec2<u32>) -> u32 {{\n    let u = rng_uniforms(params.seed, index);\n    return {call};\n}}\n"
-            ));
+            k.job.uses("lobes::discrete");
+            k.job.push(&format!("fn discrete_sample(u: vec4<f32>, n: u32, last_positive: u32) -> u32 {{\n    return {call};\n}}\n"));
+            k
         }
     }
-    src
 }
 
-/// The constants, the RNG, the math of `precision`, binning and counting kernels every job's
-/// module starts with, and the library `modules` it draws with.
-pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, modules: &[&str]) -> String {
+/// The counting kernel of a lobe `job` drawing with `samplers`: the job's own, or all of them
+/// switched at run time (the uber-kernel).
+pub(crate) fn lobe_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, samplers: &[&SamplerSpec]) -> Kernel {
+    let mut k = counting_kernel(job, workgroup_words, tile_bins, precision);
+    k.roots.push("lobes::lobe_kernel");
+    for spec in samplers {
+        k.job.uses(spec.wgsl.module);
+    }
+    if samplers.len() > 1 {
+        k.job.uses("lobes::effect_uniform");
+    }
+    k.job.push(&call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample)));
+    if precision == Precision::F64 {
+        k.f64_draw = Some(f64_draw(job));
+    }
+    k
+}
+
+/// `shaders/passes/quadrature.wgsl` (`lobes tradeoff`'s expected histogram in f32) over a
+/// `rows` × `cols` grid with an `n_nodes`-point rule, integrating the density of `spec`.
+pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_nodes: u32) -> Kernel {
+    let mut job = JobModule::new(format!("the quadrature of {}", spec.name()));
+    job.push(&format!("const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst N_NODES: u32 = {n_nodes}u;\n"));
+    job.uses(sampler_module(spec, true));
+    job.push(&call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &[spec], |w| w.pdf.into()));
+    Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job, f64_draw: None }
+}
+
+/// `lobes::kernel` with the job's constants, the math of `precision` and the counting that
+/// `ceil(tile_bins / 2)` words of workgroup memory allow; the draw is the caller's.
+fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> Kernel {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
         Job::Discrete { .. } => (1, bins),
     };
     let wg_words = tile_bins.div_ceil(2);
-    let in_workgroup = wg_words <= workgroup_words;
-    let mut src = format!(
-        "// Composed by lobes for {}\n\
-         const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n{}\n",
-        describe(job),
-        layout::consts_wgsl()
-    );
-    let counting = if in_workgroup { sources::COUNTING_WORKGROUP } else { sources::COUNTING_GLOBAL };
-    let mut library_modules = vec!["lobes::rng", "lobes::math", "lobes::reflect"];
-    library_modules.extend(modules);
-    src.push_str(&library(&library_modules, precision));
-    push_all(&mut src, &[sources::HISTOGRAM, sources::KERNEL, counting]);
-    src
-}
-
-pub(crate) fn push_all(src: &mut String, parts: &[&str]) {
-    for part in parts {
-        src.push_str(part);
-        src.push('\n');
+    let mut chosen = math_module(precision).chosen();
+    if wg_words > workgroup_words {
+        chosen.push(library::COUNTING_GLOBAL);
     }
+    let mut job_module = JobModule::new(describe(job));
+    job_module.push(&format!(
+        "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n{}",
+        layout::consts_wgsl()
+    ));
+    Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module, f64_draw: None }
 }
 
 /// The math module of a kernel's f32 code (the f64 kernels' f32 parts, such as the erf⁻¹
@@ -166,12 +236,13 @@ fn math_module(precision: Precision) -> Math {
     }
 }
 
-/// The f64 draw of a lobe job: the job's α and ωi as f64 constants, the call site
-/// `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64 erfc and
-/// erf⁻¹).
+/// The f64 draw of a lobe job, `lobes::draw` in place of `shaders/passes/lobe_draw.wgsl` (its
+/// `#import`s are added by [`Kernel::source`]): the job's α and ωi as f64 constants, the call
+/// site `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64
+/// erfc and erf⁻¹).
 ///
 /// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
-pub(crate) fn f64_draw(job: &Job) -> String {
+fn f64_draw(job: &Job) -> String {
     let Job::Lobe { lobe, incident, .. } = job else { panic!("f64 kernels exist for lobes only") };
     let spec = sampler::find(lobe.kind, lobe.method);
     let Some(sample64) = spec.wgsl.sample64 else { panic!("no f64 sampler for {}", spec.name()) };
@@ -214,4 +285,63 @@ pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
         .validate(&module)
         .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
     Ok(module)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::discrete::Distribution;
+    use crate::reference::{Lobe, Method, SAMPLERS};
+    use crate::stats::histogram::SphereGrid;
+    use glam::DVec3;
+
+    fn lobe_job(kind: LobeKind, method: Method) -> Job {
+        let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.2 };
+        Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 } }
+    }
+
+    #[test]
+    fn every_kind_of_kernel_composes_and_validates() {
+        for (kind, method) in SAMPLERS {
+            let spec = sampler::find(kind, method);
+            for precision in Precision::ALL.into_iter().filter(|&p| p != Precision::F64 || spec.wgsl.sample64.is_some()) {
+                for words in [4096, 16] {
+                    let src = compose_precision(&lobe_job(kind, method), words, 128, precision);
+                    validate("kernel", &src).unwrap_or_else(|e| panic!("{kind:?} {method:?} {precision:?} {words}: {e}"));
+                    // a histogram larger than workgroup memory counts in global memory
+                    assert_eq!(src.contains("var<workgroup> wg_bins"), words == 4096);
+                }
+            }
+            validate("quadrature", &quadrature_kernel(spec, 8, 16, 5).source()).unwrap();
+        }
+        let dist = Distribution::new(&[1.0, 0.0, 2.0, 3.0]).unwrap();
+        for method in [DiscreteMethod::Cdf, DiscreteMethod::Alias] {
+            let src = compose(&Job::Discrete { dist: dist.clone(), method }, 4096);
+            validate("discrete", &src).unwrap_or_else(|e| panic!("{method:?}: {e}"));
+            assert!(!src.contains("fn lobe_sample_at"), "a discrete kernel holds no lobe code");
+        }
+    }
+
+    #[test]
+    fn the_generated_module_is_shown_and_imports_what_it_calls() {
+        let src = compose(&lobe_job(LobeKind::Ggx, Method::Vndf), 4096);
+        assert!(src.starts_with("// Composed by lobes for ggx vndf\n"), "{}", &src[..200]);
+        assert!(src.contains("// ---- lobes::job, generated for ggx vndf ----"));
+        // the call site of the job's sampler, after the file that defines it
+        let at = |s: &str| src.find(s).unwrap_or_else(|| panic!("no {s}"));
+        assert!(at("fn ggx_sample_vndf(") < at("return ggx_sample_vndf(a, wi, u);"));
+        assert!(!src.contains("#import") && !src.contains("beckmann"));
+    }
+
+    #[test]
+    fn a_broken_pass_is_reported_at_its_own_line() {
+        let kernel_wgsl = library::source("lobes::kernel").unwrap();
+        let line = kernel_wgsl.lines().position(|l| l.trim() == "flush_bins(at.lid);").expect("kernel.wgsl flushes its bins") + 1;
+        let broken = kernel_wgsl.replace("flush_bins(at.lid);", "flush_bins(no_such_value);");
+        let mut k = kernel(&lobe_job(LobeKind::Ward, Method::Ndf), 4096, 128, Precision::F32Accurate);
+        k.chosen.push(File::generated("shaders/passes/kernel.wgsl", broken));
+        let message = k.compose().unwrap_err().to_string();
+        assert!(message.contains(&format!("shaders/passes/kernel.wgsl:{line}:")), "{message}");
+        assert!(message.contains("no_such_value"), "{message}");
+    }
 }

@@ -2,20 +2,23 @@
 //! composed into one WGSL module that holds only the code those effects need.
 //!
 //! Two levels of specialisation:
-//! - composition: a module includes the shader files of its lobe only, `shaders/lib/fresnel.wgsl`
-//!   (with `shaders/passes/effect_fresnel.wgsl`) only with a Fresnel term, `shaders/lib/masking.wgsl`
-//!   (with `shaders/passes/effect_masking.wgsl`) only with masking; all glue is in those files and
-//!   `shaders/passes/effect.wgsl`, and what this module generates is a few one-line call sites (which
-//!   sampler's functions, which selector: `effect_call_sites`);
+//! - composition: the module is the case's counting kernel (`compose::lobe_kernel`) and
+//!   `shaders/passes/weighted.wgsl`, whose estimator (`shaders/passes/effect.wgsl`) imports
+//!   `lobes::effect_fresnel` and `lobes::effect_masking`: `shaders/passes/effect_fresnel.wgsl`
+//!   (with `shaders/lib/fresnel.wgsl`) only with a Fresnel term, else `no_fresnel.wgsl`, and
+//!   likewise for masking. What this module generates is a few one-line call sites in
+//!   `lobes::job` (which sampler's functions, which selector: `samplers_glue`,
+//!   `effect_call_sites`);
 //! - override constants: what is left to choose inside a file (which Fresnel form, which
 //!   masking term, isotropic or not) is a `switch` on a WGSL `override`, fixed when the
 //!   pipeline is made, so the driver folds the branch away.
 //!
 //! The uber-kernel ([`Specialisation::Uber`]) is the opposite, for measuring what generality
 //! costs: every lobe, sampler and effect in one module, all switched at run time from the
-//! `effect` uniform.
+//! `effect` uniform (`shaders/passes/effect_uniform.wgsl`).
 
-use super::compose::{self, call_site, sources};
+use super::compose::{self, Kernel, call_site};
+use super::library;
 use super::precision::Precision;
 use crate::engine::job::Job;
 use crate::reference::effects::Effects;
@@ -56,7 +59,7 @@ pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
 
 /// The call sites of the samplers' weight, BRDF, density and (with masking) G1 that
 /// `shaders/passes/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
-/// `sampler_sample` comes with the counting kernels, [`compose::sampler_call_site`]).
+/// `sampler_sample` comes with the counting kernels, [`compose::lobe_kernel`]).
 fn samplers_glue(samplers: &[&SamplerSpec], masking: bool) -> String {
     let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, |w| w.weight.into());
     src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, |w| w.eval.into());
@@ -78,46 +81,40 @@ struct Selectors {
 const OVERRIDES: Selectors = Selectors { anisotropic: "ANISOTROPIC", fresnel: "FRESNEL", masking: "MASKING" };
 const UNIFORM: Selectors = Selectors { anisotropic: "effect.modes.w != 0u", fresnel: "effect.modes.y", masking: "effect.modes.z" };
 
-/// The generated call sites of `shaders/passes/effect.wgsl` and its effect files: which sampler,
-/// whether α is anisotropic, and for each effect either its mode (and the effect's file follows)
-/// or the constant 1.
+/// The generated call sites of `shaders/passes/effect.wgsl` and its effect files: whether α is
+/// anisotropic, and the mode of each effect the case has.
 fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
     let mut src = format!("fn effect_anisotropic() -> bool {{\n    return {};\n}}\n", sel.anisotropic);
-    src += &if fresnel {
-        format!("fn fresnel_mode() -> u32 {{\n    return {};\n}}\n", sel.fresnel)
-    } else {
-        "fn effect_fresnel(c: f32) -> f32 {\n    return 1.0;\n}\n".into()
-    };
-    src += &if masking {
-        format!("fn masking_mode() -> u32 {{\n    return {};\n}}\n", sel.masking)
-    } else {
-        "fn effect_masking(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {\n    return 1.0;\n}\n".into()
-    };
+    if fresnel {
+        src += &format!("fn fresnel_mode() -> u32 {{\n    return {};\n}}\n", sel.fresnel);
+    }
+    if masking {
+        src += &format!("fn masking_mode() -> u32 {{\n    return {};\n}}\n", sel.masking);
+    }
     src
 }
 
-/// The effect glue of a module with (or without) Fresnel and masking, then the estimator and
-/// the weighted pass.
-fn effect_files(fresnel: bool, masking: bool) -> Vec<&'static str> {
-    let mut files = Vec::new();
-    if fresnel {
-        files.push(sources::EFFECT_FRESNEL);
+/// `kernel` with the weighted pass over `samplers`, its effects chosen by `sel`: the samplers'
+/// density and weight modules, the effect files (or those without the effect), the call sites.
+fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, fresnel: bool, masking: bool) -> String {
+    kernel.roots.push("lobes::weighted");
+    for spec in samplers {
+        kernel.job.uses(compose::sampler_module(spec, true));
     }
-    if masking {
-        files.push(sources::EFFECT_MASKING);
+    if !fresnel {
+        kernel.chosen.push(library::NO_FRESNEL);
     }
-    files.extend([sources::EFFECT, sources::WEIGHTED]);
-    files
-}
-
-/// The library modules of Fresnel and masking that [`effect_files`] call.
-fn effect_modules(fresnel: bool, masking: bool) -> Vec<&'static str> {
-    [(fresnel, "lobes::fresnel"), (masking, "lobes::masking")].into_iter().filter_map(|(on, m)| on.then_some(m)).collect()
+    if !masking {
+        kernel.chosen.push(library::NO_MASKING);
+    }
+    kernel.job.push(&samplers_glue(samplers, masking));
+    kernel.job.push(&effect_call_sites(sel, fresnel, masking));
+    kernel.source()
 }
 
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
-/// that one module serves both passes of the case), the effect files it needs, the glue and
-/// `shaders/passes/weighted.wgsl`.
+/// that one module serves both passes of the case) and `shaders/passes/weighted.wgsl` with the
+/// effect files it needs.
 pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: Specialisation) -> Composed {
     let Job::Lobe { lobe, .. } = job else { panic!("effects apply to lobe jobs only") };
     match how {
@@ -125,24 +122,18 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
             let spec = sampler::find(lobe.kind, lobe.method);
             let fresnel = effects.fresnel != Fresnel::None;
             let masking = effects.masking != Masking::None && lobe.kind != LobeKind::Ward;
-            let mut modules = vec![compose::sampler_module(spec, true)];
-            modules.extend(effect_modules(fresnel, masking));
-            let mut source = compose::compose_with(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &modules);
-            source.push('\n');
+            let mut kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &[spec]);
             let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
-            source.push_str("override ANISOTROPIC: bool = true;\n");
+            kernel.job.push("override ANISOTROPIC: bool = true;\n");
             if fresnel {
-                source.push_str("override FRESNEL: u32 = 1u;\n");
+                kernel.job.push("override FRESNEL: u32 = 1u;\n");
                 constants.push(("FRESNEL", effects.fresnel.mode() as f64));
             }
             if masking {
-                source.push_str("override MASKING: u32 = 1u;\n");
+                kernel.job.push("override MASKING: u32 = 1u;\n");
                 constants.push(("MASKING", effects.masking.mode() as f64));
             }
-            source.push_str(&samplers_glue(&[spec], masking));
-            source.push_str(&effect_call_sites(&OVERRIDES, fresnel, masking));
-            compose::push_all(&mut source, &effect_files(fresnel, masking));
-            Composed { source, constants }
+            Composed { source: weighted(kernel, &[spec], &OVERRIDES, fresnel, masking), constants }
         }
         Specialisation::Uber => Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() },
     }
@@ -160,22 +151,9 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
-    let mut modules: Vec<&str> = Vec::new();
-    for spec in &REGISTRY {
-        let m = compose::sampler_module(spec, true);
-        if !modules.contains(&m) {
-            modules.push(m);
-        }
-    }
-    modules.extend(effect_modules(true, true));
-    let mut source = compose::header(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &modules);
-    source.push_str("// The uber-kernel: every lobe, sampler and effect, switched at run time\n");
-    source.push_str(&compose::sampler_call_site(&REGISTRY.iter().collect::<Vec<_>>()));
-    compose::push_all(&mut source, &[sources::LOBE_KERNEL, sources::LOBE_DRAW]);
-    source.push_str(&samplers_glue(&REGISTRY.iter().collect::<Vec<_>>(), true));
-    source.push_str(&effect_call_sites(&UNIFORM, true, true));
-    compose::push_all(&mut source, &effect_files(true, true));
-    source
+    let all: Vec<&SamplerSpec> = REGISTRY.iter().collect();
+    let kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &all);
+    weighted(kernel, &all, &UNIFORM, true, true)
 }
 
 /// The `effect` uniform of a case (`Effect` in `shaders/passes/weighted.wgsl`).

@@ -1,24 +1,105 @@
-//! The WGSL library (`shaders/lib`, `shaders/math`) composed by naga_oil.
+//! lobes' WGSL files (`shaders/lib`, `shaders/math`, `shaders/passes`) composed by naga_oil.
 //!
-//! Each library file states its own import path (`#define_import_path lobes::ggx`) and what it
-//! uses from other files (`#import lobes::reflect::{LobeSample, reflect_sample}`); apart from those
-//! directives it is plain WGSL. [`wgsl`] has naga_oil (Bevy's shader composer) compose the wanted
-//! modules: it resolves the imports, validates every file and reports an error at the file and
+//! Each file states its own import path (`#define_import_path lobes::ggx`) and what it uses
+//! from other files (`#import lobes::reflect::{LobeSample, reflect_sample}`); apart from those
+//! directives it is plain WGSL, and opens on its own in a WGSL editor that knows naga_oil.
+//! [`compose`] has naga_oil (Bevy's shader composer) compose the wanted modules: it resolves the
+//! imports and validates every file as a root of its own, reporting an error at the file and
 //! line it is in. The WGSL handed on is then the files themselves, in import order (each after
 //! the files it imports), with the directive lines blanked: the same text, comments included, as
-//! the files, which is what the passes (`shaders/passes`, which use the names of the job's
-//! composed header), `lobes shader`, `lobes check` and renderers (`lobes::embed`) need.
+//! the files, which is what the GPU engine's kernels ([`super::compose`]), `lobes shader`,
+//! `lobes check` and renderers (`lobes::embed`) need.
+//!
+//! A composition may put files of its own in place of the built-in ones with the same import
+//! path: the alternatives below (the fast math, counting in global memory, ...) and generated
+//! files (a kernel's `lobes::job`, whose `#import`s [`imports_for`] finds from the names it uses).
 //!
 //! Why not naga_oil's composed module itself: it names every imported item with a module
 //! decoration (`ggx_dX_naga_oil_mod_X…X`), and naga's WGSL writer, which could write the module
 //! back with those cut, renames whatever ends in a digit (`add64` → `add64_`), so neither is the
-//! API the files define. No two library files declare the same name
-//! (`embed`'s `no_name_is_declared_by_two_modules`), so the plain text needs no namespaces.
+//! API the files define. No two files declare the same name (`embed`'s
+//! `no_name_is_declared_by_two_modules` for the library; naga rejects a composed kernel that
+//! does), so the plain text needs no namespaces.
 
 use super::context::GpuError;
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
+
+/// One WGSL file of a composition: its path (in messages and in the composed text's file
+/// markers) and its text, a naga_oil module that names its import path.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct File {
+    pub path: Cow<'static, str>,
+    pub source: Cow<'static, str>,
+}
+
+impl File {
+    const fn builtin(path: &'static str, source: &'static str) -> Self {
+        Self { path: Cow::Borrowed(path), source: Cow::Borrowed(source) }
+    }
+
+    /// A file made at run time (the job's `lobes::job`, a test's broken copy).
+    pub fn generated(path: impl Into<String>, source: impl Into<String>) -> Self {
+        Self { path: Cow::Owned(path.into()), source: Cow::Owned(source.into()) }
+    }
+
+    /// The path its `#define_import_path` names.
+    pub fn import_path(&self) -> Option<&str> {
+        import_path(&self.source)
+    }
+}
+
+macro_rules! shader {
+    ($path:literal) => {
+        File::builtin(concat!("shaders/", $path), include_str!(concat!("../../../shaders/", $path)))
+    };
+}
+
+/// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
+/// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
+static FILES: [File; 28] = [
+    shader!("lib/rng.wgsl"),
+    shader!("lib/reflect.wgsl"),
+    shader!("lib/microfacet.wgsl"),
+    shader!("lib/microfacet_eval.wgsl"),
+    shader!("lib/ward.wgsl"),
+    shader!("lib/ward_eval.wgsl"),
+    shader!("lib/ggx.wgsl"),
+    shader!("lib/ggx_eval.wgsl"),
+    shader!("lib/beckmann.wgsl"),
+    shader!("lib/beckmann_eval.wgsl"),
+    shader!("lib/fresnel.wgsl"),
+    shader!("lib/masking.wgsl"),
+    shader!("lib/discrete.wgsl"),
+    shader!("lib/histogram.wgsl"),
+    shader!("math/f32.wgsl"),
+    shader!("passes/bindings.wgsl"),
+    shader!("passes/kernel.wgsl"),
+    shader!("passes/counting_workgroup.wgsl"),
+    shader!("passes/lobe_kernel.wgsl"),
+    shader!("passes/lobe_draw.wgsl"),
+    shader!("passes/effect_uniform.wgsl"),
+    shader!("passes/effect.wgsl"),
+    shader!("passes/effect_fresnel.wgsl"),
+    shader!("passes/effect_masking.wgsl"),
+    shader!("passes/weighted.wgsl"),
+    shader!("passes/quadrature.wgsl"),
+    shader!("check/check_params.wgsl"),
+    shader!("check/user_passes.wgsl"),
+];
+
+/// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
+pub const MATH_F32_FAST: File = shader!("math/f32_fast.wgsl");
+/// `lobes::counting` in global memory (instead of packed workgroup counters), for histograms
+/// too large for the adapter's workgroup storage.
+pub const COUNTING_GLOBAL: File = shader!("passes/counting_global.wgsl");
+/// `lobes::draw` of a discrete job (instead of a lobe's).
+pub const DISCRETE_DRAW: File = shader!("passes/discrete_draw.wgsl");
+/// `lobes::effect_fresnel` and `lobes::effect_masking` of a weighted case without the effect: 1.
+pub const NO_FRESNEL: File = shader!("passes/no_fresnel.wgsl");
+pub const NO_MASKING: File = shader!("passes/no_masking.wgsl");
 
 /// The math module the library's `#import lobes::math` resolves to (see
 /// [`super::precision::Precision`]).
@@ -30,38 +111,28 @@ pub enum Math {
     Fast,
 }
 
-/// The library's files: (path under the repository, source). The import path of each is the one
-/// its `#define_import_path` names.
-const FILES: [(&str, &str); 12] = [
-    ("shaders/lib/rng.wgsl", include_str!("../../../shaders/lib/rng.wgsl")),
-    ("shaders/lib/reflect.wgsl", include_str!("../../../shaders/lib/reflect.wgsl")),
-    ("shaders/lib/microfacet.wgsl", include_str!("../../../shaders/lib/microfacet.wgsl")),
-    ("shaders/lib/ward.wgsl", include_str!("../../../shaders/lib/ward.wgsl")),
-    ("shaders/lib/ward_eval.wgsl", include_str!("../../../shaders/lib/ward_eval.wgsl")),
-    ("shaders/lib/ggx.wgsl", include_str!("../../../shaders/lib/ggx.wgsl")),
-    ("shaders/lib/ggx_eval.wgsl", include_str!("../../../shaders/lib/ggx_eval.wgsl")),
-    ("shaders/lib/beckmann.wgsl", include_str!("../../../shaders/lib/beckmann.wgsl")),
-    ("shaders/lib/beckmann_eval.wgsl", include_str!("../../../shaders/lib/beckmann_eval.wgsl")),
-    ("shaders/lib/fresnel.wgsl", include_str!("../../../shaders/lib/fresnel.wgsl")),
-    ("shaders/lib/masking.wgsl", include_str!("../../../shaders/lib/masking.wgsl")),
-    ("shaders/lib/discrete.wgsl", include_str!("../../../shaders/lib/discrete.wgsl")),
-];
-
-const MATH_F32: (&str, &str) = ("shaders/math/f32.wgsl", include_str!("../../../shaders/math/f32.wgsl"));
-const MATH_F32_FAST: (&str, &str) = ("shaders/math/f32_fast.wgsl", include_str!("../../../shaders/math/f32_fast.wgsl"));
-
-/// The library's files with the math module of `math`.
-fn files(math: Math) -> impl Iterator<Item = (&'static str, &'static str)> {
-    let math = match math {
-        Math::Accurate => MATH_F32,
-        Math::Fast => MATH_F32_FAST,
-    };
-    FILES.into_iter().chain([math])
+impl Math {
+    /// The files that replace the defaults for this math: none, or [`MATH_F32_FAST`].
+    pub fn chosen(self) -> Vec<File> {
+        match self {
+            Math::Accurate => Vec::new(),
+            Math::Fast => vec![MATH_F32_FAST],
+        }
+    }
 }
 
-/// The file that defines import path `module` (`"lobes::ggx"`), or `None`.
+/// The file that provides import path `module`: the first of `chosen` that names it, else the
+/// built-in one.
+fn lookup<'a>(module: &str, chosen: &'a [File]) -> Option<&'a File> {
+    chosen.iter().chain(FILES.iter()).find(|f| f.import_path() == Some(module))
+}
+
+/// The built-in file that defines import path `module` (`"lobes::ggx"`), or `None`.
 pub fn source(module: &str) -> Option<&'static str> {
-    files(Math::Accurate).find(|(_, src)| import_path(src) == Some(module)).map(|(_, src)| src)
+    FILES.iter().find(|f| f.import_path() == Some(module)).map(|f| match f.source {
+        Cow::Borrowed(s) => s,
+        Cow::Owned(_) => unreachable!("built-in files are static"),
+    })
 }
 
 /// The path a file's `#define_import_path` names.
@@ -69,102 +140,167 @@ fn import_path(source: &str) -> Option<&str> {
     source.lines().find_map(|l| l.trim().strip_prefix("#define_import_path")).map(str::trim)
 }
 
-/// A composer holding every library file, with `math` as `lobes::math` (naga_oil wants a
-/// module's imports added before it).
-fn composer(math: Math, extra: Option<(&str, &str)>) -> Result<Composer, GpuError> {
-    let mut composer = Composer::default();
-    let every: Vec<&str> = files(math).filter_map(|(_, s)| import_path(s)).collect();
-    let extra = extra.map(|(p, s)| (p.to_string(), s.to_string()));
-    let all = in_import_order(&every, math).into_iter().map(|(p, s)| (p.to_string(), s.to_string())).chain(extra);
-    for (path, src) in all {
-        let added = composer.add_composable_module(ComposableModuleDescriptor { source: &src, file_path: &path, ..Default::default() });
-        if let Err(e) = added {
-            return Err(GpuError::Shader { what: path, message: e.emit_to_string(&composer) });
-        }
-    }
-    Ok(composer)
+/// The plain WGSL of the library `modules` (import paths such as `"lobes::ggx"`) and all they
+/// import, with `math` as `lobes::math` (see [`compose`]).
+pub fn wgsl(modules: &[&str], math: Math) -> Result<String, GpuError> {
+    compose(modules, &math.chosen())
 }
 
-/// The plain WGSL of the library `modules` (import paths such as `"lobes::ggx"`) and all they
-/// import, each file once and after those it imports, with `math` as `lobes::math`. Cached: a run
-/// composes the same few sets again and again.
-pub fn wgsl(modules: &[&str], math: Math) -> Result<String, GpuError> {
-    type Cache = Mutex<HashMap<(Vec<String>, Math), String>>;
+/// The plain WGSL of the modules `roots` and all they import, each file once and after those it
+/// imports, the files of `chosen` taking the place of the built-in ones of their import paths.
+/// Every file is first validated by naga_oil as a root of its own (errors at its file and line).
+/// Cached: a run composes the same few sets again and again.
+pub fn compose(roots: &[&str], chosen: &[File]) -> Result<String, GpuError> {
+    type Cache = Mutex<HashMap<(Vec<String>, Vec<File>), String>>;
     static CACHE: OnceLock<Cache> = OnceLock::new();
-    let key = (modules.iter().map(|m| m.to_string()).collect::<Vec<_>>(), math);
+    let key = (roots.iter().map(|m| m.to_string()).collect::<Vec<_>>(), chosen.to_vec());
     let cache = CACHE.get_or_init(Default::default);
     if let Some(hit) = cache.lock().unwrap().get(&key) {
         return Ok(hit.clone());
     }
-    compose(modules, math, None)?;
-    let out: String = in_import_order(modules, math).into_iter().map(|(path, src)| format!("// ---- {path} ----\n{}\n", plain(src))).collect();
+    validate(&in_import_order(roots, chosen)?)?;
+    let out: String = pieces(roots, chosen)?.iter().map(|(path, text)| format!("// ---- {path} ----\n{text}\n")).collect();
     cache.lock().unwrap().insert(key, out.clone());
     Ok(out)
 }
 
-/// `modules` and every module they import, each after those it imports, as (file path, source).
-fn in_import_order(modules: &[&str], math: Math) -> Vec<(&'static str, &'static str)> {
-    fn visit(module: &str, math: Math, out: &mut Vec<(&'static str, &'static str)>) {
-        let file = files(math).find(|(_, src)| import_path(src) == Some(module));
-        let Some(file) = file else { return };
+/// The files of [`compose`] as (path, plain WGSL) without validating them, for a caller that
+/// joins them itself (`lobes check`, which maps naga's diagnostics back to each part).
+pub fn pieces(roots: &[&str], chosen: &[File]) -> Result<Vec<(String, String)>, GpuError> {
+    Ok(in_import_order(roots, chosen)?.iter().map(|f| (f.path.to_string(), plain(&f.source))).collect())
+}
+
+/// Validates `roots` and all they import as [`compose`] does, each file a naga_oil root of its
+/// own: the first error, at its file and line.
+pub fn validate_files(roots: &[&str], chosen: &[File]) -> Result<(), GpuError> {
+    validate(&in_import_order(roots, chosen)?)
+}
+
+/// `roots` and every module they import, each after those it imports; an import that no file
+/// provides is an error.
+fn in_import_order<'a>(roots: &[&str], chosen: &'a [File]) -> Result<Vec<&'a File>, GpuError> {
+    fn visit<'a>(module: &str, chosen: &'a [File], path: &mut Vec<String>, out: &mut Vec<&'a File>) -> Result<(), GpuError> {
+        let file = lookup(module, chosen).ok_or_else(|| GpuError::Shader {
+            what: path.last().cloned().unwrap_or_else(|| "composition".into()),
+            message: format!("no file defines the import path {module}"),
+        })?;
         if out.contains(&file) {
-            return;
+            return Ok(());
         }
-        for target in imports_of(file.1) {
-            visit(target, math, out);
+        if path.contains(&module.to_string()) {
+            return Err(GpuError::Shader { what: file.path.to_string(), message: format!("imports form a cycle: {} -> {module}", path.join(" -> ")) });
         }
+        path.push(module.to_string());
+        for target in imports_of(&file.source, chosen) {
+            visit(&target, chosen, path, out)?;
+        }
+        path.pop();
         out.push(file);
+        Ok(())
     }
     let mut out = Vec::new();
-    for m in modules {
-        visit(m, math, &mut out);
+    for m in roots {
+        visit(m, chosen, &mut Vec::new(), &mut out)?;
     }
-    out
+    Ok(out)
 }
 
-/// The library modules that library module `module` imports (`#import` lines of its file),
-/// each once, in the file's order.
-pub fn imports(module: &str) -> Vec<&'static str> {
-    source(module).map(imports_of).unwrap_or_default()
+/// The built-in modules that module `module` imports (`#import` lines of its file), each once,
+/// in the file's order.
+pub fn imports(module: &str) -> Vec<String> {
+    source(module).map(|s| imports_of(s, &[])).unwrap_or_default()
 }
 
-fn imports_of(source: &str) -> Vec<&'static str> {
+/// The modules a file's `#import` lines name, each once, in the file's order (`#import
+/// lobes::ggx::ggx_d` names an item of `lobes::ggx`).
+fn imports_of(source: &str, chosen: &[File]) -> Vec<String> {
     let (_, imports, _) = naga_oil::compose::get_preprocessor_data(source);
-    let mut out: Vec<&'static str> = Vec::new();
+    let known: Vec<&str> = chosen.iter().chain(FILES.iter()).filter_map(File::import_path).collect();
+    let mut out: Vec<String> = Vec::new();
     for import in imports {
-        // `#import lobes::ggx::ggx_d` names an item of `lobes::ggx`
-        let target = files(Math::Accurate)
-            .filter_map(|(_, s)| import_path(s))
-            .find(|p| import.import == *p || import.import.starts_with(&format!("{p}::")));
-        if let Some(target) = target
-            && !out.contains(&target)
-        {
+        let target = known.iter().filter(|p| import.import == **p || import.import.starts_with(&format!("{p}::"))).max_by_key(|p| p.len());
+        // an import no file provides is kept as written, for the error that names it
+        let target = target.map_or_else(|| import.import.clone(), |p| p.to_string());
+        if !out.contains(&target) {
             out.push(target);
         }
     }
     out
 }
 
-/// A library file as plain WGSL: its `#define_import_path` and `#import` lines blanked (so that
-/// line numbers stay those of the file).
+/// A file as plain WGSL: its `#define_import_path` and `#import` lines blanked (so that line
+/// numbers stay those of the file).
 pub fn plain(source: &str) -> String {
     source.lines().map(|l| if l.trim_start().starts_with('#') { "" } else { l }).collect::<Vec<_>>().join("\n")
 }
 
-/// Composes each of `modules` and the modules they import with naga_oil, each file as the root
-/// of a module of its own (a root builds only the imported items it uses): the check that every
-/// import resolves and every file is valid WGSL, errors at the file's line. `extra`: one more
-/// file, as if it were in the library.
-fn compose(modules: &[&str], math: Math, extra: Option<(&str, &str)>) -> Result<(), GpuError> {
-    let mut composer = composer(math, extra)?;
-    let mut order = in_import_order(modules, math);
-    order.extend(extra.filter(|(_, src)| import_path(src).is_some_and(|p| modules.contains(&p))));
-    for (path, src) in order {
-        composer
-            .make_naga_module(NagaModuleDescriptor { source: src, file_path: path, ..Default::default() })
-            .map_err(|e| GpuError::Shader { what: path.into(), message: e.emit_to_string(&composer) })?;
+/// Composes each file of `order` (each after the files it imports) with naga_oil as the root of
+/// a module of its own (a root builds only the imported items it uses): the check that every
+/// import resolves and every file is valid WGSL, errors at the file's line.
+fn validate(order: &[&File]) -> Result<(), GpuError> {
+    let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
+    let mut composer = Composer::default().with_capabilities(caps);
+    // `what`: the file the error is in (it may be one that the file being built imports)
+    let error = |e: naga_oil::compose::ComposerError, c: &Composer| GpuError::Shader { what: e.source.path(c).clone(), message: e.emit_to_string(c) };
+    for f in order {
+        let added = composer.add_composable_module(ComposableModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() });
+        if let Err(e) = added {
+            return Err(error(e, &composer));
+        }
+    }
+    for f in order {
+        if let Err(e) = composer.make_naga_module(NagaModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() }) {
+            return Err(error(e, &composer));
+        }
     }
     Ok(())
+}
+
+/// The names a file declares at module scope (`fn`, `const`, `override`, `struct`, `alias`,
+/// `var`): the lines that start, after their attributes, with one of those keywords at column 0
+/// (as every file here writes its module-scope declarations).
+fn declared(source: &str) -> Vec<&str> {
+    fn ident(s: &str) -> Option<&str> {
+        let s = s.trim_start();
+        let end = s.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(s.len());
+        (end > 0).then(|| &s[..end])
+    }
+    fn skip_attributes(mut s: &str) -> &str {
+        while let Some(after) = s.strip_prefix('@') {
+            let end = after.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(after.len());
+            s = &after[end..];
+            if let Some(args) = s.strip_prefix('(') {
+                s = args.find(')').map_or("", |i| &args[i + 1..]);
+            }
+            s = s.trim_start();
+        }
+        s
+    }
+    let mut out = Vec::new();
+    for line in source.lines().filter(|l| !l.starts_with(char::is_whitespace)) {
+        let rest = skip_attributes(line);
+        for keyword in ["fn ", "const ", "override ", "struct ", "alias "] {
+            out.extend(rest.strip_prefix(keyword).and_then(ident));
+        }
+        if let Some(var) = rest.strip_prefix("var") {
+            out.extend(ident(var.find('>').map_or(var, |i| &var[i + 1..])));
+        }
+    }
+    out
+}
+
+/// The `#import` lines a generated file needs: for each module in the import closure of `from`,
+/// the names it declares that `code` uses.
+pub fn imports_for(code: &str, from: &[&str], chosen: &[File]) -> Result<String, GpuError> {
+    let used: Vec<&str> = code.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
+    let mut out = String::new();
+    for file in in_import_order(from, chosen)? {
+        let names: Vec<&str> = declared(&file.source).into_iter().filter(|n| used.contains(n)).collect();
+        if let (Some(module), false) = (file.import_path(), names.is_empty()) {
+            out += &format!("#import {module}::{{{}}}\n", names.join(", "));
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -174,12 +310,15 @@ mod tests {
     #[test]
     fn every_file_names_its_import_path_once() {
         let mut seen = Vec::new();
-        for (path, src) in files(Math::Accurate) {
-            let p = import_path(src).unwrap_or_else(|| panic!("{path} has no #define_import_path"));
+        for f in FILES.iter() {
+            let p = f.import_path().unwrap_or_else(|| panic!("{} has no #define_import_path", f.path));
             assert!(!seen.contains(&p), "{p} twice");
             seen.push(p);
         }
-        assert_eq!(import_path(MATH_F32_FAST.1), Some("lobes::math"));
+        // each alternative takes the place of a built-in file
+        for alt in [MATH_F32_FAST, COUNTING_GLOBAL, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
+            assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
+        }
     }
 
     #[test]
@@ -201,8 +340,29 @@ mod tests {
     fn a_broken_file_is_reported_at_its_own_line() {
         // line 3 of the file calls a function no module defines
         let broken = "#define_import_path lobes::broken\n#import lobes::reflect::PI\nfn f() -> f32 { return no_such_fn(PI); }\n";
-        let e = compose(&["lobes::broken"], Math::Accurate, Some(("shaders/lib/broken.wgsl", broken))).unwrap_err();
+        let e = compose(&["lobes::broken"], &[File::generated("shaders/lib/broken.wgsl", broken)]).unwrap_err();
         let message = e.to_string();
         assert!(message.contains("shaders/lib/broken.wgsl:3:"), "{message}");
+    }
+
+    #[test]
+    fn an_import_no_file_provides_or_a_cycle_is_an_error() {
+        let lost = File::generated("a.wgsl", "#define_import_path lobes::a\n#import lobes::nowhere::f\nfn g() { f(); }\n");
+        let message = compose(&["lobes::a"], &[lost]).unwrap_err().to_string();
+        assert!(message.contains("lobes::nowhere"), "{message}");
+        let a = File::generated("a.wgsl", "#define_import_path lobes::a\n#import lobes::b::g\nfn f() { g(); }\n");
+        let b = File::generated("b.wgsl", "#define_import_path lobes::b\n#import lobes::a::f\nfn g() { f(); }\n");
+        let message = compose(&["lobes::a"], &[a, b]).unwrap_err().to_string();
+        assert!(message.contains("cycle"), "{message}");
+    }
+
+    #[test]
+    fn a_generated_file_imports_the_names_it_uses() {
+        let imports = imports_for("fn f(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample { return ggx_sample_vndf(a, wi, u); }", &["lobes::ggx"], &[]).unwrap();
+        assert!(imports.contains("#import lobes::reflect::{LobeSample}"), "{imports}");
+        assert!(imports.contains("#import lobes::ggx::{ggx_sample_vndf}"), "{imports}");
+        assert_eq!(imports.lines().count(), 2, "{imports}");
+        let decl = declared("@group(0) @binding(1) var<storage, read_write> counts: array<u32>;\nconst A: u32 = 1u;\nfn main() {\n    var local = 0u;\n}\n");
+        assert_eq!(decl, ["counts", "A", "main"]);
     }
 }

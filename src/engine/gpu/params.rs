@@ -17,7 +17,7 @@ pub struct Params {
     /// First bin of the tile being counted (see [`super::GpuEngine::tiling`]; 0 when untiled).
     tile_first: u32,
     alpha: [f32; 2],
-    _pad1: [f32; 2],
+    _pad: [f32; 2],
     wi: [f32; 4],
 }
 
@@ -33,7 +33,7 @@ impl Params {
             last_positive: 0,
             tile_first: 0,
             alpha: [0.0; 2],
-            _pad1: [0.0; 2],
+            _pad: [0.0; 2],
             wi: [0.0; 4],
         };
         match job {
@@ -111,7 +111,7 @@ mod tests {
             ("last_positive", offset_of!(Params, last_positive)),
             ("tile_first", offset_of!(Params, tile_first)),
             ("alpha", offset_of!(Params, alpha)),
-            ("_pad1", offset_of!(Params, _pad1)),
+            ("_pad", offset_of!(Params, _pad)),
             ("wi", offset_of!(Params, wi)),
         ];
         let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();

@@ -4,7 +4,6 @@
 //! to set against the adaptive f64 quadrature of [`crate::stats::expected`].
 
 use crate::engine::gpu::dispatch::{Pass, Step};
-use crate::engine::gpu::precision::Precision;
 use crate::engine::gpu::{GpuEngine, GpuError, compose};
 use crate::reference::{Lobe, sampler};
 use crate::stats::expected::direction;
@@ -15,7 +14,6 @@ use rayon::prelude::*;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
-pub const QUADRATURE_WGSL: &str = include_str!("../../../shaders/passes/quadrature.wgsl");
 
 /// Each bin's probability under the density `pdf` (zero below the horizon) by the n × n
 /// Gauss–Legendre rule per bin, in f64, rows in parallel.
@@ -37,14 +35,12 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
         .collect()
 }
 
-/// The composed quadrature kernel for a lobe, grid and rule size: the lobe's files (from the
-/// sampler registry), the call site `sampler_pdf` of its density, and `shaders/passes/quadrature.wgsl`.
+/// The composed quadrature kernel for a lobe, grid and rule size: `shaders/passes/quadrature.wgsl`
+/// with a generated `lobes::job` of the grid, the rule size and the call site `sampler_pdf` of
+/// the lobe's density (from the sampler registry).
 pub fn gpu_source(lobe: &Lobe, grid: SphereGrid, n: usize) -> String {
     let spec = sampler::find(lobe.kind, lobe.method);
-    let mut src = format!("const ROWS: u32 = {}u;\nconst COLS: u32 = {}u;\nconst N_NODES: u32 = {n}u;\n", grid.rows, grid.cols);
-    src += &compose::library(&["lobes::math", "lobes::reflect", compose::sampler_module(spec, true)], Precision::F32Accurate);
-    src += &format!("fn sampler_pdf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32 {{\n    return {};\n}}\n", spec.wgsl.pdf);
-    src + QUADRATURE_WGSL
+    compose::quadrature_kernel(spec, grid.rows, grid.cols, n as u32).source()
 }
 
 /// `QuadParams` of `shaders/passes/quadrature.wgsl` (`layout_tests::quad_params_layout` checks the layouts agree).
