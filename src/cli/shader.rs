@@ -4,6 +4,7 @@
 use super::{OutputArgs, emit, emit_json, usage};
 use crate::engine::gpu::GpuEngine;
 use crate::engine::gpu::effects::{self, Composed};
+use crate::scene::Entry;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -20,30 +21,31 @@ pub struct ShaderArgs {
 
 pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     let scene = super::run::load_scene(args.scene.as_ref())?;
-    let cases: Vec<_> = match &args.case {
-        None => scene.cases.iter().collect(),
-        Some(name) => {
-            let found: Vec<_> = scene.cases.iter().filter(|c| &c.name == name).collect();
-            if found.is_empty() {
-                let names: Vec<&str> = scene.cases.iter().map(|c| c.name.as_str()).collect();
-                return Err(usage(format!("--case {name}: no such case in {}; its cases are: {}", scene.file, names.join(", "))));
-            }
-            found
-        }
-    };
+    let entries: Vec<Entry> = scene.entries().map(|(e, _)| e).filter(|e| args.case.as_ref().is_none_or(|n| e.name() == n)).collect();
+    if let (Some(name), true) = (&args.case, entries.is_empty()) {
+        let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
+        return Err(usage(format!("--case {name}: no such case in {}; its cases are: {}", scene.file, names.join(", "))));
+    }
     // The module depends on the adapter's limits (workgroup storage, storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
     let engine = GpuEngine::open().map_err(|e| eprintln!("note: {e}\nnote: composing for wgpu's default limits")).ok();
     let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
-    for case in cases {
-        let (words, tile) = match &engine {
-            Some(e) => (e.gpu.limits.max_compute_workgroup_storage_size / 4, e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins)),
-            None => (wgpu::Limits::default().max_compute_workgroup_storage_size / 4, case.job.bins() as u64),
+    for entry in entries {
+        let m = match entry {
+            Entry::Lobe(case) => {
+                let (words, tile) = match &engine {
+                    Some(e) => (e.gpu.limits.max_compute_workgroup_storage_size / 4, e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins)),
+                    None => (wgpu::Limits::default().max_compute_workgroup_storage_size / 4, case.job.bins() as u64),
+                };
+                effects::case_module(&case.job, case.effects.as_ref(), words, tile as u32)
+            }
+            // a user's sampler: its files, the glue and `lobes check`'s passes (one module for
+            // every incident angle and params, which are uniforms)
+            Entry::User(case) => Composed { source: case.sampler.composed()?, constants: Vec::new() },
         };
-        let m = effects::case_module(&case.job, case.effects.as_ref(), words, tile as u32);
         match modules.iter_mut().find(|(k, _)| *k == m) {
-            Some((_, names)) => names.push(&case.name),
-            None => modules.push((m, vec![&case.name])),
+            Some((_, names)) => names.push(entry.name()),
+            None => modules.push((m, vec![entry.name()])),
         }
     }
     if args.output.json {
