@@ -109,7 +109,7 @@ fn broken_input_is_reported_at_the_users_file() {
     assert!(e.to_string().starts_with(&format!("{}:2:12:", two.display())), "the second file's own line: {e}");
 
     let e = UserSampler::from_files(std::slice::from_ref(&first), "s", "missing", None, Domain::Sphere).unwrap_err();
-    assert!(e.to_string().contains("no function `missing`") && e.to_string().contains("-> f32`"), "{e}");
+    assert!(e.to_string().contains("function `missing`") && e.to_string().contains("-> f32`"), "{e}");
 
     let wrong = temp_wgsl("wrong.wgsl", &format!("{GOOD_SAMPLE}fn p(wi: vec3<f32>, d: vec3<f32>) -> f32 {{\n    return 1.0;\n}}\n"));
     let e = UserSampler::from_files(std::slice::from_ref(&wrong), "s", "p", None, Domain::Sphere).unwrap_err();

@@ -143,7 +143,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let cases: [(&str, &[&str]); 10] = [
         ("sampler = \"ggx.wgsl\"\n", &["bad.toml:6:", "expected a sampler table { wgsl = [\"file.wgsl\"]"]),
         ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
-        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no pdf function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_d\" }\n", &["bad.toml:6:", "ggx.wgsl:", "wrong signature"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\" }\n", &["bad.toml:6:", "no pdf"]),
         (&format!("{good}domain = \"plane\"\n"), &["bad.toml:7:", "needs bounds"]),

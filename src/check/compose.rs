@@ -166,7 +166,7 @@ pub(super) fn check_user(sources: &[Source], functions: &[(&str, Signature)]) ->
         let Some((handle, f)) = module.functions.iter().find(|(_, f)| f.name.as_deref() == Some(name)) else {
             let known: Vec<&str> = module.functions.iter().filter_map(|(_, f)| f.name.as_deref()).collect();
             return Err(CheckError::Input(format!(
-                "--{}: no function `{name}` in {files}; expected `{expected}` (functions there: {})",
+                "no {} function `{name}` in {files}; expected `{expected}` (functions there: {})",
                 sig.role,
                 if known.is_empty() { "none".to_string() } else { known.join(", ") }
             )));
