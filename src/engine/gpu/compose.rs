@@ -11,15 +11,13 @@
 
 use super::context::GpuError;
 use super::layout;
-use super::library::{self, Math};
+use super::library;
 use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
-use crate::reference::LobeKind;
 use crate::reference::sampler::{self, SamplerSpec};
 
-/// The WGSL of the passes and of the f64 kernels, which use the names the composed header
-/// defines (the library files, `shaders/lib` and `shaders/math`, are composed by
-/// [`super::library`]).
+/// The WGSL of the passes, which use the names the composed header defines (the library files,
+/// `shaders/lib` and `shaders/math`, are composed by [`super::library`]).
 pub mod sources {
     pub const HISTOGRAM: &str = include_str!("../../../shaders/lib/histogram.wgsl");
     pub const KERNEL: &str = include_str!("../../../shaders/passes/kernel.wgsl");
@@ -28,8 +26,6 @@ pub mod sources {
     pub const LOBE_KERNEL: &str = include_str!("../../../shaders/passes/lobe_kernel.wgsl");
     pub const WEIGHTED: &str = include_str!("../../../shaders/passes/weighted.wgsl");
     pub const LOBE_DRAW: &str = include_str!("../../../shaders/passes/lobe_draw.wgsl");
-    pub const F64: &str = include_str!("../../../shaders/math/f64.wgsl");
-    pub const F64_BECKMANN: &str = include_str!("../../../shaders/math/f64_beckmann.wgsl");
     pub const EFFECT: &str = include_str!("../../../shaders/passes/effect.wgsl");
     pub const EFFECT_FRESNEL: &str = include_str!("../../../shaders/passes/effect_fresnel.wgsl");
     pub const EFFECT_MASKING: &str = include_str!("../../../shaders/passes/effect_masking.wgsl");
@@ -48,7 +44,7 @@ pub(crate) fn sampler_module(spec: &SamplerSpec, eval: bool) -> &'static str {
 /// Panics if the library does not compose: its files are built in, and the tests compose every
 /// module.
 pub(crate) fn library(modules: &[&str], precision: Precision) -> String {
-    library::wgsl(modules, math_module(precision)).unwrap_or_else(|e| panic!("{e}"))
+    library::wgsl(modules, precision).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
@@ -68,7 +64,22 @@ pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerS
 
 /// `sampler_sample(a, wi, u) -> LobeSample`, what `shaders/passes/lobe_kernel.wgsl` draws with.
 pub(crate) fn sampler_call_site(samplers: &[&SamplerSpec]) -> String {
-    call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample))
+    call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample))
+}
+
+/// `lobe_alpha()` and `lobe_wi()`, a lobe job's α and ωi in the kernel's precision
+/// (`shaders/passes/lobe_kernel.wgsl`): f32 from the uniform block, f64 as constants of the
+/// job's values (the block carries f32 only, and f32(0.3) is not 0.3).
+fn lobe_parameters(job: &Job, precision: Precision) -> String {
+    let Job::Lobe { lobe, incident, .. } = job else { return String::new() };
+    let (alpha, wi) = match precision {
+        Precision::F64 => {
+            let [ax, ay, x, y, z] = [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z].map(precision::lit);
+            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"))
+        }
+        Precision::F32Accurate | Precision::F32Fast => ("params.alpha".to_string(), "params.wi.xyz".to_string()),
+    };
+    format!("fn lobe_alpha() -> vec2<Real> {{\n    return {alpha};\n}}\n\nfn lobe_wi() -> vec3<Real> {{\n    return {wi};\n}}\n")
 }
 
 /// The composed WGSL of `job`, counting all its bins.
@@ -103,11 +114,7 @@ pub(crate) fn compose_with(job: &Job, workgroup_words: u32, tile_bins: u32, prec
         Job::Lobe { lobe, .. } => {
             let spec = sampler::find(lobe.kind, lobe.method);
             src.push_str(&sampler_call_site(&[spec]));
-            push_all(&mut src, &[sources::LOBE_KERNEL]);
-            match precision {
-                Precision::F64 => src.push_str(&f64_draw(job)),
-                _ => src.push_str(sources::LOBE_DRAW),
-            }
+            push_all(&mut src, &[sources::LOBE_KERNEL, sources::LOBE_DRAW]);
         }
         Job::Discrete { method, .. } => {
             let call = match method {
@@ -126,7 +133,7 @@ pub(crate) fn compose_with(job: &Job, workgroup_words: u32, tile_bins: u32, prec
 }
 
 /// The constants, the RNG, the math of `precision`, binning and counting kernels every job's
-/// module starts with, and the library `modules` it draws with.
+/// module starts with, the library `modules` it draws with and, for a lobe job, its α and ωi.
 pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, modules: &[&str]) -> String {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
@@ -147,6 +154,7 @@ pub(crate) fn header(job: &Job, workgroup_words: u32, tile_bins: u32, precision:
     library_modules.extend(modules);
     src.push_str(&library(&library_modules, precision));
     push_all(&mut src, &[sources::HISTOGRAM, sources::KERNEL, counting]);
+    src.push_str(&lobe_parameters(job, precision));
     src
 }
 
@@ -155,44 +163,6 @@ pub(crate) fn push_all(src: &mut String, parts: &[&str]) {
         src.push_str(part);
         src.push('\n');
     }
-}
-
-/// The math module of a kernel's f32 code (the f64 kernels' f32 parts, such as the erf⁻¹
-/// guess that seeds their Newton steps, use the accurate one).
-fn math_module(precision: Precision) -> Math {
-    match precision {
-        Precision::F32Fast => Math::Fast,
-        Precision::F32Accurate | Precision::F64 => Math::Accurate,
-    }
-}
-
-/// The f64 draw of a lobe job: the job's α and ωi as f64 constants, the call site
-/// `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64 erfc and
-/// erf⁻¹).
-///
-/// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
-pub(crate) fn f64_draw(job: &Job) -> String {
-    let Job::Lobe { lobe, incident, .. } = job else { panic!("f64 kernels exist for lobes only") };
-    let spec = sampler::find(lobe.kind, lobe.method);
-    let Some(sample64) = spec.wgsl.sample64 else { panic!("no f64 sampler for {}", spec.name()) };
-    let mut s = format!(
-        "// the job's alpha and incident direction in f64\n\
-         const A64: vec2<f64> = vec2<f64>({}, {});\nconst WI64: vec3<f64> = vec3<f64>({}, {}, {});\n",
-        precision::lit(lobe.alpha_x),
-        precision::lit(lobe.alpha_y),
-        precision::lit(incident.x),
-        precision::lit(incident.y),
-        precision::lit(incident.z)
-    );
-    s += &call_site("sampler_sample64", "a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>", "LobeSample64", &[spec], |_| {
-        format!("{sample64}(a, wi, u)")
-    });
-    s += sources::F64;
-    if lobe.kind == LobeKind::Beckmann {
-        s += sources::F64_BECKMANN;
-        s += &precision::erfc_straight_line();
-    }
-    s
 }
 
 /// "ggx vndf", "discrete cdf (10 items)".
