@@ -11,9 +11,9 @@ const TWO_OVER_SQRT_PI: Real = 1.1283791670955126;
 
 // The visible-slope inversion (shaders/lib/beckmann.wgsl beckmann_visible_slope) as
 // src/reference/beckmann.rs does it: Newton inside the bisection bracket until a step is below
-// 4 ulps of x (up to 200 steps where C' -> 0 and only bisection helps), the CDF solved directly
-// (f64 keeps 2^-29 of it at u's resolution of 2^-24; the complement's 4-point quadrature is f32
-// accurate only), and the grazing limit only past tan 1e15.
+// 4 ulps of x (up to 200 steps where C' -> 0 and only bisection helps); the CDF solved directly,
+// as the reference does (the f32 kernels' complement form is exact only to its 4-point
+// quadrature, ~1e-10 in f64); the grazing limit only past tan 1e15, where it is exact to f64.
 const SLOPE_NEWTON_STEPS: i32 = 200;
 const SLOPE_TOLERANCE: Real = 8.881784197001252e-16;
 const SLOPE_GRAZING_TAN: Real = 1.0e15;
