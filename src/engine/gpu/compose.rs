@@ -185,3 +185,27 @@ pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
         .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
     Ok(module)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::sampler::REGISTRY;
+    use crate::reference::{Lobe, reflect};
+    use crate::stats::histogram::SphereGrid;
+
+    /// Every sampler's counting module composes and validates in each precision (without a
+    /// device: naga's check), and declares `Real` as that precision's type once.
+    #[test]
+    fn every_sampler_composes_in_every_precision() {
+        for spec in &REGISTRY {
+            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2 };
+            let job = Job::Lobe { lobe, incident: reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
+            for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
+                let src = compose_precision(&job, 4096, job.bins() as u32, precision);
+                assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
+                assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
+                validate(&format!("{} {}", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+            }
+        }
+    }
+}
