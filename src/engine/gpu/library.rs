@@ -25,7 +25,7 @@
 //! aliases, and naga_oil then rejects the name as one that "requires substitution"), so it cannot
 //! be imported either. For naga_oil's check alone each file is therefore read with `Real`
 //! spelled as the precision's type (`f32 ` or `f64 `, four columns like `Real`, so positions
-//! stay the file's) and the `alias` line blanked ([`for_naga_oil`]). Every file that uses `Real`
+//! stay the file's) and the `alias` line blanked ([`naga_oil_source`]). Every file that uses `Real`
 //! says `#import lobes::math::Real`: that is the dependency which brings the alias along in the
 //! plain WGSL (and to a renderer's naga_oil, `lobes::embed`), while for lobes' own naga_oil check,
 //! which sees `Real` spelled out, the import is one it does not use.
@@ -75,7 +75,7 @@ pub fn source(module: &str) -> Option<&'static str> {
     files(Precision::F32Accurate).find(|(_, src)| import_path(src) == Some(module)).map(|(_, src)| src)
 }
 
-/// The file of import path `module` as naga_oil reads it (see [`for_naga_oil`]), in f32: the
+/// The file of import path `module` as naga_oil reads it (see the module doc), in f32: the
 /// form for a renderer's naga_oil (`lobes::embed`).
 pub fn naga_oil_source(module: &str) -> Option<String> {
     source(module).map(|s| for_naga_oil(s, Precision::F32Accurate))
