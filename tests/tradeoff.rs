@@ -20,15 +20,15 @@ const GGX_VNDF: Sampler = Sampler { kind: LobeKind::Ggx, method: Method::Vndf };
 fn angle(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u32) -> compare::AngleCheck {
     let job = tradeoff::sweep_job(s, 0.3, 45.0);
     e.precision = prec;
-    let a = tradeoff::angle_error(e, &job, 1, n, prec).expect("angle check");
+    let a = tradeoff::angle_error(e, &job, 1, n).expect("angle check");
     e.precision = Precision::F32Accurate;
     a
 }
 
 /// The f64 kernels reproduce the f64 reference to far below f32 resolution (f32 kernels: ~1e-7
-/// rad), with no validity disagreement. Measured on lavapipe: ≤ 1.9e-15 rad, except Beckmann's
-/// visible normals at 5.8e-14 rad, where the kernel's own straight-line erfc (within 1.3e-12 of
-/// the exact value, `engine::gpu::precision::erfc_straight_line`) moves the visible-slope root; the
+/// rad), with no validity disagreement. Measured on lavapipe: ≤ 1.8e-15 rad, except Beckmann's
+/// visible normals at 4.5e-14 rad, where the kernel's own straight-line erfc (within 1.3e-12 of
+/// the exact value, `shaders/math/erf_f64.wgsl`) moves the visible-slope root; the
 /// reference's erfc is libm's (~1 ulp). With statrs 0.18's erfc (off by up to 1e-10) the
 /// reference itself was off, and Beckmann's visible normals differed by 3.9e-11 rad.
 #[test]

@@ -1,7 +1,8 @@
 #define_import_path lobes::beckmann_eval
 #import lobes::math::math_exp
 #import lobes::reflect::reflection_half_vector
-#import lobes::beckmann::{INV_SQRT_PI, beckmann_d, beckmann_g1_over_cos, erfc_approx}
+#import lobes::beckmann::{beckmann_d, beckmann_g1_over_cos}
+#import lobes::erf::{INV_SQRT_PI, math_erfc}
 #import lobes::microfacet_eval::{microfacet_eval, microfacet_pdf_ndf, microfacet_pdf_vndf}
 
 // Beckmann densities and BRDF for renderers that embed lobes' samplers (lobes::embed,
@@ -19,7 +20,7 @@ fn beckmann_lambda(a: vec2<f32>, w: vec3<f32>) -> f32 {
         return 0.0;
     }
     let x = c / l;
-    return -0.5 * erfc_approx(x) + math_exp(-x * x) * INV_SQRT_PI / (2.0 * x);
+    return -0.5 * math_erfc(x) + math_exp(-x * x) * INV_SQRT_PI / (2.0 * x);
 }
 
 // Height-correlated Smith G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99).

@@ -1,6 +1,6 @@
 #define_import_path lobes::histogram
 #import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF}
-#import lobes::math::math_atan2
+#import lobes::math::{Real, math_atan2, math_is_finite}
 #import lobes::reflect::PI
 
 // Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
@@ -9,21 +9,16 @@
 // reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
 const F32_MAX: f32 = 3.40282347e38;
 
-// x is neither NaN nor +-infinity (written without relying on IEEE comparisons of NaN being false).
-fn is_finite_f32(x: f32) -> bool {
-    let bits = bitcast<u32>(x);
-    return (bits & 0x7f800000u) != 0x7f800000u;
-}
-
 // 0 for a valid sample, else the reason code; the order matches reference::Invalid::check.
-fn classify(wr: vec3<f32>, pdf: f32) -> u32 {
-    if (!(is_finite_f32(wr.x) && is_finite_f32(wr.y) && is_finite_f32(wr.z))) {
+// Over Real, as the samplers (lobes::math), so that the f64 kernels bin in f64.
+fn classify(wr: vec3<Real>, pdf: Real) -> u32 {
+    if (!(math_is_finite(wr.x) && math_is_finite(wr.y) && math_is_finite(wr.z))) {
         return REASON_NON_FINITE_DIRECTION;
     }
     if (wr.z <= 0.0) {
         return REASON_BELOW_HORIZON;
     }
-    if (!is_finite_f32(pdf)) {
+    if (!math_is_finite(pdf)) {
         return REASON_NON_FINITE_PDF;
     }
     if (pdf <= 0.0) {
@@ -34,15 +29,15 @@ fn classify(wr: vec3<f32>, pdf: f32) -> u32 {
 
 // Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over
 // [-pi, pi); phi = pi wraps to column 0, cos th = 1 falls in the top row.
-fn bin_of(w: vec3<f32>) -> u32 {
+fn bin_of(w: vec3<Real>) -> u32 {
     let z = clamp(w.z, -1.0, 1.0);
-    let row = min(u32((z + 1.0) * 0.5 * f32(ROWS)), ROWS - 1u);
+    let row = min(u32((z + 1.0) * 0.5 * Real(ROWS)), ROWS - 1u);
     // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
-    var t = 0.5;
+    var t: Real = 0.5;
     if (w.x != 0.0 || w.y != 0.0) {
         t = (math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
     }
-    var col = u32(max(t, 0.0) * f32(COLS));
+    var col = u32(max(t, 0.0) * Real(COLS));
     if (col >= COLS) {
         col = 0u;
     }

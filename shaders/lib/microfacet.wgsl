@@ -1,15 +1,16 @@
 #define_import_path lobes::microfacet
+#import lobes::math::Real
 
 // Shared microfacet helpers; CPU twin: src/reference/microfacet.rs.
 
 // normalize(ax wx, ay wy, wz): w stretched to the alpha = 1 configuration (Heitz 2018, listing 1).
-fn stretch(a: vec2<f32>, w: vec3<f32>) -> vec3<f32> {
-    return normalize(vec3<f32>(a * w.xy, w.z));
+fn stretch(a: vec2<Real>, w: vec3<Real>) -> vec3<Real> {
+    return normalize(vec3<Real>(a * w.xy, w.z));
 }
 
 // The estimator weight f cos th_r / p(wr) of NDF sampling (h drawn with density D(h) cos th_h)
 // for f = D / (4 cos th_i cos th_r), before Fresnel and masking: with p(wr) = D cos th_h / (4 |wr.h|),
 // it is (wi.h) / (cos th_i cos th_h); 0 for a back-facing h (wi.h <= 0), which f excludes.
-fn microfacet_ndf_weight(wi: vec3<f32>, h: vec3<f32>) -> f32 {
+fn microfacet_ndf_weight(wi: vec3<Real>, h: vec3<Real>) -> Real {
     return max(dot(wi, h), 0.0) / (wi.z * h.z);
 }

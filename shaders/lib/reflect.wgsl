@@ -1,28 +1,29 @@
 #define_import_path lobes::reflect
+#import lobes::math::Real
 
 // The half-vector -> reflected-direction change of variables; CPU twin: src/reference/reflect.rs.
 // wr = 2 (wi.h) h - wi and p(wr) = p(h) / (4 |wr.h|) (tutorial part 2; Walter et al. 2007, eq. 14).
 
-const PI: f32 = 3.14159265358979;
+const PI: Real = 3.141592653589793;
 
 struct LobeSample {
-    h: vec3<f32>,
-    wr: vec3<f32>,
-    pdf_r: f32,
+    h: vec3<Real>,
+    wr: vec3<Real>,
+    pdf_r: Real,
 }
 
-fn reflect_about(wi: vec3<f32>, h: vec3<f32>) -> vec3<f32> {
+fn reflect_about(wi: vec3<Real>, h: vec3<Real>) -> vec3<Real> {
     return 2.0 * dot(wi, h) * h - wi;
 }
 
 // A LobeSample with its reflected density, which is 0 for light from below the surface
 // (wi.z < 0) and for reflections into it (wr.z <= 0), as in src/reference (Lobe::pdf_r).
-fn lobe_sample(wi: vec3<f32>, h: vec3<f32>, wr: vec3<f32>, pdf_r: f32) -> LobeSample {
+fn lobe_sample(wi: vec3<Real>, h: vec3<Real>, wr: vec3<Real>, pdf_r: Real) -> LobeSample {
     return LobeSample(h, wr, select(pdf_r, 0.0, wi.z < 0.0 || wr.z <= 0.0));
 }
 
 // A LobeSample from a half vector and its density p(h): p(wr) = p(h) / (4 |wr.h|).
-fn reflect_sample(wi: vec3<f32>, h: vec3<f32>, pdf_h: f32) -> LobeSample {
+fn reflect_sample(wi: vec3<Real>, h: vec3<Real>, pdf_h: Real) -> LobeSample {
     let wr = reflect_about(wi, h);
     return lobe_sample(wi, h, wr, pdf_h / (4.0 * abs(dot(wr, h))));
 }
@@ -30,20 +31,20 @@ fn reflect_sample(wi: vec3<f32>, h: vec3<f32>, pdf_h: f32) -> LobeSample {
 // The half vector of the reflection wi -> wr where both are counted (wi.z >= 0, wr.z > 0,
 // wr != -wi, h above the horizon), else vec3(0): every density of wr is 0 there, as in
 // src/reference (Lobe::pdf_r and reflect::half_vector).
-fn reflection_half_vector(wi: vec3<f32>, wr: vec3<f32>) -> vec3<f32> {
+fn reflection_half_vector(wi: vec3<Real>, wr: vec3<Real>) -> vec3<Real> {
     let s = wi + wr;
     if (wr.z <= 0.0 || wi.z < 0.0 || dot(s, s) == 0.0) {
-        return vec3<f32>(0.0);
+        return vec3<Real>(0.0);
     }
     let h = normalize(s);
-    return select(vec3<f32>(0.0), h, h.z > 0.0);
+    return select(vec3<Real>(0.0), h, h.z > 0.0);
 }
 
 // Unit vector with polar tangent t and unit azimuth (c, s): cos = 1/sqrt(1+t^2), sin = t cos.
 // Past t = 1e18 (t^2 would overflow f32) cos = 1/t and sin = 1, the same limit without inf.
-fn from_tan_theta(t: f32, c: f32, s: f32) -> vec3<f32> {
-    var ct: f32;
-    var st: f32;
+fn from_tan_theta(t: Real, c: Real, s: Real) -> vec3<Real> {
+    var ct: Real;
+    var st: Real;
     if (t > 1.0e18) {
         ct = 1.0 / t;
         st = 1.0;
@@ -51,5 +52,5 @@ fn from_tan_theta(t: f32, c: f32, s: f32) -> vec3<f32> {
         ct = inverseSqrt(1.0 + t * t);
         st = t * ct;
     }
-    return vec3<f32>(st * c, st * s, ct);
+    return vec3<Real>(st * c, st * s, ct);
 }

@@ -1,36 +1,48 @@
 #define_import_path lobes::math
 
-// The f32 math of the samplers and the binning: the transcendental functions they call, as
-// math_log, math_exp, math_sin, math_cos, math_atan2 and neg_ln. This module is the f32 one (the
-// WGSL builtins, plus an accurate -ln u); shaders/math/f32_fast.wgsl defines the same names with cheap
-// approximations for `lobes tradeoff`'s f32-fast kernels, and the composing host
-// (src/engine/gpu/compose.rs) includes one of the two. The f64 kernels (shaders/math/f64.wgsl) have
-// their own f64 math: SPIR-V defines these functions for 16- and 32-bit floats only.
+// The arithmetic of the samplers and the binning, which are written once over `Real`: this
+// module makes `Real` f32 and defines the functions they call (math_log, math_exp, math_sin,
+// math_cos, math_atan2, neg_ln, math_is_finite) and the limits of the precision, as the WGSL
+// builtins plus an accurate -ln u. shaders/math/f32_fast.wgsl defines the same names with cheap
+// approximations (`lobes tradeoff`'s f32-fast kernels), shaders/math/f64.wgsl over f64; the
+// composing host (src/engine/gpu/library.rs) includes one of the three as lobes::math.
 
-fn math_log(x: f32) -> f32 {
+alias Real = f32;
+
+// e^-x is below the smallest normal f32 (2^-126) past x = 87: densities return 0 there
+// rather than a denormal over a denormal.
+const UNDERFLOW_EXPONENT: Real = 87.0;
+
+fn math_log(x: Real) -> Real {
     return log(x);
 }
 
-fn math_exp(x: f32) -> f32 {
+fn math_exp(x: Real) -> Real {
     return exp(x);
 }
 
-fn math_sin(x: f32) -> f32 {
+fn math_sin(x: Real) -> Real {
     return sin(x);
 }
 
-fn math_cos(x: f32) -> f32 {
+fn math_cos(x: Real) -> Real {
     return cos(x);
 }
 
-fn math_atan2(y: f32, x: f32) -> f32 {
+fn math_atan2(y: Real, x: Real) -> Real {
     return atan2(y, x);
+}
+
+// x is neither NaN nor +-infinity, from the bit pattern (without relying on IEEE comparisons of
+// NaN being false, which drivers may optimise away).
+fn math_is_finite(x: Real) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
 }
 
 // -ln u. For u > 1/2, ln u = 2 atanh(s) with s = (u - 1)/(u + 1), |s| <= 1/3, summed as its
 // series 2 s (1 + s^2/3 + s^4/5 + ...) to 9 terms: full f32 relative precision near u = 1,
 // where the builtin log only promises an absolute error of 2^-21. u = 0 gives 3e38 ("infinity").
-fn neg_ln(u: f32) -> f32 {
+fn neg_ln(u: Real) -> Real {
     if (u <= 0.0) {
         return 3.0e38;
     }

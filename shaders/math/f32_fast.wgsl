@@ -5,6 +5,18 @@
 // (src/engine/gpu/compose.rs) includes in place of shaders/math/f32.wgsl, with the same names
 // (math_log, math_exp, math_sin, math_cos, math_atan2, neg_ln) defined at the end.
 // Errors quoted are the sources' (and checked by tests/tradeoff.rs through the sampled angles).
+// Only the transcendental functions differ from shaders/math/f32.wgsl: `Real` is f32 and the
+// limits and the finiteness test are f32's.
+
+alias Real = f32;
+
+// e^-x is below the smallest normal f32 past x = 87 (shaders/math/f32.wgsl).
+const UNDERFLOW_EXPONENT: Real = 87.0;
+
+// x is neither NaN nor +-infinity, from the bit pattern (shaders/math/f32.wgsl).
+fn math_is_finite(x: Real) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
 
 // log2 by the float's bit pattern plus a rational correction of the mantissa: P. Mineiro,
 // "fastapprox" (2011), fastlog2; absolute error about 1e-4.
@@ -64,27 +76,27 @@ fn fast_atan2(y: f32, x: f32) -> f32 {
 }
 
 // The names the samplers call (shaders/math/f32.wgsl).
-fn math_log(x: f32) -> f32 {
+fn math_log(x: Real) -> Real {
     return fast_log(x);
 }
 
-fn math_exp(x: f32) -> f32 {
+fn math_exp(x: Real) -> Real {
     return fast_exp(x);
 }
 
-fn math_sin(x: f32) -> f32 {
+fn math_sin(x: Real) -> Real {
     return fast_sin(x);
 }
 
-fn math_cos(x: f32) -> f32 {
+fn math_cos(x: Real) -> Real {
     return fast_cos(x);
 }
 
-fn math_atan2(y: f32, x: f32) -> f32 {
+fn math_atan2(y: Real, x: Real) -> Real {
     return fast_atan2(y, x);
 }
 
 // -ln u without the accurate series of shaders/math/f32.wgsl (u = 0 gives about 89, not 3e38).
-fn neg_ln(u: f32) -> f32 {
+fn neg_ln(u: Real) -> Real {
     return -fast_log(u);
 }

@@ -1,12 +1,14 @@
 #define_import_path lobes::draw
-#import lobes::job::{BINS, WG_SIZE, sampler_sample}
+#import lobes::math::Real
+#import lobes::job::{BINS, WG_SIZE}
 #import lobes::bindings::{params, directions_out}
 #import lobes::histogram::{classify, bin_of}
-#import lobes::lobe_kernel::{explicit_u, lobe_sample_at}
+#import lobes::lobe_kernel::{explicit_u, lobe_sample_at, lobe_sample_u}
 
-// The f32 draw of a lobe job (shaders/math/f64.wgsl has the f64 one, discrete_draw.wgsl a
-// discrete job's): `draw`, which the counting kernel (shaders/passes/kernel.wgsl) calls, and
-// the per-sample entry point of the stability suite.
+// The draw of a lobe job in the kernel's precision (Real, lobes::math: f32, or f64 for
+// `lobes tradeoff`; discrete_draw.wgsl has a discrete job's): `draw`, which the counting kernel
+// (shaders/passes/kernel.wgsl) calls, and the per-sample entry point of the stability suite and of
+// the f64 angle check.
 
 fn draw(index: vec2<u32>) -> u32 {
     let s = lobe_sample_at(index);
@@ -18,14 +20,17 @@ fn draw(index: vec2<u32>) -> u32 {
 }
 
 // Sample i uses explicit_u[i] (shaders/passes/lobe_kernel.wgsl; any u a caller can pass, 0 and 1
-// included) and writes (wr, reason code), then (h, pdf_r).
+// included) and writes (wr, reason code), (h, pdf_r) and (wr - f32(wr), 0): the part of wr
+// that f32 rounds off, 0 in the f32 kernels, with which the f64 kernels' wr comes back to ~2^-48.
 @compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {
         return;
     }
-    let s = sampler_sample(params.alpha, params.wi.xyz, explicit_u[i]);
-    directions_out[2u * i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
-    directions_out[2u * i + 1u] = vec4<f32>(s.h, s.pdf_r);
+    let s = lobe_sample_u(explicit_u[i]);
+    let wr = vec3<f32>(s.wr);
+    directions_out[3u * i] = vec4<f32>(wr, f32(classify(s.wr, s.pdf_r)));
+    directions_out[3u * i + 1u] = vec4<f32>(vec3<f32>(s.h), f32(s.pdf_r));
+    directions_out[3u * i + 2u] = vec4<f32>(vec3<f32>(s.wr - vec3<Real>(wr)), 0.0);
 }

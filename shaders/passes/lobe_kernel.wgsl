@@ -1,5 +1,6 @@
 #define_import_path lobes::lobe_kernel
-#import lobes::job::{WG_SIZE, sampler_sample}
+#import lobes::math::Real
+#import lobes::job::{WG_SIZE, sampler_sample, lobe_alpha, lobe_wi}
 #import lobes::bindings::{params, directions_out}
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::reflect::LobeSample
@@ -7,13 +8,19 @@
 
 // The draw of a lobe job: sampler_sample(alpha, wi, u) -> LobeSample is the generated call site
 // of the case's sampler in `lobes::job` (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs),
-// or in the uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site). The
-// entry points that draw in the kernel's precision, draw and explicit_samples, are in
-// shaders/passes/lobe_draw.wgsl (f32) or shaders/math/f64.wgsl (f64).
+// or in the uber-kernel a switch over all of them (src/engine/gpu/compose.rs call_site);
+// lobe_alpha() and lobe_wi(), also generated in `lobes::job`, are the job's alpha and incident
+// direction in the kernel's precision (Real: the f32 kernels read them from params, the f64
+// kernels have them as f64 constants). The entry points draw and explicit_samples are in
+// shaders/passes/lobe_draw.wgsl.
+
+// The sample of the f32 uniforms u (the RNG's, exact in either precision).
+fn lobe_sample_u(u: vec2<f32>) -> LobeSample {
+    return sampler_sample(lobe_alpha(), lobe_wi(), vec2<Real>(u));
+}
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
-    let u = rng_uniforms(params.seed, index);
-    return sampler_sample(params.alpha, params.wi.xyz, u.xy);
+    return lobe_sample_u(rng_uniforms(params.seed, index).xy);
 }
 
 // Writes (wr, reason code) of samples base .. base + count, for the per-sample check against f64.
@@ -24,7 +31,7 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = lobe_sample_at(add64(params.base, i));
-    directions_out[i] = vec4<f32>(s.wr, f32(classify(s.wr, s.pdf_r)));
+    directions_out[i] = vec4<f32>(vec3<f32>(s.wr), f32(classify(s.wr, s.pdf_r)));
 }
 
 // Explicit uniforms for the stability suite (explicit_samples, shaders/passes/lobe_draw.wgsl), or
@@ -40,5 +47,5 @@ fn bin_explicit(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let w = vec3<f32>(explicit_u[2u * i], explicit_u[2u * i + 1u].x);
-    directions_out[i] = vec4<f32>(f32(bin_of(w)), 0.0, 0.0, 0.0);
+    directions_out[i] = vec4<f32>(f32(bin_of(vec3<Real>(w))), 0.0, 0.0, 0.0);
 }

@@ -48,8 +48,7 @@ pub struct TradeoffArgs {
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Samples per sampler and precision compared one by one with the f64 reference (1 ..= 2^22:
-    /// one dispatch, its output within a 128 MiB storage binding).
+    /// Samples per sampler and precision compared one by one with the f64 reference (1 ..= 2^22).
     #[arg(long, default_value_t = 1 << 18, value_parser = clap::value_parser!(u32).range(1..=1 << 22))]
     pub angle_samples: u32,
     /// Longest predicted time of one sweep point, in seconds (the previous point's time per

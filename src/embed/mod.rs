@@ -54,7 +54,8 @@ mod discrete;
 pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable};
 
 use crate::engine::gpu::GpuError;
-use crate::engine::gpu::library::{self, Math};
+use crate::engine::gpu::library;
+use crate::engine::gpu::precision::Precision;
 
 
 /// A WGSL module of lobes, as embedded by [`wgsl`]. The listed functions are the ones meant for
@@ -161,15 +162,17 @@ impl Module {
             Module::Microfacet => &["lobes::microfacet", "lobes::microfacet_eval"],
             Module::Ward => &["lobes::ward", "lobes::ward_eval"],
             Module::Ggx => &["lobes::ggx", "lobes::ggx_eval"],
-            Module::Beckmann => &["lobes::beckmann", "lobes::beckmann_eval"],
+            Module::Beckmann => &["lobes::erf", "lobes::beckmann", "lobes::beckmann_eval"],
             Module::Discrete => &["lobes::discrete"],
         }
     }
 
-    /// The module's files as they are in `shaders/` (without its dependencies; [`wgsl`] adds
+    /// The module's files as naga_oil reads them (without its dependencies; [`wgsl`] adds
     /// those): naga_oil modules, WGSL with `#define_import_path` and `#import` directives, for a
-    /// renderer that composes its shaders with naga_oil. [`Module::Discrete`] comes with its
-    /// bindings at group 0, bindings 3 and 4.
+    /// renderer that composes its shaders with naga_oil. They are the files of `shaders/` with
+    /// the type `Real` spelled `f32` (naga_oil cannot hold the files' `alias Real = f32;`: see
+    /// `engine::gpu::library`). [`Module::Discrete`] comes with its bindings at group 0, bindings
+    /// 3 and 4.
     ///
     /// ```
     /// use lobes::embed::Module;
@@ -178,7 +181,7 @@ impl Module {
     /// assert!(Module::Ggx.source().contains("#define_import_path lobes::ggx_eval"));
     /// ```
     pub fn source(self) -> String {
-        self.parts().iter().map(|p| library::source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
+        self.parts().iter().map(|p| library::naga_oil_source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
     }
 
     /// Every name the module declares at module scope (functions, constants, structs, globals),
@@ -275,7 +278,7 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
     // the library composes every module but Discrete, whose bindings are the caller's
     let paths: Vec<&str> = resolved.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.parts().iter().copied()).collect();
     if !paths.is_empty() {
-        out.push_str(&library::wgsl(&paths, Math::Accurate).unwrap_or_else(|e| panic!("{e}")));
+        out.push_str(&library::wgsl(&paths, Precision::F32Accurate).unwrap_or_else(|e| panic!("{e}")));
     }
     if resolved.contains(&Module::Discrete) {
         out.push_str("// ---- shaders/lib/discrete.wgsl ----\n");
@@ -337,6 +340,26 @@ mod tests {
             validate(&wgsl(&[m])).unwrap_or_else(|e| panic!("{m:?}: {e}"));
         }
         validate(&wgsl(&Module::ALL)).unwrap();
+    }
+
+    /// A renderer's naga_oil composes the modules' files and a shader that imports from them.
+    #[test]
+    fn sources_compose_with_naga_oil() {
+        use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
+        let mut composer = Composer::default();
+        for p in Module::ALL.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.parts()) {
+            let source = library::naga_oil_source(p).unwrap();
+            if let Err(e) = composer.add_composable_module(ComposableModuleDescriptor { source: &source, file_path: p, ..Default::default() }) {
+                panic!("{p}: {}", e.emit_to_string(&composer));
+            }
+        }
+        let shader = "#import lobes::beckmann::beckmann_sample_vndf\n#import lobes::ggx_eval::ggx_eval\n\
+                      @compute @workgroup_size(1) fn main() {\n\
+                      let s = beckmann_sample_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), vec2(0.5));\n\
+                      let f = ggx_eval(vec2(0.3), vec3(0.0, 0.0, 1.0), s.wr);\n}\n";
+        if let Err(e) = composer.make_naga_module(NagaModuleDescriptor { source: shader, file_path: "renderer.wgsl", ..Default::default() }) {
+            panic!("{}", e.emit_to_string(&composer));
+        }
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! stress suite, the WGSL call sites of the counting and weighted kernels).
 //!
 //! An entry names the sampler, the library modules that define its WGSL functions, the call
-//! sites of those functions, and its f64 twins: the Rust reference ([`Reference`], `None` for a
-//! sampler known only as WGSL) and the f64 WGSL sampler of `lobes tradeoff` (`sample64`).
+//! sites of those functions, its f64 Rust twin ([`Reference`], `None` for a sampler known only
+//! as WGSL) and whether its WGSL also composes in f64 (`lobes tradeoff`).
 //! Adding a sampler is one entry here plus its files.
 
 use super::microfacet::{Microfacet, pdf_ndf, pdf_vndf};
@@ -43,9 +43,10 @@ pub struct Wgsl {
     pub weight: &'static str,
     /// Smith's G1(w) in terms of `a`, `w` (microfacet lobes; `None`: no masking).
     pub g1: Option<&'static str>,
-    /// The f64 sampler of `shaders/math/f64.wgsl` (`lobes tradeoff`), `fn (a: vec2<f64>, wi:
-    /// vec3<f64>, u: vec2<f32>) -> LobeSample64`; `None`: no f64 kernel.
-    pub sample64: Option<&'static str>,
+    /// Whether `module` is written over the type `Real` (`shaders/math`), so that the same
+    /// sampler composes in f64 for `lobes tradeoff`'s f64 kernels; a sampler written in f32
+    /// has no f64 kernel.
+    pub f64: bool,
 }
 
 /// The f64 reference of a sampler (`src/reference`).
@@ -77,7 +78,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: "ward_eval(a, wi, wr)",
             weight: "ward_weight(wi, s.h, s.wr)",
             g1: None,
-            sample64: Some("ward_sample64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, _, u| ward::sample_h(l.alpha_x, l.alpha_y, u),
@@ -96,7 +97,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: BECKMANN_EVAL,
             weight: MICROFACET_NDF_WEIGHT,
             g1: Some("beckmann_g1(a, w)"),
-            sample64: Some("beckmann_sample_ndf64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.beckmann().sample_ndf(u),
@@ -115,7 +116,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: BECKMANN_EVAL,
             weight: "beckmann_vndf_weight(a, wi)",
             g1: Some("beckmann_g1(a, w)"),
-            sample64: Some("beckmann_sample_vndf64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.beckmann().sample_vndf(wi, u),
@@ -134,7 +135,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: GGX_EVAL,
             weight: MICROFACET_NDF_WEIGHT,
             g1: Some("ggx_g1(a, w)"),
-            sample64: Some("ggx_sample_ndf64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.ggx().sample_ndf(u),
@@ -153,7 +154,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: GGX_EVAL,
             weight: "ggx_vndf_weight(a, wi)",
             g1: Some("ggx_g1(a, w)"),
-            sample64: Some("ggx_sample_vndf64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_vndf(wi, u),
@@ -172,7 +173,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             eval: GGX_EVAL,
             weight: "ggx_bounded_weight(a, wi)",
             g1: Some("ggx_g1(a, w)"),
-            sample64: Some("ggx_sample_bounded64"),
+            f64: true,
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_bounded(wi, u),

@@ -11,9 +11,11 @@
 //!   text): the job's constants (grid, tile, and those of [`layout::consts_wgsl`]) and its call
 //!   sites, one-line functions under fixed names that call the job's own sampler or discrete
 //!   method (`sampler_sample`, `discrete_sample`, ...), with the `#import`s they need;
-//! - a file in place of another with the same import path: the math (`shaders/math/f32.wgsl` or
-//!   `f32_fast.wgsl`), counting in workgroup or global memory, the draw of a lobe, a discrete
-//!   job or an f64 kernel, and a weighted case's effects or their absence;
+//! - a file in place of another with the same import path: the math of the kernel's precision
+//!   (`shaders/math`: `lobes::math` and `lobes::erf` in f32, f32-fast or f64, each declaring the
+//!   `Real` the samplers are written over, [`library::precision_files`]), counting in workgroup or
+//!   global memory, the draw of a lobe or a discrete job, and a weighted case's effects or their
+//!   absence;
 //! - `override` constants, fixed when a pipeline is made, for what is left to choose inside a file
 //!   (Fresnel form, masking term, anisotropy: [`super::effects`]).
 //!
@@ -29,17 +31,10 @@
 
 use super::context::GpuError;
 use super::layout;
-use super::library::{self, File, Math};
+use super::library::{self, File};
 use super::precision::{self, Precision};
 use crate::engine::job::{DiscreteMethod, Job};
-use crate::reference::LobeKind;
 use crate::reference::sampler::{self, SamplerSpec};
-
-/// The f64 kernels' WGSL (`shaders/math`), which the f64 draw (`f64_draw`) holds.
-pub mod sources {
-    pub const F64: &str = include_str!("../../../shaders/math/f64.wgsl");
-    pub const F64_BECKMANN: &str = include_str!("../../../shaders/math/f64_beckmann.wgsl");
-}
 
 pub use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 
@@ -95,8 +90,6 @@ pub(crate) struct Kernel {
     pub roots: Vec<&'static str>,
     pub chosen: Vec<File>,
     pub job: JobModule,
-    /// An f64 kernel's draw ([`f64_draw`]): its WGSL, which imports from `lobes::job`.
-    f64_draw: Option<String>,
 }
 
 impl Kernel {
@@ -112,12 +105,6 @@ impl Kernel {
     fn compose(&self) -> Result<String, GpuError> {
         let mut chosen = self.chosen.clone();
         chosen.push(self.job.file(&self.chosen)?);
-        if let Some(draw) = &self.f64_draw {
-            // the names it uses from the counting kernel's modules, as `lobes::draw`
-            let imports = library::imports_for(draw, &["lobes::lobe_kernel"], &chosen)?;
-            let what = format!("lobes::draw, f64, generated for {}", self.job.what);
-            chosen.push(File::generated(what, format!("#define_import_path lobes::draw\n{imports}{draw}")));
-        }
         let composed = library::compose(&self.roots, &chosen)?;
         Ok(format!("// Composed by lobes for {}\n{composed}", self.job.what))
     }
@@ -188,11 +175,25 @@ pub(crate) fn lobe_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, preci
     if samplers.len() > 1 {
         k.job.uses("lobes::effect_uniform");
     }
-    k.job.push(&call_site("sampler_sample", "a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample)));
-    if precision == Precision::F64 {
-        k.f64_draw = Some(f64_draw(job));
-    }
+    k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample)));
+    k.job.uses("lobes::bindings");
+    k.job.push(&lobe_parameters(job, precision));
     k
+}
+
+/// `lobe_alpha()` and `lobe_wi()`, a lobe job's α and ωi in the kernel's precision
+/// (`shaders/passes/lobe_kernel.wgsl`): f32 from the uniform block, f64 as constants of the
+/// job's values (the block carries f32 only, and f32(0.3) is not 0.3).
+fn lobe_parameters(job: &Job, precision: Precision) -> String {
+    let Job::Lobe { lobe, incident, .. } = job else { return String::new() };
+    let (alpha, wi) = match precision {
+        Precision::F64 => {
+            let [ax, ay, x, y, z] = [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z].map(precision::lit);
+            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"))
+        }
+        Precision::F32Accurate | Precision::F32Fast => ("params.alpha".to_string(), "params.wi.xyz".to_string()),
+    };
+    format!("fn lobe_alpha() -> vec2<Real> {{\n    return {alpha};\n}}\n\nfn lobe_wi() -> vec3<Real> {{\n    return {wi};\n}}\n")
 }
 
 /// `shaders/passes/quadrature.wgsl` (`lobes tradeoff`'s expected histogram in f32) over a
@@ -202,7 +203,7 @@ pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_node
     job.push(&format!("const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst N_NODES: u32 = {n_nodes}u;\n"));
     job.uses(sampler_module(spec, true));
     job.push(&call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &[spec], |w| w.pdf.into()));
-    Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job, f64_draw: None }
+    Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job }
 }
 
 /// `lobes::kernel` with the job's constants, the math of `precision` and the counting that
@@ -214,7 +215,7 @@ fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: P
         Job::Discrete { .. } => (1, bins),
     };
     let wg_words = tile_bins.div_ceil(2);
-    let mut chosen = math_module(precision).chosen();
+    let mut chosen = library::precision_files(precision);
     if wg_words > workgroup_words {
         chosen.push(library::COUNTING_GLOBAL);
     }
@@ -224,46 +225,7 @@ fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: P
          const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n{}",
         layout::consts_wgsl()
     ));
-    Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module, f64_draw: None }
-}
-
-/// The math module of a kernel's f32 code (the f64 kernels' f32 parts, such as the erf⁻¹
-/// guess that seeds their Newton steps, use the accurate one).
-fn math_module(precision: Precision) -> Math {
-    match precision {
-        Precision::F32Fast => Math::Fast,
-        Precision::F32Accurate | Precision::F64 => Math::Accurate,
-    }
-}
-
-/// The f64 draw of a lobe job, `lobes::draw` in place of `shaders/passes/lobe_draw.wgsl` (its
-/// `#import`s are added by [`Kernel::source`]): the job's α and ωi as f64 constants, the call
-/// site `sampler_sample64` of its f64 sampler, `shaders/math/f64.wgsl` (and for Beckmann the f64
-/// erfc and erf⁻¹).
-///
-/// Panics for a job without an f64 sampler (the registry's `sample64`); callers check first.
-fn f64_draw(job: &Job) -> String {
-    let Job::Lobe { lobe, incident, .. } = job else { panic!("f64 kernels exist for lobes only") };
-    let spec = sampler::find(lobe.kind, lobe.method);
-    let Some(sample64) = spec.wgsl.sample64 else { panic!("no f64 sampler for {}", spec.name()) };
-    let mut s = format!(
-        "// the job's alpha and incident direction in f64\n\
-         const A64: vec2<f64> = vec2<f64>({}, {});\nconst WI64: vec3<f64> = vec3<f64>({}, {}, {});\n",
-        precision::lit(lobe.alpha_x),
-        precision::lit(lobe.alpha_y),
-        precision::lit(incident.x),
-        precision::lit(incident.y),
-        precision::lit(incident.z)
-    );
-    s += &call_site("sampler_sample64", "a: vec2<f64>, wi: vec3<f64>, u: vec2<f32>", "LobeSample64", &[spec], |_| {
-        format!("{sample64}(a, wi, u)")
-    });
-    s += sources::F64;
-    if lobe.kind == LobeKind::Beckmann {
-        s += sources::F64_BECKMANN;
-        s += &precision::erfc_straight_line();
-    }
-    s
+    Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module }
 }
 
 /// "ggx vndf", "discrete cdf (10 items)".
@@ -291,7 +253,7 @@ pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
 mod tests {
     use super::*;
     use crate::reference::discrete::Distribution;
-    use crate::reference::{Lobe, Method, SAMPLERS};
+    use crate::reference::{Lobe, LobeKind, Method, SAMPLERS};
     use crate::stats::histogram::SphereGrid;
     use glam::DVec3;
 
@@ -304,7 +266,7 @@ mod tests {
     fn every_kind_of_kernel_composes_and_validates() {
         for (kind, method) in SAMPLERS {
             let spec = sampler::find(kind, method);
-            for precision in Precision::ALL.into_iter().filter(|&p| p != Precision::F64 || spec.wgsl.sample64.is_some()) {
+            for precision in Precision::ALL.into_iter().filter(|&p| p != Precision::F64 || spec.wgsl.f64) {
                 for words in [4096, 16] {
                     let src = compose_precision(&lobe_job(kind, method), words, 128, precision);
                     validate("kernel", &src).unwrap_or_else(|e| panic!("{kind:?} {method:?} {precision:?} {words}: {e}"));
@@ -343,5 +305,21 @@ mod tests {
         let message = k.compose().unwrap_err().to_string();
         assert!(message.contains(&format!("shaders/passes/kernel.wgsl:{line}:")), "{message}");
         assert!(message.contains("no_such_value"), "{message}");
+    }
+
+    /// Every sampler's counting module composes and validates in each precision (without a
+    /// device: naga's check), and declares `Real` as that precision's type once.
+    #[test]
+    fn every_sampler_composes_in_every_precision() {
+        for spec in &crate::reference::sampler::REGISTRY {
+            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2 };
+            let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
+            for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
+                let src = compose_precision(&job, 4096, job.bins() as u32, precision);
+                assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
+                assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
+                validate(&format!("{} {}", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+            }
+        }
     }
 }

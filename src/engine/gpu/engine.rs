@@ -289,17 +289,25 @@ impl GpuEngine {
         self.per_sample(pipeline, job, range, &tf, 1)
     }
 
-    /// The GPU's f32 samples for explicit uniforms: per sample `[ωr, reason]` and `[h, pdf_r]`.
-    pub fn explicit(&mut self, job: &Job, u: &[[f32; 2]]) -> Result<Vec<[[f32; 4]; 2]>, GpuError> {
+    /// The GPU's samples for explicit uniforms, in f32: per sample `[ωr, reason]`, `[h, pdf_r]`
+    /// and `[ωr − f32(ωr), 0]` (the rest of an f64 kernel's ωr; 0 in f32 kernels). As many
+    /// dispatches as the adapter's storage bindings and grid need.
+    pub fn explicit(&mut self, job: &Job, u: &[[f32; 2]]) -> Result<Vec<[[f32; 4]; 3]>, GpuError> {
+        const PER: u64 = 3;
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.explicit else { return Ok(Vec::new()) };
-        let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("explicit u"),
-            contents: bytemuck::cast_slice(u),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let out = self.per_sample(pipeline, job, SampleRange::whole(0, u.len() as u64), &input, 2)?;
-        Ok(out.chunks(2).map(|p| [p[0], p[1]]).collect())
+        let most = (self.max_storage_bytes() / (16 * PER)).min(self.gpu.limits.max_compute_workgroups_per_dimension as u64 * WG_SIZE as u64);
+        let mut out = Vec::with_capacity(u.len());
+        for part in u.chunks(most.max(1) as usize) {
+            let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("explicit u"),
+                contents: bytemuck::cast_slice(part),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+            let samples = self.per_sample(pipeline, job, SampleRange::whole(0, part.len() as u64), &input, PER)?;
+            out.extend(samples.chunks(PER as usize).map(|p| [p[0], p[1], p[2]]));
+        }
+        Ok(out)
     }
 
     /// The GPU's bins (`shaders/lib/histogram.wgsl`'s `bin_of`, on `job`'s grid) of f32 directions.

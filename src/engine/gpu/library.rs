@@ -20,8 +20,24 @@
 //! API the files define. No two files declare the same name (`embed`'s
 //! `no_name_is_declared_by_two_modules` for the library; naga rejects a composed kernel that
 //! does), so the plain text needs no namespaces.
+//!
+//! One source per precision: the samplers and the binning are written once over the type
+//! `Real`, which the math module of the kernel's [`Precision`] declares (`alias Real = f32;` in
+//! `shaders/math/f32.wgsl` and `f32_fast.wgsl`, `alias Real = f64;` in `shaders/math/f64.wgsl`),
+//! beside the functions of the same names in each (`math_exp`, `math_atan2`, …, and in
+//! `lobes::erf` the Gaussian integrals): [`precision_files`]. The plain WGSL handed on keeps the
+//! alias, so it is the files' own text. naga_oil 0.23 cannot hold an alias: a composable module
+//! may not declare one (naga's WGSL writer, which writes a module's header for the modules that
+//! import it, drops aliases, and naga_oil then rejects the name as one that "requires
+//! substitution"), so it cannot be imported either. For naga_oil's check alone each file is
+//! therefore read with `Real` spelled as the precision's type (`f32 ` or `f64 `, four columns
+//! like `Real`, so positions stay the file's) and the `alias` line blanked ([`for_naga_oil`]).
+//! Every file that uses `Real` says `#import lobes::math::Real`: that is the dependency which
+//! brings the alias along in the plain WGSL (and to a renderer's naga_oil, `lobes::embed`), while
+//! for lobes' own naga_oil check, which sees `Real` spelled out, the import is one it does not use.
 
 use super::context::GpuError;
+use super::precision::Precision;
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -59,7 +75,7 @@ macro_rules! shader {
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 28] = [
+static FILES: [File; 29] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -75,6 +91,7 @@ static FILES: [File; 28] = [
     shader!("lib/discrete.wgsl"),
     shader!("lib/histogram.wgsl"),
     shader!("math/f32.wgsl"),
+    shader!("math/erf_f32.wgsl"),
     shader!("passes/bindings.wgsl"),
     shader!("passes/kernel.wgsl"),
     shader!("passes/counting_workgroup.wgsl"),
@@ -92,6 +109,9 @@ static FILES: [File; 28] = [
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
 pub const MATH_F32_FAST: File = shader!("math/f32_fast.wgsl");
+/// `lobes::math` and `lobes::erf` in f64 (`lobes tradeoff`'s f64 kernels).
+pub const MATH_F64: File = shader!("math/f64.wgsl");
+pub const ERF_F64: File = shader!("math/erf_f64.wgsl");
 /// `lobes::counting` in global memory (instead of packed workgroup counters), for histograms
 /// too large for the adapter's workgroup storage.
 pub const COUNTING_GLOBAL: File = shader!("passes/counting_global.wgsl");
@@ -101,23 +121,13 @@ pub const DISCRETE_DRAW: File = shader!("passes/discrete_draw.wgsl");
 pub const NO_FRESNEL: File = shader!("passes/no_fresnel.wgsl");
 pub const NO_MASKING: File = shader!("passes/no_masking.wgsl");
 
-/// The math module the library's `#import lobes::math` resolves to (see
-/// [`super::precision::Precision`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Math {
-    /// `shaders/math/f32.wgsl`: the WGSL builtins.
-    Accurate,
-    /// `shaders/math/f32_fast.wgsl`: the same names as cheap approximations.
-    Fast,
-}
-
-impl Math {
-    /// The files that replace the defaults for this math: none, or [`MATH_F32_FAST`].
-    pub fn chosen(self) -> Vec<File> {
-        match self {
-            Math::Accurate => Vec::new(),
-            Math::Fast => vec![MATH_F32_FAST],
-        }
+/// The files that replace the defaults (`shaders/math/f32.wgsl`, `erf_f32.wgsl`) for the math of
+/// `precision` (see [`Precision`]).
+pub fn precision_files(precision: Precision) -> Vec<File> {
+    match precision {
+        Precision::F32Accurate => Vec::new(),
+        Precision::F32Fast => vec![MATH_F32_FAST],
+        Precision::F64 => vec![MATH_F64, ERF_F64],
     }
 }
 
@@ -141,9 +151,47 @@ fn import_path(source: &str) -> Option<&str> {
 }
 
 /// The plain WGSL of the library `modules` (import paths such as `"lobes::ggx"`) and all they
-/// import, with `math` as `lobes::math` (see [`compose`]).
-pub fn wgsl(modules: &[&str], math: Math) -> Result<String, GpuError> {
-    compose(modules, &math.chosen())
+/// import, in the math of `precision` (see [`compose`]).
+pub fn wgsl(modules: &[&str], precision: Precision) -> Result<String, GpuError> {
+    compose(modules, &precision_files(precision))
+}
+
+/// The built-in file of import path `module` as naga_oil reads it (see the module doc), in f32:
+/// the form for a renderer's naga_oil (`lobes::embed`).
+pub fn naga_oil_source(module: &str) -> Option<String> {
+    source(module).map(|s| for_naga_oil(s, "f32"))
+}
+
+/// A file as naga_oil reads it (see the module doc): its `alias Real` line blanked and the word
+/// `Real` spelled `scalar` (`f32` or `f64`, padded to four columns) outside the directives.
+fn for_naga_oil(source: &str, scalar: &str) -> String {
+    let scalar = format!("{scalar:<4}");
+    let word = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let line = |l: &str| -> String {
+        if l.trim_start().starts_with("alias Real") {
+            return String::new();
+        }
+        if l.trim_start().starts_with('#') {
+            return l.to_string();
+        }
+        let mut out = String::with_capacity(l.len());
+        let mut rest = l;
+        while let Some(at) = rest.find("Real") {
+            let (before, after) = (&rest[..at], &rest[at + 4..]);
+            let whole = !before.ends_with(word) && !after.starts_with(word);
+            out.push_str(before);
+            out.push_str(if whole { &scalar } else { "Real" });
+            rest = after;
+        }
+        out + rest
+    };
+    source.lines().map(line).collect::<Vec<_>>().join("\n")
+}
+
+/// The type `alias Real = T;` names in one of `order` (the math module), or f32.
+fn real_scalar(order: &[&File]) -> String {
+    let alias = order.iter().flat_map(|f| f.source.lines()).find_map(|l| l.trim().strip_prefix("alias Real ="));
+    alias.map_or("f32".to_string(), |t| t.trim().trim_end_matches(';').trim().to_string())
 }
 
 /// The plain WGSL of the modules `roots` and all they import, each file once and after those it
@@ -242,14 +290,16 @@ fn validate(order: &[&File]) -> Result<(), GpuError> {
     let mut composer = Composer::default().with_capabilities(caps);
     // `what`: the file the error is in (it may be one that the file being built imports)
     let error = |e: naga_oil::compose::ComposerError, c: &Composer| GpuError::Shader { what: e.source.path(c).clone(), message: e.emit_to_string(c) };
-    for f in order {
-        let added = composer.add_composable_module(ComposableModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() });
+    let scalar = real_scalar(order);
+    let sources: Vec<String> = order.iter().map(|f| for_naga_oil(&f.source, &scalar)).collect();
+    for (f, source) in order.iter().zip(&sources) {
+        let added = composer.add_composable_module(ComposableModuleDescriptor { source, file_path: &f.path, ..Default::default() });
         if let Err(e) = added {
             return Err(error(e, &composer));
         }
     }
-    for f in order {
-        if let Err(e) = composer.make_naga_module(NagaModuleDescriptor { source: &f.source, file_path: &f.path, ..Default::default() }) {
+    for (f, source) in order.iter().zip(&sources) {
+        if let Err(e) = composer.make_naga_module(NagaModuleDescriptor { source, file_path: &f.path, ..Default::default() }) {
             return Err(error(e, &composer));
         }
     }
@@ -316,14 +366,14 @@ mod tests {
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in [MATH_F32_FAST, COUNTING_GLOBAL, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
+        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }
 
     #[test]
     fn composed_names_are_plain() {
-        let src = wgsl(&["lobes::ggx_eval", "lobes::beckmann_eval", "lobes::ward_eval"], Math::Fast).unwrap();
+        let src = wgsl(&["lobes::ggx_eval", "lobes::beckmann_eval", "lobes::ward_eval"], Precision::F32Fast).unwrap();
         assert!(src.contains("fn ggx_sample_vndf("));
         assert!(src.contains("fn math_atan2("));
         assert!(!src.contains("#import") && !src.contains("#define_import_path"));

@@ -1,14 +1,16 @@
-//! The arithmetic of a kernel ([`Precision`]), chosen when its module is composed
-//! (`compose::math_module`, `compose::f64_draw`): the math module of the f32 kernels (`shaders/math/f32.wgsl`, or the approximations of
-//! `shaders/math/f32_fast.wgsl` under the same names), and for f64 the draw of `shaders/math/f64.wgsl` in
-//! place of `shaders/passes/lobe_draw.wgsl`. `lobes tradeoff` compares the three.
+//! The arithmetic of a kernel ([`Precision`]), chosen when its module is composed: the samplers,
+//! the binning and the passes are written once over the WGSL type `Real`, and the precision picks
+//! the math modules that declare it (`lobes::math` and `lobes::erf`, [`super::library`]).
+//! `lobes tradeoff` compares the three.
 //!
-//! - `f32-accurate`: the kernels `lobes run` judges;
-//! - `f32-fast`: `math_log`, `math_exp`, `math_sin`, `math_cos`, `math_atan2` and `neg_ln` are
-//!   bit tricks and low-order polynomials (errors 1e-4 to 1.5e-3);
-//! - `f64`: `shaders/math/f64.wgsl` (f64 samplers, f64 binning, its own f64 sin/cos/atan2/exp/ln;
-//!   plus `shaders/math/f64_beckmann.wgsl`, f64 erfc and erf⁻¹, for Beckmann), with the job's α and
-//!   ωi as f64 constants (the kernel's uniform block carries them in f32 only).
+//! - `f32-accurate`: `shaders/math/f32.wgsl` (the WGSL builtins) and `erf_f32.wgsl`; the kernels
+//!   `lobes run` judges;
+//! - `f32-fast`: `shaders/math/f32_fast.wgsl`, where `math_log`, `math_exp`, `math_sin`,
+//!   `math_cos`, `math_atan2` and `neg_ln` are bit tricks and low-order polynomials (errors 1e-4
+//!   to 1.5e-3), and `erf_f32.wgsl`;
+//! - `f64`: `shaders/math/f64.wgsl` (f64 sin/cos/atan2/exp/ln series: SPIR-V has these for 16- and
+//!   32-bit floats only) and `erf_f64.wgsl` (f64 erfc and erf⁻¹), with the job's α and ωi as f64
+//!   constants (the kernel's uniform block carries them in f32 only).
 
 use serde::Serialize;
 
@@ -35,6 +37,14 @@ impl Precision {
         }
     }
 
+    /// The WGSL scalar type of `Real` in the precision's kernels.
+    pub fn scalar(self) -> &'static str {
+        match self {
+            Precision::F32Fast | Precision::F32Accurate => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
     /// Parses `f32-fast`, `f32-accurate` or `f64`.
     pub fn parse(s: &str) -> Option<Precision> {
         Precision::ALL.into_iter().find(|p| p.name() == s.trim())
@@ -44,34 +54,6 @@ impl Precision {
 /// An f64 literal that round-trips (17 significant digits).
 pub(crate) fn lit(x: f64) -> String {
     format!("{x:.16e}lf")
-}
-
-/// Straight-line WGSL for `shaders/math/f64_beckmann.wgsl`'s erfc (no loops: llvmpipe ends a
-/// shader's loops after 65535 iterations per invocation, counted over all loops together,
-/// gallivm's `LP_MAX_TGSI_LOOP_ITERATIONS`). Relative errors against glibc's erfc, measured in f64 on
-/// a 0.001 grid: 1.3e-12 below 2.5, 5e-15 above.
-/// - `erf_series_sum64(z2)` = Σ_{n<48} (2 z²)ⁿ / (1·3·5···(2n+1)) by Horner in z², coefficients
-///   2ⁿ/(2n+1)!! formed in f64 (A&S 7.1.6), used for z < 2.5;
-/// - `erfc_cf_denominator64(z)` = z + (1/2)/(z + 1/(z + (3/2)/(z + …))) from 32 levels deep
-///   (A&S 7.1.14), used for z ≥ 2.5.
-pub fn erfc_straight_line() -> String {
-    const TERMS: usize = 48;
-    const LEVELS: usize = 32;
-    let mut c = vec![1.0f64];
-    for n in 1..TERMS {
-        c.push(c[n - 1] * 2.0 / (2 * n + 1) as f64);
-    }
-    let mut out = String::from("\nfn erf_series_sum64(z2: f64) -> f64 {\n");
-    out += &format!("    var s = {};\n", lit(c[TERMS - 1]));
-    for k in (0..TERMS - 1).rev() {
-        out += &format!("    s = s * z2 + {};\n", lit(c[k]));
-    }
-    out += "    return s;\n}\n\nfn erfc_cf_denominator64(z: f64) -> f64 {\n    var k = z;\n";
-    for n in (1..=LEVELS).rev() {
-        out += &format!("    k = z + {} / k;\n", lit(0.5 * n as f64));
-    }
-    out += "    return k;\n}\n";
-    out
 }
 
 #[cfg(test)]
@@ -84,5 +66,26 @@ mod tests {
             let s = lit(x);
             assert_eq!(s[..s.len() - 2].parse::<f64>().unwrap(), x);
         }
+    }
+
+    /// `shaders/math/erf_f64.wgsl`'s straight-line erfc: the series' coefficients are
+    /// c_n = 2ⁿ / (1·3·5···(2n+1)) (A&S 7.1.6), formed by c_n = c_{n−1}·2/(2n+1) in f64, highest
+    /// first, and the continued fraction's numerators are n/2 from 32 down to 1 (A&S 7.1.14).
+    #[test]
+    fn the_straight_line_erfc_has_the_series_coefficients() {
+        let src = include_str!("../../../shaders/math/erf_f64.wgsl");
+        let body = |name: &str| src.split(&format!("fn {name}(")).nth(1).unwrap().split("\n}").next().unwrap().to_string();
+        // the number after the last ` + ` (or ` = `, or ` / ` for `k = z + 16.0 / k;`)
+        let last = |l: &str, sep: &str| -> f64 { l.rsplit_once(sep).unwrap().1.trim_end_matches(';').trim().parse().unwrap() };
+        let series: Vec<f64> =
+            body("erf_series_sum").lines().filter(|l| l.contains("s = s * z2 + ") || l.contains("var s")).map(|l| last(l, if l.contains(" + ") { " + " } else { " = " })).collect();
+        let mut c = vec![1.0f64];
+        for n in 1..48 {
+            c.push(c[n - 1] * 2.0 / (2 * n + 1) as f64);
+        }
+        c.reverse();
+        assert_eq!(series, c);
+        let levels: Vec<f64> = body("erfc_cf_denominator").lines().filter(|l| l.contains("k = z + ")).map(|l| last(&l.replace(" / k;", ""), " + ")).collect();
+        assert_eq!(levels, (1..=32).rev().map(|n| 0.5 * n as f64).collect::<Vec<_>>());
     }
 }

@@ -205,15 +205,15 @@ pub fn unavailable(engine: &GpuEngine, sampler: Sampler, precision: Precision) -
     if !engine.gpu.has_f64() {
         return Some(format!("the adapter '{}' has no SHADER_F64", engine.gpu.info.name));
     }
-    if sampler::find(sampler.kind, sampler.method).wgsl.sample64.is_none() {
-        return Some(format!("no f64 kernel for {} (it would need f64 erfc and erfinv)", sampler.name()));
+    if !sampler::find(sampler.kind, sampler.method).wgsl.f64 {
+        return Some(format!("no f64 kernel for {} (its WGSL is written in f32, not over Real)", sampler.name()));
     }
     None
 }
 
 /// The GPU directions of samples 0 .. n of `job` under the engine's current precision against
-/// the f64 reference. For the f64 kernel the directions come back as f32 hi + lo pairs.
-pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precision: Precision) -> anyhow::Result<AngleCheck> {
+/// the f64 reference. The directions come back as f32 hi + lo pairs (lo = 0 in f32 kernels).
+pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32) -> anyhow::Result<AngleCheck> {
     let Job::Lobe { lobe, incident, .. } = job else { anyhow::bail!("angle_error: a lobe job") };
     let u: Vec<[f32; 2]> = (0..n as u64)
         .map(|i| {
@@ -228,7 +228,7 @@ pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32, precisi
         .map(|(g, u)| {
             let s = lobe.sample(*incident, [u[0] as f64, u[1] as f64]);
             let hi = DVec3::new(g[0][0] as f64, g[0][1] as f64, g[0][2] as f64);
-            let w = if precision == Precision::F64 { hi + DVec3::new(g[1][0] as f64, g[1][1] as f64, g[1][2] as f64) } else { hi };
+            let w = hi + DVec3::new(g[2][0] as f64, g[2][1] as f64, g[2][2] as f64);
             ((g[0][3] == 0.0).then_some(w), s.invalid.is_none().then_some(s.omega_r))
         })
         .collect();
@@ -281,7 +281,7 @@ fn sweep_one(
     log: &mut dyn FnMut(&str),
 ) -> anyhow::Result<(Vec<SweepPoint>, Vec<Skipped>)> {
     engine.histogram(job, SampleRange::whole(set.seed ^ 0x5eed, 1 << 16), &mut |_| {})?; // compile and warm up
-    let angle = angle_error(engine, job, set.seed, set.angle_samples, prec)?;
+    let angle = angle_error(engine, job, set.seed, set.angle_samples)?;
     let mut points: Vec<SweepPoint> = Vec::new();
     let mut skipped = Vec::new();
     for n in set.counts(s) {
