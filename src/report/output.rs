@@ -190,11 +190,7 @@ impl HistogramFile {
             weighted: None,
             user_sampler: Some(UserSamplerRecord {
                 passed: report.passed,
-                checks: report
-                    .checks
-                    .iter()
-                    .cloned()
-                    .collect(),
+                checks: report.checks.to_vec(),
                 invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
                 expected_invalid: r.expected_invalid,
                 wall_seconds: r.wall_seconds,
