@@ -131,7 +131,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         emit(&t)?;
     }
     let failed: Vec<&str> = report.checks.iter().filter(|c| !c.passed).map(|c| c.name.as_str()).collect();
-    anyhow::ensure!(failed.is_empty(), "{} failed: {}", report.sampler, failed.join(", "));
+    if !failed.is_empty() {
+        return Err(super::ChecksFailed(format!("{} failed: {}", report.sampler, failed.join(", "))).into());
+    }
     Ok(())
 }
 

@@ -7,9 +7,13 @@
 pub mod atomic;
 pub mod colour;
 pub mod heatmap;
+#[cfg(feature = "cli")]
+pub mod junit;
 pub mod label;
 pub mod output;
 pub mod schema;
+#[cfg(feature = "cli")]
+pub mod summary;
 pub mod png;
 pub mod table;
 pub mod text;
