@@ -28,8 +28,13 @@ fn main() -> ExitCode {
     match cli.run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("lobes: error: {err:#}");
-            ExitCode::from(lobes::cli::exit_code(&err))
+            let code = lobes::cli::exit_code(&err);
+            if code == lobes::cli::EXIT_INTERRUPTED {
+                eprintln!("lobes: {err:#}");
+            } else {
+                eprintln!("lobes: error: {err:#}");
+            }
+            ExitCode::from(code)
         }
     }
 }

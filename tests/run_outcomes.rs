@@ -44,7 +44,17 @@ fn read_junit(out: &Path) -> Report {
 /// and the exit code is 130.
 #[test]
 fn sigint_stops_after_the_case_in_flight_and_reports_what_finished() {
-    let dir = scratch("sigint");
+    interrupt_mid_run("INT");
+}
+
+/// SIGTERM (what CI systems send to cancel a job) does the same as Ctrl-C.
+#[test]
+fn sigterm_stops_after_the_case_in_flight_and_reports_what_finished() {
+    interrupt_mid_run("TERM");
+}
+
+fn interrupt_mid_run(signal: &str) {
+    let dir = scratch(signal);
     let n = 8;
     let scene = scene(&dir, n, 4_000_000);
     let out = dir.join("out");
@@ -61,7 +71,7 @@ fn sigint_stops_after_the_case_in_flight_and_reports_what_finished() {
     let mut first = String::new();
     stderr.read_line(&mut first).unwrap();
     assert!(first.starts_with("lobes: [1/8] c0: pass"), "{first}");
-    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let kill = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
     assert!(kill.success());
     let mut rest = String::new();
     stderr.read_to_string(&mut rest).unwrap();
@@ -69,6 +79,7 @@ fn sigint_stops_after_the_case_in_flight_and_reports_what_finished() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert_eq!(output.status.code(), Some(130), "{first}{rest}\n{stdout}");
     assert!(rest.contains("lobes: interrupted: stopping after the case in flight"), "{rest}");
+    assert!(!rest.contains("error"), "an interrupt is not reported as an error: {rest}");
 
     let summary = read_summary(&out);
     assert_eq!(summary.status, RunStatus::Interrupted);
@@ -148,4 +159,18 @@ fn a_passing_run_on_the_gpu_has_only_lobes_lines_on_stderr() {
     assert_eq!(summary.backend, "gpu");
     let suite = &read_junit(&out).test_suites[0];
     assert_eq!((suite.tests, suite.failures, suite.errors), (2, 0, 0));
+}
+
+/// `lobes --help` and the help of the commands with verdicts list every exit code.
+#[test]
+fn help_lists_the_exit_codes() {
+    for args in [&["--help"][..], &["run", "--help"], &["merge", "--help"], &["check", "--help"], &["stress", "--help"]] {
+        let output = Command::new(LOBES).args(args).output().unwrap();
+        assert_eq!(output.status.code(), Some(0));
+        let help = String::from_utf8_lossy(&output.stdout);
+        let section = help.split("Exit codes:").nth(1).unwrap_or_else(|| panic!("no exit codes in lobes {args:?}:\n{help}"));
+        for (code, words) in [(0, "passed"), (1, "failed"), (2, "bad input"), (3, "could not do the work"), (130, "interrupted")] {
+            assert!(section.lines().any(|l| l.trim_start().starts_with(&format!("{code} ")) && l.contains(words)), "{code}: {section}");
+        }
+    }
 }

@@ -76,21 +76,25 @@ pub enum Command {
     Sample(tutorial::SampleArgs),
     /// Run a scene: sample and histogram every case on the GPU, judge it with a χ² test
     /// against the f64 reference, and write histogram.json and heat maps per case.
+    #[command(after_help = EXIT_CODES)]
     Run(run::RunArgs),
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
     /// Drive every sampler with the inputs where naive formulas break, on the GPU (f32) and
     /// the CPU (f64); print case, kernel, worst errors and verdict.
+    #[command(after_help = EXIT_CODES)]
     Stress(stress::StressArgs),
     /// Print the composed WGSL that `lobes run` compiles for a scene's cases (each distinct
     /// module once), with the override constants its pipelines are made with.
     Shader(shader::ShaderArgs),
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
+    #[command(after_help = EXIT_CODES)]
     Merge(merge::MergeArgs),
     /// Judge your own WGSL sampler: its histogram against the GPU quadrature of its pdf (χ²),
     /// the pdf against the map's Jacobian, weights and albedo with an eval, and hard cases.
+    #[command(after_help = EXIT_CODES)]
     Check(check::CheckArgs),
     /// Accuracy against cost: sample count × kernel precision (f32 fast / f32 / f64), spherical
     /// caps against bounded VNDF, and the expected histogram's quadrature; writes tradeoff.md,
