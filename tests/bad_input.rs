@@ -325,7 +325,7 @@ fn usage_error(out: &Output, want: &[&str]) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(out.status.code(), Some(2), "want exit 2; stderr: {stderr}");
     assert!(out.stdout.is_empty(), "stdout: {}", String::from_utf8_lossy(&out.stdout));
-    assert!(stderr.contains("error:"), "{stderr}");
+    assert!(stderr.contains("lobes: error:"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
     for w in want {
         assert!(stderr.contains(w), "stderr lacks {w:?}: {stderr}");
@@ -373,17 +373,23 @@ fn without_gpu(cmd: &mut Command) -> &mut Command {
     cmd.env("VK_DRIVER_FILES", "/nonexistent.json").env("VK_ICD_FILENAMES", "/nonexistent.json").env_remove("WGPU_BACKEND")
 }
 
+/// Without an adapter `run` fails (3) naming the driver to install, and runs no case on the CPU
+/// behind the user's back; `--cpu` runs them on the CPU engine; `bench` fails as `run` does.
 #[test]
-fn without_an_adapter_run_warns_and_uses_the_cpu_and_bench_fails() {
+fn without_an_adapter_run_and_bench_fail_and_run_cpu_uses_the_cpu() {
     let dir = scratch("no-gpu");
     let scene = dir.join("small.toml");
     std::fs::write(&scene, SMALL).unwrap();
     let out = without_gpu(&mut lobes_cmd()).args(["run", "--json", "--out"]).arg(dir.join("out")).arg(&scene).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.starts_with("lobes: error: no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
+    assert!(out.stdout.is_empty() && !dir.join("out/first").exists(), "no case ran");
+
+    let out = without_gpu(&mut lobes_cmd()).args(["run", "--cpu", "--json", "--out"]).arg(dir.join("out")).arg(&scene).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{stderr}");
-    assert!(stderr.contains("warning: no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
-    assert!(stderr.contains("CPU reference engine"), "{stderr}");
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout, the warning on stderr");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
     assert_eq!(v["backend"], "cpu");
     for case in ["first", "broken", "last"] {
         let h: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("out").join(case).join("histogram.json")).unwrap()).unwrap();
@@ -392,8 +398,8 @@ fn without_an_adapter_run_warns_and_uses_the_cpu_and_bench_fails() {
 
     let out = without_gpu(&mut lobes_cmd()).args(["bench", "--runs", "1", "--samples", "1000"]).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.starts_with("error: no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.starts_with("lobes: error: no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
     assert!(out.stdout.is_empty());
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -405,7 +411,8 @@ fn tree(dir: &Path) -> Vec<String> {
 }
 
 /// A case whose outputs cannot be written fails alone: it leaves no `histogram.json` (not even
-/// the one an earlier run left), no temporary files, and the other cases complete; exit 1.
+/// the one an earlier run left), no temporary files, and the other cases complete; exit 3 (the
+/// tool could not do the work), and summary.json and junit.xml name the case as an error.
 #[test]
 fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     let dir = scratch("mid-way");
@@ -423,9 +430,9 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     std::fs::create_dir_all(broken.join("residual.png").join("blocker")).unwrap();
     let again = lobes_cmd().args(["run", "--cpu", "--out"]).arg(&out).arg(&scene).output().unwrap();
     let stderr = String::from_utf8_lossy(&again.stderr);
-    assert_eq!(again.status.code(), Some(1), "{stderr}");
+    assert_eq!(again.status.code(), Some(3), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(stderr.contains("error: case 'broken'") && stderr.contains("small.toml:10:1"), "{stderr}");
+    assert!(stderr.contains("lobes: error: case 'broken'") && stderr.contains("small.toml:10:1"), "{stderr}");
     assert!(stderr.contains("writing the outputs into") && stderr.contains("no histogram.json was written"), "{stderr}");
     assert!(stderr.contains("1 of 3 cases could not run"), "{stderr}");
     assert!(!broken.join("histogram.json").exists(), "the failed case left a histogram.json");
@@ -435,6 +442,11 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     for ok in ["first", "last"] {
         assert_eq!(tree(&out.join(ok)), ["expected.png", "histogram.json", "measured.png", "residual.png"]);
     }
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((summary["errors"].as_u64(), summary["failed"].as_u64(), summary["status"].as_str()), (Some(1), Some(0), Some("complete")));
+    assert!(summary["cases"][1]["error"].as_str().unwrap().contains("residual.png"), "{summary}");
+    let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(junit.contains(r#"<testcase name="broken" classname="lobes">"#) && junit.contains("<error message=\"writing the outputs into"), "{junit}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -26,13 +26,13 @@ fn json(args: &[&str]) -> Value {
     values.into_iter().next().unwrap()
 }
 
-/// Runs `lobes args`, expects exit code 2, nothing on stdout, and `error:` plus `flag` on stderr.
+/// Runs `lobes args`, expects exit code 2, nothing on stdout, and `lobes: error:` plus `flag` on stderr.
 fn bad(args: &[&str], flag: &str) {
     let out = lobes(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "lobes {args:?}: want exit 2, stderr: {stderr}");
     assert!(out.stdout.is_empty(), "lobes {args:?}: printed on stdout: {}", String::from_utf8_lossy(&out.stdout));
-    assert!(stderr.starts_with("error: "), "lobes {args:?}: stderr: {stderr}");
+    assert!(stderr.starts_with("lobes: error: "), "lobes {args:?}: stderr: {stderr}");
     assert!(stderr.contains(flag), "lobes {args:?}: stderr does not name {flag}: {stderr}");
     assert!(!stderr.contains("panicked"), "lobes {args:?} panicked: {stderr}");
 }
@@ -67,11 +67,12 @@ fn clap_definition_is_consistent() {
 
 #[test]
 fn exit_codes_separate_bad_input_from_failures() {
-    use lobes::cli::{EXIT_FAILURE, EXIT_USAGE, exit_code, usage};
+    use lobes::cli::{ChecksFailed, EXIT_CHECKS_FAILED, EXIT_TOOL_FAILURE, EXIT_USAGE, exit_code, usage};
     assert_eq!(exit_code(&usage("--x: bad")), EXIT_USAGE);
     assert_eq!(exit_code(&usage("--x: bad").context("while running")), EXIT_USAGE);
-    assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_FAILURE);
-    assert_eq!((EXIT_USAGE, EXIT_FAILURE), (2, 1));
+    assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_TOOL_FAILURE);
+    assert_eq!(exit_code(&ChecksFailed("1 of 2 cases failed".into()).into()), EXIT_CHECKS_FAILED);
+    assert_eq!((EXIT_CHECKS_FAILED, EXIT_USAGE, EXIT_TOOL_FAILURE), (1, 2, 3));
 }
 
 #[test]

@@ -101,6 +101,8 @@ fn every_file_lobes_writes_validates_against_its_schema() {
 
     let run = lobes(&dir, &["run", "scene.toml", "--out", "full", "--json"]);
     validate("run-summary.schema.json", &run, "the summary of lobes run");
+    // OUT/summary.json is the same summary
+    assert_eq!(file(&dir.join("full/summary.json")), run, "summary.json and --json agree");
     let summary: RunSummary = serde_json::from_value(run).unwrap();
     assert_eq!(summary.format_version, SUMMARY_VERSION);
     assert_eq!(summary.cases.iter().map(|c| c.case.as_str()).collect::<Vec<_>>(), cases);
@@ -118,6 +120,7 @@ fn every_file_lobes_writes_validates_against_its_schema() {
     }
     let merge = lobes(&dir, &["merge", "parts", "--out", "merged", "--json"]);
     validate("run-summary.schema.json", &merge, "the summary of lobes merge");
+    assert_eq!(file(&dir.join("merged/summary.json")), merge, "summary.json and --json agree");
     let merged: RunSummary = serde_json::from_value(merge).unwrap();
     assert_eq!(merged.shard_files, Some(6));
 

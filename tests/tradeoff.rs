@@ -184,7 +184,7 @@ fn cli_writes_outputs_and_rejects_bad_input() {
         assert!(stderr.contains(needle), "{args:?}: {stderr}");
     }
 
-    // no adapter: a runtime failure (1) that names the package to install
+    // no adapter: the tool could not do the work (3); the message names the package to install
     let out = Command::new(env!("CARGO_BIN_EXE_lobes"))
         .args(["tradeoff", "--parts", "quadrature"])
         .env("VK_DRIVER_FILES", "/nonexistent.json")
@@ -193,7 +193,7 @@ fn cli_writes_outputs_and_rejects_bad_input() {
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
     assert!(stderr.contains("no GPU adapter found") && stderr.contains("mesa-vulkan-drivers"), "{stderr}");
 }
 

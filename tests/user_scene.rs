@@ -120,6 +120,20 @@ incident_theta = 30
     let failed = broken.failed_checks.clone().unwrap();
     assert!(failed.iter().any(|c| c == "jacobian") && failed.iter().any(|c| c == "chi2"), "{failed:?}");
     assert!(out_dir.join("no-jacobian/histogram.json").is_file());
+    // summary.json is the --json summary; junit.xml reports the failure with its reason
+    let written: RunSummary = serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(written, s);
+    let reason = broken.failure.clone().unwrap();
+    assert!(reason.contains("jacobian: ") && reason.contains("chi2: "), "{reason}");
+    let junit = quick_junit::Report::deserialize_from_str(&std::fs::read_to_string(out_dir.join("junit.xml")).unwrap()).unwrap();
+    let suite = &junit.test_suites[0];
+    assert_eq!((suite.tests, suite.failures, suite.errors), (2, 1, 0));
+    match &suite.test_cases[1].status {
+        quick_junit::TestCaseStatus::NonSuccess { kind: quick_junit::NonSuccessKind::Failure, message, .. } => {
+            assert_eq!(message.as_ref().map(|m| m.as_str()), Some(reason.as_str()))
+        }
+        other => panic!("no-jacobian is not a failure in junit.xml: {other:?}"),
+    }
     // The table names the failed checks.
     let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));

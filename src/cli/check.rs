@@ -132,7 +132,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         t += if report.passed { "passed\n" } else { "FAILED\n" };
         emit(&t)?;
     }
-    anyhow::ensure!(report.passed, "{} failed: {}", report.sampler, report.failed().join(", "));
+    if !report.passed {
+        return Err(super::ChecksFailed(format!("{} failed: {}", report.sampler, report.failed().join(", "))).into());
+    }
     Ok(())
 }
 
@@ -169,6 +171,8 @@ fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs
         t.push('\n');
         emit(&t)?;
     }
-    anyhow::ensure!(sweep.passed, "{}: {}", sweep.sampler, sweep.verdict());
+    if !sweep.passed {
+        return Err(super::ChecksFailed(format!("{}: {}", sweep.sampler, sweep.verdict())).into());
+    }
     Ok(())
 }

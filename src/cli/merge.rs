@@ -2,8 +2,8 @@
 //! I/N`, [`crate::run::shard`]) and judges the sums as `lobes run` judges a case
 //! ([`crate::run::merge`], [`crate::run::judge`]), with the same outputs and table.
 
-use super::{OutputArgs, emit, emit_json, parse_level, prepare_out};
-use crate::report::output::{self, CaseSummary, RunSummary, SUMMARY_VERSION};
+use super::{ChecksFailed, OutputArgs, emit, emit_json, parse_level, prepare_out};
+use crate::report::output::{self, CaseSummary, RunSummary};
 use crate::run::judge;
 use crate::run::merge::{merge, read_shards};
 use crate::stats::chi2::sidak;
@@ -34,35 +34,26 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     let (adapter, backend) = (&merged.adapter, &merged.backend);
     if merged.mixed_adapters() {
         eprintln!(
-            "warning: the shards come from more than one adapter ({adapter}); their counts add exactly, \
+            "lobes: warning: the shards come from more than one adapter ({adapter}); their counts add exactly, \
              but the sum is not bit-identical to a run on any one of them"
         );
     }
     let n = merged.scene.cases.len();
     let level = sidak(args.significance, n);
     prepare_out(&args.out)?;
+    crate::report::summary::remove(&args.out)?;
     let mut rows = Vec::new();
-    let mut summary = Vec::new();
-    let mut failed = 0;
+    let mut summary = RunSummary { shard_files: Some(shards.len()), ..RunSummary::new(adapter.clone(), backend.clone(), args.significance, level) };
     for (case, sampled, parts) in merged.iter() {
         let result = judge(case, sampled.clone(), level)?;
         output::write_case(&args.out, &result, adapter, backend)?;
-        failed += usize::from(!result.passed());
         rows.push(output::table_row(&result));
         summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
     }
+    crate::report::summary::write(&args.out, &summary)?;
+    let failed = summary.failed;
     if args.output.json {
-        emit_json(&RunSummary {
-            format_version: SUMMARY_VERSION,
-            adapter: adapter.clone(),
-            backend: backend.clone(),
-            significance: args.significance,
-            per_case_significance: level,
-            shard_files: Some(shards.len()),
-            failed,
-            errors: 0,
-            cases: summary,
-        })?;
+        emit_json(&summary)?;
     } else {
         let mut text = format!(
             "adapter: {adapter}\nmerged {} shard files of scene {} ({})\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n",
@@ -75,9 +66,11 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         if shards.iter().any(|s| s.file.timing.gpu_seconds.is_none()) {
             text += "\n* wall time (no GPU timestamps for some shards)\n";
         }
-        text += &format!("\noutputs in {}\n", args.out.display());
+        text += &format!("\noutputs in {} (summary.json, junit.xml)\n", args.out.display());
         emit(&text)?;
     }
-    anyhow::ensure!(failed == 0, "{failed} of {n} cases failed the χ² test or the albedo checks");
+    if failed > 0 {
+        return Err(ChecksFailed(format!("{failed} of {n} cases failed the χ² test or the albedo checks")).into());
+    }
     Ok(())
 }

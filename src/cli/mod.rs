@@ -1,19 +1,23 @@
 //! The `lobes` command line: argument definitions, input validation and dispatch.
 //!
 //! Each subcommand is a variant of [`Command`] whose arguments are a clap `Args` struct and
-//! whose work is a function returning `anyhow::Result<()>`. Errors are of two kinds:
+//! whose work is a function returning `anyhow::Result<()>`. [`exit_code`] maps its error to the
+//! process's exit code ([`EXIT_CODES`], also in `lobes --help` and the README):
 //!
-//! - bad input, reported as a [`UsageError`] (or by clap itself while parsing), exit code
-//!   [`EXIT_USAGE`] = 2;
-//! - anything else (I/O, GPU, …), exit code [`EXIT_FAILURE`] = 1.
+//! - a case or check that ran and failed its test: a [`ChecksFailed`], [`EXIT_CHECKS_FAILED`] = 1;
+//! - bad input: a [`UsageError`] (or clap's own while parsing), [`EXIT_USAGE`] = 2;
+//! - the tool could not do the work (no adapter, a lost device, an output not written, any
+//!   other error): [`EXIT_TOOL_FAILURE`] = 3;
+//! - stopped by SIGINT or SIGTERM: an [`Interrupted`], [`EXIT_INTERRUPTED`] = 130.
 //!
-//! [`exit_code`] tells the two apart. Syntax and per-value checks (a malformed list, u outside
-//! [0, 1], α ≤ 0) run as clap value parsers, so clap's message names the flag; checks that need
-//! the reference (weights, which methods a lobe supports) run in the subcommand and produce a
-//! [`UsageError`] whose message starts with the flag.
+//! Syntax and per-value checks (a malformed list, u outside [0, 1], α ≤ 0) run as clap value
+//! parsers, so clap's message names the flag; checks that need the reference (weights, which
+//! methods a lobe supports) run in the subcommand and produce a [`UsageError`] whose message
+//! starts with the flag.
 
 pub mod bench;
 pub mod check;
+pub mod interrupt;
 pub mod merge;
 pub mod run;
 pub mod shader;
@@ -25,21 +29,35 @@ use crate::reference::{LobeKind, Method};
 use crate::run::shard::ShardError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
-use std::fmt;
 use std::io::Write;
 use std::path::Path;
 
+/// Exit code when every case ran and some failed its checks (χ², albedo, a user's checks).
+pub const EXIT_CHECKS_FAILED: u8 = 1;
 /// Exit code for bad input: usage and validation errors (clap's own code for usage errors).
 pub const EXIT_USAGE: u8 = 2;
-/// Exit code for runtime failures.
-pub const EXIT_FAILURE: u8 = 1;
+/// Exit code when the tool could not do the work: no GPU adapter, a lost device, an output
+/// that could not be written, a case that could not run.
+pub const EXIT_TOOL_FAILURE: u8 = 3;
+/// Exit code of a run stopped by SIGINT or SIGTERM (128 + SIGINT, as shells report Ctrl-C).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// The exit codes, as `lobes --help` shows them.
+pub const EXIT_CODES: &str = "Exit codes:
+  0    every case passed (or the command succeeded)
+  1    some case or check ran and failed its test
+  2    bad input: a scene, a flag or a file lobes cannot use
+  3    the tool could not do the work: no GPU adapter (without --cpu), a lost device,
+       an output that could not be written
+  130  interrupted (SIGINT/SIGTERM): finished cases are reported and written";
 
 /// The `lobes` command line.
 #[derive(Debug, Parser)]
 #[command(
     name = "lobes",
     version,
-    about = "Importance sampling of reflectance lobes and discrete distributions, checked against an f64 reference"
+    about = "Importance sampling of reflectance lobes and discrete distributions, checked against an f64 reference",
+    after_help = EXIT_CODES
 )]
 pub struct Cli {
     /// The subcommand to run.
@@ -58,21 +76,25 @@ pub enum Command {
     Sample(tutorial::SampleArgs),
     /// Run a scene: sample and histogram every case on the GPU, judge it with a χ² test
     /// against the f64 reference, and write histogram.json and heat maps per case.
+    #[command(after_help = EXIT_CODES)]
     Run(run::RunArgs),
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
     /// Drive every sampler with the inputs where naive formulas break, on the GPU (f32) and
     /// the CPU (f64); print case, kernel, worst errors and verdict.
+    #[command(after_help = EXIT_CODES)]
     Stress(stress::StressArgs),
     /// Print the composed WGSL that `lobes run` compiles for a scene's cases (each distinct
     /// module once), with the override constants its pipelines are made with.
     Shader(shader::ShaderArgs),
     /// Add up the shards of a scene (`lobes run SCENE --shard I/N`), judge the sums with the χ²
     /// test and write the same outputs as `lobes run`.
+    #[command(after_help = EXIT_CODES)]
     Merge(merge::MergeArgs),
     /// Judge your own WGSL sampler: its histogram against the GPU quadrature of its pdf (χ²),
     /// the pdf against the map's Jacobian, weights and albedo with an eval, and hard cases.
+    #[command(after_help = EXIT_CODES)]
     Check(check::CheckArgs),
     /// Accuracy against cost: sample count × kernel precision (f32 fast / f32 / f64), spherical
     /// caps against bounded VNDF, and the expected histogram's quadrature; writes tradeoff.md,
@@ -100,27 +122,42 @@ impl Cli {
 
 /// Bad input found after clap's parsing: the message names the flag and what is allowed.
 /// [`exit_code`] maps it to [`EXIT_USAGE`].
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
 pub struct UsageError(pub String);
-
-impl fmt::Display for UsageError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for UsageError {}
 
 /// A [`UsageError`] as an `anyhow::Error`.
 pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
 }
 
-/// The process exit code for an error: [`EXIT_USAGE`] if a [`UsageError`], a clap error or bad
-/// shards ([`ShardError`]) are anywhere in its chain, else [`EXIT_FAILURE`].
+/// Cases or checks that ran and failed their tests (the outputs are complete).
+/// [`exit_code`] maps it to [`EXIT_CHECKS_FAILED`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct ChecksFailed(pub String);
+
+/// A run stopped by SIGINT or SIGTERM after the case in flight. [`exit_code`] maps it to
+/// [`EXIT_INTERRUPTED`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct Interrupted(pub String);
+
+/// The process exit code for an error, by what is anywhere in its chain: an [`Interrupted`]
+/// gives [`EXIT_INTERRUPTED`]; a [`UsageError`], a clap error or bad shards ([`ShardError`])
+/// [`EXIT_USAGE`]; a [`ChecksFailed`] [`EXIT_CHECKS_FAILED`]; anything else (the tool could not
+/// do the work) [`EXIT_TOOL_FAILURE`].
 pub fn exit_code(err: &anyhow::Error) -> u8 {
-    let bad_input = err.chain().any(|e| e.is::<UsageError>() || e.is::<clap::Error>() || e.is::<ShardError>());
-    if bad_input { EXIT_USAGE } else { EXIT_FAILURE }
+    let any = |f: &dyn Fn(&(dyn std::error::Error + 'static)) -> bool| err.chain().any(f);
+    if any(&|e| e.is::<Interrupted>()) {
+        EXIT_INTERRUPTED
+    } else if any(&|e| e.is::<UsageError>() || e.is::<clap::Error>() || e.is::<ShardError>()) {
+        EXIT_USAGE
+    } else if any(&|e| e.is::<ChecksFailed>()) {
+        EXIT_CHECKS_FAILED
+    } else {
+        EXIT_TOOL_FAILURE
+    }
 }
 
 /// Creates the `--out` folder; a path that is not a folder or cannot be created is bad input.
@@ -379,6 +416,20 @@ mod tests {
         let err = anyhow::Error::from(ShardError("case 'c': samples 3..6 are missing".into())).context("lobes merge");
         assert_eq!(exit_code(&err), EXIT_USAGE);
         assert_eq!(exit_code(&usage("x")), EXIT_USAGE);
-        assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_FAILURE);
+        assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_TOOL_FAILURE);
+    }
+
+    #[test]
+    fn each_outcome_has_its_own_exit_code() {
+        let failed = anyhow::Error::from(ChecksFailed("1 of 3 cases failed".into())).context("lobes run");
+        assert_eq!(exit_code(&failed), EXIT_CHECKS_FAILED);
+        let stopped = anyhow::Error::from(Interrupted("interrupted".into())).context("lobes run");
+        assert_eq!(exit_code(&stopped), EXIT_INTERRUPTED);
+        let mut codes = [EXIT_CHECKS_FAILED, EXIT_USAGE, EXIT_TOOL_FAILURE, EXIT_INTERRUPTED, 0];
+        codes.sort();
+        assert!(codes.windows(2).all(|w| w[0] < w[1]), "distinct codes: {codes:?}");
+        for code in [EXIT_CHECKS_FAILED, EXIT_USAGE, EXIT_TOOL_FAILURE, EXIT_INTERRUPTED] {
+            assert!(EXIT_CODES.contains(&format!("\n  {code} ")), "--help documents {code}");
+        }
     }
 }

@@ -2,8 +2,8 @@
 //! the f64 reference, with per-case outputs and a table; with `--shard I/N`, one shard of every
 //! case, written as raw results for `lobes merge`.
 
-use super::{OutputArgs, emit, emit_json, parse_level, prepare_out, usage};
-use crate::report::output::{self, CaseSummary, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
+use super::{ChecksFailed, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, prepare_out, usage};
+use crate::report::output::{self, CaseSummary, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
@@ -11,19 +11,23 @@ use crate::scene::{Case, DEFAULT_SCENE, Entry, Scene, UserCase};
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 #[derive(Debug, Clone, Args)]
 pub struct RunArgs {
     /// Scene file (TOML); without it, the embedded scenes/all-lobes.toml (every lobe and method).
     pub scene: Option<PathBuf>,
-    /// Output folder: one subfolder per case with histogram.json and PNG heat maps.
+    /// Output folder: one subfolder per case with histogram.json and PNG heat maps, and the
+    /// run's summary.json and junit.xml (also when cases fail or the run is interrupted).
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
     /// Family-wise significance level, Šidák-corrected over the scene's cases.
     #[arg(long, default_value_t = 0.01, value_parser = parse_level, allow_hyphen_values = true)]
     pub significance: f64,
-    /// Use the CPU reference engine even if a GPU adapter exists.
+    /// Run on the CPU reference engine (f64, all cores) instead of a GPU adapter. Without it a
+    /// missing adapter is an error (exit 3), never a silent move to the CPU.
     #[arg(long)]
     pub cpu: bool,
     /// Run only shard I of N (0 ≤ I < N) of every case: its contiguous range of sample indices,
@@ -73,7 +77,7 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
             .map_err(|e| usage(format!("{}: case '{}': {e}", scene.case_location(i), case.name)))?;
         if tiling.tiles > 1 {
             eprintln!(
-                "note: case '{}': {} bins exceed one storage binding of this adapter; counting them in {} passes of {} bins",
+                "lobes: note: case '{}': {} bins exceed one storage binding of this adapter; counting them in {} passes of {} bins",
                 case.name,
                 case.job.bins(),
                 tiling.tiles,
@@ -96,9 +100,9 @@ fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
 
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
 /// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
-fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, bar: &ProgressBar) -> anyhow::Result<CaseResult> {
+fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
     remove_stale(out, &case.name)?;
-    let sampled = run_case(backend, case, 0..case.samples, &mut |done| bar.set_position(done))?;
+    let sampled = run_case(backend, case, 0..case.samples, progress)?;
     let result = judge(case, sampled, level)?;
     let adapter = backend.adapter();
     output::write_case(out, &result, &adapter, backend.name())
@@ -107,12 +111,12 @@ fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, bar
 }
 
 /// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
-fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path) -> anyhow::Result<([String; 9], CaseSummary, bool)> {
+fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path) -> anyhow::Result<([String; 9], CaseSummary)> {
     remove_stale(out, &case.name)?;
     let result = run_user(backend, case, level)?;
     output::write_user_case(out, &result, backend.name())
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
-    Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }, result.passed()))
+    Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }))
 }
 
 /// The first user's sampler case of a scene and its location, if any.
@@ -127,6 +131,40 @@ fn progress_bar(samples: u64, name: &str) -> ProgressBar {
     bar
 }
 
+/// Progress off a terminal (a CI log), where indicatif draws nothing: a plain line per finished
+/// case, and a line a minute while a long case runs.
+struct PlainProgress {
+    on: bool,
+    cases: usize,
+}
+
+impl PlainProgress {
+    const EVERY: Duration = Duration::from_secs(60);
+
+    fn new(cases: usize) -> Self {
+        PlainProgress { on: !std::io::stderr().is_terminal(), cases }
+    }
+
+    /// The progress callback of case `i` (lobe cases report samples done).
+    fn samples<'a>(&self, i: usize, name: &'a str, samples: u64, bar: &'a ProgressBar) -> impl FnMut(u64) + 'a {
+        let (on, cases, start) = (self.on, self.cases, Instant::now());
+        let mut last = start;
+        move |done| {
+            bar.set_position(done);
+            if on && last.elapsed() >= Self::EVERY {
+                last = Instant::now();
+                eprintln!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64());
+            }
+        }
+    }
+
+    fn finished(&self, i: usize, name: &str, verdict: &str, seconds: f64) {
+        if self.on {
+            eprintln!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases);
+        }
+    }
+}
+
 pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     if let Some(shard) = args.shard {
         return run_shard(args, shard);
@@ -138,89 +176,100 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         return Err(usage(format!("{at}: case '{name}' is a WGSL sampler, which runs on a GPU adapter only; run without --cpu")));
     }
     prepare_out(&args.out)?;
-    let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
+    crate::report::summary::remove(&args.out)?;
+    let mut backend = Backend::open(args.cpu)?;
     check_fits(&backend, &scene)?;
-    let adapter = backend.adapter();
+    interrupt::watch()?;
     let n = scene.len();
     let level = sidak(args.significance, n);
+    let mut summary = RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level);
     let mut rows = Vec::new();
-    let mut summary = Vec::new();
-    let (mut failed, mut errors) = (0, 0);
-    let (mut cpu_rows, mut wall_rows, mut user_rows) = (false, false, false);
-    // A case that cannot run (device lost, a write that fails) is reported and skipped; the
-    // others still run. After a lost device the remaining cases run on the CPU engine.
+    let (mut wall_rows, mut user_rows) = (false, false);
+    let plain = PlainProgress::new(n);
+    // The case in which the device was lost: no further case runs on it.
+    let mut lost: Option<String> = None;
+    // A case that cannot run (a write that fails, a lost device) is reported and the others
+    // still run; a stop asked for by SIGINT/SIGTERM ends the run after the case in flight.
     for (i, (entry, at)) in scene.entries().enumerate() {
-        let outcome = match entry {
-            Entry::Lobe(case) => {
+        if interrupt::requested() {
+            summary.status = RunStatus::Interrupted;
+            summary.not_run.push(entry.name().to_string());
+            continue;
+        }
+        let t = Instant::now();
+        let outcome = match (&lost, entry) {
+            (Some(where_lost), _) => Err(anyhow::anyhow!("not run: the GPU device was lost in case '{where_lost}'")),
+            (None, Entry::Lobe(case)) => {
                 let bar = progress_bar(case.samples, &case.name);
-                let outcome = run_and_write(&mut backend, case, level, &args.out, &bar);
+                let outcome = run_and_write(&mut backend, case, level, &args.out, &mut plain.samples(i, &case.name, case.samples, &bar));
                 bar.finish_and_clear();
                 outcome.map(|result| {
-                    if result.gpu_seconds.is_none() {
-                        if backend.name() == "cpu" { cpu_rows = true } else { wall_rows = true }
-                    }
-                    let row = output::table_row(&result);
-                    (row, CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) }, result.passed())
+                    wall_rows |= result.gpu_seconds.is_none();
+                    (output::table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) })
                 })
             }
-            Entry::User(case) => {
+            (None, Entry::User(case)) => {
                 user_rows = true;
                 let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
-                bar.enable_steady_tick(std::time::Duration::from_millis(200));
+                bar.enable_steady_tick(Duration::from_millis(200));
                 let outcome = run_user_and_write(&backend, case, level, &args.out);
                 bar.finish_and_clear();
                 outcome
             }
         };
-        match outcome {
-            Ok((row, case_summary, passed)) => {
-                failed += usize::from(!passed);
+        let verdict = match outcome {
+            Ok((row, case_summary)) => {
+                let verdict = if case_summary.passed { "pass" } else { "FAIL" };
                 rows.push(row);
                 summary.push(case_summary);
+                verdict
             }
             Err(e) => {
-                errors += 1;
-                eprintln!("error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
-                if device_lost(&e) && matches!(backend, Backend::Gpu(_)) && i + 1 < n {
-                    eprintln!("warning: the GPU device is unusable; the remaining cases run on the CPU reference engine (f64, all cores)");
-                    backend = Backend::Cpu;
+                if lost.is_none() {
+                    eprintln!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
+                    if device_lost(&e) {
+                        eprintln!("lobes: error: the GPU device is unusable; the remaining cases do not run");
+                        lost = Some(entry.name().to_string());
+                    }
                 }
                 let dash = || "-".to_string();
                 rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
                 summary.push(CaseSummary::error(&entry, format!("{e:#}")));
+                "ERROR"
             }
-        }
+        };
+        plain.finished(i, entry.name(), verdict, t.elapsed().as_secs_f64());
     }
+    let written = crate::report::summary::write(&args.out, &summary);
     if args.output.json {
-        emit_json(&RunSummary {
-            format_version: SUMMARY_VERSION,
-            adapter,
-            backend: backend.name().into(),
-            significance: args.significance,
-            per_case_significance: level,
-            shard_files: None,
-            failed,
-            errors,
-            cases: summary,
-        })?;
+        emit_json(&summary)?;
     } else {
-        let mut text = format!("adapter: {adapter}\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n", args.significance);
+        let mut text = format!("adapter: {}\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n", summary.adapter, args.significance);
         text += &output::format_table(&rows);
-        if cpu_rows {
-            text += "\n* wall time of the CPU engine (no GPU adapter)\n";
-        }
         if wall_rows {
-            text += "\n* wall time: the adapter has no timestamp queries\n";
+            text += if args.cpu { "\n* wall time of the CPU engine (--cpu)\n" } else { "\n* wall time: the adapter has no timestamp queries\n" };
         }
         if user_rows {
             text += "\n† a WGSL sampler of your own: wall time of all its checks (lobes check); FAIL names the checks that failed\n";
         }
-        text += &format!("\noutputs in {}\n", args.out.display());
+        if !summary.not_run.is_empty() {
+            text += &format!("\ninterrupted: {} of {n} cases not run ({})\n", summary.not_run.len(), summary.not_run.join(", "));
+        }
+        text += &format!("\noutputs in {} (summary.json, junit.xml)\n", args.out.display());
         emit(&text)?;
     }
+    let (errors, failed) = (summary.errors, summary.failed);
+    if summary.status == RunStatus::Interrupted {
+        if let Err(e) = &written {
+            eprintln!("lobes: error: {e:#}");
+        }
+        let finished = n - summary.not_run.len();
+        return Err(Interrupted(format!("interrupted after {finished} of {n} cases ({errors} could not run, {failed} failed)")).into());
+    }
+    written?;
     match (errors, failed) {
         (0, 0) => Ok(()),
-        (0, f) => anyhow::bail!("{f} of {n} cases failed the χ² test or the albedo checks (or, for a WGSL sampler, one of its checks)"),
+        (0, f) => Err(ChecksFailed(format!("{f} of {n} cases failed the χ² test or the albedo checks (or, for a WGSL sampler, one of its checks)")).into()),
         (e, 0) => anyhow::bail!("{e} of {n} cases could not run (see the errors above)"),
         (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test or the albedo checks"),
     }
@@ -237,7 +286,7 @@ fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
              run it without --shard, or put it in a scene of its own"
         )));
     }
-    let mut backend = if args.cpu { Backend::Cpu } else { Backend::open_or_cpu() };
+    let mut backend = Backend::open(args.cpu)?;
     let adapter = backend.adapter();
     prepare_out(&args.out)?;
     let origin = ShardOrigin { scene: &source, cases: scene.cases.len(), shard, adapter: &adapter, backend: backend.name() };

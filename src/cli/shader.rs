@@ -28,7 +28,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     }
     // The module depends on the adapter's limits (workgroup storage, storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
-    let engine = GpuEngine::open().map_err(|e| eprintln!("note: {e}\nnote: composing for wgpu's default limits")).ok();
+    let engine = GpuEngine::open().map_err(|e| eprintln!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits")).ok();
     let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
     for entry in entries {
         let m = match entry {

@@ -57,6 +57,8 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
         t += &format!("\n{} rows, {failed} failed\n", rows.len());
         emit(&t)?;
     }
-    anyhow::ensure!(failed == 0, "{failed} stress rows failed");
+    if failed > 0 {
+        return Err(super::ChecksFailed(format!("{failed} stress rows failed")).into());
+    }
     Ok(())
 }

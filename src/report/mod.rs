@@ -9,9 +9,13 @@ pub mod atomic;
 pub mod check;
 pub mod colour;
 pub mod heatmap;
+#[cfg(feature = "cli")]
+pub mod junit;
 pub mod label;
 pub mod output;
 pub mod schema;
+#[cfg(feature = "cli")]
+pub mod summary;
 pub mod png;
 pub mod table;
 pub mod text;

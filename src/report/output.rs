@@ -1,6 +1,6 @@
 //! Per-case outputs: `histogram.json` and PNG heat maps of the measured histogram, the
 //! expected one and the signed residual (measured − expected)/√expected; shard files; and the
-//! `--json` summaries of `lobes run` and `lobes merge`. Each is a serde struct that writer and
+//! summary of `lobes run` and `lobes merge` (`OUT/summary.json`, `OUT/junit.xml`, `--json`). Each is a serde struct that writer and
 //! reader share, with a `format_version`; `docs/schema/` holds their JSON Schema
 //! ([`super::schema`]). Every file is written atomically ([`super::atomic`]), and
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
@@ -24,8 +24,9 @@ use std::path::{Path, PathBuf};
 
 /// The version of the layout of `histogram.json`.
 pub const HISTOGRAM_VERSION: u32 = 1;
-/// The version of the layout of the `--json` summaries of `lobes run` and `lobes merge`.
-pub const SUMMARY_VERSION: u32 = 1;
+/// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
+/// `--json`) and of `lobes run --shard` (2: the run's status, lobes' version, why a case failed).
+pub const SUMMARY_VERSION: u32 = 2;
 
 /// `histogram.json`: a case's measured and expected histograms and its verdicts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -264,7 +265,8 @@ fn write_maps(folder: &Path, name: &str, a: &Axes, measured: &[f64], expected: &
     for (file, title, values, scale) in maps {
         let (rows, cols, row_label, col_label, row_range, col_range) = (a.rows, a.cols, a.row_label, a.col_label, a.row_range, a.col_range);
         let map = Heatmap { title: &title, rows, cols, values, scale, row_label, col_label, row_range, col_range };
-        heatmap::write_png(&map, &folder.join(file))?;
+        let path = folder.join(file);
+        heatmap::write_png(&map, &path).map_err(|e| anyhow::anyhow!("cannot write {}: {e:#}", path.display()))?;
     }
     Ok(())
 }
@@ -307,11 +309,17 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> a
     Ok(())
 }
 
-/// The `--json` summary of `lobes run` and `lobes merge`.
+/// The summary of `lobes run` and `lobes merge`: `OUT/summary.json` (written on every run that
+/// got as far as its output folder, failed and interrupted ones included,
+/// [`super::summary::write`]) and the `--json` output.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct RunSummary {
     /// [`SUMMARY_VERSION`].
     pub format_version: u32,
+    /// The version of lobes that wrote it.
+    pub lobes_version: String,
+    /// Whether every case of the scene is in `cases`, or the run was interrupted.
+    pub status: RunStatus,
     pub adapter: String,
     pub backend: String,
     /// The family-wise level, and the Šidák-corrected level of each case.
@@ -324,7 +332,47 @@ pub struct RunSummary {
     pub failed: usize,
     /// Cases that could not run (always 0 for `lobes merge`, which stops at the first error).
     pub errors: usize,
+    /// The cases that finished (passed, failed or could not run), in scene order.
     pub cases: Vec<CaseSummary>,
+    /// The scene's cases that never started because the run was interrupted.
+    pub not_run: Vec<String>,
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum RunStatus {
+    /// Every case of the scene ran (or could not run, with its error).
+    Complete,
+    /// Stopped by SIGINT or SIGTERM after the case in flight; `not_run` lists the rest.
+    Interrupted,
+}
+
+impl RunSummary {
+    /// The summary header of a run of this version of lobes; the caller fills in the cases.
+    pub fn new(adapter: String, backend: String, significance: f64, per_case_significance: f64) -> Self {
+        RunSummary {
+            format_version: SUMMARY_VERSION,
+            lobes_version: env!("CARGO_PKG_VERSION").into(),
+            status: RunStatus::Complete,
+            adapter,
+            backend,
+            significance,
+            per_case_significance,
+            shard_files: None,
+            failed: 0,
+            errors: 0,
+            cases: Vec::new(),
+            not_run: Vec::new(),
+        }
+    }
+
+    /// Adds a finished case, counting it as failed or as an error.
+    pub fn push(&mut self, case: CaseSummary) {
+        self.failed += usize::from(case.error.is_none() && !case.passed);
+        self.errors += usize::from(case.error.is_some());
+        self.cases.push(case);
+    }
 }
 
 /// One case of a [`RunSummary`].
@@ -335,7 +383,7 @@ pub struct CaseSummary {
     /// The shards added up (`lobes merge` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shards: Option<usize>,
-    /// The backend the case ran on (`lobes run` only: it may move to the CPU mid-run).
+    /// The backend the case ran on (`lobes run` only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backend: Option<String>,
     /// The case's verdict ([`CaseResult::passed`]): χ² and, where weighted, the albedo checks;
@@ -344,6 +392,9 @@ pub struct CaseSummary {
     /// The checks a user's sampler failed, by name (absent for lobes' own samplers).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub failed_checks: Option<Vec<String>>,
+    /// Why a case that ran failed, in one line (absent where it passed or could not run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub failure: Option<String>,
     /// What the case measured (absent where it could not run).
     #[serde(flatten)]
     pub measured: Option<CaseMeasured>,
@@ -387,6 +438,7 @@ impl CaseSummary {
             backend: None,
             passed: r.passed(),
             failed_checks: None,
+            failure: failure(r),
             measured: Some(CaseMeasured {
                 gpu_seconds: r.gpu_seconds,
                 wall_seconds: r.histogram_seconds,
@@ -417,6 +469,10 @@ impl CaseSummary {
             backend: None,
             passed: r.passed(),
             failed_checks: Some(r.failed_checks().into_iter().map(String::from).collect()),
+            failure: (!r.passed()).then(|| {
+                let failed = r.report.checks.iter().filter(|c| !c.passed);
+                failed.map(|c| format!("{}: {}", c.name(), c.summary)).collect::<Vec<_>>().join("; ")
+            }),
             measured: Some(CaseMeasured {
                 gpu_seconds: None,
                 wall_seconds: r.wall_seconds,
@@ -447,11 +503,41 @@ impl CaseSummary {
             backend: None,
             passed: false,
             failed_checks: None,
+            failure: None,
             measured: None,
             error: Some(error),
             output: None,
         }
     }
+}
+
+/// Why a case failed, in one line: the χ² test and, where weighted, the albedo checks.
+fn failure(r: &CaseResult) -> Option<String> {
+    let mut why = Vec::new();
+    let c = &r.chi2;
+    if !c.passed {
+        why.push(format!("χ² = {:.1} with {} dof, p = {:.3e} below the case's level {:.3e}", c.statistic, c.dof, c.p_value, c.significance));
+        if c.in_impossible_cells > 0 {
+            why.push(format!("{} samples in bins of zero probability", c.in_impossible_cells));
+        }
+    }
+    if let Some(w) = r.weighted.as_ref().filter(|w| !w.check.passed) {
+        let a = &w.check;
+        why.push(format!(
+            "albedo {:.5} against {:.5} by quadrature (relative error {:+.1e}, p = {:.3e}, level {:.3e})",
+            a.albedo, a.reference, a.relative_error, a.p_value, a.significance
+        ));
+        if let Some(p) = a.furnace_p_value.filter(|&p| p < a.significance) {
+            why.push(format!("white furnace p = {p:.3e}"));
+        }
+        if a.max_weight_error > a.weight_error_limit {
+            why.push(format!("weight error {:.1e} above the limit {:.1e}", a.max_weight_error, a.weight_error_limit));
+        }
+        if a.overflow > 0 {
+            why.push(format!("{} weights not finite or ≥ 2²³", a.overflow));
+        }
+    }
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// The `--json` summary of `lobes run --shard I/N`.

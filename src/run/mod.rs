@@ -28,20 +28,15 @@ pub const ANGLE_CHECK_SAMPLES: u32 = 4096;
 /// Where histograms are made.
 pub enum Backend {
     Gpu(Box<GpuEngine>),
-    /// The f64 reference on all cores, where no GPU adapter exists.
+    /// The f64 reference on all cores, when asked for (`lobes run --cpu`).
     Cpu,
 }
 
 impl Backend {
-    /// The GPU if an adapter opens, else the CPU engine after a warning naming the fix.
-    pub fn open_or_cpu() -> Backend {
-        match GpuEngine::open() {
-            Ok(e) => Backend::Gpu(Box::new(e)),
-            Err(e) => {
-                eprintln!("warning: {e}\nwarning: running on the CPU reference engine instead (f64, all cores)");
-                Backend::Cpu
-            }
-        }
+    /// The CPU engine if `cpu`, else the GPU; no adapter is an error naming the fix (never a
+    /// silent move to the CPU, which would run no WGSL kernel at all).
+    pub fn open(cpu: bool) -> Result<Backend, GpuError> {
+        if cpu { Ok(Backend::Cpu) } else { GpuEngine::open().map(|e| Backend::Gpu(Box::new(e))) }
     }
 
     pub fn adapter(&self) -> String {
@@ -207,8 +202,8 @@ pub fn judge(case: &Case, sampled: Sampled, significance: f64) -> anyhow::Result
     })
 }
 
-/// Whether `err` left the GPU device unusable, so that `lobes run` moves the remaining cases
-/// to the CPU engine ([`GpuError::is_device_lost`] anywhere in its chain).
+/// Whether `err` left the GPU device unusable, so that `lobes run` runs no further case on it
+/// ([`GpuError::is_device_lost`] anywhere in its chain).
 pub fn device_lost(err: &anyhow::Error) -> bool {
     err.chain().any(|e| e.downcast_ref::<GpuError>().is_some_and(GpuError::is_device_lost))
 }
@@ -218,7 +213,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_lost_device_moves_the_run_to_the_cpu_and_an_inconsistent_tile_does_not() {
+    fn a_lost_device_stops_the_run_and_an_inconsistent_tile_does_not() {
         let lost = anyhow::Error::new(GpuError::Lost("Parent device is lost".into())).context("case 'a'");
         assert!(device_lost(&lost));
         let tile = anyhow::Error::new(GpuError::Inconsistent("tile 1 of 3 counted invalid samples".into())).context("case 'a'");

@@ -47,8 +47,8 @@ impl Albedo {
     }
 }
 
-/// A check's error as a run's: a GPU error keeps its type, so that a lost device moves the run's
-/// remaining cases to the CPU ([`super::device_lost`]).
+/// A check's error as a run's: a GPU error keeps its type, so that a lost device stops the run's
+/// remaining cases ([`super::device_lost`]).
 fn run_error(e: CheckError) -> anyhow::Error {
     match e {
         CheckError::Gpu(g) => anyhow::Error::new(g),

@@ -1,0 +1,32 @@
+//! SIGINT (Ctrl-C) and SIGTERM during `lobes run`: the first signal asks the run to stop after
+//! the case in flight (which then reports and writes what finished, [`super::Interrupted`]); a
+//! second one ends the process at once with [`super::EXIT_INTERRUPTED`]. Every file lobes writes
+//! is atomic ([`crate::report::atomic`]) and a case's `histogram.json` comes last, so a case cut
+//! short that way leaves a folder without `histogram.json`: recognisably incomplete.
+
+use signal_hook::consts::{SIGINT, SIGTERM};
+use signal_hook::iterator::Signals;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Whether a signal arrived since [`watch`].
+static REQUESTED: AtomicBool = AtomicBool::new(false);
+
+/// Starts watching for SIGINT and SIGTERM, on a thread of its own (where printing is safe).
+pub fn watch() -> anyhow::Result<()> {
+    let mut signals = Signals::new([SIGINT, SIGTERM]).map_err(|e| anyhow::anyhow!("cannot watch for Ctrl-C: {e}"))?;
+    std::thread::spawn(move || {
+        for _ in signals.forever() {
+            if REQUESTED.swap(true, Ordering::SeqCst) {
+                eprintln!("lobes: interrupted again: stopping now; the case in flight has no histogram.json");
+                std::process::exit(super::EXIT_INTERRUPTED.into());
+            }
+            eprintln!("lobes: interrupted: stopping after the case in flight (interrupt again to stop now)");
+        }
+    });
+    Ok(())
+}
+
+/// Whether a stop was asked for.
+pub fn requested() -> bool {
+    REQUESTED.load(Ordering::SeqCst)
+}
