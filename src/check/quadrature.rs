@@ -291,12 +291,14 @@ pub struct SphereIntegral {
 }
 
 /// A sphere integral's parts: per hemisphere, bands of a = 1 − |cos θ| doubling away from the
-/// pole, [0, 2⁻³⁰], [2⁻³⁰, 2⁻²⁹], …, [½, 1], each cut into `AZIMUTH_PARTS` in φ. A peak at a
-/// pole of width w (a ≈ w²/2) then starts on parts of its own size in a, which bins uniform in
-/// cos θ reach only past [`MAX_DEPTH`] for w below ~10⁻² (a microfacet D with α = 10⁻³).
+/// pole, [0, 2⁻³⁰], [2⁻³⁰, 2⁻²⁹], …, [2⁻⁷, 2⁻⁶], then 2⁶ − 1 even bands of 2⁻⁶ to the equator,
+/// each cut into `AZIMUTH_PARTS` in φ. A peak at a pole of width w (a ≈ w²/2) then starts on
+/// parts of its own size in a, which bins uniform in cos θ reach only past [`MAX_DEPTH`] for w
+/// below ~10⁻² (a microfacet D with α = 10⁻³); the even bands keep the parts away from the pole
+/// small, where a kink such as max(0, ω·h)'s crosses them.
 const POLE_BANDS: i32 = 30;
-const AZIMUTH_PARTS: u32 = 64;
 const EVEN_BANDS: i32 = 6;
+const AZIMUTH_PARTS: u32 = 64;
 
 /// The sample count of the tolerance (module doc) for a sphere integral: 10¹², a part's
 /// tolerance 10⁻⁸ √(its integral) plus the rounding of its sum (f32's 2·10⁻⁶ on the GPU).
@@ -340,6 +342,16 @@ pub fn sphere_integral_f64(f: &(dyn Fn(glam::DVec3) -> f64 + Send + Sync)) -> Sp
 /// A WGSL function `fn name(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`
 /// (the signature of `lobes check`'s pdf), compiled once with lobes' quadrature pass and
 /// integrated over the unit sphere in d on the GPU, in f32, for any `params` and `wi`.
+///
+/// ```no_run
+/// use lobes::check::{Source, quadrature::WgslIntegrand};
+/// let gpu = lobes::engine::gpu::Gpu::new()?;
+/// // the cosine density max(0, cos θ) / π integrates to 1
+/// let text = "fn cosine(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return max(d.z, 0.0) / 3.14159265; }";
+/// let f = WgslIntegrand::new(&gpu, vec![Source { name: "cosine.wgsl".into(), text: text.into() }], "cosine")?;
+/// assert!((f.integrate(&[], glam::DVec3::Z)?.value - 1.0).abs() < 1e-5);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub struct WgslIntegrand<'g> {
     passes: Passes<'g>,
 }
