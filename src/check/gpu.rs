@@ -37,6 +37,8 @@ pub(super) struct Passes<'g> {
     module: wgpu::ShaderModule,
     /// GPU time of the passes run so far (timestamp queries; `None` without them).
     gpu_seconds: std::cell::Cell<Option<f64>>,
+    /// Each entry point's pipeline, created at its first run (a quadrature runs one per round).
+    pipelines: std::cell::RefCell<std::collections::HashMap<String, wgpu::ComputePipeline>>,
 }
 
 /// The generated wrappers that call the user's functions under the names the passes use.
@@ -108,7 +110,7 @@ impl<'g> Passes<'g> {
             source: wgpu::ShaderSource::Wgsl(composed.text.as_str().into()),
         });
         gpu.check_errors()?;
-        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)) })
+        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default() })
     }
 
     /// GPU time of the passes run so far, where the adapter has timestamp queries.
@@ -120,7 +122,7 @@ impl<'g> Passes<'g> {
     /// `out_bytes` of the buffer it writes (binding 2, or binding 3 for the histogram's counters).
     fn run(&self, entry: &str, params: &Params, input: &[[f32; 4]], invocations: u32, out_bytes: u64, counts: bool) -> Result<Vec<u8>, CheckError> {
         let gpu = self.gpu;
-        let pipeline = gpu.pipeline(&self.module, None, entry, &[]);
+        let pipeline = self.pipelines.borrow_mut().entry(entry.to_string()).or_insert_with(|| gpu.pipeline(&self.module, None, entry, &[])).clone();
         let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check params"),
             contents: bytemuck::bytes_of(params),

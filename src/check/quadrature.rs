@@ -13,10 +13,15 @@
 //!
 //! Sphere bins are integrated over (a, φ) with a = 1 − |cos θ| per hemisphere (see
 //! `lobes_domain_point`), so that parts next to a pole keep their f32 resolution.
+//!
+//! The same rules integrate a function over the whole sphere ([`WgslIntegrand`] on the GPU,
+//! [`sphere_integral_f64`] on the CPU), from parts graded toward the poles rather than a
+//! histogram's bins: what the microfacet identities of `tests/microfacet_identities.rs` need.
 
-use super::gpu::{Params, Passes};
+use super::gpu::{self, Params, Passes};
 
-use super::{CheckError, Domain};
+use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
+use crate::engine::gpu::Gpu;
 use crate::stats::gauss_legendre::GaussLegendre;
 use serde::{Deserialize, Serialize};
 
@@ -188,10 +193,14 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64) -> Vec<Part>
 /// Integrates the user's pdf and eval over every bin. `width` is the narrowest feature expected,
 /// in radians on the sphere or domain units on the plane; `samples` the run's sample count.
 pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64) -> Result<Integrals, CheckError> {
+    refine(f, initial_parts(domain, rows, cols, width), (rows * cols) as usize, samples)
+}
+
+/// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says.
+fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) -> Result<Integrals, CheckError> {
     let n = samples.max(1) as f64;
     let rounding = f.rounding();
     let tolerance = |v: f64, n: f64| tolerance(v, n, rounding);
-    let bins = (rows * cols) as usize;
     let mut out = Integrals {
         probabilities: vec![0.0; bins],
         eval: vec![0.0; bins],
@@ -203,7 +212,6 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
         rounds: 0,
     };
     let mut bin_error = vec![0.0; bins];
-    let mut pending = initial_parts(domain, rows, cols, width);
     while !pending.is_empty() {
         out.rounds += 1;
         out.parts += pending.len() as u64;
@@ -266,4 +274,116 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
         .map(|(e, p)| e / (p.max(1.0 / n) / n).sqrt())
         .fold(0.0, f64::max);
     Ok(out)
+}
+
+/// ∫ f(d) dω over the unit sphere ([`WgslIntegrand::integrate`], [`sphere_integral_f64`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereIntegral {
+    pub value: f64,
+    /// Σ over parts of the accepted |fine − coarse| differences.
+    pub error_estimate: f64,
+    /// Parts accepted at the depth limit without agreeing.
+    pub unconverged_parts: u64,
+    /// Parts whose integral came out NaN, infinite or negative (left out of `value`).
+    pub bad_parts: u64,
+    /// Parts evaluated in all.
+    pub parts: u64,
+}
+
+/// A sphere integral's parts: per hemisphere, bands of a = 1 − |cos θ| doubling away from the
+/// pole, [0, 2⁻³⁰], [2⁻³⁰, 2⁻²⁹], …, [2⁻⁷, 2⁻⁶], then 2⁶ − 1 even bands of 2⁻⁶ to the equator,
+/// each cut into `AZIMUTH_PARTS` in φ. A peak at a pole of width w (a ≈ w²/2) then starts on
+/// parts of its own size in a, which bins uniform in cos θ reach only past [`MAX_DEPTH`] for w
+/// below ~10⁻² (a microfacet D with α = 10⁻³); the even bands keep the parts away from the pole
+/// small, where a kink such as max(0, ω·h)'s crosses them.
+const POLE_BANDS: i32 = 30;
+const EVEN_BANDS: i32 = 6;
+const AZIMUTH_PARTS: u32 = 64;
+
+/// The sample count of the tolerance (module doc) for a sphere integral: 10¹², a part's
+/// tolerance 10⁻⁸ √(its integral) plus the rounding of its sum (f32's 2·10⁻⁶ on the GPU).
+const SPHERE_SAMPLES: u64 = 1_000_000_000_000;
+
+fn graded_parts() -> Vec<Part> {
+    let step = 2f64.powi(-EVEN_BANDS);
+    let graded = (0..POLE_BANDS - EVEN_BANDS).map(|k| 2f64.powi(k - POLE_BANDS));
+    let even = (1..=1 << EVEN_BANDS).map(|k| k as f64 * step);
+    let edges: Vec<f64> = std::iter::once(0.0).chain(graded).chain(even).collect();
+    let dphi = std::f64::consts::TAU / AZIMUTH_PARTS as f64;
+    let mut parts = Vec::new();
+    for h in [1.0f32, -1.0] {
+        for band in edges.windows(2) {
+            for j in 0..AZIMUTH_PARTS {
+                let b = (-std::f64::consts::PI + j as f64 * dphi, -std::f64::consts::PI + (j + 1) as f64 * dphi);
+                parts.push(Part { a: (band[0], band[1]), b, h, bin: 0, depth: 0, coarse: None });
+            }
+        }
+    }
+    parts
+}
+
+fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
+    let i = refine(f, graded_parts(), 1, SPHERE_SAMPLES)?;
+    Ok(SphereIntegral { value: i.probabilities[0], error_estimate: i.error_estimate, unconverged_parts: i.unconverged_parts, bad_parts: i.bad_parts, parts: i.parts })
+}
+
+/// ∫ f(d) dω over the unit sphere in f64 on the CPU, by the rules and parts of [`WgslIntegrand`].
+///
+/// ```
+/// use lobes::check::quadrature::sphere_integral_f64;
+/// // ∫ max(0, cos θ) dω = π
+/// let i = sphere_integral_f64(&|d| d.z.max(0.0));
+/// assert!((i.value - std::f64::consts::PI).abs() < 1e-12);
+/// ```
+pub fn sphere_integral_f64(f: &(dyn Fn(glam::DVec3) -> f64 + Send + Sync)) -> SphereIntegral {
+    sphere_integral(&CpuPdf { pdf: f, plane: false }).expect("the CPU rules do not fail")
+}
+
+/// A WGSL function `fn name(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`
+/// (the signature of `lobes check`'s pdf), compiled once with lobes' quadrature pass and
+/// integrated over the unit sphere in d on the GPU, in f32, for any `params` and `wi`.
+///
+/// ```no_run
+/// use lobes::check::{Source, quadrature::WgslIntegrand};
+/// let gpu = lobes::engine::gpu::Gpu::new()?;
+/// // the cosine density max(0, cos θ) / π integrates to 1
+/// let text = "fn cosine(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return max(d.z, 0.0) / 3.14159265; }";
+/// let f = WgslIntegrand::new(&gpu, vec![Source { name: "cosine.wgsl".into(), text: text.into() }], "cosine")?;
+/// assert!((f.integrate(&[], glam::DVec3::Z)?.value - 1.0).abs() < 1e-5);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub struct WgslIntegrand<'g> {
+    passes: Passes<'g>,
+}
+
+/// The sampler the passes' module needs to compose (it holds every pass); the quadrature pass
+/// never calls it.
+const UNSAMPLED: &str = "quadrature_integrand_unsampled";
+
+impl<'g> WgslIntegrand<'g> {
+    /// Composes `sources` (which define `function`) with the quadrature pass; errors point at
+    /// the sources' file:line:column as `lobes check`'s do.
+    pub fn new(gpu: &'g Gpu, mut sources: Vec<Source>, function: &str) -> Result<Self, CheckError> {
+        sources.push(Source {
+            name: "the quadrature's unused sampler (src/check/quadrature.rs)".into(),
+            text: format!("fn {UNSAMPLED}(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{ return vec4<f32>(0.0); }}\n"),
+        });
+        let sampler = UserSampler { sources, sample: UNSAMPLED.into(), pdf: function.into(), eval: None, domain: Domain::Sphere };
+        sampler.validate()?;
+        Ok(Self { passes: Passes::new(gpu, &gpu::compose(&sampler)?)? })
+    }
+
+    /// ∫ function(wi, d, params) dω(d) over the unit sphere; `params` are at most 16 numbers,
+    /// zero-padded into `params: array<vec4<f32>, 4>` as `lobes check --params` are.
+    pub fn integrate(&self, params: &[f64], wi: glam::DVec3) -> Result<SphereIntegral, CheckError> {
+        if params.len() > MAX_PARAMS {
+            return Err(CheckError::Input(format!("{} params given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", params.len())));
+        }
+        let mut p: Params = bytemuck::Zeroable::zeroed();
+        for (i, v) in params.iter().enumerate() {
+            p.user[i / 4][i % 4] = *v as f32;
+        }
+        p.wi = [wi.x as f32, wi.y as f32, wi.z as f32, 0.0];
+        sphere_integral(&(&self.passes, &p))
+    }
 }
