@@ -129,6 +129,7 @@ fn three_shards_merge_to_exactly_the_unsharded_run() {
         }
     }
     assert!(dir.join("merged/beckmann-ndf/albedo.png").is_file());
+    assert!(dir.join("merged/index.html").is_file() && dir.join("full/index.html").is_file());
     // the same table as `lobes run`
     let text = lobes(&dir, &["merge", "part0", "part1", "part2", "--out", "merged-again"]);
     let table = String::from_utf8_lossy(&text.stdout);

@@ -191,6 +191,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             }
         }
     }
+    let heading = [format!("adapter: {adapter}"), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
+    crate::report::html::write_index(&args.out, &heading, &summary)?;
     if args.output.json {
         emit_json(&RunSummary {
             format_version: SUMMARY_VERSION,
@@ -204,7 +206,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             cases: summary,
         })?;
     } else {
-        let mut text = format!("adapter: {adapter}\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n", args.significance);
+        let mut text = format!("{}\n\n", heading.join("\n"));
         text += &output::format_table(&rows);
         if cpu_rows {
             text += "\n* wall time of the CPU engine (no GPU adapter)\n";
