@@ -30,7 +30,7 @@ pub struct Panel {
 const PANEL: (u32, u32) = (560, 380);
 const HEAD_H: u32 = 64;
 /// The legend's width: the narrowest picture.
-const LEGEND_W: u32 = 780;
+const LEGEND_W: u32 = 860;
 const TEXT_PX: f64 = 16.0;
 const BAR: RGBColor = RGBColor(240, 150, 40);
 const BAR_OUT: RGBColor = RGBColor(210, 30, 30);
@@ -85,7 +85,7 @@ where
     };
     let rect = |c: RGBColor| move |x: i32| Ok(area.draw(&Rectangle::new([(x, y - 7), (x + 22, y + 7)], c.filled()))?);
     entry(&rect(BAR), "measured")?;
-    entry(&rect(BAR_OUT), "measured, outside the band")?;
+    entry(&rect(BAR_OUT), "outside the band (1 bin in 20 by chance)")?;
     entry(&|x| Ok(area.draw(&PathElement::new([(x, y), (x + 22, y)], BLACK.stroke_width(2)))?), "expected")?;
     entry(&rect(BAND), "expected ± 2σ (σ = √expected)")
 }
