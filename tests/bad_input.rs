@@ -436,12 +436,13 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     assert!(stderr.contains("writing the outputs into") && stderr.contains("no histogram.json was written"), "{stderr}");
     assert!(stderr.contains("1 of 3 cases could not run"), "{stderr}");
     assert!(!broken.join("histogram.json").exists(), "the failed case left a histogram.json");
-    assert_eq!(tree(&broken), ["expected.png", "measured.png", "residual.png"], "no temporary files are left");
+    // (marginals.png, written after residual.png, is the earlier run's)
+    assert_eq!(tree(&broken), ["expected.png", "marginals.png", "measured.png", "residual.png"], "no temporary files are left");
     let table = String::from_utf8_lossy(&again.stdout);
     assert!(table.lines().any(|l| l.starts_with("broken") && l.contains("ERROR")), "{table}");
-    for ok in ["first", "last"] {
-        assert_eq!(tree(&out.join(ok)), ["expected.png", "histogram.json", "measured.png", "residual.png"]);
-    }
+    assert_eq!(tree(&out.join("first")), ["expected.png", "histogram.json", "marginals.png", "measured.png", "residual.png"]);
+    // a discrete case: a bar chart of its items
+    assert_eq!(tree(&out.join("last")), ["bars.png", "histogram.json"]);
     let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!((summary["errors"].as_u64(), summary["failed"].as_u64(), summary["status"].as_str()), (Some(1), Some(0), Some("complete")));
     assert!(summary["cases"][1]["error"].as_str().unwrap().contains("residual.png"), "{summary}");

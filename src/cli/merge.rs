@@ -50,18 +50,17 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         rows.push(output::table_row(&result));
         summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
     }
-    crate::report::summary::write(&args.out, &summary)?;
+    let heading = [
+        format!("adapter: {adapter}"),
+        format!("merged {} shard files of scene {} ({})", shards.len(), merged.scene_name, merged.scene_fnv1a64),
+        format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance),
+    ];
+    crate::report::summary::write(&args.out, &summary, &heading)?;
     let failed = summary.failed;
     if args.output.json {
         emit_json(&summary)?;
     } else {
-        let mut text = format!(
-            "adapter: {adapter}\nmerged {} shard files of scene {} ({})\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n",
-            shards.len(),
-            merged.scene_name,
-            merged.scene_fnv1a64,
-            args.significance,
-        );
+        let mut text = format!("{}\n\n", heading.join("\n"));
         text += &output::format_table(&rows);
         if shards.iter().any(|s| s.file.timing.gpu_seconds.is_none()) {
             text += "\n* wall time (no GPU timestamps for some shards)\n";

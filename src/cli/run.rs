@@ -240,11 +240,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         };
         plain.finished(i, entry.name(), verdict, t.elapsed().as_secs_f64());
     }
-    let written = crate::report::summary::write(&args.out, &summary);
+    let heading = [format!("adapter: {}", summary.adapter), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
+    let written = crate::report::summary::write(&args.out, &summary, &heading);
     if args.output.json {
         emit_json(&summary)?;
     } else {
-        let mut text = format!("adapter: {}\nsignificance {} (Šidák over {n} cases: {level:.3e} each)\n\n", summary.adapter, args.significance);
+        let mut text = format!("{}\n\n", heading.join("\n"));
         text += &output::format_table(&rows);
         if wall_rows {
             text += if args.cpu { "\n* wall time of the CPU engine (--cpu)\n" } else { "\n* wall time: the adapter has no timestamp queries\n" };

@@ -3,6 +3,9 @@
 //! - [`Scale::Sequential`]: viridis-like, from `min(0, min v)` to `max v`. When every value
 //!   is `>= 0` and `max / min_positive > 1e3`, it switches to `log10(1 + v/p)` with `p` the
 //!   smallest positive value (for integer counts `p = 1`, i.e. plain `log10(1 + v)`).
+//! - [`Mapping::counts`]: for counts and expected counts drawn on one scale, `log10(1 + v/p)`
+//!   with `p` fixed at [`COUNT_FLOOR`] (a tenth of one count) rather than the smallest value, so
+//!   that an expected tail of 1e-300 does not stretch the scale over 300 empty decades.
 //! - [`Scale::Diverging`]: blue-white-red, symmetric in `[-L, L]` with `L = max |v|`
 //!   (at least a tiny positive number), so 0 is white.
 //!
@@ -48,6 +51,11 @@ pub(crate) const BLUE_WHITE_RED: [[u8; 3]; 5] = [
     [103, 0, 31],
 ];
 
+/// The floor of a log count scale ([`Mapping::counts`]): a tenth of one count. Expected counts
+/// far below it are as good as zero (no bin holds a tenth of a sample), while a bin expecting
+/// about one count stands clearly above an empty one.
+pub const COUNT_FLOOR: f64 = 0.1;
+
 /// Maps finite values to `t ∈ [0, 1]` along the colormap, and back for tick labels.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Mapping {
@@ -71,6 +79,17 @@ impl Mapping {
                 Some(p) if s.min >= 0.0 && s.max / p > LOG_RATIO => Mapping::Log { p, hi: s.max },
                 _ => Self::linear(s.min.min(0.0), s.max),
             },
+        }
+    }
+
+    /// The scale of counts and expected counts drawn side by side (fit it to both): logarithmic
+    /// from [`COUNT_FLOOR`] when the largest value exceeds `LOG_RATIO` floors, else linear from 0.
+    pub fn counts(values: &[f64]) -> Self {
+        let s = Stats::of(values);
+        if s.min >= 0.0 && s.max / COUNT_FLOOR > LOG_RATIO {
+            Mapping::Log { p: COUNT_FLOOR, hi: s.max }
+        } else {
+            Self::linear(s.min.min(0.0), s.max)
         }
     }
 
@@ -185,5 +204,20 @@ mod tests {
             Mapping::fit(Scale::Sequential, &[f64::NAN]),
             Mapping::Linear { lo: 0.0, hi: 1.0 }
         );
+    }
+
+    #[test]
+    fn a_count_scale_starts_at_its_floor_whatever_the_smallest_value() {
+        // an expected tail of 4.9e-319 beside 1e5 counts: the middle of the scale is
+        // p(√(1 + hi/p) − 1) with p = 0.1 (t = ½ of ln(1 + v/p)/ln(1 + hi/p)), about 99.9
+        let m = Mapping::counts(&[0.0, 4.9e-319, 3.0, 1e5]);
+        assert_eq!(m, Mapping::Log { p: 0.1, hi: 1e5 });
+        let mid = 0.1 * ((1.0f64 + 1e6).sqrt() - 1.0);
+        assert!((m.value_at(0.5) - mid).abs() < 1e-9 * mid, "{}", m.value_at(0.5));
+        // one count sits at ln 11 / ln(1 + 1e6) of the way up, well clear of an empty bin
+        assert!((m.unit(1.0) - 11f64.ln() / 1_000_001f64.ln()).abs() < 1e-12);
+        assert_eq!(m.unit(0.0), 0.0);
+        // few counts: linear from 0
+        assert_eq!(Mapping::counts(&[0.5, 40.0]), Mapping::Linear { lo: 0.0, hi: 40.0 });
     }
 }

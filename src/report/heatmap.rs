@@ -18,7 +18,7 @@ pub use super::colour::{Mapping, Scale};
 /// A 2-D histogram to draw.
 #[derive(Debug, Clone, Copy)]
 pub struct Heatmap<'a> {
-    /// Title drawn at the top (any text; characters the font lacks become a box).
+    /// Title drawn at the top, a line per `\n` (any text; characters the font lacks become a box).
     pub title: &'a str,
     /// Number of rows (the vertical axis, e.g. cos θ bins).
     pub rows: usize,
@@ -81,8 +81,10 @@ pub fn render_scaled(h: &Heatmap, mapping: Mapping) -> RgbImage {
         draw_nan_key(&mut img, &lay);
     }
     draw_axis_labels(&mut img, h, &lay);
-    let title_x = (lay.width as i64 - text_width(h.title) as i64) / 2;
-    draw_text(&mut img, title_x.max(PAD as i64), PAD as i64, h.title, INK);
+    for (k, line) in h.title.split('\n').enumerate() {
+        let x = (lay.width as i64 - text_width(line) as i64) / 2;
+        draw_text(&mut img, x.max(PAD as i64), (PAD + k as u32 * LINE_H) as i64, line, INK);
+    }
     img
 }
 
@@ -99,7 +101,7 @@ pub fn write_png_scaled(h: &Heatmap, mapping: Mapping, path: &Path) -> io::Resul
 
 fn write_image(img: &RgbImage, path: &Path) -> io::Result<()> {
     let png = super::png::encode(img).map_err(io::Error::other)?;
-    super::atomic::write_atomic(path, &png)
+    super::atomic::write_atomic(path, &png).map_err(|e| io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display())))
 }
 
 /// Value of cell `i` (row-major); missing cells read as NaN.
@@ -139,8 +141,9 @@ impl Layout {
             h.row_label.into(),
         ];
         let left = row_texts.iter().map(|s| text_width(s)).max().unwrap_or(0) + GAP + PAD;
-        // title line, then the colour-bar caption line, then the map
-        let map_y = PAD + LINE_H + GAP + LINE_H + GAP + LINE_H / 2;
+        // the title's lines, then the colour-bar caption line, then the map
+        let title_lines = h.title.split('\n').count() as u32;
+        let map_y = PAD + title_lines * LINE_H + GAP + LINE_H + GAP + LINE_H / 2;
         let bar_x = left + map_w + BAR_GAP;
         let tick_w = ticks.iter().map(|s| text_width(s)).max().unwrap_or(0);
         let key_w = if has_bad {
@@ -149,7 +152,8 @@ impl Layout {
             0
         };
         let right = bar_x + BAR_W + TICK_LEN + GAP + tick_w.max(key_w).max(text_width("log")) + PAD;
-        let width = right.max((text_width(h.title) + 2 * PAD).min(MAX_WIDTH));
+        let title_w = h.title.split('\n').map(text_width).max().unwrap_or(0);
+        let width = right.max((title_w + 2 * PAD).min(MAX_WIDTH));
         // below the map: the column labels, and (lower, clear of the last tick label) the NaN key
         let height = nan_key_y(map_y, map_h) + LINE_H + PAD;
         Layout {

@@ -1,17 +1,24 @@
-//! Reports: per-case JSON and PNG heat maps (of `lobes run` and `lobes check`), the run table,
-//! the JSON Schema of every output, the one atomic file writer, and `lobes tradeoff`'s outputs.
+//! Reports: per-case JSON and PNG pictures (of `lobes run` and `lobes check`), the run table and
+//! its HTML page, the JSON Schema of every output, the one atomic file writer, and
+//! `lobes tradeoff`'s outputs.
 //!
 //! [`heatmap`] lays out a heat map from a [`colour`] scale, [`label`]s and [`text`], and
-//! [`png`] encodes it; [`table`] prints terminal tables; [`output`] writes a case's files,
-//! [`check`] those of `lobes check`.
+//! [`png`] encodes it; [`marginals`] charts bins against their expectation; [`compare`] draws a
+//! measured histogram against its expectation with both (one code path for `lobes run` and
+//! `lobes check`), titled by [`caption`]; [`table`] prints terminal tables; [`output`] writes a
+//! case's files, [`check`] those of `lobes check`; [`html`] writes the run's `index.html`.
 
 pub mod atomic;
+pub mod caption;
 pub mod check;
 pub mod colour;
+pub mod compare;
 pub mod heatmap;
 #[cfg(feature = "cli")]
 pub mod junit;
+pub mod html;
 pub mod label;
+pub mod marginals;
 pub mod output;
 pub mod schema;
 #[cfg(feature = "cli")]

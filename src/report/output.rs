@@ -6,6 +6,8 @@
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
 
 use super::atomic::write_atomic;
+use super::caption;
+use super::compare::{self, Bins, Comparison};
 use super::heatmap::{self, Heatmap, Scale};
 use crate::check::Domain;
 use crate::engine::job::Job;
@@ -231,58 +233,19 @@ pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     Ok(file)
 }
 
-/// A histogram's grid and the labels and ranges of its axes.
-#[derive(Clone, Copy)]
-struct Axes {
-    rows: usize,
-    cols: usize,
-    row_label: &'static str,
-    col_label: &'static str,
-    row_range: (f64, f64),
-    col_range: (f64, f64),
-}
-
-impl Axes {
-    /// Rows over cos θ in [−1, 1], columns over φ in [−π, π) (as lobes bins directions).
-    fn sphere(rows: usize, cols: usize) -> Self {
-        Axes { rows, cols, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-std::f64::consts::PI, std::f64::consts::PI) }
-    }
-}
-
-/// Writes the heat maps of the measured and expected counts and the signed residual
-/// (measured − expected)/√expected into `folder`.
-fn write_maps(folder: &Path, name: &str, a: &Axes, measured: &[f64], expected: &[f64]) -> anyhow::Result<()> {
-    let residual: Vec<f64> = measured
-        .iter()
-        .zip(expected)
-        .map(|(&o, &e)| if e > 0.0 { (o - e) / e.sqrt() } else if o > 0.0 { f64::NAN } else { 0.0 })
-        .collect();
-    let maps = [
-        ("measured.png", format!("{name}: measured counts"), measured, Scale::Sequential),
-        ("expected.png", format!("{name}: expected counts"), expected, Scale::Sequential),
-        ("residual.png", format!("{name}: (measured - expected)/sqrt(expected)"), &residual[..], Scale::Diverging),
-    ];
-    for (file, title, values, scale) in maps {
-        let (rows, cols, row_label, col_label, row_range, col_range) = (a.rows, a.cols, a.row_label, a.col_label, a.row_range, a.col_range);
-        let map = Heatmap { title: &title, rows, cols, values, scale, row_label, col_label, row_range, col_range };
-        let path = folder.join(file);
-        heatmap::write_png(&map, &path).map_err(|e| anyhow::anyhow!("cannot write {}: {e:#}", path.display()))?;
-    }
-    Ok(())
-}
-
 /// Writes the heat maps and then `histogram.json` of a user's sampler case into `dir/<case>/`.
 pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
-    let (rows, cols) = (r.report.rows as usize, r.report.cols as usize);
-    let axes = match r.report.domain {
-        Domain::Sphere => Axes::sphere(rows, cols),
-        Domain::Plane { bounds: [x0, y0, x1, y1] } => Axes { rows, cols, row_label: "y", col_label: "x", row_range: (y0, y1), col_range: (x0, x1) },
+    let doc = HistogramFile::of_user(r, backend);
+    let (rows, cols) = (doc.description.rows, doc.description.cols);
+    let bins = match r.report.domain {
+        Domain::Sphere => Bins::Sphere { rows, cols },
+        Domain::Plane { bounds } => Bins::Plane { rows, cols, bounds },
     };
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
-    write_maps(&folder, &r.case.name, &axes, &measured, &r.report.expected)?;
-    let doc = HistogramFile::of_user(r, backend);
+    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), r.chi2.p_value));
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
     write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
     Ok(())
 }
@@ -291,20 +254,28 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str) -> anyhow::Res
 pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
-    let axes = match &r.case.job {
-        Job::Lobe { grid, .. } => Axes::sphere(grid.rows as usize, grid.cols as usize),
-        Job::Discrete { dist, .. } => Axes { rows: 1, cols: dist.len(), row_label: "", col_label: "index", row_range: (0.0, 1.0), col_range: (0.0, dist.len() as f64) },
+    let doc = HistogramFile::new(r, adapter, backend);
+    let (rows, cols) = (doc.description.rows, doc.description.cols);
+    let bins = match &r.case.job {
+        Job::Lobe { .. } => Bins::Sphere { rows, cols },
+        Job::Discrete { .. } => Bins::Items(cols),
     };
     let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();
-    write_maps(&folder, &r.case.name, &axes, &measured, &r.expected.bins)?;
+    let mut verdict = caption::verdict(r.passed(), r.chi2.p_value);
+    if r.weighted.as_ref().is_some_and(|w| !w.check.passed) {
+        verdict += ", albedo check failed";
+    }
+    let caption = format!("{} ({}): {verdict}", r.case.name, caption::parameters(&doc.description));
+    let invalid: u64 = r.counts.invalid.iter().sum();
+    let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note })?;
     if let Some(w) = &r.weighted {
         let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
         let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
-        let Axes { rows, cols, row_label, col_label, row_range, col_range } = axes;
-        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label, col_label, row_range, col_range };
+        let pi = std::f64::consts::PI;
+        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi) };
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
-    let doc = HistogramFile::new(r, adapter, backend);
     write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
     Ok(())
 }

@@ -19,6 +19,19 @@ pub fn font_bytes() -> &'static [u8] {
     dejavu::sans::regular()
 }
 
+/// The family name the embedded font goes by in `plotters` charts ([`register_plotters_font`]).
+pub const PLOTTERS_FONT: &str = "sans-serif";
+
+/// Hands the embedded font to `plotters` as [`PLOTTERS_FONT`] (once per process; call before
+/// drawing a chart).
+pub fn register_plotters_font() {
+    static REGISTERED: std::sync::Once = std::sync::Once::new();
+    REGISTERED.call_once(|| {
+        plotters::style::register_font(PLOTTERS_FONT, plotters::style::FontStyle::Normal, font_bytes())
+            .unwrap_or_else(|_| panic!("the embedded font parses"));
+    });
+}
+
 static FONT: LazyLock<FontRef<'static>> =
     LazyLock::new(|| FontRef::try_from_slice(font_bytes()).expect("the embedded DejaVu Sans parses"));
 

@@ -8,13 +8,11 @@ use image::RgbImage;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
-use std::sync::Once;
 
 /// Size of one panel, and the height of the legend above the panels.
 const PANEL: (u32, u32) = (460, 340);
 const LEGEND_H: u32 = 40;
-/// The family name the embedded font is registered under for plotters.
-const FONT: &str = "sans-serif";
+use crate::report::text::PLOTTERS_FONT as FONT;
 const TEXT_PX: f64 = 16.0;
 const GREY: RGBColor = RGBColor(120, 120, 120);
 
@@ -28,11 +26,7 @@ fn colour(p: Precision) -> RGBColor {
 
 /// The picture: a legend line, then the panels two to a row.
 pub fn plot(sweep: &Sweep) -> anyhow::Result<RgbImage> {
-    static FONT_REGISTERED: Once = Once::new();
-    FONT_REGISTERED.call_once(|| {
-        plotters::style::register_font(FONT, FontStyle::Normal, text::font_bytes())
-            .unwrap_or_else(|_| panic!("the embedded font parses"));
-    });
+    text::register_plotters_font();
     let panels = sweep.lobes.len().max(1) as u32;
     let cols = panels.min(2);
     let rows = panels.div_ceil(cols);

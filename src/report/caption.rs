@@ -1,0 +1,57 @@
+//! A case in words: its lobe, method and parameters, and its verdict; the titles of its pictures
+//! and its entry in `index.html` say the same.
+
+use super::label::compact;
+use crate::run::record::{CaseDescription, Params};
+
+/// The lobe, method and parameters, e.g. `ggx vndf, α 0.3 × 0.1, θi 40°, φi 60°`.
+pub fn parameters(d: &CaseDescription) -> String {
+    let angles = |theta: f64, phi: f64| if phi == 0.0 { format!("θi {}°", compact(theta)) } else { format!("θi {}°, φi {}°", compact(theta), compact(phi)) };
+    match &d.params {
+        Params::Lobe { alpha_x, alpha_y, incident_theta_deg, incident_phi_deg } => {
+            let alpha = if alpha_x == alpha_y { compact(*alpha_x) } else { format!("{} × {}", compact(*alpha_x), compact(*alpha_y)) };
+            format!("{} {}, α {alpha}, {}", d.lobe, d.method, angles(*incident_theta_deg, *incident_phi_deg))
+        }
+        Params::Discrete { weights } => {
+            let shown: Vec<String> = weights.iter().take(12).map(|&w| compact(w)).collect();
+            let more = if weights.len() > 12 { format!(", … {} in all", weights.len()) } else { String::new() };
+            format!("discrete {}, weights [{}{more}]", d.method, shown.join(", "))
+        }
+        Params::User { sample, incident_theta_deg, incident_phi_deg, domain, .. } => {
+            let at = match (incident_theta_deg, incident_phi_deg) {
+                (Some(t), Some(p)) => format!(", {}", angles(*t, *p)),
+                _ => String::new(),
+            };
+            format!("WGSL sampler {sample} on the {domain}{at}")
+        }
+    }
+}
+
+/// The verdict in words: `pass` or `FAIL`, and the χ² p-value.
+pub fn verdict(passed: bool, p_value: f64) -> String {
+    format!("{}, χ² p = {}", if passed { "pass" } else { "FAIL" }, compact(p_value))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lobe(alpha_x: f64, alpha_y: f64, phi: f64) -> CaseDescription {
+        CaseDescription {
+            lobe: "ggx".into(),
+            method: "vndf".into(),
+            params: Params::Lobe { alpha_x, alpha_y, incident_theta_deg: 40.0, incident_phi_deg: phi },
+            rows: 64,
+            cols: 128,
+        }
+    }
+
+    #[test]
+    fn parameters_in_words() {
+        assert_eq!(parameters(&lobe(0.3, 0.3, 0.0)), "ggx vndf, α 0.3, θi 40°");
+        assert_eq!(parameters(&lobe(0.5, 0.1, 60.0)), "ggx vndf, α 0.5 × 0.1, θi 40°, φi 60°");
+        let d = CaseDescription { lobe: "discrete".into(), method: "alias".into(), params: Params::Discrete { weights: vec![0.0, 3.0, 1e-3] }, rows: 1, cols: 3 };
+        assert_eq!(parameters(&d), "discrete alias, weights [0, 3, 1e-3]");
+        assert_eq!(verdict(false, 1.5e-7), "FAIL, χ² p = 1.5e-7");
+    }
+}

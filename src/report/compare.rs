@@ -1,0 +1,275 @@
+//! Pictures that compare a measured histogram with its expectation, written alike by `lobes run`
+//! (per case) and `lobes check --out`.
+//!
+//! A 2-D histogram (the sphere over (cos θ, φ), or a plane over (y, x)) gets
+//! - `measured.png` (counts per bin) and `expected.png` (N × ∫pdf per bin) on one shared count
+//!   scale ([`Mapping::counts`]: logarithmic from a tenth of one count), so equal colours are
+//!   equal counts;
+//! - `residual.png`, (measured − expected)/√expected per bin, the bin's signed contribution to
+//!   χ² (diverging, 0 white, over ±[`RESIDUAL_LIMIT`]; see [`residual`]); samples in a bin that
+//!   expects nothing have no finite residual and are grey ("nan" on the key);
+//! - `marginals.png`, the two marginals with their ±2σ bands ([`super::marginals`]).
+//!
+//! Rows at the top or bottom of the grid with neither a sample nor half an expected count (the
+//! lower hemisphere of a reflection lobe) are left out, and the axes show the range drawn; on
+//! the sphere the columns are rotated so that the lobe's mean φ sits in the middle of the map,
+//! never cut in two at its edges (φ in degrees, as a scene gives the incident direction).
+//!
+//! A discrete distribution gets `bars.png`: each item's count against its expectation. Every
+//! picture is titled with the case's caption (name, parameters, verdict).
+
+use super::heatmap::{self, Heatmap, Mapping, Scale};
+use super::marginals::{self, Panel};
+use crate::stats::chi2::MIN_EXPECTED;
+use std::f64::consts::PI;
+use std::ops::Range;
+use std::path::Path;
+
+/// The file names.
+pub const MEASURED_PNG: &str = "measured.png";
+pub const EXPECTED_PNG: &str = "expected.png";
+pub const RESIDUAL_PNG: &str = "residual.png";
+pub const MARGINALS_PNG: &str = "marginals.png";
+pub const BARS_PNG: &str = "bars.png";
+
+/// The residual map's colour scale runs over ±5 in every picture: a correct sampler's residuals
+/// are about standard normal, pale on this scale, and a bin beyond ±5 (p < 6e-7 alone) is
+/// saturated whatever else the map holds, so maps compare across cases.
+pub const RESIDUAL_LIMIT: f64 = 5.0;
+
+/// How the bins of a histogram lie.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Bins {
+    /// Directions: `rows` over cos θ ∈ [−1, 1] by `cols` over φ ∈ [−π, π), row-major.
+    Sphere { rows: usize, cols: usize },
+    /// Points of the box `[x0, y0, x1, y1]`: `rows` over y by `cols` over x, row-major.
+    Plane { rows: usize, cols: usize, bounds: [f64; 4] },
+    /// The items of a discrete distribution.
+    Items(usize),
+}
+
+/// A measured histogram and its expectation.
+#[derive(Debug, Clone, Copy)]
+pub struct Comparison<'a> {
+    pub bins: Bins,
+    /// Counts per bin.
+    pub measured: &'a [f64],
+    /// Expected counts per bin.
+    pub expected: &'a [f64],
+    /// What every title starts with: the case, its parameters and its verdict.
+    pub caption: &'a str,
+    /// What the measured counts leave out, e.g. "12 invalid samples not shown" (may be empty).
+    pub note: &'a str,
+}
+
+/// The residual of one bin as drawn: (m − e)/√e; NaN for samples where nothing is expected;
+/// 0 where fewer than [`MIN_EXPECTED`] samples are expected: the χ² test judges those bins
+/// pooled, and one stray sample where 0.01 is expected would read as +10 although Poisson finds
+/// nothing wrong with it. (Zeroing only bins whose count is small too would leave exactly the
+/// sparse bins that happen to be high, a red fringe around every lobe.)
+pub fn residual(measured: f64, expected: f64) -> f64 {
+    if measured > 0.0 && expected <= 0.0 {
+        f64::NAN
+    } else if expected < MIN_EXPECTED {
+        0.0
+    } else {
+        (measured - expected) / expected.sqrt()
+    }
+}
+
+/// The rows `first..end` of a row-major grid that hold a sample or at least half an expected
+/// count, with every row in between (all rows when none does).
+pub fn drawn_rows(measured: &[f64], expected: &[f64], rows: usize, cols: usize) -> Range<usize> {
+    let occupied = |r: usize| {
+        let cells = r * cols..(r + 1) * cols;
+        measured[cells.clone()].iter().any(|&c| c > 0.0) || expected[cells].iter().sum::<f64>() >= 0.5
+    };
+    match ((0..rows).find(|&r| occupied(r)), (0..rows).rfind(|&r| occupied(r))) {
+        (Some(first), Some(last)) => first..last + 1,
+        _ => 0..rows,
+    }
+}
+
+/// The column of a sphere grid drawn first, so that the expected mass's circular mean φ̄ lands in
+/// the middle of the map: column 0 (φ from −π) unless the mass has a clear direction (mean
+/// resultant length ≥ 0.05 of the total; an isotropic lobe has none).
+pub fn first_column(expected: &[f64], cols: usize) -> usize {
+    let width = 2.0 * PI / cols as f64;
+    let (mut x, mut y, mut total) = (0.0, 0.0, 0.0);
+    for (i, e) in expected.iter().enumerate() {
+        let phi = -PI + ((i % cols) as f64 + 0.5) * width;
+        (x, y, total) = (x + e * phi.cos(), y + e * phi.sin(), total + e);
+    }
+    if total <= 0.0 || x.hypot(y) < 0.05 * total {
+        return 0;
+    }
+    // the map's left edge half a turn before φ̄, on a column edge: φ0 = −π + first·width ≈ φ̄ − π
+    ((y.atan2(x) / width).round() as i64).rem_euclid(cols as i64) as usize
+}
+
+/// Writes the pictures of `c` into `dir`: the maps and `marginals.png` of a 2-D histogram,
+/// `bars.png` of a discrete one.
+pub fn write(dir: &Path, c: &Comparison) -> anyhow::Result<()> {
+    match c.bins {
+        Bins::Items(n) => {
+            let panel = Panel {
+                title: "samples per item, measured against expected".into(),
+                x_label: "item",
+                edges: (0..=n).map(|i| i as f64 - 0.5).collect(),
+                measured: c.measured.to_vec(),
+                expected: c.expected.to_vec(),
+            };
+            marginals::write_png(&dir.join(BARS_PNG), c.caption, &[panel])
+        }
+        Bins::Sphere { rows, cols } | Bins::Plane { rows, cols, .. } => write_grid(dir, c, rows, cols),
+    }
+}
+
+/// The caption, and under it what the picture shows.
+fn title(c: &Comparison, what: &str) -> String {
+    format!("{}\n{what}", c.caption)
+}
+
+fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        c.measured.len() == rows * cols && c.expected.len() == rows * cols,
+        "a {rows} × {cols} histogram with {} measured and {} expected bins",
+        c.measured.len(),
+        c.expected.len()
+    );
+    let drawn = drawn_rows(c.measured, c.expected, rows, cols);
+    let first = match c.bins {
+        Bins::Sphere { .. } => first_column(c.expected, cols),
+        _ => 0,
+    };
+    // the drawn rows, each from column `first` round to the one before it
+    let cells = |values: &[f64]| -> Vec<f64> {
+        drawn.clone().flat_map(|r| (0..cols).map(move |k| values[r * cols + (k + first) % cols])).collect()
+    };
+    let (measured, expected) = (cells(c.measured), cells(c.expected));
+    let residuals: Vec<f64> = measured.iter().zip(&expected).map(|(&m, &e)| residual(m, e)).collect();
+
+    let (row_label, col_label, (r0, r1), (c0, c1)) = match c.bins {
+        Bins::Plane { bounds: [x0, y0, x1, y1], .. } => ("y", "x", (y0, y1), (x0, x1)),
+        _ => {
+            let phi0 = -180.0 + first as f64 * 360.0 / cols as f64;
+            ("cos θ", "φ (degrees)", (-1.0, 1.0), (phi0, phi0 + 360.0))
+        }
+    };
+    let row_edge = |r: usize| r0 + (r1 - r0) * r as f64 / rows as f64;
+    let col_edge = |k: usize| c0 + (c1 - c0) * k as f64 / cols as f64;
+    let base = Heatmap {
+        title: "",
+        rows: drawn.len(),
+        cols,
+        values: &[],
+        scale: Scale::Sequential,
+        row_label,
+        col_label,
+        row_range: (row_edge(drawn.start), row_edge(drawn.end)),
+        col_range: (c0, c1),
+    };
+    let counts = Mapping::counts(&[&measured[..], &expected[..]].concat());
+    let measured_title = if c.note.is_empty() { "measured counts".to_string() } else { format!("measured counts ({})", c.note) };
+    let clipped = if residuals.iter().any(|r| r.abs() > RESIDUAL_LIMIT) { format!(", colours clipped at ±{RESIDUAL_LIMIT}") } else { String::new() };
+    let grey = if residuals.iter().any(|r| r.is_nan()) { "; grey: samples where nothing is expected" } else { "" };
+    let pooled = format!("; 0 where under {MIN_EXPECTED} are expected (pooled by χ²)");
+    let maps = [
+        (MEASURED_PNG, title(c, &measured_title), &measured, Scale::Sequential, counts),
+        (EXPECTED_PNG, title(c, "expected counts, N × ∫pdf (same colour scale)"), &expected, Scale::Sequential, counts),
+        (
+            RESIDUAL_PNG,
+            title(c, &format!("(measured − expected)/√expected{pooled}{clipped}{grey}")),
+            &residuals,
+            Scale::Diverging,
+            Mapping::Symmetric { lim: RESIDUAL_LIMIT },
+        ),
+    ];
+    for (file, title, values, scale, mapping) in maps {
+        heatmap::write_png_scaled(&Heatmap { title: &title, values, scale, ..base }, mapping, &dir.join(file))?;
+    }
+
+    // the marginals: sums over the columns of each drawn row, and over the drawn rows of each column
+    let row_sums = |v: &[f64]| -> Vec<f64> { v.chunks(cols).map(|row| row.iter().sum()).collect() };
+    let col_sums = |v: &[f64]| -> Vec<f64> { (0..cols).map(|k| v.iter().skip(k).step_by(cols).sum()).collect() };
+    let panels = [
+        Panel {
+            title: format!("over {row_label}"),
+            x_label: row_label,
+            edges: (drawn.start..=drawn.end).map(row_edge).collect(),
+            measured: row_sums(&measured),
+            expected: row_sums(&expected),
+        },
+        Panel {
+            title: format!("over {col_label}"),
+            x_label: col_label,
+            edges: (0..=cols).map(col_edge).collect(),
+            measured: col_sums(&measured),
+            expected: col_sums(&expected),
+        },
+    ];
+    marginals::write_png(&dir.join(MARGINALS_PNG), c.caption, &panels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 × 8 grid whose values are `mass(row, col)`.
+    fn grid(mass: impl Fn(usize, usize) -> f64) -> Vec<f64> {
+        (0..32).map(|i| mass(i / 8, i % 8)).collect()
+    }
+
+    #[test]
+    fn empty_rows_at_the_edges_are_left_out_and_the_lobe_is_centred() {
+        // a reflection lobe: the upper two rows (cos θ ≥ 0), around φ = ±π (columns 0 and 7)
+        let lobe = grid(|r, c| if r >= 2 && (c == 0 || c == 7) { 100.0 } else if r >= 2 { 1.0 } else { 0.0 });
+        assert_eq!(drawn_rows(&lobe, &lobe, 4, 8), 2..4);
+        // φ̄ = π: the map runs over [0, 2π), columns 4..8 then 0..4
+        assert_eq!(first_column(&lobe, 8), 4);
+        // a lobe around φ = 0 (columns 3 and 4) stays on [−π, π); a row between occupied
+        // rows is drawn even when empty
+        let forward = grid(|r, c| if r != 1 && (c == 3 || c == 4) { 100.0 } else { 0.0 });
+        assert_eq!(drawn_rows(&forward, &forward, 4, 8), 0..4);
+        assert_eq!(first_column(&forward, 8), 0);
+        // a lobe in columns 1 and 2 (φ ∈ [−3π/4, −π/4), φ̄ = −π/2) is drawn from column 6
+        // (φ from π/2): columns 6 7 0 1 2 3 4 5, the lobe either side of the middle
+        let side = grid(|_, c| if c == 1 || c == 2 { 10.0 } else { 1.0 });
+        assert_eq!(first_column(&side, 8), 6);
+        // no direction (isotropic) or nothing at all: as binned
+        assert_eq!(first_column(&grid(|_, _| 1.0), 8), 0);
+        let zero = grid(|_, _| 0.0);
+        assert_eq!(first_column(&zero, 8), 0);
+        assert_eq!(drawn_rows(&zero, &zero, 4, 8), 0..4);
+        // samples alone keep a row
+        let stray = grid(|r, c| if r == 0 && c == 0 { 1.0 } else { 0.0 });
+        assert_eq!(drawn_rows(&stray, &zero, 4, 8), 0..1);
+    }
+
+    #[test]
+    fn residuals_of_empty_and_impossible_bins() {
+        assert_eq!(residual(0.0, 0.0), 0.0);
+        assert!(residual(3.0, 0.0).is_nan());
+        assert_eq!(residual(1.0, 0.01), 0.0, "a stray sample in a pooled bin");
+        assert_eq!(residual(12.0, 4.0), 0.0);
+        assert_eq!(residual(16.0, 25.0), -1.8);
+        assert_eq!(residual(13.0, 9.0), 4.0 / 3.0);
+    }
+
+    #[test]
+    fn the_pictures_of_a_grid_and_of_items() {
+        let dir = tempfile::tempdir().unwrap();
+        let lobe = grid(|r, c| if r >= 2 { 50.0 + 10.0 * c as f64 } else { 0.0 });
+        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &lobe, expected: &lobe, caption: "lobe", note: "" };
+        write(dir.path(), &c).unwrap();
+        for png in [MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, MARGINALS_PNG] {
+            assert!(dir.path().join(png).is_file(), "{png}");
+        }
+        // two drawn rows: the map is as tall as its smallest size, not four rows
+        let items = Comparison { bins: Bins::Items(3), measured: &[1.0, 2.0, 3.0], expected: &[1.0, 2.0, 3.0], caption: "d", note: "" };
+        write(dir.path(), &items).unwrap();
+        assert!(dir.path().join(BARS_PNG).is_file());
+        let short = Comparison { measured: &lobe[..5], ..c };
+        assert!(write(dir.path(), &short).is_err());
+    }
+}
