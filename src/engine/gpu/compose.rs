@@ -344,36 +344,25 @@ mod tests {
         assert!(message.contains("no_such_value"), "{message}");
     }
 
-    /// A rotated lobe's kernel turns directions at its call site (into the lobe's frame, the
-    /// sample back out), in every precision; an unrotated lobe's kernel holds no rotation.
-    #[test]
-    fn rotated_lobes_turn_directions_at_the_call_site() {
-        for spec in &crate::reference::sampler::REGISTRY {
-            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle: 30.0 };
-            let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
-            for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
-                let src = compose_precision(&job, 4096, job.bins() as u32, precision);
-                validate(&format!("rotated {} {}", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
-                assert!(src.contains("    let wi = frame_to_local(lobe_frame(), wi_world);\n"), "{}", spec.name());
-                assert!(src.contains(&format!("return sample_to_world(lobe_frame(), {}(a, wi, u));", spec.wgsl.sample)));
-            }
-            let plain = compose(&Job::Lobe { lobe: Lobe { alpha_angle: 0.0, ..lobe }, incident: DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } }, 4096);
-            assert!(!plain.contains("frame_to_local(lobe_frame()") && !plain.contains("sample_to_world(lobe_frame()"));
-        }
-    }
-
     /// Every sampler's counting module composes and validates in each precision (without a
-    /// device: naga's check), and declares `Real` as that precision's type once.
+    /// device: naga's check), and declares `Real` as that precision's type once; rotated, its
+    /// call site turns ωi into the lobe's frame and the sample back, and unrotated it holds no
+    /// rotation.
     #[test]
     fn every_sampler_composes_in_every_precision() {
         for spec in &crate::reference::sampler::REGISTRY {
-            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle: 0.0 };
-            let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
-            for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
-                let src = compose_precision(&job, 4096, job.bins() as u32, precision);
-                assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
-                assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
-                validate(&format!("{} {}", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+            for alpha_angle in [0.0, 30.0] {
+                let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle };
+                let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
+                for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
+                    let src = compose_precision(&job, 4096, job.bins() as u32, precision);
+                    assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
+                    assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
+                    validate(&format!("{} {} {alpha_angle}°", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+                    let turned = format!("    let wi = frame_to_local(lobe_frame(), wi_world);\n    return sample_to_world(lobe_frame(), {}(a, wi, u));", spec.wgsl.sample);
+                    assert_eq!(src.contains(&turned), lobe.is_rotated(), "{} {alpha_angle}°", spec.name());
+                    assert_eq!(src.contains("frame_to_local(lobe_frame()"), lobe.is_rotated());
+                }
             }
         }
     }
