@@ -33,7 +33,7 @@ pub struct Verdict {
 /// The cases: a GGX lobe sampled by visible normals, seen at 45°, and the tutorial's discrete
 /// distribution sampled with an alias table.
 pub fn cases() -> Vec<(String, Job)> {
-    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3 };
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
     let incident: DVec3 = reflect::spherical(45f64.to_radians(), 0.0);
     let ggx = Job::Lobe { lobe, incident, grid: SphereGrid { rows: 32, cols: 64 } };
     let dist = Distribution::new(&[15.0, 5.0, 5.0, 25.0, 5.0, 10.0, 15.0, 5.0, 5.0, 10.0]).expect("valid weights");

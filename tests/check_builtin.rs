@@ -36,7 +36,7 @@ fn every_builtin_sampler_passes_lobes_check() {
             // ∫pdf over the sphere by the GPU quadrature of the WGSL pdf, against the f64 CPU
             // quadrature of the f64 reference (src/reference): 1 − the mass below the horizon.
             // 2e-5: an f32 pdf summed over ~2000 parts in f32 (measured: at most ~2e-6 apart)
-            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.15 };
+            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.15, alpha_angle: 0.0 };
             let wi = spherical(theta.to_radians(), 20f64.to_radians());
             let f64_mass = 1.0 - lobe_probabilities(&lobe, wi, SphereGrid { rows: 32, cols: 64 }, &Quadrature::default()).below_horizon;
             let gpu_mass = r.figures::<NormalizationFigures>().expect("a normalization check").pdf_integral;

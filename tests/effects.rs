@@ -24,7 +24,7 @@ const GRID: SphereGrid = SphereGrid { rows: 32, cols: 64 };
 const N: u64 = 1 << 22;
 
 fn job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64) -> Job {
-    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
     Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), 0.3), grid: GRID }
 }
 

@@ -162,7 +162,7 @@ fn embedded_samplers_densities_and_brdfs_match_the_f64_reference() {
         let bytes = dispatch(&gpu, &source, "sample_all", &[&layout], &[&group], n, &out);
         let res: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
         for (k, &(kind, method)) in kernels.iter().enumerate() {
-            let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+            let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
             let (mut compared, mut mismatches, mut max_angle, mut worst_pdf, mut worst_eval, mut worst_self) = (0, 0, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
             for i in 0..n as usize {
                 let [x, y, z, pdf_s] = res[12 * i + 2 * k];

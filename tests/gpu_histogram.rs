@@ -19,7 +19,7 @@ const GRID: SphereGrid = SphereGrid { rows: 64, cols: 128 };
 const N: u64 = 10_000_000;
 
 fn lobe_job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, phi_deg: f64) -> Job {
-    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
     Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), phi_deg.to_radians()), grid: GRID }
 }
 

@@ -36,7 +36,7 @@ fn small(storage_bytes: u64) -> GpuEngine {
 
 fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, rows: u32, cols: u32) -> Job {
     Job::Lobe {
-        lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay },
+        lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 },
         incident: reflect::spherical(theta_deg.to_radians(), 0.3),
         grid: SphereGrid { rows, cols },
     }

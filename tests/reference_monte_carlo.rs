@@ -61,7 +61,7 @@ fn chi_square_p_values_match_tables() {
 }
 
 fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64) -> Lobe {
-    Lobe { kind, method, alpha_x: ax, alpha_y: ay }
+    Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }
 }
 
 /// The two configurations every sampler is checked in: isotropic α = 0.3 at θi = 60°, and

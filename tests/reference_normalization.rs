@@ -46,7 +46,7 @@ fn integrate(ax: f64, ay: f64, cuts: &Cuts, what: &str, f: impl Fn(DVec3) -> f64
 }
 
 fn lobe(kind: LobeKind, method: Method, (ax, ay): (f64, f64)) -> Lobe {
-    Lobe { kind, method, alpha_x: ax, alpha_y: ay }
+    Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }
 }
 
 /// Records the worst |got − want| so each test can print how far from the tolerance it was.

@@ -33,6 +33,7 @@ fn lobe() -> impl Strategy<Value = Lobe> {
         method: KINDS[k].1,
         alpha_x: ax,
         alpha_y: if iso { ax } else { ay },
+        alpha_angle: 0.0,
     })
 }
 
@@ -181,7 +182,7 @@ fn endpoint_uniforms_give_unit_vectors_and_continue_the_interior() {
     }
     for (kind, method) in KINDS {
         for (ax, ay) in [(0.01, 0.01), (0.3, 0.3), (0.05, 0.3), (1.0, 1.0)] {
-            let l = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+            let l = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
             for &wi in &dirs {
                 for u0 in [0.0, 0.25, 0.5, 1.0] {
                     for u1 in [0.0, 0.25, 0.5, 1.0] {
@@ -199,7 +200,7 @@ fn endpoint_uniforms_give_unit_vectors_and_continue_the_interior() {
         }
     }
     // GGX VNDF at normal incidence: u2 = 1 gives the horizon normal that u2 → 1 tends to.
-    let ggx = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.05, alpha_y: 0.3 };
+    let ggx = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.05, alpha_y: 0.3, alpha_angle: 0.0 };
     for u0 in [0.0, 0.1, 0.3, 0.8] {
         let end = ggx.sample_h(DVec3::Z, [u0, 1.0]);
         let near = ggx.sample_h(DVec3::Z, [u0, 1.0 - 1e-12]);
@@ -208,7 +209,7 @@ fn endpoint_uniforms_give_unit_vectors_and_continue_the_interior() {
     // Beckmann VNDF with u1 = 0 (visible slope x = −∞) and u2 = 1/2 (y = 0): the horizon normal
     // keeps the azimuth of the normals just inside, that of the stretched, rotated x axis.
     for (ax, ay, wi) in [(0.3, 0.3, DVec3::Z), (0.05, 0.3, lobes::reference::reflect::spherical(1.0, 0.7))] {
-        let b = Lobe { kind: LobeKind::Beckmann, method: Method::Vndf, alpha_x: ax, alpha_y: ay };
+        let b = Lobe { kind: LobeKind::Beckmann, method: Method::Vndf, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
         let end = b.sample_h(wi, [0.0, 0.5]);
         let near = b.sample_h(wi, [1e-300, 0.5]);
         let azimuth = |h: DVec3| DVec3::new(h.x, h.y, 0.0).normalize();

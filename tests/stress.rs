@@ -84,7 +84,7 @@ fn binning_at_edges_poles_and_the_seam() {
     use lobes::stats::histogram::SphereGrid;
     let mut e = engine();
     let grid = SphereGrid { rows: 64, cols: 128 };
-    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
     let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid };
     let mut dirs: Vec<[f32; 3]> = Vec::new();
     for z in grid.cos_theta_edges() {
@@ -126,7 +126,7 @@ fn random_search_beyond_the_listed_cases() {
         // near the antipode of ωs loses the direction: seen at 25000:1, not handled yet)
         let ay = if i % 3 == 0 { ax } else { (ax * 10f64.powf(3.0 * (2.0 * r[1] - 1.0))).clamp(1e-6, 10.0) };
         let wi = reflect::spherical((90.0 * r[2]).to_radians(), 360f64.to_radians() * r[3]);
-        let case = StressCase { name: format!("random {i}: {kind:?} {method:?} α ({ax:.3e}, {ay:.3e}) ωi {wi:?}"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay }, incident: wi };
+        let case = StressCase { name: format!("random {i}: {kind:?} {method:?} α ({ax:.3e}, {ay:.3e}) ωi {wi:?}"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }, incident: wi };
         for row in run_case(&case, Some(&mut e)).unwrap() {
             if !row.passed {
                 failed.push(format!("{} [{}]: {:?}", row.case, row.kernel, row));

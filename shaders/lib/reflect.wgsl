@@ -16,6 +16,27 @@ fn reflect_about(wi: vec3<Real>, h: vec3<Real>) -> vec3<Real> {
     return 2.0 * dot(wi, h) * h - wi;
 }
 
+// Rotated anisotropy (CPU twin: src/reference/frame.rs): r = (cos, sin) of the angle from +x to
+// the lobe's alpha_x axis about the normal. frame_to_local is R^-1 w, frame_to_world is R w; the
+// generated call sites of a rotated lobe (src/engine/gpu/compose.rs call_site) turn what they
+// pass to a sampler into its frame and what it returns back. p and f are unchanged: a rotation
+// keeps solid angle, and reflection commutes with it.
+fn frame_to_local(r: vec2<Real>, w: vec3<Real>) -> vec3<Real> {
+    return vec3<Real>(r.x * w.x + r.y * w.y, r.x * w.y - r.y * w.x, w.z);
+}
+
+fn frame_to_world(r: vec2<Real>, w: vec3<Real>) -> vec3<Real> {
+    return vec3<Real>(r.x * w.x - r.y * w.y, r.y * w.x + r.x * w.y, w.z);
+}
+
+fn sample_to_local(r: vec2<Real>, s: LobeSample) -> LobeSample {
+    return LobeSample(frame_to_local(r, s.h), frame_to_local(r, s.wr), s.pdf_r);
+}
+
+fn sample_to_world(r: vec2<Real>, s: LobeSample) -> LobeSample {
+    return LobeSample(frame_to_world(r, s.h), frame_to_world(r, s.wr), s.pdf_r);
+}
+
 // A LobeSample with its reflected density, which is 0 for light from below the surface
 // (wi.z < 0) and for reflections into it (wr.z <= 0), as in src/reference (Lobe::pdf_r).
 fn lobe_sample(wi: vec3<Real>, h: vec3<Real>, wr: vec3<Real>, pdf_r: Real) -> LobeSample {

@@ -12,7 +12,7 @@ struct Params {
     last_positive: u32,
     tile_first: u32,
     alpha: vec2<f32>,
-    _pad: vec2<f32>,
+    frame: vec2<f32>,
     wi: vec4<f32>,
 }
 

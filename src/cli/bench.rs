@@ -58,7 +58,7 @@ pub fn bench_jobs(alpha: f64) -> Vec<Job> {
     SAMPLERS
         .into_iter()
         .map(|(kind, method)| Job::Lobe {
-            lobe: Lobe { kind, method, alpha_x: alpha, alpha_y: alpha },
+            lobe: Lobe { kind, method, alpha_x: alpha, alpha_y: alpha, alpha_angle: 0.0 },
             incident: reflect::spherical(45f64.to_radians(), 0.0),
             grid: SphereGrid { rows: 64, cols: 128 },
         })

@@ -287,7 +287,7 @@ impl LobeArgs {
             // clap's group, conflicts and requires rule these out; keep a clear message anyway.
             _ => return Err(usage("give either --alpha A or both --alpha-x AX and --alpha-y AY")),
         };
-        Ok(crate::reference::Lobe { kind, method, alpha_x, alpha_y })
+        Ok(crate::reference::Lobe { kind, method, alpha_x, alpha_y, alpha_angle: 0.0 })
     }
 }
 

@@ -15,7 +15,7 @@ const BLOCK: u64 = 1 << 16;
 ///
 /// ```
 /// use lobes::{engine::job::{Job, SampleRange}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
-/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
+/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
 /// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } };
 /// let counts = lobes::engine::cpu::histogram(&job, SampleRange::whole(1, 10_000));
 /// assert_eq!(counts.total(), 10_000);

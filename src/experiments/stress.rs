@@ -92,10 +92,10 @@ pub fn cases() -> Vec<StressCase> {
     for (kind, method) in SAMPLERS {
         let label = format!("{}-{}", kind.name(), method.name());
         for (an, ax, ay) in alphas {
-            out.push(StressCase { name: format!("{label} {an} 45deg"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay }, incident: deg(45.0) });
+            out.push(StressCase { name: format!("{label} {an} 45deg"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }, incident: deg(45.0) });
         }
         for (inn, wi) in incidents {
-            out.push(StressCase { name: format!("{label} a0.3 {inn}"), lobe: Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.3 }, incident: wi });
+            out.push(StressCase { name: format!("{label} a0.3 {inn}"), lobe: Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 }, incident: wi });
         }
     }
     out

@@ -26,7 +26,7 @@ use serde::Serialize;
 /// ```
 /// use lobes::reference::effects::Effects;
 /// use lobes::reference::{Lobe, LobeKind, Method, fresnel::Fresnel, masking::Masking, reflect::spherical};
-/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3 };
+/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
 /// let wi = spherical(0.6, 0.0);
 /// let e = Effects { fresnel: Fresnel::Schlick { f0: 0.04 }, masking: Masking::HeightCorrelated };
 /// let s = lobe.sample(wi, [0.3, 0.7]);
@@ -77,6 +77,7 @@ impl Effects {
         if wi.z <= 0.0 || wr.z <= 0.0 {
             return 0.0;
         }
+        let (wi, wr) = (l.to_local(wi), l.to_local(wr));
         let h = (wi + wr).normalize();
         let f = self.fresnel.reflectance(wi.dot(h));
         match l.kind {
@@ -92,7 +93,7 @@ impl Effects {
     /// - bounded VNDF, p(ωr) = D / (2 (k cos θi + t)): w = F G (k cos θi + t) / (2 cos θi);
     /// - Ward, p(ωr) = p(h) / (4 |ωr·h|): w = F (ωi·h)⁺ cos³θh √(|cos θr| / cos θi) (Walter 2005, eq. 10).
     pub fn weight(&self, l: &Lobe, wi: DVec3, s: &LobeSample) -> f64 {
-        let (h, wr) = (s.h, s.omega_r);
+        let (wi, h, wr) = (l.to_local(wi), l.to_local(s.h), l.to_local(s.omega_r));
         let f = self.fresnel.reflectance(wi.dot(h));
         if l.kind == LobeKind::Ward {
             return f * wi.dot(h).max(0.0) * h.z.powi(3) * (wr.z.abs() / wi.z).sqrt();
@@ -120,6 +121,7 @@ impl Effects {
         if self.fresnel != Fresnel::None || l.kind == LobeKind::Ward || l.method == Method::Bounded {
             return None;
         }
+        let wi = l.to_local(wi);
         let lambda = || match l.kind {
             LobeKind::Ggx => ggx(l).lambda(wi),
             _ => beckmann(l).lambda(wi),
@@ -148,7 +150,7 @@ mod tests {
             (LobeKind::Beckmann, Method::Ndf),
             (LobeKind::Beckmann, Method::Vndf),
         ] {
-            let l = Lobe { kind, method, alpha_x: 0.4, alpha_y: 0.2 };
+            let l = Lobe { kind, method, alpha_x: 0.4, alpha_y: 0.2, alpha_angle: 0.0 };
             let mut checked = 0;
             for u in [[0.1, 0.2], [0.5, 0.9], [0.8, 0.35], [0.3, 0.55], [0.05, 0.7]] {
                 let s = l.sample(wi, u);
@@ -162,7 +164,7 @@ mod tests {
             }
             assert!(checked >= 3, "{kind:?} {method:?}: only {checked} samples above the horizon");
         }
-        let l = Lobe { kind: LobeKind::Ward, method: Method::Ndf, alpha_x: 0.3, alpha_y: 0.1 };
+        let l = Lobe { kind: LobeKind::Ward, method: Method::Ndf, alpha_x: 0.3, alpha_y: 0.1, alpha_angle: 0.0 };
         let e = Effects { fresnel: Fresnel::Schlick { f0: 0.04 }, masking: Masking::None };
         let s = l.sample(wi, [0.3, 0.6]);
         let direct = e.eval(&l, wi, s.omega_r) * s.omega_r.z / l.pdf_r(wi, s.omega_r);

@@ -113,7 +113,7 @@ pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleC
 /// ```
 /// use lobes::{engine::job::{Job, SampleRange}, run::compare::albedo_check, stats::{histogram::SphereGrid, expected::Quadrature}};
 /// use lobes::reference::{Lobe, LobeKind, Method, effects::Effects, masking::Masking, fresnel::Fresnel, reflect::spherical};
-/// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5 };
+/// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
 /// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 } };
 /// let effects = Effects { fresnel: Fresnel::None, masking: Masking::G1 };
 /// let sums = lobes::engine::cpu::weighted(&job, &effects, SampleRange::whole(1, 200_000));

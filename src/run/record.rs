@@ -28,7 +28,16 @@ pub struct CaseDescription {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
 pub enum Params {
-    Lobe { alpha_x: f64, alpha_y: f64, incident_theta_deg: f64, incident_phi_deg: f64 },
+    Lobe {
+        alpha_x: f64,
+        alpha_y: f64,
+        /// Degrees from +x to the αx axis about the normal (rotated anisotropy; 0 in records
+        /// written before it existed).
+        #[serde(default)]
+        alpha_angle: f64,
+        incident_theta_deg: f64,
+        incident_phi_deg: f64,
+    },
     Discrete { weights: Vec<f64> },
     /// A user's WGSL sampler ([`crate::check`]).
     User {
@@ -58,6 +67,7 @@ impl CaseDescription {
                 params: Params::Lobe {
                     alpha_x: lobe.alpha_x,
                     alpha_y: lobe.alpha_y,
+                    alpha_angle: lobe.alpha_angle,
                     incident_theta_deg: case.incident_deg.0,
                     incident_phi_deg: case.incident_deg.1,
                 },

@@ -12,6 +12,7 @@
 //! lobe = "ggx"          # ward | beckmann | ggx | discrete
 //! method = "vndf"       # ndf | vndf | bounded (lobes); cdf | alias (discrete)
 //! alpha = 0.2           # or alpha_x and alpha_y
+//! alpha_angle = 30.0    # degrees from +x to the alpha_x axis about the normal (default 0)
 //! incident_theta = 45.0 # degrees from the normal, [0, 90)
 //! incident_phi = 0.0    # degrees
 //! # effects (any of them makes the case weighted: Σ f cos θ / pdf per bin)
@@ -106,6 +107,7 @@ struct RawCase {
     alpha: Option<Val>,
     alpha_x: Option<Val>,
     alpha_y: Option<Val>,
+    alpha_angle: Option<Val>,
     incident_theta: Option<Sweep>,
     incident_phi: Option<Sweep>,
     weights: Option<Spanned<Weights>>,
@@ -617,7 +619,12 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         None => d.bins.unwrap_or(SphereGrid { rows: 64, cols: 128 }),
     };
     let incident = reflect::spherical(theta.to_radians(), phi.to_radians());
-    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay };
+    // allowed with any α (an isotropic lobe turned is the same lobe), so sweeps over α need no special case
+    let angle = match &c.alpha_angle {
+        Some(v) => number(ctx, v, "alpha_angle", |x| (-360.0..=360.0).contains(&x), "alpha_angle is in degrees from +x to the alpha_x axis, −360 ≤ angle ≤ 360")?,
+        None => 0.0,
+    };
+    let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: angle };
     let effects = effects(ctx, c, kind)?;
     if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
         let span = c.samples.as_ref().or(d.samples.map(|(_, v)| v)).map_or(spanned.span(), |v| v.span());
@@ -634,8 +641,8 @@ fn incident_phi(ctx: &Ctx, point: &Point) -> Result<f64, SceneError> {
     }
 }
 
-fn roughness_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 3] {
-    [("alpha", c.alpha.as_ref()), ("alpha_x", c.alpha_x.as_ref()), ("alpha_y", c.alpha_y.as_ref())]
+fn roughness_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 4] {
+    [("alpha", c.alpha.as_ref()), ("alpha_x", c.alpha_x.as_ref()), ("alpha_y", c.alpha_y.as_ref()), ("alpha_angle", c.alpha_angle.as_ref())]
 }
 
 fn effect_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 6] {
@@ -751,6 +758,22 @@ mod tests {
         assert!(err.message.contains("longer than 100 characters") && err.line == 2, "{err}");
         let dup = "[[case]]\nname = \"g-theta0\"\nlobe = \"ward\"\nalpha = 0.2\n[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0]\n";
         assert!(Scene::parse("s.toml", dup).unwrap_err().message.contains("duplicate case name 'g-theta0'"));
+    }
+
+    #[test]
+    fn alpha_angle_turns_the_lobe_frame_in_degrees() {
+        let case = |extra: &str| Scene::parse("s.toml", &format!("[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha_x = 0.3\nalpha_y = 0.1\n{extra}"));
+        let angle = |extra: &str| match &case(extra).unwrap().cases[0].job {
+            Job::Lobe { lobe, .. } => lobe.alpha_angle,
+            Job::Discrete { .. } => panic!("a lobe"),
+        };
+        assert_eq!(angle(""), 0.0);
+        assert_eq!(angle("alpha_angle = 90\n"), 90.0);
+        assert_eq!(angle("alpha_angle = -45.0\n"), -45.0);
+        let err = case("alpha_angle = 400\n").unwrap_err();
+        assert!(err.message.contains("alpha_angle is in degrees") && (err.line, err.column) == (6, 15), "{err}");
+        let err = Scene::parse("s.toml", "[[case]]\nname = \"d\"\nlobe = \"discrete\"\nweights = [1, 2]\nalpha_angle = 10\n").unwrap_err();
+        assert!(err.message.contains("alpha_angle") && err.line == 5, "{err}");
     }
 
     #[test]

@@ -113,16 +113,46 @@ impl Kernel {
 /// A generated call site `fn NAME(ARGS) -> RET` returning `expr` of the sampler's
 /// [`Wgsl`](crate::reference::sampler::Wgsl): directly for one sampler, for several by a
 /// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/passes/effect_uniform.wgsl`).
-pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], expr: impl Fn(&sampler::Wgsl) -> String) -> String {
+///
+/// With `rotated` (a lobe whose tangent frame is turned, [`Lobe::alpha_angle`](crate::reference::Lobe::alpha_angle))
+/// the call site takes world directions and hands the sampler its own frame: each `vec3` and
+/// `LobeSample` argument is turned by `lobe_frame()` first ([`in_lobe_frame`]), and a returned
+/// `LobeSample` is turned back (`shaders/lib/reflect.wgsl`, f64 twin `src/reference/frame.rs`),
+/// so no sampler knows about the rotation.
+pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], rotated: bool, expr: impl Fn(&sampler::Wgsl) -> String) -> String {
+    let (params, prologue) = if rotated { in_lobe_frame(args) } else { (args.to_string(), String::new()) };
+    let value = |e: String| if rotated && ret == "LobeSample" { format!("sample_to_world(lobe_frame(), {e})") } else { e };
     if let [only] = samplers {
-        return format!("fn {name}({args}) -> {ret} {{\n    return {};\n}}\n", expr(&only.wgsl));
+        return format!("fn {name}({params}) -> {ret} {{\n{prologue}    return {};\n}}\n", value(expr(&only.wgsl)));
     }
-    let mut body = format!("fn {name}({args}) -> {ret} {{\n    var r: {ret};\n    switch effect.modes.x {{\n");
+    let mut body = format!("fn {name}({params}) -> {ret} {{\n{prologue}    var r: {ret};\n    switch effect.modes.x {{\n");
     for (i, s) in samplers.iter().enumerate() {
         let label = if i + 1 == samplers.len() { "default".to_string() } else { format!("case {}u", s.id()) };
         body += &format!("        {label}: {{ r = {}; }}\n", expr(&s.wgsl));
     }
-    body + "    }\n    return r;\n}\n"
+    body + &format!("    }}\n    return {};\n}}\n", value("r".into()))
+}
+
+/// The parameters of a rotated lobe's call site and the prologue that turns its directions into
+/// the lobe's frame: a `w: vec3<…>` argument arrives as `w_world` and is `frame_to_local`'d into
+/// `w`, a `s: LobeSample` likewise by `sample_to_local`; other arguments pass as they are.
+fn in_lobe_frame(args: &str) -> (String, String) {
+    let mut params = Vec::new();
+    let mut prologue = String::new();
+    for arg in args.split(", ") {
+        let (name, ty) = arg.split_once(": ").expect("call-site arguments are `name: type`");
+        let turn = match ty {
+            "LobeSample" => "sample_to_local",
+            _ if ty.starts_with("vec3<") => "frame_to_local",
+            _ => {
+                params.push(arg.to_string());
+                continue;
+            }
+        };
+        params.push(format!("{name}_world: {ty}"));
+        prologue += &format!("    let {name} = {turn}(lobe_frame(), {name}_world);\n");
+    }
+    (params.join(", "), prologue)
 }
 
 /// The composed WGSL of `job`, counting all its bins.
@@ -175,25 +205,32 @@ pub(crate) fn lobe_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, preci
     if samplers.len() > 1 {
         k.job.uses("lobes::effect_uniform");
     }
-    k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>", "LobeSample", samplers, |w| format!("{}(a, wi, u)", w.sample)));
+    let Job::Lobe { lobe, .. } = job else { panic!("a lobe kernel is for a lobe job") };
+    let sample = |w: &sampler::Wgsl| format!("{}(a, wi, u)", w.sample);
+    k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>", "LobeSample", samplers, lobe.is_rotated(), sample));
     k.job.uses("lobes::bindings");
     k.job.push(&lobe_parameters(job, precision));
     k
 }
 
-/// `lobe_alpha()` and `lobe_wi()`, a lobe job's α and ωi in the kernel's precision
-/// (`shaders/passes/lobe_kernel.wgsl`): f32 from the uniform block, f64 as constants of the
-/// job's values (the block carries f32 only, and f32(0.3) is not 0.3).
+/// `lobe_alpha()`, `lobe_wi()` and `lobe_frame()`, a lobe job's α, ωi and (cos, sin) of its
+/// frame angle in the kernel's precision (`shaders/passes/lobe_kernel.wgsl`, [`call_site`]):
+/// f32 from the uniform block, f64 as constants of the job's values (the block carries f32
+/// only, and f32(0.3) is not 0.3).
 fn lobe_parameters(job: &Job, precision: Precision) -> String {
     let Job::Lobe { lobe, incident, .. } = job else { return String::new() };
-    let (alpha, wi) = match precision {
+    let (alpha, wi, frame) = match precision {
         Precision::F64 => {
-            let [ax, ay, x, y, z] = [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z].map(precision::lit);
-            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"))
+            let f = lobe.frame();
+            let [ax, ay, x, y, z, c, s] = [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z, f.cos, f.sin].map(precision::lit);
+            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"), format!("vec2<f64>({c}, {s})"))
         }
-        Precision::F32Accurate | Precision::F32Fast => ("params.alpha".to_string(), "params.wi.xyz".to_string()),
+        Precision::F32Accurate | Precision::F32Fast => ("params.alpha".to_string(), "params.wi.xyz".to_string(), "params.frame".to_string()),
     };
-    format!("fn lobe_alpha() -> vec2<Real> {{\n    return {alpha};\n}}\n\nfn lobe_wi() -> vec3<Real> {{\n    return {wi};\n}}\n")
+    format!(
+        "fn lobe_alpha() -> vec2<Real> {{\n    return {alpha};\n}}\n\nfn lobe_wi() -> vec3<Real> {{\n    return {wi};\n}}\n\n\
+         fn lobe_frame() -> vec2<Real> {{\n    return {frame};\n}}\n"
+    )
 }
 
 /// `shaders/passes/quadrature.wgsl` (`lobes tradeoff`'s expected histogram in f32) over a
@@ -202,7 +239,7 @@ pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_node
     let mut job = JobModule::new(format!("the quadrature of {}", spec.name()));
     job.push(&format!("const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst N_NODES: u32 = {n_nodes}u;\n"));
     job.uses(sampler_module(spec, true));
-    job.push(&call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &[spec], |w| w.pdf.into()));
+    job.push(&call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", &[spec], false, |w| w.pdf.into()));
     Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job }
 }
 
@@ -258,7 +295,7 @@ mod tests {
     use glam::DVec3;
 
     fn lobe_job(kind: LobeKind, method: Method) -> Job {
-        let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.2 };
+        let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle: 0.0 };
         Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 } }
     }
 
@@ -308,17 +345,24 @@ mod tests {
     }
 
     /// Every sampler's counting module composes and validates in each precision (without a
-    /// device: naga's check), and declares `Real` as that precision's type once.
+    /// device: naga's check), and declares `Real` as that precision's type once; rotated, its
+    /// call site turns ωi into the lobe's frame and the sample back, and unrotated it holds no
+    /// rotation.
     #[test]
     fn every_sampler_composes_in_every_precision() {
         for spec in &crate::reference::sampler::REGISTRY {
-            let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2 };
-            let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
-            for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
-                let src = compose_precision(&job, 4096, job.bins() as u32, precision);
-                assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
-                assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
-                validate(&format!("{} {}", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+            for alpha_angle in [0.0, 30.0] {
+                let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle };
+                let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
+                for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
+                    let src = compose_precision(&job, 4096, job.bins() as u32, precision);
+                    assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
+                    assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
+                    validate(&format!("{} {} {alpha_angle}°", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+                    let turned = format!("    let wi = frame_to_local(lobe_frame(), wi_world);\n    return sample_to_world(lobe_frame(), {}(a, wi, u));", spec.wgsl.sample);
+                    assert_eq!(src.contains(&turned), lobe.is_rotated(), "{} {alpha_angle}°", spec.name());
+                    assert_eq!(src.contains("frame_to_local(lobe_frame()"), lobe.is_rotated());
+                }
             }
         }
     }

@@ -60,12 +60,12 @@ pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
 /// The call sites of the samplers' weight, BRDF, density and (with masking) G1 that
 /// `shaders/passes/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
 /// `sampler_sample` comes with the counting kernels, [`compose::lobe_kernel`]).
-fn samplers_glue(samplers: &[&SamplerSpec], masking: bool) -> String {
-    let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, |w| w.weight.into());
-    src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, |w| w.eval.into());
-    src += &call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", samplers, |w| w.pdf.into());
+fn samplers_glue(samplers: &[&SamplerSpec], rotated: bool, masking: bool) -> String {
+    let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, rotated, |w| w.weight.into());
+    src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, rotated, |w| w.eval.into());
+    src += &call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", samplers, rotated, |w| w.pdf.into());
     if masking {
-        src += &call_site("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", samplers, |w| w.g1.unwrap_or("1.0").into());
+        src += &call_site("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", samplers, rotated, |w| w.g1.unwrap_or("1.0").into());
     }
     src
 }
@@ -96,7 +96,7 @@ fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
 
 /// `kernel` with the weighted pass over `samplers`, its effects chosen by `sel`: the samplers'
 /// density and weight modules, the effect files (or those without the effect), the call sites.
-fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, fresnel: bool, masking: bool) -> String {
+fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rotated: bool, fresnel: bool, masking: bool) -> String {
     kernel.roots.push("lobes::weighted");
     for spec in samplers {
         kernel.job.uses(compose::sampler_module(spec, true));
@@ -107,7 +107,7 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, fres
     if !masking {
         kernel.chosen.push(library::NO_MASKING);
     }
-    kernel.job.push(&samplers_glue(samplers, masking));
+    kernel.job.push(&samplers_glue(samplers, rotated, masking));
     kernel.job.push(&effect_call_sites(sel, fresnel, masking));
     kernel.source()
 }
@@ -133,7 +133,7 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
                 kernel.job.push("override MASKING: u32 = 1u;\n");
                 constants.push(("MASKING", effects.masking.mode() as f64));
             }
-            Composed { source: weighted(kernel, &[spec], &OVERRIDES, fresnel, masking), constants }
+            Composed { source: weighted(kernel, &[spec], &OVERRIDES, lobe.is_rotated(), fresnel, masking), constants }
         }
         Specialisation::Uber => Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() },
     }
@@ -151,9 +151,10 @@ pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, t
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
 fn compose_uber(job: &Job, workgroup_words: u32) -> String {
+    let Job::Lobe { lobe, .. } = job else { panic!("the uber-kernel draws lobes") };
     let all: Vec<&SamplerSpec> = REGISTRY.iter().collect();
     let kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &all);
-    weighted(kernel, &all, &UNIFORM, true, true)
+    weighted(kernel, &all, &UNIFORM, lobe.is_rotated(), true, true)
 }
 
 /// The `effect` uniform of a case (`Effect` in `shaders/passes/weighted.wgsl`).
@@ -170,7 +171,7 @@ mod tests {
     use glam::DVec3;
 
     fn job(kind: LobeKind, method: Method, anisotropic: bool) -> Job {
-        let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: if anisotropic { 0.1 } else { 0.3 } };
+        let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: if anisotropic { 0.1 } else { 0.3 }, alpha_angle: 0.0 };
         Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 } }
     }
 
@@ -189,5 +190,16 @@ mod tests {
         let c = compose_effects(&job(LobeKind::Ggx, Method::Vndf, false), &Effects::NONE, 4096, Specialisation::Uber);
         compose::validate("uber", &c.source).unwrap();
         assert!(c.constants.is_empty());
+        // a rotated lobe's weight, BRDF, density and G1 take world directions into its frame
+        let effects = Effects { fresnel: Fresnel::Schlick { f0: 0.04 }, masking: Masking::HeightCorrelated };
+        for (kind, method) in SAMPLERS {
+            let Job::Lobe { lobe, incident, grid } = job(kind, method, true) else { unreachable!() };
+            let rotated = Job::Lobe { lobe: Lobe { alpha_angle: 57.0, ..lobe }, incident, grid };
+            for how in [Specialisation::Specialised, Specialisation::Uber] {
+                let c = compose_effects(&rotated, &effects, 4096, how);
+                compose::validate("rotated effects", &c.source).unwrap_or_else(|e| panic!("{kind:?} {method:?} {how:?}: {e}"));
+                assert!(c.source.contains("    let s = sample_to_local(lobe_frame(), s_world);\n"));
+            }
+        }
     }
 }

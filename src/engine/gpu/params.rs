@@ -17,7 +17,8 @@ pub struct Params {
     /// First bin of the tile being counted (see [`super::GpuEngine::tiling`]; 0 when untiled).
     tile_first: u32,
     alpha: [f32; 2],
-    _pad: [f32; 2],
+    /// (cos, sin) of the lobe's frame angle (rotated anisotropy, `lobe_frame()` of the kernels).
+    frame: [f32; 2],
     wi: [f32; 4],
 }
 
@@ -33,12 +34,14 @@ impl Params {
             last_positive: 0,
             tile_first: 0,
             alpha: [0.0; 2],
-            _pad: [0.0; 2],
+            frame: [1.0, 0.0],
             wi: [0.0; 4],
         };
         match job {
             Job::Lobe { lobe, incident, .. } => {
+                let frame = lobe.frame();
                 p.alpha = [lobe.alpha_x as f32, lobe.alpha_y as f32];
+                p.frame = [frame.cos as f32, frame.sin as f32];
                 p.wi = [incident.x as f32, incident.y as f32, incident.z as f32, 0.0];
             }
             Job::Discrete { dist, .. } => {
@@ -111,7 +114,7 @@ mod tests {
             ("last_positive", offset_of!(Params, last_positive)),
             ("tile_first", offset_of!(Params, tile_first)),
             ("alpha", offset_of!(Params, alpha)),
-            ("_pad", offset_of!(Params, _pad)),
+            ("frame", offset_of!(Params, frame)),
             ("wi", offset_of!(Params, wi)),
         ];
         let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();

@@ -55,7 +55,7 @@ impl Sampler {
     }
 
     pub fn lobe(&self, alpha: f64) -> Lobe {
-        Lobe { kind: self.kind, method: self.method, alpha_x: alpha, alpha_y: alpha }
+        Lobe { kind: self.kind, method: self.method, alpha_x: alpha, alpha_y: alpha, alpha_angle: 0.0 }
     }
 }
 

@@ -109,7 +109,7 @@ mod layout_tests {
 
     #[test]
     fn quad_params_layout() {
-        let lobe = Lobe { kind: crate::reference::LobeKind::Ward, method: crate::reference::Method::Ndf, alpha_x: 0.3, alpha_y: 0.3 };
+        let lobe = Lobe { kind: crate::reference::LobeKind::Ward, method: crate::reference::Method::Ndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
         let source = gpu_source(&lobe, SphereGrid { rows: 4, cols: 8 }, 3);
         let members = [("alpha", offset_of!(QuadParams, alpha)), ("_pad", offset_of!(QuadParams, _pad)), ("wi", offset_of!(QuadParams, wi))];
         crate::engine::gpu::layout::check_struct(&source, "QuadParams", size_of::<QuadParams>(), align_of::<QuadParams>(), &members).unwrap();
