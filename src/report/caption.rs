@@ -8,8 +8,11 @@ use crate::run::record::{CaseDescription, Params};
 pub fn parameters(d: &CaseDescription) -> String {
     let angles = |theta: f64, phi: f64| if phi == 0.0 { format!("θi {}°", compact(theta)) } else { format!("θi {}°, φi {}°", compact(theta), compact(phi)) };
     match &d.params {
-        Params::Lobe { alpha_x, alpha_y, incident_theta_deg, incident_phi_deg } => {
-            let alpha = if alpha_x == alpha_y { compact(*alpha_x) } else { format!("{} × {}", compact(*alpha_x), compact(*alpha_y)) };
+        Params::Lobe { alpha_x, alpha_y, alpha_angle, incident_theta_deg, incident_phi_deg } => {
+            let mut alpha = if alpha_x == alpha_y { compact(*alpha_x) } else { format!("{} × {}", compact(*alpha_x), compact(*alpha_y)) };
+            if *alpha_angle != 0.0 {
+                alpha += &format!(" turned {}°", compact(*alpha_angle));
+            }
             format!("{} {}, α {alpha}, {}", d.lobe, d.method, angles(*incident_theta_deg, *incident_phi_deg))
         }
         Params::Discrete { weights } => {
@@ -40,7 +43,7 @@ mod tests {
         CaseDescription {
             lobe: "ggx".into(),
             method: "vndf".into(),
-            params: Params::Lobe { alpha_x, alpha_y, incident_theta_deg: 40.0, incident_phi_deg: phi },
+            params: Params::Lobe { alpha_x, alpha_y, alpha_angle: 0.0, incident_theta_deg: 40.0, incident_phi_deg: phi },
             rows: 64,
             cols: 128,
         }
@@ -50,6 +53,11 @@ mod tests {
     fn parameters_in_words() {
         assert_eq!(parameters(&lobe(0.3, 0.3, 0.0)), "ggx vndf, α 0.3, θi 40°");
         assert_eq!(parameters(&lobe(0.5, 0.1, 60.0)), "ggx vndf, α 0.5 × 0.1, θi 40°, φi 60°");
+        let mut turned = lobe(0.05, 0.3, 0.0);
+        if let Params::Lobe { alpha_angle, .. } = &mut turned.params {
+            *alpha_angle = 30.0;
+        }
+        assert_eq!(parameters(&turned), "ggx vndf, α 0.05 × 0.3 turned 30°, θi 40°");
         let d = CaseDescription { lobe: "discrete".into(), method: "alias".into(), params: Params::Discrete { weights: vec![0.0, 3.0, 1e-3] }, rows: 1, cols: 3 };
         assert_eq!(parameters(&d), "discrete alias, weights [0, 3, 1e-3]");
         assert_eq!(verdict(false, 1.5e-7), "FAIL, χ² p = 1.5e-7");
