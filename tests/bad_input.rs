@@ -429,11 +429,12 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     assert!(stderr.contains("writing the outputs into") && stderr.contains("no histogram.json was written"), "{stderr}");
     assert!(stderr.contains("1 of 3 cases could not run"), "{stderr}");
     assert!(!broken.join("histogram.json").exists(), "the failed case left a histogram.json");
-    assert_eq!(tree(&broken), ["expected.png", "measured.png", "residual.png"], "no temporary files are left");
+    // the earlier run's arrays and timing.json stay (histogram.json marks a complete folder)
+    assert_eq!(tree(&broken), ["counts.npy", "expected.npy", "expected.png", "measured.png", "residual.png", "timing.json"], "no temporary files are left");
     let table = String::from_utf8_lossy(&again.stdout);
     assert!(table.lines().any(|l| l.starts_with("broken") && l.contains("ERROR")), "{table}");
     for ok in ["first", "last"] {
-        assert_eq!(tree(&out.join(ok)), ["expected.png", "histogram.json", "measured.png", "residual.png"]);
+        assert_eq!(tree(&out.join(ok)), ["counts.npy", "expected.npy", "expected.png", "histogram.json", "measured.png", "residual.png", "timing.json"]);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -147,6 +147,20 @@ pub struct OutputArgs {
     pub json: bool,
 }
 
+/// How `lobes run` and `lobes merge` write their JSON files.
+#[derive(Debug, Clone, Args)]
+pub struct FileArgs {
+    /// Indent histogram.json and timing.json for reading (default: compact, one line).
+    #[arg(long)]
+    pub pretty: bool,
+}
+
+impl FileArgs {
+    pub fn style(&self) -> crate::report::output::JsonStyle {
+        if self.pretty { crate::report::output::JsonStyle::Pretty } else { crate::report::output::JsonStyle::Compact }
+    }
+}
+
 /// Writes `text` to stdout; a failed write (closed pipe, full disk) is a runtime error.
 pub fn emit(text: &str) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();

@@ -2,8 +2,8 @@
 //! the f64 reference, with per-case outputs and a table; with `--shard I/N`, one shard of every
 //! case, written as raw results for `lobes merge`.
 
-use super::{OutputArgs, emit, emit_json, parse_level, prepare_out, usage};
-use crate::report::output::{self, CaseSummary, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
+use super::{FileArgs, OutputArgs, emit, emit_json, parse_level, prepare_out, usage};
+use crate::report::output::{self, CaseSummary, JsonStyle, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
@@ -30,6 +30,8 @@ pub struct RunArgs {
     /// written as raw counts to `OUT/<case>/shard-I-of-N.json` for `lobes merge`.
     #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
     pub shard: Option<Shard>,
+    #[command(flatten)]
+    pub files: FileArgs,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -96,21 +98,21 @@ fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
 
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
 /// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
-fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, bar: &ProgressBar) -> anyhow::Result<CaseResult> {
+fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, style: JsonStyle, bar: &ProgressBar) -> anyhow::Result<CaseResult> {
     remove_stale(out, &case.name)?;
     let sampled = run_case(backend, case, 0..case.samples, &mut |done| bar.set_position(done))?;
     let result = judge(case, sampled, level)?;
     let adapter = backend.adapter();
-    output::write_case(out, &result, &adapter, backend.name())
+    output::write_case(out, &result, &adapter, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok(result)
 }
 
 /// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
-fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path) -> anyhow::Result<([String; 9], CaseSummary, bool)> {
+fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path, style: JsonStyle) -> anyhow::Result<([String; 9], CaseSummary, bool)> {
     remove_stale(out, &case.name)?;
     let result = run_user(backend, case, level)?;
-    output::write_user_case(out, &result, backend.name())
+    output::write_user_case(out, &result, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }, result.passed()))
 }
@@ -153,7 +155,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         let outcome = match entry {
             Entry::Lobe(case) => {
                 let bar = progress_bar(case.samples, &case.name);
-                let outcome = run_and_write(&mut backend, case, level, &args.out, &bar);
+                let outcome = run_and_write(&mut backend, case, level, &args.out, args.files.style(), &bar);
                 bar.finish_and_clear();
                 outcome.map(|result| {
                     if result.gpu_seconds.is_none() {
@@ -167,7 +169,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 user_rows = true;
                 let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
                 bar.enable_steady_tick(std::time::Duration::from_millis(200));
-                let outcome = run_user_and_write(&backend, case, level, &args.out);
+                let outcome = run_user_and_write(&backend, case, level, &args.out, args.files.style());
                 bar.finish_and_clear();
                 outcome
             }

@@ -2,7 +2,8 @@
 //! the JSON Schema of every output, the one atomic file writer, and `lobes tradeoff`'s outputs.
 //!
 //! [`heatmap`] lays out a heat map from a [`colour`] scale, [`label`]s and [`text`], and
-//! [`png`] encodes it; [`table`] prints terminal tables; [`output`] writes a case's files,
+//! [`png`] encodes it; [`table`] prints terminal tables; [`output`] writes a case's files
+//! (its arrays as NumPy [`npy`]),
 //! [`check`] those of `lobes check`.
 
 pub mod atomic;
@@ -12,6 +13,7 @@ pub mod heatmap;
 pub mod label;
 pub mod output;
 pub mod schema;
+pub mod npy;
 pub mod png;
 pub mod table;
 pub mod text;
