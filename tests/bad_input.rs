@@ -81,7 +81,10 @@ fn roughness_angles_and_non_finite_numbers() {
         scene_error(&ggx(&format!("alpha = ⟦{v}\n")), &[&format!("alpha = {shown} is not allowed"), "finite number > 0"]);
     }
     scene_error(&ggx("alpha = ⟦\"0.2\"\n"), &["alpha must be a number, got a string"]);
-    scene_error(&ggx("alpha = ⟦[0.2]\n"), &["alpha must be a number, got an array"]);
+    // an array sweeps (one case per value); an array inside it is not a number
+    scene_error(&ggx("alpha = [0.1, ⟦[0.2]]\n"), &["alpha must be a number, got an array"]);
+    scene_error(&ggx("alpha = 0.2\nincident_theta = [0, ⟦95]\n"), &["incident_theta", "0 ≤ θ < 90"]);
+    scene_error(&ggx("alpha = ⟦[]\n"), &["alpha = [] sweeps over no values"]);
     scene_error(&ggx("alpha_x = 0.1\nalpha_y = ⟦0\n"), &["alpha_y = 0 is not allowed"]);
     scene_error(&ggx("alpha_x = ⟦nan\nalpha_y = 0.1\n"), &["alpha_x = NaN"]);
     scene_error(&ggx("alpha_x = ⟦0.1\n"), &["alpha_x needs alpha_y"]);
