@@ -45,7 +45,7 @@ fn syntax_errors_and_unknown_keys() {
     scene_error("[[case]⟦\nname = \"a\"\n", &["expected `]`"]);
     scene_error("[[case]]\nname = \"a⟦\nlobe = \"ggx\"\n", &["string"]);
     scene_error(&ggx("alpha = 0.2\nalpha⟦\n"), &["expected `=`"]);
-    scene_error(&ggx("alpha = 0.2\n⟦alpah = 0.3\n"), &["unknown field `alpah`", "expected one of", "`alpha`"]);
+    scene_error(&ggx("alpha = 0.2\n⟦alpah = 0.3\n"), &["unknown field `alpah`", "expected one of", "`alpha`", "(did you mean 'alpha'?)"]);
     scene_error(&format!("⟦sample = 5\n{}", ggx("alpha = 0.2\n")), &["unknown field `sample`", "`defaults`", "`case`"]);
     scene_error(&format!("[defaults]\n⟦lobe = \"ggx\"\n{}", ggx("alpha = 0.2\n")), &["unknown field `lobe`", "`samples`", "`bins`", "`seed`"]);
     scene_error(&ggx("alpha = 0.2\n⟦alpha = 0.3\n"), &["duplicate key"]);
@@ -66,7 +66,10 @@ fn names_lobes_and_methods() {
     scene_error(&format!("{}\n[[case]]\nname = ⟦\"c\"\nlobe = \"ward\"\nalpha = 0.1\n", ggx("alpha = 0.2\n")), &["duplicate case name 'c'", "1:1"]);
     scene_error(&format!("{}\n[[case]]\nname = ⟦\"C\"\nlobe = \"ward\"\nalpha = 0.1\n", ggx("alpha = 0.2\n")), &["duplicate case name 'C'", "ignoring case"]);
     scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"phong\"\nalpha = 0.2\n", &["lobe 'phong' is unknown", "ward, beckmann, ggx or discrete"]);
-    scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"GGX\"\nalpha = 0.2\n", &["lobe 'GGX' is unknown"]);
+    scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"GGX\"\nalpha = 0.2\n", &["lobe 'GGX' is unknown", "(did you mean 'ggx'?)"]);
+    scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"vndff\"\n"), &["method 'vndff' is unknown", "(did you mean 'vndf'?)"]);
+    scene_error(&ggx("alpha = 0.2\n⟦incident_tehta = 30\n"), &["unknown field `incident_tehta`", "(did you mean 'incident_theta'?)"]);
+    scene_error(&ggx("alpha = 0.2\nmasking = ⟦\"height_correlated\"\n"), &["(did you mean 'height-correlated'?)"]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"importance\"\n"), &["method 'importance' is unknown", "ndf, vndf or bounded"]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"cdf\"\n"), &["cdf and alias are for lobe = \"discrete\""]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦1\n"), &["method must be a string"]);

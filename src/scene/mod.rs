@@ -37,6 +37,7 @@
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
 
+pub mod suggest;
 mod sweep;
 mod user;
 
@@ -51,6 +52,7 @@ use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use serde::Deserialize;
 use std::collections::HashMap;
+use suggest::did_you_mean;
 use sweep::{Point, Sweep};
 use std::ops::Range;
 use toml::{Spanned, Value};
@@ -380,9 +382,7 @@ impl Scene {
         let ctx = Ctx { file, text };
         let raw: RawScene = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            let message = e
-                .message()
-                .trim()
+            let message = suggest::unknown_field(e.message().trim())
                 .replace("struct RawScene", "[defaults] and [[case]] tables")
                 .replace("struct RawDefaults", "a [defaults] table")
                 .replace("struct RawCase", "a [[case]] table")
@@ -577,6 +577,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
 fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common) -> Result<Case, SceneError> {
     let c = spanned.get_ref();
     let Common { name, samples, seed } = common;
+    const LOBES: [&str; 4] = ["ward", "beckmann", "ggx", "discrete"];
     let lobes_allowed = "use ward, beckmann, ggx or discrete";
     let Some(lobe_v) = &c.lobe else {
         return Err(ctx.err(
@@ -591,7 +592,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         let method = match method {
             None | Some(("cdf", _)) => DiscreteMethod::Cdf,
             Some(("alias", _)) => DiscreteMethod::Alias,
-            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias"))),
+            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias{}", did_you_mean(other, ["cdf", "alias"])))),
         };
         reject_keys(ctx, &roughness_keys(point), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
         reject_keys(
@@ -626,14 +627,17 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         "ward" => LobeKind::Ward,
         "beckmann" => LobeKind::Beckmann,
         "ggx" => LobeKind::Ggx,
-        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}"))),
+        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}{}", did_you_mean(other, LOBES)))),
     };
     let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
     let method = match method.map_or("ndf", |m| m.0) {
         "ndf" => Method::Ndf,
         "vndf" => Method::Vndf,
         "bounded" => Method::Bounded,
-        other => return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\")"))),
+        other => {
+            let hint = did_you_mean(other, ["ndf", "vndf", "bounded"]);
+            return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\"){hint}")));
+        }
     };
     if !kind.supports(method) {
         return Err(ctx.err(
@@ -716,7 +720,10 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<E
             "dielectric" => Fresnel::Dielectric {
                 eta: required(ctx, v, p.get("eta"), "eta", |x| x > 0.0, "eta is the relative index of refraction n_t / n_i, > 0")?,
             },
-            other => return Err(ctx.err(v.span(), format!("fresnel '{other}' is unknown; {fresnel_allowed}"))),
+            other => {
+                let hint = did_you_mean(other, ["none", "schlick", "conductor", "dielectric"]);
+                return Err(ctx.err(v.span(), format!("fresnel '{other}' is unknown; {fresnel_allowed}{hint}")));
+            }
         },
     };
     // Parameters that the chosen form does not read.
@@ -736,7 +743,10 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<E
                 "g1" => Masking::G1,
                 "separable" => Masking::Separable,
                 "height-correlated" => Masking::HeightCorrelated,
-                other => return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}"))),
+                other => {
+                    let hint = did_you_mean(other, ["none", "g1", "separable", "height-correlated"]);
+                    return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}{hint}")));
+                }
             };
             if kind == LobeKind::Ward && m != Masking::None {
                 return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));

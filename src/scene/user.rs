@@ -80,7 +80,7 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
         Some(v) => match string(ctx, v, "domain", allowed)? {
             "sphere" => false,
             "plane" => true,
-            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}"))),
+            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, ["sphere", "plane"])))),
         },
     };
     if !plane {
