@@ -16,6 +16,7 @@ pub mod bench;
 pub mod check;
 pub mod merge;
 pub mod run;
+pub mod scene;
 pub mod shader;
 pub mod stress;
 pub mod tradeoff;
@@ -59,6 +60,9 @@ pub enum Command {
     /// Run a scene: sample and histogram every case on the GPU, judge it with a χ² test
     /// against the f64 reference, and write histogram.json and heat maps per case.
     Run(run::RunArgs),
+    /// Print a scene template with every key and its default (--template), or the cases a
+    /// scene makes, its sweeps expanded.
+    Scene(scene::SceneArgs),
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
@@ -88,6 +92,7 @@ impl Cli {
             Command::PdfConvert(args) => tutorial::pdf_convert(&args),
             Command::Sample(args) => tutorial::sample(&args),
             Command::Run(args) => run::run(&args),
+            Command::Scene(args) => scene::run(&args),
             Command::Bench(args) => bench::run(&args),
             Command::Stress(args) => stress::run(&args),
             Command::Merge(args) => merge::run(&args),

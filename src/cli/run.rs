@@ -7,7 +7,7 @@ use crate::report::output::{self, CaseSummary, JsonStyle, RunSummary, SUMMARY_VE
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
-use crate::scene::{Case, DEFAULT_SCENE, Entry, Scene, UserCase};
+use crate::scene::{Case, DEFAULT_SCENE, Entry, Overrides, Scene, UserCase};
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -15,8 +15,19 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, Clone, Args)]
 pub struct RunArgs {
-    /// Scene file (TOML); without it, the embedded scenes/all-lobes.toml (every lobe and method).
+    /// Scene file (TOML), or - to read it from standard input; without it, the embedded
+    /// scenes/all-lobes.toml (every lobe and method).
     pub scene: Option<PathBuf>,
+    /// Run only the cases whose names match NAME, a pattern such as 'ggx-*' (* any text, ? one
+    /// character, [ab] one of them; ignoring case); repeat it for more.
+    #[arg(long = "case", value_name = "NAME", conflicts_with = "shard")]
+    pub cases: Vec<String>,
+    /// Samples of every case, in place of the scene's.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=crate::scene::MAX_SAMPLES), allow_hyphen_values = true, conflicts_with = "shard")]
+    pub samples: Option<u64>,
+    /// Seed of every case, in place of the scene's.
+    #[arg(long, value_name = "S", allow_hyphen_values = true, conflicts_with = "shard")]
+    pub seed: Option<u64>,
     /// Output folder: one subfolder per case with histogram.json and PNG heat maps.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -40,12 +51,19 @@ pub struct RunArgs {
 /// be read, is not UTF-8 or is not a valid scene is a [`super::UsageError`] naming the file (and
 /// the line and column).
 pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
-    read_scene(path).map(|(_, scene)| scene)
+    read_scene(path, Overrides::default()).map(|(_, scene)| scene)
 }
 
-/// [`load_scene`], with the scene's name and text (for shard files).
-fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(SceneSource, Scene)> {
-    let (name, text) = match path {
+/// [`load_scene`] with `overrides`, and the scene's name and text (for shard files). The path
+/// `-` reads the scene from standard input (a user sampler's files are then found relative to
+/// the current folder).
+fn read_scene(path: Option<&PathBuf>, overrides: Overrides) -> anyhow::Result<(SceneSource, Scene)> {
+    let (name, bytes) = match path {
+        Some(p) if p.as_os_str() == "-" => {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes).map_err(|e| usage(format!("cannot read the scene from standard input: {e}")))?;
+            ("<stdin>".to_string(), bytes)
+        }
         Some(p) => {
             let bytes = std::fs::read(p).map_err(|e| {
                 usage(format!(
@@ -53,15 +71,13 @@ fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(SceneSource, Scene)> {
                     p.display()
                 ))
             })?;
-            let name = p.display().to_string();
-            let scene = Scene::from_bytes(&name, &bytes).map_err(|e| usage(e.to_string()))?;
-            // from_bytes has checked that the file is UTF-8
-            return Ok((SceneSource { name, text: String::from_utf8_lossy(&bytes).into_owned() }, scene));
+            (p.display().to_string(), bytes)
         }
-        None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.to_string()),
+        None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.as_bytes().to_vec()),
     };
-    let scene = Scene::parse(&name, &text).map_err(|e| usage(e.to_string()))?;
-    Ok((SceneSource { name, text }, scene))
+    let scene = Scene::from_bytes_with(&name, &bytes, overrides).map_err(|e| usage(e.to_string()))?;
+    // from_bytes has checked that the text is UTF-8
+    Ok((SceneSource { name, text: String::from_utf8_lossy(&bytes).into_owned() }, scene))
 }
 
 /// Checks, before anything runs, that every case fits the GPU adapter (histograms larger than a
@@ -133,7 +149,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     if let Some(shard) = args.shard {
         return run_shard(args, shard);
     }
-    let scene = load_scene(args.scene.as_ref())?;
+    let overrides = Overrides { samples: args.samples, seed: args.seed };
+    let scene = read_scene(args.scene.as_ref(), overrides)?.1.select(&args.cases).map_err(usage)?;
     if args.cpu
         && let Some((name, at)) = first_user_case(&scene)
     {
@@ -231,7 +248,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
 /// `lobes run SCENE --shard I/N --out DIR`: samples shard I of every case and writes
 /// `DIR/<case>/shard-I-of-N.json` for `lobes merge`.
 fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
-    let (source, scene) = read_scene(args.scene.as_ref())?;
+    let (source, scene) = read_scene(args.scene.as_ref(), Overrides::default())?;
     if let Some((name, at)) = first_user_case(&scene) {
         return Err(usage(format!(
             "{at}: case '{name}' is a WGSL sampler of your own, which --shard does not split: its checks (the Jacobian probe, \

@@ -37,8 +37,10 @@
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
 
+mod select;
 pub mod suggest;
 mod sweep;
+pub mod template;
 mod user;
 
 pub use user::UserCase;
@@ -78,6 +80,15 @@ pub const DEFAULT_SEED: u64 = 1;
 /// A lobe case's bins unless the case or `[defaults]` sets them: 64 rows over cos θ, 128
 /// columns over φ.
 pub const DEFAULT_BINS: SphereGrid = SphereGrid { rows: 64, cols: 128 };
+/// A lobe case's sampler unless `method` is given.
+pub const DEFAULT_METHOD: Method = Method::Ndf;
+/// A discrete case's sampler unless `method` is given.
+pub const DEFAULT_DISCRETE_METHOD: DiscreteMethod = DiscreteMethod::Cdf;
+/// A lobe case's incident polar angle in degrees unless given (a user sampler's is
+/// [`crate::check::Settings`]'s).
+pub const DEFAULT_INCIDENT_THETA: f64 = 0.0;
+/// A case's incident azimuth in degrees unless given.
+pub const DEFAULT_INCIDENT_PHI: f64 = 0.0;
 /// The longest case name (it names a folder).
 pub const MAX_NAME_LEN: usize = 100;
 
@@ -590,7 +601,8 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
 
     if lobe_name == "discrete" {
         let method = match method {
-            None | Some(("cdf", _)) => DiscreteMethod::Cdf,
+            None => DEFAULT_DISCRETE_METHOD,
+            Some(("cdf", _)) => DiscreteMethod::Cdf,
             Some(("alias", _)) => DiscreteMethod::Alias,
             Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias{}", did_you_mean(other, ["cdf", "alias"])))),
         };
@@ -630,7 +642,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}{}", did_you_mean(other, LOBES)))),
     };
     let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
-    let method = match method.map_or("ndf", |m| m.0) {
+    let method = match method.map_or(DEFAULT_METHOD.name(), |m| m.0) {
         "ndf" => Method::Ndf,
         "vndf" => Method::Vndf,
         "bounded" => Method::Bounded,
@@ -667,7 +679,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
     };
     let theta = match point.get("incident_theta") {
         Some(t) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
-        None => 0.0,
+        None => DEFAULT_INCIDENT_THETA,
     };
     let phi = incident_phi(ctx, point)?;
     let grid = match point.get("bins") {
@@ -691,7 +703,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
 fn incident_phi(ctx: &Ctx, point: &Point) -> Result<f64, SceneError> {
     match point.get("incident_phi") {
         Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360"),
-        None => Ok(0.0),
+        None => Ok(DEFAULT_INCIDENT_PHI),
     }
 }
 
