@@ -17,7 +17,9 @@
 //!
 //! - `dfg.f32`: 32 × 32 × 2 little-endian f32, row-major: the value at byte offset
 //!   4 · (2 (32 j + i) + c) is A (c = 0) or B (c = 1) of roughness row j and NdotV column i
-//!   (no header; 8192 bytes);
+//!   (no header; 8192 bytes), for a renderer that uploads it as it is;
+//! - `dfg.npy`: the same table as a NumPy array of shape (32, 32, 2), `<f4`
+//!   (`numpy.load("dfg.npy")[j, i, c]`; [`lobes::report::npy`]);
 //! - `dfg.png`: the same table as an 8-bit RGB image, R = A, G = B, B = 0, row j from the top.
 //!
 //! It then integrates the same table on the CPU in f64 by numerical quadrature that uses no
@@ -234,11 +236,14 @@ pub fn dfg_reference() -> Vec<[f64; 2]> {
         .collect()
 }
 
-/// Writes `dfg.f32` and `dfg.png` into `dir`.
+/// Writes `dfg.f32`, `dfg.npy` and `dfg.png` into `dir`.
 pub fn write_outputs(dir: &Path, lut: &[[f32; 2]]) -> anyhow::Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let raw: Vec<u8> = lut.iter().flat_map(|t| t.iter().flat_map(|x| x.to_le_bytes())).collect();
     lobes::report::atomic::write_atomic(&dir.join("dfg.f32"), &raw)?;
+    let flat: Vec<f32> = lut.iter().flatten().copied().collect();
+    let npy = lobes::report::npy::encode(&[SIZE as usize, SIZE as usize, 2], &flat);
+    lobes::report::atomic::write_atomic(&dir.join("dfg.npy"), &npy)?;
     let to8 = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
     let rgb: Vec<u8> = lut.iter().flat_map(|t| [to8(t[0]), to8(t[1]), 0]).collect();
     let img = image::RgbImage::from_raw(SIZE, SIZE, rgb).expect("SIZE × SIZE RGB texels");
@@ -306,7 +311,7 @@ fn main() -> std::process::ExitCode {
         ((texel as u32 / SIZE) as f64 + 0.5) / SIZE as f64,
         ["A (scale)", "B (bias)"][c]
     );
-    println!("wrote {} and {}", dir.join("dfg.f32").display(), dir.join("dfg.png").display());
+    println!("wrote {}, {} and {}", dir.join("dfg.f32").display(), dir.join("dfg.npy").display(), dir.join("dfg.png").display());
     if report.max_error > TOLERANCE {
         eprintln!("error: the GPU table differs from the f64 quadrature by more than {TOLERANCE:.0e}");
         return std::process::ExitCode::FAILURE;

@@ -45,7 +45,7 @@ fn syntax_errors_and_unknown_keys() {
     scene_error("[[case]⟦\nname = \"a\"\n", &["expected `]`"]);
     scene_error("[[case]]\nname = \"a⟦\nlobe = \"ggx\"\n", &["string"]);
     scene_error(&ggx("alpha = 0.2\nalpha⟦\n"), &["expected `=`"]);
-    scene_error(&ggx("alpha = 0.2\n⟦alpah = 0.3\n"), &["unknown field `alpah`", "expected one of", "`alpha`"]);
+    scene_error(&ggx("alpha = 0.2\n⟦alpah = 0.3\n"), &["unknown field `alpah`", "expected one of", "`alpha`", "(did you mean 'alpha'?)"]);
     scene_error(&format!("⟦sample = 5\n{}", ggx("alpha = 0.2\n")), &["unknown field `sample`", "`defaults`", "`case`"]);
     scene_error(&format!("[defaults]\n⟦lobe = \"ggx\"\n{}", ggx("alpha = 0.2\n")), &["unknown field `lobe`", "`samples`", "`bins`", "`seed`"]);
     scene_error(&ggx("alpha = 0.2\n⟦alpha = 0.3\n"), &["duplicate key"]);
@@ -66,7 +66,10 @@ fn names_lobes_and_methods() {
     scene_error(&format!("{}\n[[case]]\nname = ⟦\"c\"\nlobe = \"ward\"\nalpha = 0.1\n", ggx("alpha = 0.2\n")), &["duplicate case name 'c'", "1:1"]);
     scene_error(&format!("{}\n[[case]]\nname = ⟦\"C\"\nlobe = \"ward\"\nalpha = 0.1\n", ggx("alpha = 0.2\n")), &["duplicate case name 'C'", "ignoring case"]);
     scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"phong\"\nalpha = 0.2\n", &["lobe 'phong' is unknown", "ward, beckmann, ggx or discrete"]);
-    scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"GGX\"\nalpha = 0.2\n", &["lobe 'GGX' is unknown"]);
+    scene_error("[[case]]\nname = \"c\"\nlobe = ⟦\"GGX\"\nalpha = 0.2\n", &["lobe 'GGX' is unknown", "(did you mean 'ggx'?)"]);
+    scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"vndff\"\n"), &["method 'vndff' is unknown", "(did you mean 'vndf'?)"]);
+    scene_error(&ggx("alpha = 0.2\n⟦incident_tehta = 30\n"), &["unknown field `incident_tehta`", "(did you mean 'incident_theta'?)"]);
+    scene_error(&ggx("alpha = 0.2\nmasking = ⟦\"height_correlated\"\n"), &["(did you mean 'height-correlated'?)"]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"importance\"\n"), &["method 'importance' is unknown", "ndf, vndf or bounded"]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦\"cdf\"\n"), &["cdf and alias are for lobe = \"discrete\""]);
     scene_error(&ggx("alpha = 0.2\nmethod = ⟦1\n"), &["method must be a string"]);
@@ -81,7 +84,10 @@ fn roughness_angles_and_non_finite_numbers() {
         scene_error(&ggx(&format!("alpha = ⟦{v}\n")), &[&format!("alpha = {shown} is not allowed"), "finite number > 0"]);
     }
     scene_error(&ggx("alpha = ⟦\"0.2\"\n"), &["alpha must be a number, got a string"]);
-    scene_error(&ggx("alpha = ⟦[0.2]\n"), &["alpha must be a number, got an array"]);
+    // an array sweeps (one case per value); an array inside it is not a number
+    scene_error(&ggx("alpha = [0.1, ⟦[0.2]]\n"), &["alpha must be a number, got an array"]);
+    scene_error(&ggx("alpha = 0.2\nincident_theta = [0, ⟦95]\n"), &["incident_theta", "0 ≤ θ < 90"]);
+    scene_error(&ggx("alpha = ⟦[]\n"), &["alpha = [] sweeps over no values"]);
     scene_error(&ggx("alpha_x = 0.1\nalpha_y = ⟦0\n"), &["alpha_y = 0 is not allowed"]);
     scene_error(&ggx("alpha_x = ⟦nan\nalpha_y = 0.1\n"), &["alpha_x = NaN"]);
     scene_error(&ggx("alpha_x = ⟦0.1\n"), &["alpha_x needs alpha_y"]);
@@ -436,13 +442,20 @@ fn a_case_that_fails_mid_way_leaves_no_histogram_json() {
     assert!(stderr.contains("writing the outputs into") && stderr.contains("no histogram.json was written"), "{stderr}");
     assert!(stderr.contains("1 of 3 cases could not run"), "{stderr}");
     assert!(!broken.join("histogram.json").exists(), "the failed case left a histogram.json");
-    // (marginals.png, written after residual.png, is the earlier run's)
-    assert_eq!(tree(&broken), ["expected.png", "marginals.png", "measured.png", "residual.png"], "no temporary files are left");
+    // (marginals.png, written after residual.png, the earlier run's arrays and timing.json stay:
+    // histogram.json marks a complete folder)
+    assert_eq!(
+        tree(&broken),
+        ["counts.npy", "expected.npy", "expected.png", "marginals.png", "measured.png", "residual.png", "timing.json"],
+        "no temporary files are left"
+    );
     let table = String::from_utf8_lossy(&again.stdout);
     assert!(table.lines().any(|l| l.starts_with("broken") && l.contains("ERROR")), "{table}");
-    assert_eq!(tree(&out.join("first")), ["expected.png", "histogram.json", "marginals.png", "measured.png", "residual.png"]);
+    let arrays = ["counts.npy", "expected.npy"];
+    let (json, timing) = ("histogram.json", "timing.json");
+    assert_eq!(tree(&out.join("first")), [arrays[0], arrays[1], "expected.png", json, "marginals.png", "measured.png", "residual.png", timing]);
     // a discrete case: a bar chart of its items
-    assert_eq!(tree(&out.join("last")), ["bars.png", "histogram.json"]);
+    assert_eq!(tree(&out.join("last")), ["bars.png", arrays[0], arrays[1], json, timing]);
     let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!((summary["errors"].as_u64(), summary["failed"].as_u64(), summary["status"].as_str()), (Some(1), Some(0), Some("complete")));
     assert!(summary["cases"][1]["error"].as_str().unwrap().contains("residual.png"), "{summary}");

@@ -319,6 +319,10 @@ fn dfg_lut_example_matches_the_f64_quadrature() {
     for t in &report.lut {
         assert!(t[0] > 0.0 && t[1] >= 0.0 && t[0] + t[1] <= 1.0 + 1e-3, "{t:?}");
     }
+    let (shape, npy) = lobes::report::npy::decode::<f32>(&std::fs::read(dir.join("dfg.npy")).unwrap()).unwrap();
+    assert_eq!(shape, [32, 32, 2]);
+    assert_eq!(npy[2 * (32 * 5 + 7) + 1], at(5, 7, 1), "dfg.npy[5, 7, 1] is dfg.f32's value there");
+    assert_eq!(npy, report.lut.iter().flatten().copied().collect::<Vec<f32>>());
     let png = image::open(dir.join("dfg.png")).unwrap();
     assert_eq!((png.width(), png.height()), (32, 32));
 }

@@ -1,13 +1,13 @@
 //! The JSON Schemas in `docs/schema/` are those generated from the output structs, and every
 //! JSON file lobes writes validates against its schema: `histogram.json` of a run and of a
-//! merge, shard files, and the `--json` summaries of `lobes run`, `lobes run --shard` and
+//! merge, its `timing.json`, shard files, and the `--json` summaries of `lobes run`, `lobes run --shard` and
 //! `lobes merge`. The files read back through the same structs that wrote them.
 //! GPU test: it needs a wgpu adapter (lavapipe in CI) and fails without one.
 //!
 //! After a change to an output struct, regenerate the schemas with
 //! `LOBES_WRITE_SCHEMA=1 cargo test --release --test schema`.
 
-use lobes::report::output::{CaseSummary, HistogramFile, RunSummary, SUMMARY_VERSION, ShardSummary};
+use lobes::report::output::{CaseSummary, HistogramFile, JsonStyle, RunSummary, SUMMARY_VERSION, ShardSummary, TimingFile};
 use lobes::report::schema::{schemas, to_text};
 use lobes::run::shard::ShardFile;
 use serde_json::Value;
@@ -130,7 +130,11 @@ fn every_file_lobes_writes_validates_against_its_schema() {
             validate("histogram.schema.json", &file(&path), &path.display().to_string());
             let h = HistogramFile::read(&path).unwrap();
             // what the struct reads is all the file holds: written again, it is the same text
-            assert!(serde_json::to_string_pretty(&h).unwrap() == std::fs::read_to_string(&path).unwrap(), "{}", path.display());
+            assert!(JsonStyle::Compact.to_bytes(&h).unwrap() == std::fs::read(&path).unwrap(), "{}", path.display());
+            let timing = path.with_file_name("timing.json");
+            validate("timing.schema.json", &file(&timing), &timing.display().to_string());
+            let t: TimingFile = serde_json::from_value(file(&timing)).unwrap();
+            assert_eq!((t.histogram.is_some(), t.weighted.is_some(), t.quadrature_seconds.is_some()), (true, case == "weighted", case != "alias"));
             assert_eq!(h.weighted.is_some(), case == "weighted");
             assert_eq!(h.per_sample_check.is_some(), case != "alias", "{}", path.display());
         }
@@ -148,8 +152,11 @@ fn every_file_lobes_writes_validates_against_its_schema() {
         let path = dir.join("user").join(case).join("histogram.json");
         validate("histogram.schema.json", &file(&path), &path.display().to_string());
         let h = HistogramFile::read(&path).unwrap();
-        assert!(serde_json::to_string_pretty(&h).unwrap() == std::fs::read_to_string(&path).unwrap(), "{}", path.display());
+        assert!(JsonStyle::Compact.to_bytes(&h).unwrap() == std::fs::read(&path).unwrap(), "{}", path.display());
         assert!(h.user_sampler.is_some() && h.invalid.is_none());
+        let timing = path.with_file_name("timing.json");
+        validate("timing.schema.json", &file(&timing), &timing.display().to_string());
+        assert!(serde_json::from_value::<TimingFile>(file(&timing)).unwrap().checks_wall_seconds.is_some());
     }
 
     // the schemas are not vacuous: a damaged file does not validate

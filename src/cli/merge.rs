@@ -2,7 +2,7 @@
 //! I/N`, [`crate::run::shard`]) and judges the sums as `lobes run` judges a case
 //! ([`crate::run::merge`], [`crate::run::judge`]), with the same outputs and table.
 
-use super::{ChecksFailed, OutputArgs, emit, emit_json, parse_level, prepare_out};
+use super::{ChecksFailed, FileArgs, OutputArgs, emit, emit_json, parse_level, prepare_out};
 use crate::report::output::{self, CaseSummary, RunSummary};
 use crate::run::judge;
 use crate::run::merge::{merge, read_shards};
@@ -23,6 +23,8 @@ pub struct MergeArgs {
     /// Family-wise significance level, Šidák-corrected over the scene's cases.
     #[arg(long, default_value_t = 0.01, value_parser = parse_level, allow_hyphen_values = true)]
     pub significance: f64,
+    #[command(flatten)]
+    pub files: FileArgs,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -46,7 +48,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     let mut summary = RunSummary { shard_files: Some(shards.len()), ..RunSummary::new(adapter.clone(), backend.clone(), args.significance, level) };
     for (case, sampled, parts) in merged.iter() {
         let result = judge(case, sampled.clone(), level)?;
-        output::write_case(&args.out, &result, adapter, backend)?;
+        output::write_case(&args.out, &result, adapter, backend, args.files.style())?;
         rows.push(output::table_row(&result));
         summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
     }

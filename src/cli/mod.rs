@@ -20,6 +20,7 @@ pub mod check;
 pub mod interrupt;
 pub mod merge;
 pub mod run;
+pub mod scene;
 pub mod shader;
 pub mod stress;
 pub mod tradeoff;
@@ -78,6 +79,9 @@ pub enum Command {
     /// against the f64 reference, and write histogram.json and heat maps per case.
     #[command(after_help = EXIT_CODES)]
     Run(run::RunArgs),
+    /// Print a scene template with every key and its default (--template), or the cases a
+    /// scene makes, its sweeps expanded.
+    Scene(scene::SceneArgs),
     /// Measure samples per second (sampling + histogram on the device) per lobe, method and
     /// backend: the GPU adapter and the f64 CPU reference on all cores.
     Bench(bench::BenchArgs),
@@ -110,6 +114,7 @@ impl Cli {
             Command::PdfConvert(args) => tutorial::pdf_convert(&args),
             Command::Sample(args) => tutorial::sample(&args),
             Command::Run(args) => run::run(&args),
+            Command::Scene(args) => scene::run(&args),
             Command::Bench(args) => bench::run(&args),
             Command::Stress(args) => stress::run(&args),
             Command::Merge(args) => merge::run(&args),
@@ -182,6 +187,20 @@ pub struct OutputArgs {
     /// Print exactly one JSON object on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// How `lobes run` and `lobes merge` write their JSON files.
+#[derive(Debug, Clone, Args)]
+pub struct FileArgs {
+    /// Indent histogram.json and timing.json for reading (default: compact, one line).
+    #[arg(long)]
+    pub pretty: bool,
+}
+
+impl FileArgs {
+    pub fn style(&self) -> crate::report::output::JsonStyle {
+        if self.pretty { crate::report::output::JsonStyle::Pretty } else { crate::report::output::JsonStyle::Compact }
+    }
 }
 
 /// Writes `text` to stdout; a failed write (closed pipe, full disk) is a runtime error.

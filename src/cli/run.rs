@@ -2,12 +2,12 @@
 //! the f64 reference, with per-case outputs and a table; with `--shard I/N`, one shard of every
 //! case, written as raw results for `lobes merge`.
 
-use super::{ChecksFailed, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, prepare_out, usage};
-use crate::report::output::{self, CaseSummary, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
+use super::{ChecksFailed, FileArgs, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, prepare_out, usage};
+use crate::report::output::{self, CaseSummary, JsonStyle, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
-use crate::scene::{Case, DEFAULT_SCENE, Entry, Scene, UserCase};
+use crate::scene::{Case, DEFAULT_SCENE, Entry, Overrides, Scene, UserCase};
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -17,8 +17,19 @@ use std::time::{Duration, Instant};
 
 #[derive(Debug, Clone, Args)]
 pub struct RunArgs {
-    /// Scene file (TOML); without it, the embedded scenes/all-lobes.toml (every lobe and method).
+    /// Scene file (TOML), or - to read it from standard input; without it, the embedded
+    /// scenes/all-lobes.toml (every lobe and method).
     pub scene: Option<PathBuf>,
+    /// Run only the cases whose names match NAME, a pattern such as 'ggx-*' (* any text, ? one
+    /// character, [ab] one of them; ignoring case); repeat it for more.
+    #[arg(long = "case", value_name = "NAME", conflicts_with = "shard")]
+    pub cases: Vec<String>,
+    /// Samples of every case, in place of the scene's.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=crate::scene::MAX_SAMPLES), allow_hyphen_values = true, conflicts_with = "shard")]
+    pub samples: Option<u64>,
+    /// Seed of every case, in place of the scene's.
+    #[arg(long, value_name = "S", allow_hyphen_values = true, conflicts_with = "shard")]
+    pub seed: Option<u64>,
     /// Output folder: one subfolder per case with histogram.json and PNG heat maps, and the
     /// run's summary.json and junit.xml (also when cases fail or the run is interrupted).
     #[arg(long, default_value = "out")]
@@ -35,6 +46,8 @@ pub struct RunArgs {
     #[arg(long, value_name = "I/N", value_parser = Shard::parse)]
     pub shard: Option<Shard>,
     #[command(flatten)]
+    pub files: FileArgs,
+    #[command(flatten)]
     pub output: OutputArgs,
 }
 
@@ -42,12 +55,19 @@ pub struct RunArgs {
 /// be read, is not UTF-8 or is not a valid scene is a [`super::UsageError`] naming the file (and
 /// the line and column).
 pub fn load_scene(path: Option<&PathBuf>) -> anyhow::Result<Scene> {
-    read_scene(path).map(|(_, scene)| scene)
+    read_scene(path, Overrides::default()).map(|(_, scene)| scene)
 }
 
-/// [`load_scene`], with the scene's name and text (for shard files).
-fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(SceneSource, Scene)> {
-    let (name, text) = match path {
+/// [`load_scene`] with `overrides`, and the scene's name and text (for shard files). The path
+/// `-` reads the scene from standard input (a user sampler's files are then found relative to
+/// the current folder).
+fn read_scene(path: Option<&PathBuf>, overrides: Overrides) -> anyhow::Result<(SceneSource, Scene)> {
+    let (name, bytes) = match path {
+        Some(p) if p.as_os_str() == "-" => {
+            let mut bytes = Vec::new();
+            std::io::Read::read_to_end(&mut std::io::stdin().lock(), &mut bytes).map_err(|e| usage(format!("cannot read the scene from standard input: {e}")))?;
+            ("<stdin>".to_string(), bytes)
+        }
         Some(p) => {
             let bytes = std::fs::read(p).map_err(|e| {
                 usage(format!(
@@ -55,15 +75,13 @@ fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(SceneSource, Scene)> {
                     p.display()
                 ))
             })?;
-            let name = p.display().to_string();
-            let scene = Scene::from_bytes(&name, &bytes).map_err(|e| usage(e.to_string()))?;
-            // from_bytes has checked that the file is UTF-8
-            return Ok((SceneSource { name, text: String::from_utf8_lossy(&bytes).into_owned() }, scene));
+            (p.display().to_string(), bytes)
         }
-        None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.to_string()),
+        None => ("<embedded scenes/all-lobes.toml>".to_string(), DEFAULT_SCENE.as_bytes().to_vec()),
     };
-    let scene = Scene::parse(&name, &text).map_err(|e| usage(e.to_string()))?;
-    Ok((SceneSource { name, text }, scene))
+    let scene = Scene::from_bytes_with(&name, &bytes, overrides).map_err(|e| usage(e.to_string()))?;
+    // from_bytes has checked that the text is UTF-8
+    Ok((SceneSource { name, text: String::from_utf8_lossy(&bytes).into_owned() }, scene))
 }
 
 /// Checks, before anything runs, that every case fits the GPU adapter (histograms larger than a
@@ -100,21 +118,21 @@ fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
 
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
 /// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
-fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
+fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, style: JsonStyle, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
     remove_stale(out, &case.name)?;
     let sampled = run_case(backend, case, 0..case.samples, progress)?;
     let result = judge(case, sampled, level)?;
     let adapter = backend.adapter();
-    output::write_case(out, &result, &adapter, backend.name())
+    output::write_case(out, &result, &adapter, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok(result)
 }
 
 /// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
-fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path) -> anyhow::Result<([String; 9], CaseSummary)> {
+fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path, style: JsonStyle) -> anyhow::Result<([String; 9], CaseSummary)> {
     remove_stale(out, &case.name)?;
     let result = run_user(backend, case, level)?;
-    output::write_user_case(out, &result, backend.name())
+    output::write_user_case(out, &result, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }))
 }
@@ -169,7 +187,8 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     if let Some(shard) = args.shard {
         return run_shard(args, shard);
     }
-    let scene = load_scene(args.scene.as_ref())?;
+    let overrides = Overrides { samples: args.samples, seed: args.seed };
+    let scene = read_scene(args.scene.as_ref(), overrides)?.1.select(&args.cases).map_err(usage)?;
     if args.cpu
         && let Some((name, at)) = first_user_case(&scene)
     {
@@ -201,7 +220,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             (Some(where_lost), _) => Err(anyhow::anyhow!("not run: the GPU device was lost in case '{where_lost}'")),
             (None, Entry::Lobe(case)) => {
                 let bar = progress_bar(case.samples, &case.name);
-                let outcome = run_and_write(&mut backend, case, level, &args.out, &mut plain.samples(i, &case.name, case.samples, &bar));
+                let outcome = run_and_write(&mut backend, case, level, &args.out, args.files.style(), &mut plain.samples(i, &case.name, case.samples, &bar));
                 bar.finish_and_clear();
                 outcome.map(|result| {
                     wall_rows |= result.gpu_seconds.is_none();
@@ -212,7 +231,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 user_rows = true;
                 let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
                 bar.enable_steady_tick(Duration::from_millis(200));
-                let outcome = run_user_and_write(&backend, case, level, &args.out);
+                let outcome = run_user_and_write(&backend, case, level, &args.out, args.files.style());
                 bar.finish_and_clear();
                 outcome
             }
@@ -279,7 +298,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
 /// `lobes run SCENE --shard I/N --out DIR`: samples shard I of every case and writes
 /// `DIR/<case>/shard-I-of-N.json` for `lobes merge`.
 fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
-    let (source, scene) = read_scene(args.scene.as_ref())?;
+    let (source, scene) = read_scene(args.scene.as_ref(), Overrides::default())?;
     if let Some((name, at)) = first_user_case(&scene) {
         return Err(usage(format!(
             "{at}: case '{name}' is a WGSL sampler of your own, which --shard does not split: its checks (the Jacobian probe, \

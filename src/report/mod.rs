@@ -6,7 +6,7 @@
 //! [`png`] encodes it; [`marginals`] charts bins against their expectation; [`compare`] draws a
 //! measured histogram against its expectation with both (one code path for `lobes run` and
 //! `lobes check`), titled by [`caption`]; [`table`] prints terminal tables; [`output`] writes a
-//! case's files, [`check`] those of `lobes check`; [`html`] writes the run's `index.html`.
+//! case's files (its arrays as NumPy [`npy`]), [`check`] those of `lobes check`; [`html`] writes the run's `index.html`.
 
 pub mod atomic;
 pub mod caption;
@@ -23,6 +23,7 @@ pub mod output;
 pub mod schema;
 #[cfg(feature = "cli")]
 pub mod summary;
+pub mod npy;
 pub mod png;
 pub mod table;
 pub mod text;

@@ -1,14 +1,21 @@
 //! Per-case outputs: `histogram.json` and PNG heat maps of the measured histogram, the
-//! expected one and the signed residual (measured − expected)/√expected; shard files; and the
-//! summary of `lobes run` and `lobes merge` (`OUT/summary.json`, `OUT/junit.xml`, `--json`). Each is a serde struct that writer and
+//! expected one and the signed residual (measured − expected)/√expected, the same histograms as
+//! `counts.npy` and `expected.npy` ([`super::npy`]), and `timing.json`; shard files; and the
+//! summary of `lobes run` and `lobes merge` (`OUT/summary.json`, `OUT/junit.xml`, `--json`). Each
+//! is a serde struct that writer and
 //! reader share, with a `format_version`; `docs/schema/` holds their JSON Schema
 //! ([`super::schema`]). Every file is written atomically ([`super::atomic`]), and
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
+//!
+//! `histogram.json` holds only what the scene and the adapter determine: the times are in
+//! `timing.json`, so two runs of a scene on one adapter write byte-identical `histogram.json`
+//! files. JSON is compact unless `--pretty` asks for indentation.
 
 use super::atomic::write_atomic;
 use super::caption;
 use super::compare::{self, Bins, Comparison};
 use super::heatmap::{self, Heatmap, Scale};
+use super::npy;
 use crate::check::Domain;
 use crate::engine::job::Job;
 use crate::stats::histogram::SphereGrid;
@@ -24,8 +31,10 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The version of the layout of `histogram.json`.
-pub const HISTOGRAM_VERSION: u32 = 1;
+/// The version of the layout of `histogram.json` (2: the times moved to `timing.json`).
+pub const HISTOGRAM_VERSION: u32 = 2;
+/// The version of the layout of `timing.json`.
+pub const TIMING_VERSION: u32 = 1;
 /// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
 /// `--json`) and of `lobes run --shard` (2: the run's status, lobes' version, why a case failed).
 pub const SUMMARY_VERSION: u32 = 2;
@@ -56,7 +65,6 @@ pub struct HistogramFile {
     pub invalid: Option<ByReason<u64>>,
     pub expected_invalid: Option<ByReason<f64>>,
     pub chi2: Chi2,
-    pub timing: Timing,
     /// GPU directions of the first samples against f64 (GPU lobe cases).
     pub per_sample_check: Option<AngleCheck>,
     /// The expected histogram's quadrature (lobe cases).
@@ -70,6 +78,48 @@ pub struct HistogramFile {
     pub user_sampler: Option<UserSamplerRecord>,
 }
 
+/// `timing.json`: a case's times, which differ from run to run (kept out of `histogram.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct TimingFile {
+    /// [`TIMING_VERSION`].
+    pub format_version: u32,
+    pub case: String,
+    /// The histogram pass (lobes' samplers).
+    pub histogram: Option<Timing>,
+    /// The expected histogram's quadrature (lobe cases).
+    pub quadrature_seconds: Option<f64>,
+    /// The weighted pass of a case with effects.
+    pub weighted: Option<WeightedTiming>,
+    /// Wall time of all the checks of a user's WGSL sampler.
+    pub checks_wall_seconds: Option<f64>,
+}
+
+impl TimingFile {
+    /// The `timing.json` of a case.
+    pub fn new(r: &CaseResult) -> Self {
+        TimingFile {
+            format_version: TIMING_VERSION,
+            case: r.case.name.clone(),
+            histogram: Some(Timing { gpu_seconds: r.gpu_seconds, histogram_wall_seconds: r.histogram_seconds }),
+            quadrature_seconds: r.expected.quadrature.as_ref().map(|_| r.quadrature_seconds),
+            weighted: r.weighted.as_ref().map(|w| WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds }),
+            checks_wall_seconds: None,
+        }
+    }
+
+    /// The `timing.json` of a user's sampler case.
+    pub fn of_user(r: &UserResult) -> Self {
+        TimingFile {
+            format_version: TIMING_VERSION,
+            case: r.case.name.clone(),
+            histogram: None,
+            quadrature_seconds: None,
+            weighted: None,
+            checks_wall_seconds: Some(r.wall_seconds),
+        }
+    }
+}
+
 /// The `user_sampler` section: every check of `lobes check` and the invalid samples by the
 /// check's reasons ([`crate::check::REASONS`]), pooled into one cell of the χ² test.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -81,8 +131,6 @@ pub struct UserSamplerRecord {
     pub invalid: UserInvalid,
     /// The expected count of the pooled invalid cell.
     pub expected_invalid: f64,
-    /// Wall time of all the checks.
-    pub wall_seconds: f64,
 }
 
 /// Invalid samples of a user's sampler by reason.
@@ -100,7 +148,6 @@ pub struct QuadratureRecord {
     pub error_estimate: f64,
     pub max_error_sigma_at_1e8: f64,
     pub below_horizon_probability: f64,
-    pub seconds: f64,
 }
 
 /// The `weighted` section: the effects, the verdict, and per bin the albedo estimate, its f64
@@ -109,7 +156,6 @@ pub struct QuadratureRecord {
 pub struct WeightedRecord {
     pub effects: Effects,
     pub check: AlbedoCheck,
-    pub timing: WeightedTiming,
     pub bin_albedo: Vec<Vec<f64>>,
     pub bin_albedo_reference: Vec<Vec<f64>>,
     pub bin_max_weight_error: Vec<Vec<f32>>,
@@ -147,13 +193,11 @@ impl HistogramFile {
             invalid: Some(r.counts.invalid.into()),
             expected_invalid: Some(r.expected.invalid.into()),
             chi2: r.chi2.clone(),
-            timing: Timing { gpu_seconds: r.gpu_seconds, histogram_wall_seconds: r.histogram_seconds },
             per_sample_check: r.angle.clone(),
             quadrature: r.expected.quadrature.as_ref().map(|q| QuadratureRecord {
                 error_estimate: q.error_estimate,
                 max_error_sigma_at_1e8: q.max_error_sigma,
                 below_horizon_probability: q.below_horizon,
-                seconds: r.quadrature_seconds,
             }),
             workgroup_counting: r.workgroup_counting,
             weighted: r.weighted.as_ref().map(|w| WeightedRecord::new(r, w, cols)),
@@ -186,7 +230,6 @@ impl HistogramFile {
             invalid: None,
             expected_invalid: None,
             chi2: r.chi2.clone(),
-            timing: Timing { gpu_seconds: None, histogram_wall_seconds: r.wall_seconds },
             per_sample_check: None,
             quadrature: None,
             workgroup_counting: None,
@@ -196,7 +239,6 @@ impl HistogramFile {
                 checks: report.checks.to_vec(),
                 invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
                 expected_invalid: r.expected_invalid,
-                wall_seconds: r.wall_seconds,
             }),
         }
     }
@@ -215,7 +257,6 @@ impl WeightedRecord {
         WeightedRecord {
             effects: r.case.effects.expect("a weighted case has effects"),
             check: w.check.clone(),
-            timing: WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds },
             bin_albedo: nested(&estimate, cols),
             bin_albedo_reference: nested(&w.check.reference_bins, cols),
             bin_max_weight_error: nested(&w.sums.max_error, cols),
@@ -233,8 +274,9 @@ pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     Ok(file)
 }
 
-/// Writes the heat maps and then `histogram.json` of a user's sampler case into `dir/<case>/`.
-pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str) -> anyhow::Result<()> {
+/// Writes the pictures, the arrays, `timing.json` and then `histogram.json` of a user's
+/// sampler case into `dir/<case>/`.
+pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonStyle) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
     let doc = HistogramFile::of_user(r, backend);
@@ -246,12 +288,52 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str) -> anyhow::Res
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
     let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), r.chi2.p_value));
     compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
-    write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
-    Ok(())
+    let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
+    files.write(&folder, [rows as usize, cols as usize], style)
 }
 
-/// Writes the heat maps and then `histogram.json` into `dir/<case>/`.
-pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> anyhow::Result<()> {
+/// How JSON files are laid out: compact (one line), or indented for people (`--pretty`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JsonStyle {
+    #[default]
+    Compact,
+    Pretty,
+}
+
+impl JsonStyle {
+    /// `value` as JSON in this style, with a final newline.
+    pub fn to_bytes(self, value: &impl Serialize) -> serde_json::Result<Vec<u8>> {
+        let mut text = match self {
+            JsonStyle::Compact => serde_json::to_string(value)?,
+            JsonStyle::Pretty => serde_json::to_string_pretty(value)?,
+        };
+        text.push('\n');
+        Ok(text.into_bytes())
+    }
+}
+
+/// The files of a case after its heat maps: `counts.npy`, `expected.npy`, `timing.json`, and
+/// `histogram.json` last.
+struct CaseFiles<'a> {
+    counts: &'a [u64],
+    expected: &'a [f64],
+    timing: TimingFile,
+    histogram: HistogramFile,
+}
+
+impl CaseFiles<'_> {
+    /// `shape`: the histogram's rows × cols.
+    fn write(&self, folder: &Path, shape: [usize; 2], style: JsonStyle) -> anyhow::Result<()> {
+        write_atomic(&folder.join("counts.npy"), &npy::encode(&shape, self.counts))?;
+        write_atomic(&folder.join("expected.npy"), &npy::encode(&shape, self.expected))?;
+        write_atomic(&folder.join("timing.json"), &style.to_bytes(&self.timing)?)?;
+        write_atomic(&folder.join("histogram.json"), &style.to_bytes(&self.histogram)?)?;
+        Ok(())
+    }
+}
+
+/// Writes the heat maps, the arrays, `timing.json` and then `histogram.json` into `dir/<case>/`.
+pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, style: JsonStyle) -> anyhow::Result<()> {
     let folder = dir.join(&r.case.name);
     std::fs::create_dir_all(&folder)?;
     let doc = HistogramFile::new(r, adapter, backend);
@@ -276,8 +358,8 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str) -> a
         let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi) };
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
-    write_atomic(&folder.join("histogram.json"), serde_json::to_string_pretty(&doc)?.as_bytes())?;
-    Ok(())
+    let files = CaseFiles { counts: &r.counts.bins, expected: &r.expected.bins, timing: TimingFile::new(r), histogram: doc };
+    files.write(&folder, [rows as usize, cols as usize], style)
 }
 
 /// The summary of `lobes run` and `lobes merge`: `OUT/summary.json` (written on every run that

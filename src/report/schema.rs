@@ -2,7 +2,7 @@
 //! structs that write and read them. `docs/schema/` holds them; `tests/schema.rs` checks that
 //! they are up to date and that the files of a run, a shard run, a merge and a check validate.
 
-use super::output::{HistogramFile, RunSummary, ShardSummary};
+use super::output::{HistogramFile, RunSummary, ShardSummary, TimingFile};
 use crate::check::Report as CheckReport;
 use crate::check::power::PowerSweep;
 use crate::run::shard::ShardFile;
@@ -16,6 +16,8 @@ pub fn schemas() -> Vec<(&'static str, serde_json::Value)> {
     vec![
         // DIR/<case>/histogram.json of `lobes run` and `lobes merge`
         one::<HistogramFile>("histogram.schema.json"),
+        // DIR/<case>/timing.json of `lobes run` and `lobes merge`
+        one::<TimingFile>("timing.schema.json"),
         // DIR/<case>/shard-I-of-N.json of `lobes run --shard I/N`
         one::<ShardFile>("shard.schema.json"),
         // stdout of `lobes run --json` and `lobes merge --json`

@@ -29,13 +29,19 @@
 //! incident_theta = [0, 45, 80]  # an array sweeps: one case per value, named my-ggx-theta0 …
 //! ```
 //!
+//! Any key with one number or name sweeps when given an array (`alpha = [0.1, 0.3]`,
+//! `method = ["ndf", "vndf"]`), and several such keys make their product ([`sweep`]).
+//!
 //! Every value is read as a TOML value first and checked here, so a wrong type, a value out
 //! of range, NaN or infinity, an unknown name or a key that does not apply to the case's lobe
 //! is a [`SceneError`] pointing at the value (a value set in `[defaults]` is reported where
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
 
+mod select;
+pub mod suggest;
 mod sweep;
+pub mod template;
 mod user;
 
 pub use user::UserCase;
@@ -49,6 +55,7 @@ use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use serde::Deserialize;
 use std::collections::HashMap;
+use suggest::did_you_mean;
 use sweep::{Point, Sweep};
 use std::ops::Range;
 use toml::{Spanned, Value};
@@ -67,6 +74,24 @@ pub const MAX_BINS: u64 = 1 << 24;
 /// The largest sample count of a weighted case (its 64-bit fixed-point sums hold 2^32 samples
 /// of mean weight up to 4096).
 pub const MAX_WEIGHTED_SAMPLES: u64 = 1 << 32;
+/// A case's samples unless the case or `[defaults]` sets them.
+pub const DEFAULT_SAMPLES: u64 = 10_000_000;
+/// A case's seed unless the case or `[defaults]` sets it.
+pub const DEFAULT_SEED: u64 = 1;
+/// A lobe case's bins unless the case or `[defaults]` sets them: 64 rows over cos θ, 128
+/// columns over φ.
+pub const DEFAULT_BINS: SphereGrid = SphereGrid { rows: 64, cols: 128 };
+/// A lobe case's sampler unless `method` is given.
+pub const DEFAULT_METHOD: Method = Method::Ndf;
+/// A discrete case's sampler unless `method` is given.
+pub const DEFAULT_DISCRETE_METHOD: DiscreteMethod = DiscreteMethod::Cdf;
+/// A lobe case's incident polar angle in degrees unless given (a user sampler's is
+/// [`crate::check::Settings`]'s).
+pub const DEFAULT_INCIDENT_THETA: f64 = 0.0;
+/// A case's incident azimuth in degrees unless given.
+pub const DEFAULT_INCIDENT_PHI: f64 = 0.0;
+/// The turn of a lobe's tangent frame, degrees (`alpha_angle`).
+pub const DEFAULT_ALPHA_ANGLE: f64 = 0.0;
 /// The longest case name (it names a folder).
 pub const MAX_NAME_LEN: usize = 100;
 
@@ -103,27 +128,52 @@ struct RawDefaults {
 struct RawCase {
     name: Option<Val>,
     lobe: Option<Val>,
-    method: Option<Val>,
-    alpha: Option<Val>,
-    alpha_x: Option<Val>,
-    alpha_y: Option<Val>,
-    alpha_angle: Option<Val>,
+    method: Option<Sweep>,
+    alpha: Option<Sweep>,
+    alpha_x: Option<Sweep>,
+    alpha_y: Option<Sweep>,
+    alpha_angle: Option<Sweep>,
     incident_theta: Option<Sweep>,
     incident_phi: Option<Sweep>,
     weights: Option<Spanned<Weights>>,
-    samples: Option<Val>,
-    bins: Option<Val>,
-    seed: Option<Val>,
+    samples: Option<Sweep>,
+    bins: Option<Sweep>,
+    seed: Option<Sweep>,
     weighted: Option<Val>,
-    fresnel: Option<Val>,
-    f0: Option<Val>,
-    eta: Option<Val>,
-    k: Option<Val>,
-    masking: Option<Val>,
+    fresnel: Option<Sweep>,
+    f0: Option<Sweep>,
+    eta: Option<Sweep>,
+    k: Option<Sweep>,
+    masking: Option<Sweep>,
     sampler: Option<Spanned<user::RawSampler>>,
     params: Option<Sweep>,
     domain: Option<Val>,
     bounds: Option<Val>,
+}
+
+impl RawCase {
+    /// The sweepable keys' values, in the order of [`sweep::KEYS`].
+    fn sweeps(&self) -> [Option<&Sweep>; sweep::KEYS.len()] {
+        [
+            &self.method,
+            &self.alpha,
+            &self.alpha_x,
+            &self.alpha_y,
+            &self.alpha_angle,
+            &self.incident_theta,
+            &self.incident_phi,
+            &self.fresnel,
+            &self.f0,
+            &self.eta,
+            &self.k,
+            &self.masking,
+            &self.params,
+            &self.bins,
+            &self.samples,
+            &self.seed,
+        ]
+        .map(Option::as_ref)
+    }
 }
 
 /// `weights = [...]`, each item with its own span (so an error points at the bad weight).
@@ -321,22 +371,34 @@ fn grid(ctx: &Ctx, v: &Val, even_rows: bool, allowed: &str) -> Result<SphereGrid
     Ok(SphereGrid { rows: r, cols: c })
 }
 
-/// `[defaults]`, each value validated where it is written.
+/// `[defaults]`, each value validated where it is written, and the command line's overrides.
 struct Defaults<'a> {
     samples: Option<(u64, &'a Val)>,
     bins: Option<SphereGrid>,
     seed: Option<u64>,
+    overrides: Overrides,
+}
+
+/// Values that replace those of every case (`lobes run --samples N --seed S`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Overrides {
+    /// Samples of every case, 1 ..= [`MAX_SAMPLES`] (a weighted case: ..= [`MAX_WEIGHTED_SAMPLES`]).
+    pub samples: Option<u64>,
+    pub seed: Option<u64>,
 }
 
 impl Scene {
     /// Parses and validates a scene; `file` names it in errors.
     pub fn parse(file: &str, text: &str) -> Result<Scene, SceneError> {
+        Scene::parse_with(file, text, Overrides::default())
+    }
+
+    /// [`Scene::parse`], with `overrides` replacing every case's samples and seed.
+    pub fn parse_with(file: &str, text: &str, overrides: Overrides) -> Result<Scene, SceneError> {
         let ctx = Ctx { file, text };
         let raw: RawScene = toml::from_str(text).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            let message = e
-                .message()
-                .trim()
+            let message = suggest::unknown_field(e.message().trim())
                 .replace("struct RawScene", "[defaults] and [[case]] tables")
                 .replace("struct RawDefaults", "a [defaults] table")
                 .replace("struct RawCase", "a [[case]] table")
@@ -350,6 +412,7 @@ impl Scene {
             samples: d.and_then(|d| d.samples.as_ref()).map(|v| samples(&ctx, v).map(|n| (n, v))).transpose()?,
             bins: d.and_then(|d| d.bins.as_ref()).map(|v| bins(&ctx, v)).transpose()?,
             seed: d.and_then(|d| d.seed.as_ref()).map(|v| seed(&ctx, v)).transpose()?,
+            overrides,
         };
         if raw.case.is_empty() {
             return Err(ctx.err(0..0, "the scene has no [[case]] tables; add at least one (see scenes/all-lobes.toml)"));
@@ -391,8 +454,13 @@ impl Scene {
 
     /// Parses a scene from raw bytes: text that is not UTF-8 is an error at the first bad byte.
     pub fn from_bytes(file: &str, bytes: &[u8]) -> Result<Scene, SceneError> {
+        Scene::from_bytes_with(file, bytes, Overrides::default())
+    }
+
+    /// [`Scene::from_bytes`] with [`Overrides`].
+    pub fn from_bytes_with(file: &str, bytes: &[u8], overrides: Overrides) -> Result<Scene, SceneError> {
         match std::str::from_utf8(bytes) {
-            Ok(text) => Scene::parse(file, text),
+            Ok(text) => Scene::parse_with(file, text, overrides),
             Err(e) => {
                 let good = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
                 let (line, column) = line_column(good, good.len());
@@ -475,31 +543,25 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
     let c = spanned.get_ref();
     let name = check_name(ctx, spanned)?;
     let name_span = c.name.as_ref().map_or(spanned.span(), |n| n.span());
-    let samples = match &c.samples {
-        Some(v) => samples(ctx, v)?,
-        None => d.samples.map_or(10_000_000, |(n, _)| n),
-    };
-    let seed = match &c.seed {
-        Some(v) => seed(ctx, v)?,
-        None => d.seed.unwrap_or(1),
-    };
-    for (key, sweep) in [("incident_theta", &c.incident_theta), ("incident_phi", &c.incident_phi)] {
+    let sweeps = c.sweeps();
+    for (key, sweep) in sweep::KEYS.iter().zip(sweeps) {
         if let Some(s) = sweep
+            && !key.list
             && s.is_empty_sweep()
         {
-            return Err(ctx.err(s.span(), format!("{key} = [] sweeps over no values; give a number, or an array of numbers (one case each)")));
+            return Err(ctx.err(s.span(), format!("{} = [] sweeps over no values; give a value, or an array of values (one case each)", key.name)));
         }
     }
+    let points = sweep::points(sweeps);
     let sampler = match &c.sampler {
-        Some(raw) => Some(user::sampler(ctx, c, raw)?),
+        Some(raw) => Some(user::sampler(ctx, c, &points[0], raw)?),
         None => {
-            let user_keys = [("params", c.params.as_ref().map(Sweep::whole)), ("domain", c.domain.clone()), ("bounds", c.bounds.clone())];
-            let user_keys: Vec<(&str, Option<&Val>)> = user_keys.iter().map(|(k, v)| (*k, v.as_ref())).collect();
+            let user_keys = [("params", points[0].get("params")), ("domain", c.domain.as_ref()), ("bounds", c.bounds.as_ref())];
             reject_keys(ctx, &user_keys, "only applies to a user sampler (sampler = { wgsl = [...], sample = ..., pdf = ... }); remove it")?;
             None
         }
     };
-    sweep::points(c.incident_theta.as_ref(), c.incident_phi.as_ref(), c.params.as_ref())
+    points
         .into_iter()
         .map(|point| {
             let name = format!("{name}{}", point.suffix);
@@ -509,9 +571,19 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
                     format!("the sweep makes the case name '{name}', longer than {MAX_NAME_LEN} characters (it names a folder); shorten the name"),
                 ));
             }
+            let samples = match (d.overrides.samples, point.get("samples")) {
+                (Some(n), _) => n,
+                (None, Some(v)) => samples(ctx, v)?,
+                (None, None) => d.samples.map_or(DEFAULT_SAMPLES, |(n, _)| n),
+            };
+            let seed = match (d.overrides.seed, point.get("seed")) {
+                (Some(s), _) => s,
+                (None, Some(v)) => seed(ctx, v)?,
+                (None, None) => d.seed.unwrap_or(DEFAULT_SEED),
+            };
             let common = Common { name, samples, seed };
             match &sampler {
-                Some(s) => user::case(ctx, spanned, d, &point, common, s).map(Parsed::User),
+                Some(s) => user::case(ctx, d, &point, common, s).map(Parsed::User),
                 None => validate_case(ctx, spanned, d, &point, common).map(Parsed::Lobe),
             }
         })
@@ -521,6 +593,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
 fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common) -> Result<Case, SceneError> {
     let c = spanned.get_ref();
     let Common { name, samples, seed } = common;
+    const LOBES: [&str; 4] = ["ward", "beckmann", "ggx", "discrete"];
     let lobes_allowed = "use ward, beckmann, ggx or discrete";
     let Some(lobe_v) = &c.lobe else {
         return Err(ctx.err(
@@ -529,25 +602,22 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         ));
     };
     let lobe_name = string(ctx, lobe_v, "lobe", lobes_allowed)?;
-    let method = c.method.as_ref().map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
+    let method = point.get("method").map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
 
     if lobe_name == "discrete" {
         let method = match method {
-            None | Some(("cdf", _)) => DiscreteMethod::Cdf,
+            None => DEFAULT_DISCRETE_METHOD,
+            Some(("cdf", _)) => DiscreteMethod::Cdf,
             Some(("alias", _)) => DiscreteMethod::Alias,
-            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias"))),
+            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias{}", did_you_mean(other, ["cdf", "alias"])))),
         };
-        reject_keys(ctx, &roughness_keys(c), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
+        reject_keys(ctx, &roughness_keys(point), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
         reject_keys(
             ctx,
-            &[
-                ("incident_theta", point.incident_theta.as_ref()),
-                ("incident_phi", point.incident_phi.as_ref()),
-                ("bins", c.bins.as_ref()),
-            ],
+            &[("incident_theta", point.get("incident_theta")), ("incident_phi", point.get("incident_phi")), ("bins", point.get("bins"))],
             "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
         )?;
-        reject_keys(ctx, &effect_keys(c), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
+        reject_keys(ctx, &effect_keys(c, point), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
         let Some(w) = &c.weights else {
             return Err(ctx.err(lobe_v.span(), "a discrete case needs weights = [w0, w1, ...]: finite numbers ≥ 0, not all zero"));
         };
@@ -574,14 +644,17 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         "ward" => LobeKind::Ward,
         "beckmann" => LobeKind::Beckmann,
         "ggx" => LobeKind::Ggx,
-        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}"))),
+        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}{}", did_you_mean(other, LOBES)))),
     };
     let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
-    let method = match method.map_or("ndf", |m| m.0) {
+    let method = match method.map_or(DEFAULT_METHOD.name(), |m| m.0) {
         "ndf" => Method::Ndf,
         "vndf" => Method::Vndf,
         "bounded" => Method::Bounded,
-        other => return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\")"))),
+        other => {
+            let hint = did_you_mean(other, ["ndf", "vndf", "bounded"]);
+            return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\"){hint}")));
+        }
     };
     if !kind.supports(method) {
         return Err(ctx.err(
@@ -594,7 +667,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
     }
     let rough = "roughness must be a finite number > 0";
     let positive = |v: &Val, key| number(ctx, v, key, |x| x > 0.0, rough);
-    let (ax, ay) = match (&c.alpha, &c.alpha_x, &c.alpha_y) {
+    let (ax, ay) = match (point.get("alpha"), point.get("alpha_x"), point.get("alpha_y")) {
         (Some(a), None, None) => {
             let a = positive(a, "alpha")?;
             (a, a)
@@ -609,71 +682,70 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
             return Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})")));
         }
     };
-    let theta = match &point.incident_theta {
+    let theta = match point.get("incident_theta") {
         Some(t) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
-        None => 0.0,
+        None => DEFAULT_INCIDENT_THETA,
     };
     let phi = incident_phi(ctx, point)?;
-    let grid = match &c.bins {
+    let grid = match point.get("bins") {
         Some(v) => bins(ctx, v)?,
-        None => d.bins.unwrap_or(SphereGrid { rows: 64, cols: 128 }),
+        None => d.bins.unwrap_or(DEFAULT_BINS),
     };
     let incident = reflect::spherical(theta.to_radians(), phi.to_radians());
     // allowed with any α (an isotropic lobe turned is the same lobe), so sweeps over α need no special case
-    let angle = match &c.alpha_angle {
+    let angle = match point.get("alpha_angle") {
         Some(v) => number(ctx, v, "alpha_angle", |x| (-360.0..=360.0).contains(&x), "alpha_angle is in degrees from +x to the alpha_x axis, −360 ≤ angle ≤ 360")?,
-        None => 0.0,
+        None => DEFAULT_ALPHA_ANGLE,
     };
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: angle };
-    let effects = effects(ctx, c, kind)?;
+    let effects = effects(ctx, c, point, kind)?;
     if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
-        let span = c.samples.as_ref().or(d.samples.map(|(_, v)| v)).map_or(spanned.span(), |v| v.span());
-        return Err(ctx.err(span, format!("samples = {samples} is too many for a weighted case; at most 2^32 (4294967296)")));
+        let (span, given) = match (d.overrides.samples, point.get("samples").or(d.samples.map(|(_, v)| v))) {
+            (Some(_), _) => (spanned.span(), " (--samples)"),
+            (None, v) => (v.map_or(spanned.span(), |v| v.span()), ""),
+        };
+        return Err(ctx.err(span, format!("samples = {samples}{given} is too many for a weighted case; at most 2^32 (4294967296)")));
     }
     Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi), effects })
 }
 
 /// `incident_phi` of a case (0 unless given).
 fn incident_phi(ctx: &Ctx, point: &Point) -> Result<f64, SceneError> {
-    match &point.incident_phi {
+    match point.get("incident_phi") {
         Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360"),
-        None => Ok(0.0),
+        None => Ok(DEFAULT_INCIDENT_PHI),
     }
 }
 
-fn roughness_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 4] {
-    [("alpha", c.alpha.as_ref()), ("alpha_x", c.alpha_x.as_ref()), ("alpha_y", c.alpha_y.as_ref()), ("alpha_angle", c.alpha_angle.as_ref())]
+fn roughness_keys(p: &Point) -> [(&'static str, Option<&Val>); 4] {
+    ["alpha", "alpha_x", "alpha_y", "alpha_angle"].map(|k| (k, p.get(k)))
 }
 
-fn effect_keys(c: &RawCase) -> [(&'static str, Option<&Val>); 6] {
-    [
-        ("weighted", c.weighted.as_ref()),
-        ("fresnel", c.fresnel.as_ref()),
-        ("f0", c.f0.as_ref()),
-        ("eta", c.eta.as_ref()),
-        ("k", c.k.as_ref()),
-        ("masking", c.masking.as_ref()),
-    ]
+fn effect_keys<'a>(c: &'a RawCase, p: &'a Point) -> [(&'static str, Option<&'a Val>); 6] {
+    [("weighted", c.weighted.as_ref()), ("fresnel", p.get("fresnel")), ("f0", p.get("f0")), ("eta", p.get("eta")), ("k", p.get("k")), ("masking", p.get("masking"))]
 }
 
 /// The effects of a lobe case: `None` unless it asks for a weighted histogram.
-fn effects(ctx: &Ctx, c: &RawCase, kind: LobeKind) -> Result<Option<Effects>, SceneError> {
+fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<Effects>, SceneError> {
     let fresnel_allowed = "use none, schlick (with f0), conductor (with eta and k) or dielectric (with eta)";
-    let fresnel = match &c.fresnel {
+    let fresnel = match p.get("fresnel") {
         None => Fresnel::None,
         Some(v) => match string(ctx, v, "fresnel", fresnel_allowed)? {
             "none" => Fresnel::None,
             "schlick" => Fresnel::Schlick {
-                f0: required(ctx, v, c.f0.as_ref(), "f0", |x| (0.0..=1.0).contains(&x), "f0 is the reflectance at normal incidence, 0 ≤ f0 ≤ 1")?,
+                f0: required(ctx, v, p.get("f0"), "f0", |x| (0.0..=1.0).contains(&x), "f0 is the reflectance at normal incidence, 0 ≤ f0 ≤ 1")?,
             },
             "conductor" => Fresnel::Conductor {
-                eta: required(ctx, v, c.eta.as_ref(), "eta", |x| x > 0.0, "eta is the real part of the index of refraction, > 0")?,
-                k: required(ctx, v, c.k.as_ref(), "k", |x| x >= 0.0, "k is the absorption (imaginary part of the index), ≥ 0")?,
+                eta: required(ctx, v, p.get("eta"), "eta", |x| x > 0.0, "eta is the real part of the index of refraction, > 0")?,
+                k: required(ctx, v, p.get("k"), "k", |x| x >= 0.0, "k is the absorption (imaginary part of the index), ≥ 0")?,
             },
             "dielectric" => Fresnel::Dielectric {
-                eta: required(ctx, v, c.eta.as_ref(), "eta", |x| x > 0.0, "eta is the relative index of refraction n_t / n_i, > 0")?,
+                eta: required(ctx, v, p.get("eta"), "eta", |x| x > 0.0, "eta is the relative index of refraction n_t / n_i, > 0")?,
             },
-            other => return Err(ctx.err(v.span(), format!("fresnel '{other}' is unknown; {fresnel_allowed}"))),
+            other => {
+                let hint = did_you_mean(other, ["none", "schlick", "conductor", "dielectric"]);
+                return Err(ctx.err(v.span(), format!("fresnel '{other}' is unknown; {fresnel_allowed}{hint}")));
+            }
         },
     };
     // Parameters that the chosen form does not read.
@@ -681,11 +753,11 @@ fn effects(ctx: &Ctx, c: &RawCase, kind: LobeKind) -> Result<Option<Effects>, Sc
         Some(v) if !used => Err(ctx.err(v.span(), format!("{key} does not apply to fresnel = \"{}\"; remove it ({fresnel_allowed})", fresnel.name()))),
         _ => Ok(()),
     };
-    unused("f0", c.f0.as_ref(), matches!(fresnel, Fresnel::Schlick { .. }))?;
-    unused("eta", c.eta.as_ref(), matches!(fresnel, Fresnel::Conductor { .. } | Fresnel::Dielectric { .. }))?;
-    unused("k", c.k.as_ref(), matches!(fresnel, Fresnel::Conductor { .. }))?;
+    unused("f0", p.get("f0"), matches!(fresnel, Fresnel::Schlick { .. }))?;
+    unused("eta", p.get("eta"), matches!(fresnel, Fresnel::Conductor { .. } | Fresnel::Dielectric { .. }))?;
+    unused("k", p.get("k"), matches!(fresnel, Fresnel::Conductor { .. }))?;
     let masking_allowed = "use none, g1, separable or height-correlated";
-    let masking = match &c.masking {
+    let masking = match p.get("masking") {
         None => Masking::None,
         Some(v) => {
             let m = match string(ctx, v, "masking", masking_allowed)? {
@@ -693,7 +765,10 @@ fn effects(ctx: &Ctx, c: &RawCase, kind: LobeKind) -> Result<Option<Effects>, Sc
                 "g1" => Masking::G1,
                 "separable" => Masking::Separable,
                 "height-correlated" => Masking::HeightCorrelated,
-                other => return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}"))),
+                other => {
+                    let hint = did_you_mean(other, ["none", "g1", "separable", "height-correlated"]);
+                    return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}{hint}")));
+                }
             };
             if kind == LobeKind::Ward && m != Masking::None {
                 return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));
@@ -708,7 +783,7 @@ fn effects(ctx: &Ctx, c: &RawCase, kind: LobeKind) -> Result<Option<Effects>, Sc
             other => return Err(ctx.err(v.span(), format!("weighted must be true or false, got {}", kind_of(other)))),
         },
     };
-    let asked = c.fresnel.as_ref().or(c.masking.as_ref());
+    let asked = p.get("fresnel").or(p.get("masking"));
     match (weighted, asked) {
         (Some((false, _)), Some(v)) => Err(ctx.err(
             v.span(),
@@ -774,6 +849,42 @@ mod tests {
         assert!(err.message.contains("alpha_angle is in degrees") && (err.line, err.column) == (6, 15), "{err}");
         let err = Scene::parse("s.toml", "[[case]]\nname = \"d\"\nlobe = \"discrete\"\nweights = [1, 2]\nalpha_angle = 10\n").unwrap_err();
         assert!(err.message.contains("alpha_angle") && err.line == 5, "{err}");
+        // swept like the other numbers
+        let scene = case("alpha_angle = [0, 30]\n").unwrap();
+        let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
+        assert_eq!(names, ["g-turn0", "g-turn30"]);
+    }
+
+    #[test]
+    fn roughness_method_samples_seed_and_bins_sweep_as_a_product() {
+        let text = "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nmethod = [\"ndf\", \"vndf\"]\nalpha = [0.1, 0.3]\nsamples = [1000, 2000]\n\n\
+                    [[case]]\nname = \"a\"\nlobe = \"beckmann\"\nalpha_x = [0.1, 0.2]\nalpha_y = 0.05\nbins = [[8, 16], [16, 32]]\nseed = [7, 9]\n\n\
+                    [[case]]\nname = \"d\"\nlobe = \"discrete\"\nmethod = [\"cdf\", \"alias\"]\nweights = [1, 2]\n\n\
+                    [[case]]\nname = \"f\"\nlobe = \"ggx\"\nalpha = 0.2\nfresnel = \"schlick\"\nf0 = [0.04, 1]\n";
+        let scene = Scene::parse("s.toml", text).unwrap();
+        let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
+        assert_eq!(names.len(), 8 + 8 + 2 + 2);
+        assert_eq!(names[..3], ["g-ndf-alpha0.1-n1000", "g-ndf-alpha0.1-n2000", "g-ndf-alpha0.3-n1000"]);
+        assert_eq!(names[7], "g-vndf-alpha0.3-n2000");
+        assert_eq!(names[8..10], ["a-ax0.1-bins8_16-seed7", "a-ax0.1-bins8_16-seed9"]);
+        assert_eq!(names[15], "a-ax0.2-bins16_32-seed9");
+        assert_eq!(names[16..], ["d-cdf", "d-alias", "f-f0_0.04", "f-f0_1"]);
+        let lobe = |i: usize| match &scene.cases[i].job {
+            Job::Lobe { lobe, grid, .. } => (lobe.method, lobe.alpha_x, lobe.alpha_y, grid.rows, grid.cols),
+            Job::Discrete { .. } => panic!("a lobe"),
+        };
+        assert_eq!(lobe(7), (Method::Vndf, 0.3, 0.3, 64, 128));
+        assert_eq!((scene.cases[7].samples, scene.cases[7].seed), (2000, DEFAULT_SEED));
+        assert_eq!(lobe(15), (Method::Ndf, 0.2, 0.05, 16, 32));
+        assert_eq!((scene.cases[15].samples, scene.cases[15].seed), (DEFAULT_SAMPLES, 9));
+        assert!(matches!(scene.cases[17].job, Job::Discrete { method: DiscreteMethod::Alias, .. }));
+        assert_eq!(scene.cases[19].effects.unwrap().fresnel, Fresnel::Schlick { f0: 1.0 });
+        // each swept value is checked where it is written
+        let err = Scene::parse("s.toml", "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nmethod = [\"vndf\", \"cdf\"]\nalpha = 0.1\n").unwrap_err();
+        assert_eq!((err.line, err.column), (4, 19), "{err}");
+        // overrides win over the scene and its sweeps
+        let scene = Scene::parse_with("s.toml", text, Overrides { samples: Some(500), seed: Some(4) }).unwrap();
+        assert!(scene.entries().all(|(e, _)| e.samples() == 500) && scene.cases.iter().all(|c| c.seed == 4));
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! Sweeps: a case key given an array of values stands for one case per value, named after the
 //! case and the value (`incident_theta = [0, 45, 80]` in case `ggx` makes `ggx-theta0`,
-//! `ggx-theta45` and `ggx-theta80`). Several swept keys make every combination. The swept keys
-//! are `incident_theta` and `incident_phi` (lobe and user-sampler cases) and `params` (user
-//! samplers: an array of lists, `params = [[0.3, 0.3], [0.1, 0.1]]`).
+//! `ggx-theta45` and `ggx-theta80`). Several swept keys make every combination (their product,
+//! in the order of [`KEYS`]). Every key with one number or name sweeps: `method`, `alpha`,
+//! `alpha_x`, `alpha_y`, `incident_theta`, `incident_phi`, `fresnel`, `f0`, `eta`, `k`, `masking`,
+//! `samples` and `seed`; keys whose value is a list sweep over an array of lists: `params`
+//! (user samplers, `params = [[0.3, 0.3], [0.1, 0.1]]`) and `bins` (`bins = [[32, 64], [64, 128]]`).
 
 use super::Val;
 use serde::Deserialize;
@@ -96,47 +98,82 @@ impl Sweep {
     }
 }
 
-/// One case of a sweep: the value of each key there (each as written where not swept), and the
-/// suffix its name gets (empty where nothing is swept).
+/// A sweepable key: its name, the short label its values get in case names, and whether its
+/// single value is a list (then an array of lists sweeps).
+pub(super) struct Key {
+    pub name: &'static str,
+    label: &'static str,
+    pub list: bool,
+}
+
+const fn key(name: &'static str, label: &'static str, list: bool) -> Key {
+    Key { name, label, list }
+}
+
+/// Every sweepable key, in the order of the product (and of the name suffixes). The label of a
+/// name key (method, fresnel, masking) is empty: the name alone is readable (`ggx-vndf`).
+pub(super) const KEYS: [Key; 16] = [
+    key("method", "", false),
+    key("alpha", "alpha", false),
+    key("alpha_x", "ax", false),
+    key("alpha_y", "ay", false),
+    key("alpha_angle", "turn", false),
+    key("incident_theta", "theta", false),
+    key("incident_phi", "phi", false),
+    key("fresnel", "", false),
+    key("f0", "f0_", false),
+    key("eta", "eta", false),
+    key("k", "k", false),
+    key("masking", "", false),
+    key("params", "params", true),
+    key("bins", "bins", true),
+    key("samples", "n", false),
+    key("seed", "seed", false),
+];
+
+/// One case of a sweep: the value of each key of [`KEYS`] there (as written where not swept),
+/// and the suffix its name gets (empty where nothing is swept).
 #[derive(Debug, Clone, Default)]
 pub(super) struct Point {
-    pub incident_theta: Option<Val>,
-    pub incident_phi: Option<Val>,
-    pub params: Option<Val>,
+    values: [Option<Val>; KEYS.len()],
     pub suffix: String,
 }
 
-/// A value in a case name: numbers as written (45, 0.5, -30), lists joined by `_`.
+impl Point {
+    /// The value of `key` (one of [`KEYS`]) at this point.
+    pub fn get(&self, key: &str) -> Option<&Val> {
+        let i = KEYS.iter().position(|k| k.name == key).unwrap_or_else(|| panic!("{key} is not a sweepable key"));
+        self.values[i].as_ref()
+    }
+}
+
+/// A value in a case name: numbers as written (45, 0.5, -30), names as they are, lists joined
+/// by `_`.
 fn label(v: &Value) -> String {
     match v {
         Value::Integer(i) => i.to_string(),
         Value::Float(f) => f.to_string(),
+        Value::String(s) => s.clone(),
         Value::Array(items) => items.iter().map(label).collect::<Vec<_>>().join("_"),
         other => other.type_str().to_string(),
     }
 }
 
-/// Every combination of the swept keys' values, in the order theta, phi, params.
-pub(super) fn points(theta: Option<&Sweep>, phi: Option<&Sweep>, params: Option<&Sweep>) -> Vec<Point> {
-    type Set = fn(&mut Point, Val);
-    type Split = fn(&Sweep) -> Option<Vec<Val>>;
-    let keys: [(Option<&Sweep>, &str, Split, Set); 3] = [
-        (theta, "theta", Sweep::scalars, |p, v| p.incident_theta = Some(v)),
-        (phi, "phi", Sweep::scalars, |p, v| p.incident_phi = Some(v)),
-        (params, "params", Sweep::lists, |p, v| p.params = Some(v)),
-    ];
+/// Every combination of the swept keys' values; `sweeps[i]` is the value of `KEYS[i]`.
+pub(super) fn points(sweeps: [Option<&Sweep>; KEYS.len()]) -> Vec<Point> {
     let mut points = vec![Point::default()];
-    for (sweep, short, values, set) in keys {
+    for (i, (key, sweep)) in KEYS.iter().zip(sweeps).enumerate() {
         let Some(sweep) = sweep else { continue };
-        points = match values(sweep) {
-            None => points.into_iter().map(|mut p| { set(&mut p, sweep.whole()); p }).collect(),
+        let values = if key.list { sweep.lists() } else { sweep.scalars() };
+        points = match values {
+            None => points.into_iter().map(|mut p| { p.values[i] = Some(sweep.whole()); p }).collect(),
             Some(values) => points
                 .into_iter()
                 .flat_map(|p| {
                     values.iter().map(move |v| {
                         let mut q = p.clone();
-                        q.suffix = format!("{}-{short}{}", q.suffix, label(v.get_ref()));
-                        set(&mut q, v.clone());
+                        q.suffix = format!("{}-{}{}", q.suffix, key.label, label(v.get_ref()));
+                        q.values[i] = Some(v.clone());
                         q
                     })
                 })
@@ -155,6 +192,8 @@ mod tests {
         theta: Option<Sweep>,
         phi: Option<Sweep>,
         params: Option<Sweep>,
+        alpha: Option<Sweep>,
+        method: Option<Sweep>,
     }
 
     /// (suffix, θ, φ, params) of each point.
@@ -162,11 +201,15 @@ mod tests {
 
     fn expand(toml_text: &str) -> Vec<Expanded> {
         let t: T = toml::from_str(toml_text).unwrap();
-        points(t.theta.as_ref(), t.phi.as_ref(), t.params.as_ref())
+        let mut sweeps: [Option<&Sweep>; KEYS.len()] = Default::default();
+        for (name, sweep) in [("incident_theta", &t.theta), ("incident_phi", &t.phi), ("params", &t.params), ("alpha", &t.alpha), ("method", &t.method)] {
+            sweeps[KEYS.iter().position(|k| k.name == name).unwrap()] = sweep.as_ref();
+        }
+        points(sweeps)
             .into_iter()
             .map(|p| {
-                let v = |x: Option<Val>| x.map(|x| x.into_inner());
-                (p.suffix, v(p.incident_theta), v(p.incident_phi), v(p.params))
+                let v = |key| p.get(key).map(|x| x.get_ref().clone());
+                (p.suffix.clone(), v("incident_theta"), v("incident_phi"), v("params"))
             })
             .collect()
     }
@@ -198,5 +241,15 @@ mod tests {
         assert_eq!(grid[7].2, Some(Value::Integer(90)));
         assert_eq!(grid[7].3, Some(Value::Array(vec![Value::Float(0.1), Value::Float(0.2)])));
         assert!(expand("theta = []").is_empty());
+    }
+
+    #[test]
+    fn names_and_numbers_sweep_in_the_order_of_the_keys() {
+        let grid = expand("theta = [0, 60]\nalpha = [0.1, 0.3]\nmethod = [\"ndf\", \"vndf\"]");
+        let names: Vec<&str> = grid.iter().map(|g| g.0.as_str()).collect();
+        assert_eq!(names[..3], ["-ndf-alpha0.1-theta0", "-ndf-alpha0.1-theta60", "-ndf-alpha0.3-theta0"]);
+        assert_eq!(names.len(), 8);
+        assert_eq!(names[7], "-vndf-alpha0.3-theta60");
+        assert_eq!(grid[7].1, Some(Value::Integer(60)));
     }
 }

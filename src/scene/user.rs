@@ -36,14 +36,14 @@ const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
 /// The sampler of a `[[case]]` table: its files read and checked against the contract.
-pub(super) fn sampler(ctx: &Ctx, c: &RawCase, raw: &Spanned<RawSampler>) -> Result<Arc<UserSampler>, SceneError> {
+pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSampler>) -> Result<Arc<UserSampler>, SceneError> {
     let not_here = "does not apply to a user sampler (its WGSL is the whole sampler); remove it";
-    reject_keys(ctx, &[("lobe", c.lobe.as_ref()), ("method", c.method.as_ref())], not_here)?;
-    reject_keys(ctx, &roughness_keys(c), not_here)?;
+    reject_keys(ctx, &[("lobe", c.lobe.as_ref()), ("method", p.get("method"))], not_here)?;
+    reject_keys(ctx, &roughness_keys(p), not_here)?;
     if let Some(w) = &c.weights {
         return Err(ctx.err(w.span(), format!("weights {not_here}")));
     }
-    reject_keys(ctx, &effect_keys(c), "does not apply to a user sampler (give an eval function for the weight and albedo checks); remove it")?;
+    reject_keys(ctx, &effect_keys(c, p), "does not apply to a user sampler (give an eval function for the weight and albedo checks); remove it")?;
     let r = raw.get_ref();
     let name = |v: &Option<Val>, key: &str| -> Result<Option<String>, SceneError> {
         v.as_ref().map(|v| string(ctx, v, &format!("sampler.{key}"), SAMPLER_ALLOWED).map(String::from)).transpose()
@@ -80,7 +80,7 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
         Some(v) => match string(ctx, v, "domain", allowed)? {
             "sphere" => false,
             "plane" => true,
-            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}"))),
+            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, ["sphere", "plane"])))),
         },
     };
     if !plane {
@@ -103,19 +103,18 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
 }
 
 /// One case of a user's sampler at one point of its sweeps.
-pub(super) fn case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>) -> Result<UserCase, SceneError> {
-    let c = spanned.get_ref();
+pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>) -> Result<UserCase, SceneError> {
     let defaults = Settings::default();
-    let incident_theta = match &point.incident_theta {
+    let incident_theta = match point.get("incident_theta") {
         Some(t) => number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?,
         None => defaults.incident_theta,
     };
     let incident_phi = incident_phi(ctx, point)?;
-    let params = match &point.params {
+    let params = match point.get("params") {
         None => Vec::new(),
         Some(p) => params(ctx, p)?,
     };
-    let bins = match (&c.bins, &d.bins) {
+    let bins = match (point.get("bins"), &d.bins) {
         (Some(v), _) => Some(grid(ctx, v, false, GRID_ALLOWED)?),
         (None, Some(g)) => Some(*g),
         (None, None) => None,
