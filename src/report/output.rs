@@ -289,7 +289,7 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonSty
     let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), r.chi2.p_value));
     compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
     let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
-    files.write(&folder, [rows as usize, cols as usize], style)
+    files.write(&folder, [rows, cols], style)
 }
 
 /// How JSON files are laid out: compact (one line), or indented for people (`--pretty`).
@@ -359,7 +359,7 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
     let files = CaseFiles { counts: &r.counts.bins, expected: &r.expected.bins, timing: TimingFile::new(r), histogram: doc };
-    files.write(&folder, [rows as usize, cols as usize], style)
+    files.write(&folder, [rows, cols], style)
 }
 
 /// The summary of `lobes run` and `lobes merge`: `OUT/summary.json` (written on every run that
