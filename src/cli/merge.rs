@@ -67,7 +67,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         if shards.iter().any(|s| s.file.timing.gpu_seconds.is_none()) {
             text += "\n* wall time (no GPU timestamps for some shards)\n";
         }
-        text += &format!("\noutputs in {} (summary.json, junit.xml)\n", args.out.display());
+        text += &format!("\noutputs in {} (index.html, summary.json, junit.xml)\n", args.out.display());
         emit(&text)?;
     }
     if failed > 0 {

@@ -275,7 +275,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         if !summary.not_run.is_empty() {
             text += &format!("\ninterrupted: {} of {n} cases not run ({})\n", summary.not_run.len(), summary.not_run.join(", "));
         }
-        text += &format!("\noutputs in {} (summary.json, junit.xml)\n", args.out.display());
+        text += &format!("\noutputs in {} (index.html, summary.json, junit.xml)\n", args.out.display());
         emit(&text)?;
     }
     let (errors, failed) = (summary.errors, summary.failed);

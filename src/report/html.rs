@@ -201,8 +201,8 @@ dl.figures { display: grid; grid-template-columns: max-content auto; gap: 2px 16
 dl.figures dt { color: #555; }
 dl.figures dd { margin: 0; }
 .pictures { display: flex; flex-wrap: wrap; gap: 12px; }
-figure { margin: 0; flex: 0 1 560px; }
-figure.wide { flex-basis: 1132px; }
+figure { margin: 0; flex: 0 1 460px; }
+figure.wide { flex-basis: 944px; }
 figure img { max-width: 100%; height: auto; border: 1px solid #ddd; background: #fff; }
 figcaption { font-size: 13px; color: #555; }
 ";
