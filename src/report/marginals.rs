@@ -114,7 +114,8 @@ where
         .x_desc(p.x_label)
         .y_desc("samples per bin")
         .y_label_formatter(&|v| super::label::compact(*v))
-        .x_label_formatter(&|v| super::label::compact(*v))
+        // a tick computed as a sum of steps lands near 0 as ±1e-16: shown as 0
+        .x_label_formatter(&|v| super::label::compact(if v.abs() < 1e-9 * (x1 - x0) { 0.0 } else { *v }))
         .label_style((FONT, TEXT_PX - 2.0))
         .axis_desc_style((FONT, TEXT_PX))
         .bold_line_style(RGBColor(230, 230, 230))
