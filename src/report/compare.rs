@@ -103,8 +103,10 @@ pub fn first_column(expected: &[f64], cols: usize) -> usize {
     if total <= 0.0 || x.hypot(y) < 0.05 * total {
         return 0;
     }
-    // the map's left edge half a turn before φ̄, on a column edge: φ0 = −π + first·width ≈ φ̄ − π
-    ((y.atan2(x) / width).round() as i64).rem_euclid(cols as i64) as usize
+    // the map's left edge half a turn before φ̄, on a column edge: φ0 = −π + first·width ≈ φ̄ − π,
+    // and where the columns allow on a multiple of 45° (so the axis ends read as round angles)
+    let step = if cols % 8 == 0 { cols as i64 / 8 } else { 1 };
+    (((y.atan2(x) / width / step as f64).round() as i64) * step).rem_euclid(cols as i64) as usize
 }
 
 /// Writes the pictures of `c` into `dir`: the maps and `marginals.png` of a 2-D histogram,
@@ -236,6 +238,10 @@ mod tests {
         // (φ from π/2): columns 6 7 0 1 2 3 4 5, the lobe either side of the middle
         let side = grid(|_, c| if c == 1 || c == 2 { 10.0 } else { 1.0 });
         assert_eq!(first_column(&side, 8), 6);
+        // with 16 columns the edge moves in steps of 2 columns (45°): a lobe in column 5
+        // (φ̄ = −56.25°) is drawn around the middle −45°, from column 14 (φ from 135°)
+        let side16: Vec<f64> = (0..64).map(|i| if i % 16 == 5 { 10.0 } else { 1.0 }).collect();
+        assert_eq!(first_column(&side16, 16), 14);
         // no direction (isotropic) or nothing at all: as binned
         assert_eq!(first_column(&grid(|_, _| 1.0), 8), 0);
         let zero = grid(|_, _| 0.0);
