@@ -105,7 +105,7 @@ pub fn first_column(expected: &[f64], cols: usize) -> usize {
     }
     // the map's left edge half a turn before φ̄, on a column edge: φ0 = −π + first·width ≈ φ̄ − π,
     // and where the columns allow on a multiple of 45° (so the axis ends read as round angles)
-    let step = if cols % 8 == 0 { cols as i64 / 8 } else { 1 };
+    let step = if cols.is_multiple_of(8) { cols as i64 / 8 } else { 1 };
     (((y.atan2(x) / width / step as f64).round() as i64) * step).rem_euclid(cols as i64) as usize
 }
 
