@@ -18,8 +18,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     write_atomic_with(path, |out| out.write_all(bytes))
 }
 
-/// Writes `path` atomically with `write`, which gets the temporary file (buffered).
+/// Writes `path` atomically with `write`, which gets the temporary file (buffered). An error
+/// names the path: `cannot write PATH: REASON`.
 pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
+    replace(path, write).map_err(|e| io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display())))
+}
+
+fn replace(path: &Path, write: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -76,12 +81,21 @@ mod tests {
             Err(io::Error::other("the encoder failed"))
         })
         .unwrap_err();
-        assert_eq!(err.to_string(), "the encoder failed");
+        // the writer's own error, named by the path
+        assert_eq!(err.to_string(), format!("cannot write {}: the encoder failed", path.display()));
         assert_eq!(std::fs::read(&path).unwrap(), b"old");
         // a target that is a folder cannot be replaced by a file
         std::fs::create_dir(dir.path().join("blocked")).unwrap();
         assert!(write_atomic(&dir.path().join("blocked"), b"x").is_err());
         assert_eq!(names(dir.path()), ["blocked", "x.json"]);
         assert!(write_atomic(&dir.path().join("no/such/folder/x"), b"x").is_err());
+    }
+
+    #[test]
+    fn an_error_names_the_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let blocked = dir.path().join("no-such-folder").join("a.txt");
+        let message = write_atomic(&blocked, b"x").unwrap_err().to_string();
+        assert!(message.starts_with(&format!("cannot write {}: ", blocked.display())), "{message}");
     }
 }

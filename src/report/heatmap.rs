@@ -101,7 +101,7 @@ pub fn write_png_scaled(h: &Heatmap, mapping: Mapping, path: &Path) -> io::Resul
 
 fn write_image(img: &RgbImage, path: &Path) -> io::Result<()> {
     let png = super::png::encode(img).map_err(io::Error::other)?;
-    super::atomic::write_atomic(path, &png).map_err(|e| io::Error::new(e.kind(), format!("cannot write {}: {e}", path.display())))
+    super::atomic::write_atomic(path, &png)
 }
 
 /// Value of cell `i` (row-major); missing cells read as NaN.

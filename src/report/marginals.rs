@@ -65,7 +65,7 @@ pub fn plot(caption: &str, panels: &[Panel]) -> anyhow::Result<RgbImage> {
 /// Renders [`plot`] and writes it as a PNG to `path`, atomically.
 pub fn write_png(path: &Path, caption: &str, panels: &[Panel]) -> anyhow::Result<()> {
     let png = super::png::encode(&plot(caption, panels)?)?;
-    super::atomic::write_atomic(path, &png).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))
+    Ok(super::atomic::write_atomic(path, &png)?)
 }
 
 /// The caption line, then one swatch and name per element of the charts.

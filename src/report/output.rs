@@ -270,7 +270,7 @@ pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     let folder = dir.join(&shard.case);
     std::fs::create_dir_all(&folder)?;
     let file = folder.join(shard.shard.file_name());
-    write_atomic(&file, serde_json::to_string(shard)?.as_bytes()).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", file.display()))?;
+    write_atomic(&file, serde_json::to_string(shard)?.as_bytes())?;
     Ok(file)
 }
 

@@ -38,7 +38,7 @@ pub fn write(out: &Path, summary: &RunSummary, heading: &[String]) -> anyhow::Re
     ];
     for (name, text) in files {
         let path = out.join(name);
-        write_atomic(&path, text.as_bytes()).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+        write_atomic(&path, text.as_bytes())?;
     }
     Ok(())
 }
