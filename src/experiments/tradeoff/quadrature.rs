@@ -6,7 +6,7 @@
 use crate::engine::gpu::dispatch::{Pass, Step};
 use crate::engine::gpu::{GpuEngine, GpuError, compose};
 use crate::reference::{Lobe, sampler};
-use crate::stats::expected::direction;
+use crate::stats::expected::integrate_rect;
 use crate::stats::gauss_legendre::GaussLegendre;
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
@@ -29,7 +29,7 @@ pub fn fixed_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid
                 if zs[r + 1] <= 0.0 {
                     return 0.0;
                 }
-                gl.integrate_2d((zs[r], zs[r + 1]), (ps[c], ps[c + 1]), |z, phi| pdf(direction(z, phi)))
+                integrate_rect(gl, (zs[r], zs[r + 1]), (ps[c], ps[c + 1]), &|w| pdf(w))
             })
         })
         .collect()
