@@ -189,12 +189,17 @@ impl Module {
     /// assert!(Module::Rng.dependencies().is_empty());
     /// ```
     pub fn dependencies(self) -> Vec<Module> {
-        let imported: Vec<String> = self.parts().iter().flat_map(|p| library::imports(p)).collect();
-        Module::ALL.into_iter().filter(|&m| m != self && m.parts().iter().any(|p| imported.iter().any(|i| i == p))).collect()
+        let imported: Vec<String> = self.import_paths().iter().flat_map(|p| library::imports(p)).collect();
+        Module::ALL.into_iter().filter(|&m| m != self && m.import_paths().iter().any(|p| imported.iter().any(|i| i == p))).collect()
     }
 
-    /// The import paths of the module's files (`#define_import_path` in `shaders/lib`).
-    fn parts(self) -> &'static [&'static str] {
+    /// The import paths of the module's files (`#define_import_path` in `shaders/lib`), the
+    /// paths of its [`naga_oil_modules`].
+    ///
+    /// ```
+    /// assert_eq!(lobes::embed::Module::Ggx.import_paths(), ["lobes::ggx", "lobes::ggx_eval"]);
+    /// ```
+    pub fn import_paths(self) -> &'static [&'static str] {
         match self {
             Module::Rng => &["lobes::rng"],
             Module::Reflect => &["lobes::math", "lobes::reflect"],
@@ -222,7 +227,7 @@ impl Module {
     /// assert!(Module::Ggx.source().contains("#define_import_path lobes::ggx_eval"));
     /// ```
     pub fn source(self) -> String {
-        self.parts().iter().map(|p| library::naga_oil_source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
+        self.import_paths().iter().map(|p| library::naga_oil_source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
     }
 
     /// The module named `name` (its [`Module::name`]).
@@ -356,7 +361,7 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
 /// (what lobes' kernels compose), [`Module::Discrete`] at its default bindings.
 fn short_wgsl(modules: &[Module]) -> String {
     let resolved = resolve(modules);
-    let paths: Vec<&str> = resolved.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.parts().iter().copied()).collect();
+    let paths: Vec<&str> = resolved.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.import_paths().iter().copied()).collect();
     let mut out = String::new();
     if !paths.is_empty() {
         out.push_str(&library::wgsl(&paths, Precision::F32Accurate).unwrap_or_else(|e| panic!("{e}")));
@@ -479,7 +484,7 @@ impl NagaOilModule {
 pub fn naga_oil_modules() -> Vec<NagaOilModule> {
     Module::ALL
         .iter()
-        .flat_map(|m| m.parts())
+        .flat_map(|m| m.import_paths())
         .map(|&p| NagaOilModule { import_path: p, source: library::naga_oil_source(p).expect("a library module") })
         .collect()
 }
