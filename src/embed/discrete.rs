@@ -1,7 +1,6 @@
 //! Uploading a discrete distribution for `shaders/lib/discrete.wgsl`.
 
-use crate::engine::job::DiscreteMethod;
-use crate::reference::discrete::{self, AliasTable, Distribution};
+use crate::reference::discrete::{self, AliasTable, DiscreteMethod, Distribution};
 
 /// Items per block of the two-level CDF, and the most items sampled with one uniform
 /// (`crate::reference::discrete::BLOCK`; `DISCRETE_BLOCK` in the WGSL).

@@ -496,7 +496,7 @@ pub fn naga_oil_modules() -> Vec<NagaOilModule> {
 /// assert!(lobes::embed::validate("fn f() -> f32 { return ggx_d(vec2(0.1), vec3(0.0, 0.0, 1.0)); }").is_err());
 /// ```
 pub fn validate(source: &str) -> Result<(), GpuError> {
-    crate::engine::gpu::compose::validate("embedded lobes WGSL", source).map(|_| ())
+    library::validate_module("embedded lobes WGSL", source).map(|_| ())
 }
 
 #[cfg(test)]
