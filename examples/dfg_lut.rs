@@ -76,10 +76,10 @@ fn dfg(@builtin(global_invocation_id) gid: vec3<u32>) {
     var total = vec2<f32>(0.0);
     var block = vec2<f32>(0.0);
     for (var k = 0u; k < lut.samples; k++) {
-        let s = ggx_sample_vndf(a, v, hammersley(k, lut.samples));
+        let s = lobes_ggx_sample_vndf(a, v, hammersley(k, lut.samples));
         if (s.wr.z > 0.0 && s.pdf_r > 0.0) {
             // f NdotL / p(l) with f = D G2 / (4 NdotV NdotL): D(h) cancels against the pdf's.
-            let w = ggx_d(a, s.h) * ggx_g2(a, v, s.wr) / (4.0 * v.z) / s.pdf_r;
+            let w = lobes_ggx_d(a, s.h) * lobes_ggx_g2(a, v, s.wr) / (4.0 * v.z) / s.pdf_r;
             let fc = pow(1.0 - clamp(dot(v, s.h), 0.0, 1.0), 5.0);
             block += w * vec2<f32>(1.0 - fc, fc);
         }

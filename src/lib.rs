@@ -23,15 +23,48 @@
 //!   default feature `cli` (clap, indicatif).
 //! - [`embed`]: the WGSL samplers, densities and BRDFs for your own wgpu shaders, and helpers
 //!   that upload discrete distributions.
+//!
+//! Features: `cli` (default) is the command line and everything; `check` is the library
+//! without the command line (what a renderer's tests need for [`check`]); without either
+//! (`default-features = false`) the crate is [`embed`] alone, with the few modules it is made
+//! of ([`engine::gpu::library`], [`engine::gpu::context`], [`engine::gpu::precision`],
+//! [`reference::discrete`]), and depends on wgpu, naga, naga_oil, bytemuck, thiserror and
+//! pollster only.
 
+#[cfg(feature = "check")]
 pub mod check;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod embed;
+#[cfg(feature = "check")]
 pub mod engine;
+#[cfg(feature = "check")]
 pub mod experiments;
+#[cfg(feature = "check")]
 pub mod reference;
+#[cfg(feature = "check")]
 pub mod report;
+#[cfg(feature = "check")]
 pub mod run;
+#[cfg(feature = "check")]
 pub mod scene;
+#[cfg(feature = "check")]
 pub mod stats;
+
+/// What [`embed`] is made of, without the `check` feature (the same files as under it).
+#[cfg(not(feature = "check"))]
+pub mod engine {
+    /// The GPU engine's WGSL library and device context.
+    pub mod gpu {
+        pub mod context;
+        pub mod library;
+        pub mod precision;
+        pub use context::{Gpu, GpuError};
+    }
+}
+
+/// What [`embed`] is made of, without the `check` feature: the discrete distributions.
+#[cfg(not(feature = "check"))]
+pub mod reference {
+    pub mod discrete;
+}

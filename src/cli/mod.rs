@@ -25,6 +25,7 @@ pub mod shader;
 pub mod stress;
 pub mod tradeoff;
 pub mod tutorial;
+pub mod wgsl;
 
 use crate::reference::{LobeKind, Method};
 use crate::run::shard::ShardError;
@@ -104,6 +105,9 @@ pub enum Command {
     /// caps against bounded VNDF, and the expected histogram's quadrature; writes tradeoff.md,
     /// tradeoff.png and tradeoff.json with --out.
     Tradeoff(tradeoff::TradeoffArgs),
+    /// Print lobes' WGSL for your own shaders: the named modules (rng, ggx, fresnel, ...) with
+    /// what they use, every name prefixed `lobes_`; or, with --naga-oil, as naga_oil modules.
+    Wgsl(wgsl::WgslArgs),
 }
 
 impl Cli {
@@ -121,6 +125,7 @@ impl Cli {
             Command::Shader(args) => shader::run(&args),
             Command::Tradeoff(args) => tradeoff::run(&args),
             Command::Check(args) => check::run(&args),
+            Command::Wgsl(args) => wgsl::run(&args),
         }
     }
 }

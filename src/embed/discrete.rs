@@ -1,7 +1,6 @@
 //! Uploading a discrete distribution for `shaders/lib/discrete.wgsl`.
 
-use crate::engine::job::DiscreteMethod;
-use crate::reference::discrete::{self, AliasTable, Distribution};
+use crate::reference::discrete::{self, AliasTable, DiscreteMethod, Distribution};
 
 /// Items per block of the two-level CDF, and the most items sampled with one uniform
 /// (`crate::reference::discrete::BLOCK`; `DISCRETE_BLOCK` in the WGSL).
@@ -10,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 /// Where [`Module::Discrete`](super::Module::Discrete)'s two storage buffers are bound: both in
-/// `group`, the f32 table (`discrete_f`) at binding `table` and the u32 aliases (`discrete_u`)
+/// `group`, the f32 table (`lobes_discrete_f`) at binding `table` and the u32 aliases (`lobes_discrete_u`)
 /// at binding `alias`. The default is the file's own: group 0, bindings 3 and 4.
 ///
 /// ```
@@ -21,9 +20,9 @@ use wgpu::util::DeviceExt;
 pub struct DiscreteBindings {
     /// The bind group index (`@group`).
     pub group: u32,
-    /// The binding of `discrete_f: array<f32>`: the CDF, or the alias thresholds.
+    /// The binding of `lobes_discrete_f: array<f32>`: the CDF, or the alias thresholds.
     pub table: u32,
-    /// The binding of `discrete_u: array<u32>`: the alias indices.
+    /// The binding of `lobes_discrete_u: array<u32>`: the alias indices.
     pub alias: u32,
 }
 
@@ -35,7 +34,7 @@ impl Default for DiscreteBindings {
 
 /// The two scalars the WGSL sampling functions take besides the uniforms, laid out for a
 /// uniform or storage buffer: 16 bytes, `#[repr(C)]`, [`Pod`], matching [`DISCRETE_INFO_WGSL`].
-/// Pass `n_items` as `n` to both samplers and `last_positive` to `discrete_sample_cdf`.
+/// Pass `n_items` as `n` to both samplers and `last_positive` to `lobes_discrete_sample_cdf`.
 ///
 /// ```
 /// assert_eq!(std::mem::size_of::<lobes::embed::DiscreteInfo>(), 16);
@@ -45,31 +44,32 @@ impl Default for DiscreteBindings {
 pub struct DiscreteInfo {
     /// The number of items n (the length of the tables).
     pub n_items: u32,
-    /// The largest index with a positive weight (`discrete_sample_cdf` never returns more).
+    /// The largest index with a positive weight (`lobes_discrete_sample_cdf` never returns more).
     pub last_positive: u32,
     /// Padding to 16 bytes (uniform buffers round structs up to 16).
     pub _pad: [u32; 2],
 }
 
 /// The WGSL twin of [`DiscreteInfo`], for a renderer that binds it as its own uniform:
-/// `struct DiscreteInfo { n_items: u32, last_positive: u32, _pad: vec2<u32> }`.
+/// `struct LobesDiscreteInfo { n_items: u32, last_positive: u32, _pad: vec2<u32> }` (prefixed
+/// like every name lobes exports).
 ///
 /// ```
-/// let src = format!("{}\n@group(0) @binding(0) var<uniform> info: DiscreteInfo;",
+/// let src = format!("{}\n@group(0) @binding(0) var<uniform> info: LobesDiscreteInfo;",
 ///                   lobes::embed::DISCRETE_INFO_WGSL);
 /// lobes::embed::validate(&src).unwrap();
 /// ```
-pub const DISCRETE_INFO_WGSL: &str = "struct DiscreteInfo {\n    n_items: u32,\n    last_positive: u32,\n    _pad: vec2<u32>,\n}\n";
+pub const DISCRETE_INFO_WGSL: &str = "struct LobesDiscreteInfo {\n    n_items: u32,\n    last_positive: u32,\n    _pad: vec2<u32>,\n}\n";
 
 /// A distribution's tables as the WGSL reads them, on the host. Both are arrays of plain
 /// little-endian 4-byte scalars ([`Pod`]: upload with `bytemuck::cast_slice`):
 ///
-/// - `table: Vec<f32>` → `discrete_f: array<f32>`, n entries. For the CDF method entry i is
+/// - `table: Vec<f32>` → `lobes_discrete_f: array<f32>`, n entries. For the CDF method entry i is
 ///   (Σ_{j≤i} w_j) / Σ w, formed in f64 and rounded to f32 (so the last positive entry is
 ///   exactly 1); beyond [`BLOCK`] items, the two-level layout of [`DiscreteTable::cdf`]. For
 ///   the alias method entry i is column i's threshold in [0, 1] (Vose's construction in f64,
 ///   rounded to f32).
-/// - `alias: Vec<u32>` → `discrete_u: array<u32>`: for the alias method n entries, column i's
+/// - `alias: Vec<u32>` → `lobes_discrete_u: array<u32>`: for the alias method n entries, column i's
 ///   alias; for the CDF method a single 0 (the binding must exist; a storage buffer may not be
 ///   empty).
 ///
@@ -92,9 +92,9 @@ pub const DISCRETE_INFO_WGSL: &str = "struct DiscreteInfo {\n    n_items: u32,\n
 pub struct DiscreteTable {
     /// Which sampler the tables are for.
     pub method: DiscreteMethod,
-    /// `discrete_f`: the CDF or the alias thresholds, n × f32.
+    /// `lobes_discrete_f`: the CDF or the alias thresholds, n × f32.
     pub table: Vec<f32>,
-    /// `discrete_u`: the aliases, n × u32 (one 0 for the CDF method).
+    /// `lobes_discrete_u`: the aliases, n × u32 (one 0 for the CDF method).
     pub alias: Vec<u32>,
     /// n and the last positive index.
     pub info: DiscreteInfo,
@@ -107,9 +107,9 @@ impl DiscreteTable {
     }
 
     /// The CDF tables. Up to [`BLOCK`] items the table is the CDF itself, for
-    /// `discrete_sample_cdf(u.x, info.n_items, info.last_positive)`. Longer tables are beyond
+    /// `lobes_discrete_sample_cdf(u.x, info.n_items, info.last_positive)`. Longer tables are beyond
     /// what one 24-bit uniform and an f32 CDF can resolve; they take the two-level layout of
-    /// `discrete_sample_cdf_blocks(u.xy, info.n_items, info.last_positive)`: first the CDF over
+    /// `lobes_discrete_sample_cdf_blocks(u.xy, info.n_items, info.last_positive)`: first the CDF over
     /// blocks of [`BLOCK`] items (⌈n / BLOCK⌉ entries: the global CDF at each block's last item),
     /// then each block's own CDF (n entries in all), so `table.len()` = n + ⌈n / BLOCK⌉.
     /// [`DiscreteTable::two_level`] says which.
@@ -136,12 +136,12 @@ impl DiscreteTable {
     }
 
     /// Whether the table has the two-level CDF layout (the CDF method with more than [`BLOCK`]
-    /// items), to be sampled with `discrete_sample_cdf_blocks`.
+    /// items), to be sampled with `lobes_discrete_sample_cdf_blocks`.
     pub fn two_level(&self) -> bool {
         self.method == DiscreteMethod::Cdf && self.info.n_items as usize > BLOCK
     }
 
-    /// The alias tables, for `discrete_sample_alias(u2, info.n_items)`.
+    /// The alias tables, for `lobes_discrete_sample_alias(u2, info.n_items)`.
     pub fn alias(dist: &Distribution) -> Self {
         let t = AliasTable::new(dist);
         let table = t.threshold.iter().map(|&x| x as f32).collect();
@@ -181,7 +181,7 @@ impl DiscreteTable {
 ///     entries: &buffers.bind_group_entries(bindings),
 /// });
 /// // In WGSL (from embed::wgsl_with(&[Module::Rng, Module::Discrete], bindings)):
-/// //   let index = discrete_sample_alias(u.xy, N_ITEMS);   // N_ITEMS = buffers.info.n_items
+/// //   let index = lobes_discrete_sample_alias(u.xy, N_ITEMS);   // N_ITEMS = buffers.info.n_items
 /// # let _ = (group, embed::wgsl_with(&[Module::Discrete], bindings));
 /// # }
 /// ```
@@ -189,9 +189,9 @@ impl DiscreteTable {
 pub struct DiscreteBuffers {
     /// Which sampler the tables are for.
     pub method: DiscreteMethod,
-    /// `discrete_f`: the CDF or the thresholds, n × f32.
+    /// `lobes_discrete_f`: the CDF or the thresholds, n × f32.
     pub table: wgpu::Buffer,
-    /// `discrete_u`: the aliases, n × u32 (one 0 for the CDF method).
+    /// `lobes_discrete_u`: the aliases, n × u32 (one 0 for the CDF method).
     pub alias: wgpu::Buffer,
     /// n and the last positive index.
     pub info: DiscreteInfo,
@@ -261,6 +261,6 @@ mod tests {
             ("last_positive", offset_of!(DiscreteInfo, last_positive)),
             ("_pad", offset_of!(DiscreteInfo, _pad)),
         ];
-        crate::engine::gpu::layout::check_struct(DISCRETE_INFO_WGSL, "DiscreteInfo", size_of::<DiscreteInfo>(), align_of::<DiscreteInfo>(), &members).unwrap();
+        crate::engine::gpu::layout::check_struct(DISCRETE_INFO_WGSL, "LobesDiscreteInfo", size_of::<DiscreteInfo>(), align_of::<DiscreteInfo>(), &members).unwrap();
     }
 }

@@ -59,27 +59,9 @@ impl SampleRange {
     }
 }
 
-/// How a discrete distribution is sampled (a job's, and `lobes discrete`'s).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum DiscreteMethod {
-    /// Binary search for the first CDF entry ≥ u (the tutorial's rule).
-    Cdf,
-    /// Walker's alias table (Vose's construction), one uniform per draw.
-    Alias,
-}
-
-impl DiscreteMethod {
-    pub const ALL: [DiscreteMethod; 2] = [DiscreteMethod::Cdf, DiscreteMethod::Alias];
-
-    /// The name in scene files, on the command line and in JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            DiscreteMethod::Cdf => "cdf",
-            DiscreteMethod::Alias => "alias",
-        }
-    }
-}
+/// How a discrete distribution is sampled (with the distributions, so that `lobes::embed`
+/// needs no engine).
+pub use crate::reference::discrete::DiscreteMethod;
 
 /// A sampling job: a lobe seen from one incident direction, or a discrete distribution.
 #[derive(Debug, Clone)]

@@ -10,6 +10,28 @@
 
 use thiserror::Error;
 
+/// How a discrete distribution is sampled (a job's, and `lobes discrete`'s).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "check", derive(serde::Serialize, serde::Deserialize), serde(rename_all = "lowercase"))]
+pub enum DiscreteMethod {
+    /// Binary search for the first CDF entry ≥ u (the tutorial's rule).
+    Cdf,
+    /// Walker's alias table (Vose's construction), one uniform per draw.
+    Alias,
+}
+
+impl DiscreteMethod {
+    pub const ALL: [DiscreteMethod; 2] = [DiscreteMethod::Cdf, DiscreteMethod::Alias];
+
+    /// The name in scene files, on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            DiscreteMethod::Cdf => "cdf",
+            DiscreteMethod::Alias => "alias",
+        }
+    }
+}
+
 /// Why a list of weights cannot define a distribution.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum WeightsError {

@@ -273,18 +273,7 @@ pub fn describe(job: &Job) -> String {
     }
 }
 
-/// Parses and validates a composed module with naga, so that a broken composition is a clear
-/// error rather than a wgpu panic.
-pub fn validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
-    let module = naga::front::wgsl::parse_str(source)
-        .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
-    // FLOAT64 for lobes::experiments::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.
-    let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
-        .validate(&module)
-        .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
-    Ok(module)
-}
+pub use super::library::validate_module as validate;
 
 #[cfg(test)]
 mod tests {

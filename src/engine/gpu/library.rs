@@ -306,6 +306,19 @@ fn validate(order: &[&File]) -> Result<(), GpuError> {
     Ok(())
 }
 
+/// Parses and validates a composed module with naga, so that a broken composition is a clear
+/// error rather than a wgpu panic.
+pub fn validate_module(what: &str, source: &str) -> Result<naga::Module, GpuError> {
+    let module = naga::front::wgsl::parse_str(source)
+        .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
+    // FLOAT64 for lobes::experiments::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.
+    let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        .validate(&module)
+        .map_err(|e| GpuError::Shader { what: what.into(), message: format!("{e:?}") })?;
+    Ok(module)
+}
+
 /// The names a file declares at module scope (`fn`, `const`, `override`, `struct`, `alias`,
 /// `var`): the lines that start, after their attributes, with one of those keywords at column 0
 /// (as every file here writes its module-scope declarations).

@@ -12,11 +12,9 @@
 //!   32-bit floats only) and `erf_f64.wgsl` (f64 erfc and erf⁻¹), with the job's α and ωi as f64
 //!   constants (the kernel's uniform block carries them in f32 only).
 
-use serde::Serialize;
-
 /// The arithmetic of a sampling kernel.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
-#[serde(rename_all = "kebab-case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "check", derive(serde::Serialize), serde(rename_all = "kebab-case"))]
 pub enum Precision {
     /// f32 with cheap approximations of ln, exp, sin, cos and atan2.
     F32Fast,
@@ -52,6 +50,7 @@ impl Precision {
 }
 
 /// An f64 literal that round-trips (17 significant digits).
+#[cfg(feature = "check")]
 pub(crate) fn lit(x: f64) -> String {
     format!("{x:.16e}lf")
 }
