@@ -2,7 +2,7 @@
 //!
 //! Each subcommand is a variant of [`Command`] whose arguments are a clap `Args` struct and
 //! whose work is a function returning `anyhow::Result<()>`. [`exit_code`] maps its error to the
-//! process's exit code ([`EXIT_CODES`], also in `lobes --help` and the README):
+//! process's exit code ([`EXIT_CODES`], also in `lobes --help` and docs/errors.md):
 //!
 //! - a case or check that ran and failed its test: a [`ChecksFailed`], [`EXIT_CHECKS_FAILED`] = 1;
 //! - bad input: a [`UsageError`] (or clap's own while parsing), [`EXIT_USAGE`] = 2;
