@@ -67,14 +67,17 @@ struct Line {
 /// The shell lines of a page's fenced blocks; an unknown shell-like info string is an error.
 fn shell_lines(page: &str, text: &str, errors: &mut Vec<String>) -> Vec<Line> {
     let mut out = Vec::new();
-    let mut block: Option<Option<Kind>> = None; // Some(None): a fence that is not a shell block
+    // The open fence's backtick count and its kind (None: a block that is not a shell block).
+    let mut block: Option<(usize, Option<Kind>)> = None;
     let mut pending: Option<Line> = None;
     for (i, raw) in text.lines().enumerate() {
         let number = i + 1;
         let trimmed = raw.trim();
-        if let Some(info) = trimmed.strip_prefix("```") {
-            if block.is_some() {
-                if info.trim().is_empty() {
+        let ticks = trimmed.len() - trimmed.trim_start_matches('`').len();
+        if ticks >= 3 {
+            let info = &trimmed[ticks..];
+            if let Some((open, _)) = block {
+                if ticks >= open && info.trim().is_empty() {
                     block = None;
                     if let Some(p) = pending.take() {
                         errors.push(format!("{page}:{}: a `\\` continuation runs into the end of the block", p.number));
@@ -84,7 +87,7 @@ fn shell_lines(page: &str, text: &str, errors: &mut Vec<String>) -> Vec<Line> {
             }
             let info = info.trim();
             let first = info.split_whitespace().next().unwrap_or("");
-            block = Some(match info {
+            block = Some((ticks, match info {
                 "sh" => Some(Kind::Run),
                 "sh install" => Some(Kind::Install),
                 "sh cluster" => Some(Kind::Cluster),
@@ -94,10 +97,10 @@ fn shell_lines(page: &str, text: &str, errors: &mut Vec<String>) -> Vec<Line> {
                     None
                 }
                 _ => None,
-            });
+            }));
             continue;
         }
-        let Some(Some(kind)) = block else { continue };
+        let Some((_, Some(kind))) = block else { continue };
         let line = match pending.take() {
             Some(mut p) => {
                 p.text.push(' ');
@@ -444,4 +447,19 @@ fn normalize(path: &Path) -> String {
         }
     }
     parts.join("/")
+}
+
+/// The block reader on a made-up page: kinds, joined continuations, line numbers, a longer
+/// fence holding a shorter one, and a shell block under another name reported.
+#[test]
+fn the_block_reader_finds_every_shell_line() {
+    let page = "text\n```sh\nlobes a \\\n  --b   # exit 1\n\n```\n````md\n```sh\nnot read\n```\n````\n```sh install\nsudo dnf install x\n```\n```bash\nlobes c\n```\n```toml\nx = 1\n```\n";
+    let mut errors = Vec::new();
+    let lines = shell_lines("p.md", page, &mut errors);
+    let got: Vec<(usize, &str, Kind)> = lines.iter().map(|l| (l.number, l.text.as_str(), l.kind)).collect();
+    assert_eq!(got, [(3, "lobes a --b   # exit 1", Kind::Run), (13, "sudo dnf install x", Kind::Install)]);
+    assert_eq!(expected_exit(&lines[0].text), 1);
+    assert_eq!(errors, ["p.md:15: shell block ```bash: use ```sh (run), ```sh install, ```sh cluster or ```sh dev"]);
+    assert_eq!(command_of("CARGO_TARGET_DIR=$PWD/target cargo test --release"), "cargo test --release");
+    assert_eq!(normalize(Path::new("docs/../scenes/./a.toml")), "scenes/a.toml");
 }
