@@ -1,4 +1,4 @@
-//! How `lobes run` ends, as CI sees it: the exit code of each outcome (README "Exit codes"),
+//! How `lobes run` ends, as CI sees it: the exit code of each outcome (docs/errors.md "Exit codes"),
 //! `OUT/summary.json` and `OUT/junit.xml` on every run (interrupted and failed ones too), and a
 //! stderr that holds only lobes' own lines. A failing case (exit 1) is in tests/user_scene.rs,
 //! bad scenes (2) and no adapter (3) in tests/bad_input.rs.

@@ -2,7 +2,7 @@
 //!
 //! Each subcommand is a variant of [`Command`] whose arguments are a clap `Args` struct and
 //! whose work is a function returning `anyhow::Result<()>`. [`exit_code`] maps its error to the
-//! process's exit code ([`EXIT_CODES`], also in `lobes --help` and the README):
+//! process's exit code ([`EXIT_CODES`], also in `lobes --help` and docs/errors.md):
 //!
 //! - a case or check that ran and failed its test: a [`ChecksFailed`], [`EXIT_CHECKS_FAILED`] = 1;
 //! - bad input: a [`UsageError`] (or clap's own while parsing), [`EXIT_USAGE`] = 2;
@@ -70,11 +70,15 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    // The tutorial's worked examples (docs/tutorial.md): listed after the main commands.
     /// Sample a discrete distribution by CDF inversion or an alias table (tutorial part 1).
+    #[command(display_order = 100)]
     Discrete(tutorial::DiscreteArgs),
     /// Convert a half-vector pdf p(ωh) to the reflected pdf p(ωr), in plane (tutorial part 2).
+    #[command(display_order = 101)]
     PdfConvert(tutorial::PdfConvertArgs),
     /// Draw one half vector from a lobe and reflect ωi about it (tutorial part 3).
+    #[command(display_order = 102)]
     Sample(tutorial::SampleArgs),
     /// Run a scene: sample and histogram every case on the GPU, judge it with a χ² test
     /// against the f64 reference, and write histogram.json and heat maps per case.

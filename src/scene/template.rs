@@ -84,7 +84,7 @@ mod tests {
     use crate::scene::Scene;
 
     /// The template parses, and its values are what a case that sets nothing gets, and the
-    /// documented defaults (README: 10 000 000 samples, 64 × 128 bins, seed 1, ndf, cdf, θ 0).
+    /// documented defaults (docs/scenes.md: 10 000 000 samples, 64 × 128 bins, seed 1, ndf, cdf, θ 0).
     #[test]
     fn the_template_parses_and_states_the_defaults() {
         let t = Scene::parse("template.toml", &template()).unwrap();
