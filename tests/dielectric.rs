@@ -10,8 +10,9 @@
 //! rejected: the refraction density without eq. 17's η², and with the reflection Jacobian
 //! 1/(4|ωo·h|) in place of eq. 17's.
 //!
-//! Also: the hard cases in f64, and the density and the white furnace integrated over the sphere
-//! against masses formed in h space.
+//! Also: the hard cases in f64, the density and the white furnace integrated over the sphere
+//! against masses formed in h space, and the f32 WGSL twin (`examples/samplers/rough_dielectric.wgsl`)
+//! judged by `lobes check` against the f64 density on the GPU.
 
 use glam::DVec3;
 use lobes::experiments::stress::HORIZON_BAND;
@@ -233,5 +234,63 @@ fn the_density_integrates_to_the_mass_of_valid_samples_and_the_furnace_to_one() 
                 assert!((near + far + wrong_side - 1.0).abs() < 3e-4, "{what}: furnace {near} + {far} + {wrong_side}");
             }
         }
+    }
+}
+
+// ---- the f32 WGSL twin on the GPU, through `lobes check` ----
+
+use lobes::check::{Domain, Reference, Settings, UserSampler, check};
+
+fn rough_glass(source: Option<String>) -> UserSampler {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers");
+    let mut files = vec![dir.join("ggx_vndf.wgsl"), dir.join("rough_dielectric.wgsl")];
+    if let Some(text) = source {
+        let path = std::env::temp_dir().join(format!("lobes-broken-dielectric-{}.wgsl", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        files[1] = path;
+    }
+    UserSampler::from_files(&files, "rd_sample", "rd_pdf", Some("rd_eval"), Domain::Sphere).unwrap()
+}
+
+fn settings(ax: f64, ay: f64, eta: f64, theta: f64) -> Settings {
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
+    let d = RoughDielectric::new(lobe, eta).unwrap();
+    Settings { params: vec![ax, ay, eta], incident_theta: theta, reference: Some(Reference::new(move |wi, wo| d.pdf(wi, wo))), ..Settings::default() }
+}
+
+/// Every check of `lobes check` but one passes for the f32 sampler (pdf consistency,
+/// normalisation, χ² against the f64 reference's density, weights, albedo, hard cases), from
+/// outside and inside, η above and below 1 (TIR), anisotropic. The one is `jacobian`: it
+/// differentiates the map (u.x, u.y) → d at fixed u.z, whose density is p(d)/F on the reflected
+/// side and p(d)/T across (the event chosen by u.z scales it), so pdf · |J| is F or T there, not 1.
+#[test]
+fn the_wgsl_twin_passes_lobes_check_against_the_f64_density() {
+    let gpu = lobes::engine::gpu::Gpu::new().unwrap_or_else(|e| panic!("lobes check needs a GPU adapter: {e}"));
+    let s = rough_glass(None);
+    for (ax, ay, eta, theta) in [(0.3, 0.3, 1.5, 30.0), (0.5, 0.25, 1.0 / 1.5, 60.0), (0.4, 0.4, 1.5, 140.0), (0.2, 0.35, 2.5, 175.0)] {
+        let r = check(&gpu, &s, &settings(ax, ay, eta, theta)).unwrap();
+        for c in &r.checks {
+            eprintln!("α ({ax}, {ay}) η {eta} θi {theta}: {} {} {}", c.name(), c.passed, c.summary);
+        }
+        let failed: Vec<&str> = r.checks.iter().filter(|c| !c.passed && c.name() != "jacobian").map(|c| c.name()).collect();
+        assert!(failed.is_empty() && r.checks.len() == 8, "α ({ax}, {ay}) η {eta} θi {theta}: {failed:?}");
+    }
+}
+
+/// The same sampler with eq. 17's η² dropped from its Jacobian (in its reported pdf and its pdf
+/// function alike, so the samples are unchanged) fails χ² against its own pdf, normalisation
+/// and the albedo.
+#[test]
+fn the_wgsl_twin_without_eta_squared_is_rejected() {
+    let gpu = lobes::engine::gpu::Gpu::new().unwrap_or_else(|e| panic!("lobes check needs a GPU adapter: {e}"));
+    let text = std::fs::read_to_string(std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers/rough_dielectric.wgsl")).unwrap();
+    let broken = text.replace("return eta * eta * ct * s * s / (k * k);", "return ct * s * s / (k * k);");
+    assert_ne!(broken, text);
+    let r = check(&gpu, &rough_glass(Some(broken)), &Settings { reference: None, ..settings(0.3, 0.3, 1.5, 30.0) }).unwrap();
+    for c in &r.checks {
+        eprintln!("broken: {} {} {}", c.name(), c.passed, c.summary);
+    }
+    for name in ["chi2", "normalization", "albedo"] {
+        assert!(!r.get(name).unwrap().passed, "{name} passed the broken sampler");
     }
 }
