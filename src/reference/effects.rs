@@ -53,7 +53,7 @@ fn beckmann(l: &Lobe) -> Beckmann {
 }
 
 /// D(h) of a microfacet lobe.
-fn d(l: &Lobe, h: DVec3) -> f64 {
+pub(crate) fn d(l: &Lobe, h: DVec3) -> f64 {
     match l.kind {
         LobeKind::Ggx => ggx(l).d(h),
         LobeKind::Beckmann => beckmann(l).d(h),
@@ -63,7 +63,7 @@ fn d(l: &Lobe, h: DVec3) -> f64 {
 
 /// Smith's G1(ω) of a microfacet lobe in its grazing-stable form (|cos θ| for ω below the
 /// horizon); 1 for Ward, which has no masking.
-fn g1(l: &Lobe, w: DVec3) -> f64 {
+pub(crate) fn g1(l: &Lobe, w: DVec3) -> f64 {
     match l.kind {
         LobeKind::Ggx => ggx(l).g1(w),
         LobeKind::Beckmann => w.z.abs() * beckmann(l).g1_over_cos(w),

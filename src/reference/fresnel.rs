@@ -60,17 +60,32 @@ pub fn schlick(c: f64, f0: f64) -> f64 {
     f0 + (1.0 - f0) * (1.0 - c.clamp(0.0, 1.0)).powi(5)
 }
 
-/// A dielectric seen from outside (pbrt-v4 `FrDielectric`, eq. 9.5); 1 past the critical angle.
+/// Snell's law: cos θt = √(1 − (1 − cos²θi)/η²) of the ray refracted at cos θi = `c` ≥ 0 into
+/// the medium of relative index η = η_t/η_i; `None` at and past the critical angle (total
+/// internal reflection, η < 1).
+pub fn cos_transmitted(c: f64, eta: f64) -> Option<f64> {
+    let sin2_t = (1.0 - c * c) / (eta * eta);
+    (sin2_t < 1.0).then(|| (1.0 - sin2_t).sqrt())
+}
+
+/// A dielectric seen from the side of ωi, η = η_t/η_i (pbrt-v4 `FrDielectric`, eq. 9.5);
+/// 1 past the critical angle.
 pub fn dielectric(c: f64, eta: f64) -> f64 {
     let ci = c.clamp(0.0, 1.0);
-    let sin2_t = (1.0 - ci * ci) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
-    let ct = (1.0 - sin2_t).sqrt();
+    let Some(ct) = cos_transmitted(ci, eta) else { return 1.0 };
     let r_parl = (eta * ci - ct) / (eta * ci + ct);
     let r_perp = (ci - eta * ct) / (ci + eta * ct);
     0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
+
+/// The transmittance T = 1 − F of [`dielectric`], formed without the cancellation of 1 − F as
+/// F → 1 (near the critical angle and at grazing incidence, where T is what a refraction's
+/// density is made of): for r = (a − b)/(a + b), 1 − r² = 4ab/(a + b)², so
+/// T = 2ηc cos θt (1/(ηc + cos θt)² + 1/(c + η cos θt)²); 0 past the critical angle.
+pub fn dielectric_transmittance(c: f64, eta: f64) -> f64 {
+    let ci = c.clamp(0.0, 1.0);
+    let Some(ct) = cos_transmitted(ci, eta) else { return 0.0 };
+    2.0 * eta * ci * ct * ((eta * ci + ct).powi(-2) + (ci + eta * ct).powi(-2))
 }
 
 /// Complex numbers as (re, im), just what the conductor's Fresnel equations need.
@@ -138,6 +153,23 @@ mod tests {
         for c in [0.05, 0.3, 0.7, 1.0] {
             assert!((conductor(c, 1.5, 0.0) - dielectric(c, 1.5)).abs() < 1e-14, "cos {c}");
         }
+    }
+
+    #[test]
+    fn transmittance_is_one_minus_reflectance_and_keeps_its_digits_near_the_critical_angle() {
+        for eta in [1.5, 1.0 / 1.5, 2.5] {
+            for c in [0.2, 0.5, 0.9, 1.0] {
+                assert!((dielectric_transmittance(c, eta) + dielectric(c, eta) - 1.0).abs() < 1e-15, "η {eta} c {c}");
+            }
+        }
+        // just inside the critical angle from glass (cos θt ~ 1e-7): to first order in cos θt,
+        // T = 2 cos θt (1/(ηc) + η/c), which 1 − F gets to only ~9 digits
+        let eta: f64 = 1.0 / 1.5;
+        let c = (1.0 - eta * eta * (1.0 - 1e-14f64)).sqrt();
+        let ct = cos_transmitted(c, eta).unwrap();
+        let first_order = 2.0 * ct * (1.0 / (eta * c) + eta / c);
+        assert!(ct < 1e-6 && (dielectric_transmittance(c, eta) / first_order - 1.0).abs() < 1e-6, "cos θt {ct}");
+        assert_eq!(dielectric_transmittance(c * 0.999, eta), 0.0);
     }
 
     #[test]

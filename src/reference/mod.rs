@@ -5,6 +5,7 @@
 //! explicitly (u ∈ [0, 1], 1 included), so any sample can be reproduced one at a time.
 
 pub mod beckmann;
+pub mod dielectric;
 pub mod discrete;
 pub mod effects;
 pub mod frame;

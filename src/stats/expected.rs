@@ -163,6 +163,17 @@ pub fn lobe_probabilities(lobe: &Lobe, wi: DVec3, grid: SphereGrid, q: &Quadratu
 /// The probability of each upper-hemisphere bin of `grid` under the density `pdf` (per unit
 /// solid angle, zero below the horizon) whose narrowest feature is about `width` radians.
 pub fn probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature) -> Expected {
+    bin_probabilities(pdf, grid, width, q, false)
+}
+
+/// As [`probabilities`], over every bin of the sphere: for a density that also lives below the
+/// horizon (a rough dielectric's transmission, [`crate::reference::dielectric`]).
+/// `below_horizon` is then the mass of no bin, 1 − Σ probabilities.
+pub fn sphere_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature) -> Expected {
+    bin_probabilities(pdf, grid, width, q, true)
+}
+
+fn bin_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature, sphere: bool) -> Expected {
     let zs = grid.cos_theta_edges();
     let ps = grid.phi_edges();
     let f = |w: DVec3| pdf(w);
@@ -172,7 +183,7 @@ pub fn probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, widt
             (0..grid.cols as usize)
                 .map(|c| {
                     let bin = Rect { z: (zs[r], zs[r + 1]), phi: (ps[c], ps[c + 1]) };
-                    if bin.z.1 <= 0.0 {
+                    if bin.z.1 <= 0.0 && !sphere {
                         return (0.0, 0.0, 0.0); // p(ωr) = 0 below the horizon
                     }
                     let (v, e) = integrate_bin(&f, bin, initial_split(bin, width, q), q);
