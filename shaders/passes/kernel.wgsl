@@ -52,10 +52,15 @@ fn sample_histogram(at: Invocation) {
     for (var k = 0u; k < n; k++) {
         let cell = draw(add64(base, first + k * WG_SIZE));
         if (cell < BINS) {
-            // a pass counts the bins tile_first .. tile_first + TILE_BINS (all, untiled)
-            let in_tile = cell - params.tile_first;
-            if (in_tile < TILE_BINS) {
-                count_bin(in_tile);
+            // a pass counts the bins tile_first .. tile_first + TILE_BINS; untiled (TILE_BINS =
+            // BINS, tile_first 0) all of them, with no test the compiler cannot remove
+            if (TILE_BINS == BINS) {
+                count_bin(cell);
+            } else {
+                let in_tile = cell - params.tile_first;
+                if (in_tile < TILE_BINS) {
+                    count_bin(in_tile);
+                }
             }
         } else {
             invalid += select(vec4<u32>(0u), vec4<u32>(1u), vec4<u32>(cell - BINS) == vec4<u32>(0u, 1u, 2u, 3u));
