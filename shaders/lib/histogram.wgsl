@@ -9,22 +9,16 @@
 // reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
 const F32_MAX: f32 = 3.40282347e38;
 
-// 0 for a valid sample, else the reason code; the order matches reference::Invalid::check.
-// Over Real, as the samplers (lobes::math), so that the f64 kernels bin in f64.
+// 0 for a valid sample, else the reason code: the first that applies in the order of
+// reference::Invalid::check, chosen by selects from the last to the first (no branches: a SIMD
+// driver runs every branch anyway, under a mask). Over Real, as the samplers (lobes::math), so
+// that the f64 kernels bin in f64.
 fn classify(wr: vec3<Real>, pdf: Real) -> u32 {
-    if (!(math_is_finite(wr.x) && math_is_finite(wr.y) && math_is_finite(wr.z))) {
-        return REASON_NON_FINITE_DIRECTION;
-    }
-    if (wr.z <= 0.0) {
-        return REASON_BELOW_HORIZON;
-    }
-    if (!math_is_finite(pdf)) {
-        return REASON_NON_FINITE_PDF;
-    }
-    if (pdf <= 0.0) {
-        return REASON_ZERO_PDF;
-    }
-    return 0u;
+    var reason = select(0u, REASON_ZERO_PDF, pdf <= 0.0);
+    reason = select(reason, REASON_NON_FINITE_PDF, !math_is_finite(pdf));
+    reason = select(reason, REASON_BELOW_HORIZON, wr.z <= 0.0);
+    let finite = math_is_finite(wr.x) && math_is_finite(wr.y) && math_is_finite(wr.z);
+    return select(reason, REASON_NON_FINITE_DIRECTION, !finite);
 }
 
 // Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over
@@ -33,13 +27,8 @@ fn bin_of(w: vec3<Real>) -> u32 {
     let z = clamp(w.z, -1.0, 1.0);
     let row = min(u32((z + 1.0) * 0.5 * Real(ROWS)), ROWS - 1u);
     // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
-    var t: Real = 0.5;
-    if (w.x != 0.0 || w.y != 0.0) {
-        t = (math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI));
-    }
-    var col = u32(max(t, 0.0) * Real(COLS));
-    if (col >= COLS) {
-        col = 0u;
-    }
-    return row * COLS + col;
+    let pole = w.x == 0.0 && w.y == 0.0;
+    let t = select((math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI)), 0.5, pole);
+    let col = u32(max(t, 0.0) * Real(COLS));
+    return row * COLS + select(col, 0u, col >= COLS);
 }

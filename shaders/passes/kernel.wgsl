@@ -29,26 +29,41 @@ fn sample_of(at: Invocation, k: u32) -> u32 {
     return (at.wg.x + at.wg.y * at.nwg.x) * (WG_SIZE * SAMPLES_PER_THREAD) + k * WG_SIZE + at.lid;
 }
 
+// How many samples invocation `at` draws of a dispatch of `count`: its k-th, sample_of(at, k),
+// for k below this (all SAMPLES_PER_THREAD in every workgroup but the last). One bound per
+// invocation rather than a test per sample: the loop then runs without a per-sample mask
+// (llvmpipe: ~10 % fewer instructions per sample, BENCHMARKS.md "Kernel structure").
+fn samples_of(at: Invocation, count: u32) -> u32 {
+    let first = sample_of(at, 0u);
+    if (first >= count) {
+        return 0u;
+    }
+    return min(SAMPLES_PER_THREAD, (count - first + WG_SIZE - 1u) / WG_SIZE);
+}
+
 @compute @workgroup_size(WG_SIZE)
 fn sample_histogram(at: Invocation) {
     // Per-reason counts in four registers, updated without branches (a dynamically indexed
     // private array costs a scatter per SIMD lane on CPU drivers).
     var invalid = vec4<u32>(0u);
-    let count = params.count;
     let base = params.base;
-    for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
-        let local = sample_of(at, k);
-        if (local < count) {
-            let cell = draw(add64(base, local));
-            if (cell < BINS) {
-                // a pass counts the bins tile_first .. tile_first + TILE_BINS (all, untiled)
+    let first = sample_of(at, 0u);
+    let n = samples_of(at, params.count);
+    for (var k = 0u; k < n; k++) {
+        let cell = draw(add64(base, first + k * WG_SIZE));
+        if (cell < BINS) {
+            // a pass counts the bins tile_first .. tile_first + TILE_BINS; untiled (TILE_BINS =
+            // BINS, tile_first 0) all of them, with no test the compiler cannot remove
+            if (TILE_BINS == BINS) {
+                count_bin(cell);
+            } else {
                 let in_tile = cell - params.tile_first;
                 if (in_tile < TILE_BINS) {
                     count_bin(in_tile);
                 }
-            } else {
-                invalid += select(vec4<u32>(0u), vec4<u32>(1u), vec4<u32>(cell - BINS) == vec4<u32>(0u, 1u, 2u, 3u));
             }
+        } else {
+            invalid += select(vec4<u32>(0u), vec4<u32>(1u), vec4<u32>(cell - BINS) == vec4<u32>(0u, 1u, 2u, 3u));
         }
     }
     flush_bins(at.lid);

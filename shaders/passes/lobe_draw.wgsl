@@ -13,10 +13,7 @@
 fn draw(index: vec2<u32>) -> u32 {
     let s = lobe_sample_at(index);
     let reason = classify(s.wr, s.pdf_r);
-    if (reason != 0u) {
-        return BINS + reason - 1u;
-    }
-    return bin_of(s.wr);
+    return select(bin_of(s.wr), BINS + reason - 1u, reason != 0u);
 }
 
 // Sample i uses explicit_u[i] (shaders/passes/lobe_kernel.wgsl; any u a caller can pass, 0 and 1

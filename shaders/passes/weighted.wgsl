@@ -1,9 +1,9 @@
 #define_import_path lobes::weighted
-#import lobes::job::{BINS, CELLS, SAMPLES_PER_THREAD, WG_SIZE, WEIGHT_LIMIT, WEIGHT_SCALE, SQUARE_SCALE}
+#import lobes::job::{BINS, CELLS, WG_SIZE, WEIGHT_LIMIT, WEIGHT_SCALE, SQUARE_SCALE}
 #import lobes::bindings::params
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::histogram::{classify, bin_of}
-#import lobes::kernel::{Invocation, sample_of}
+#import lobes::kernel::{Invocation, sample_of, samples_of}
 #import lobes::effect::{effect_sample, effect_weight, effect_check}
 
 // The weighted histogram: per cell, the sum of the estimator weights w = f(wi, wr) cos th_r / p(wr)
@@ -74,12 +74,10 @@ fn weighted_histogram(at: Invocation) {
     var squares_bins = vec2<u32>(0u);
     var squares_all = vec2<u32>(0u);
     var overflow = 0u;
-    for (var k = 0u; k < SAMPLES_PER_THREAD; k++) {
-        let local = sample_of(at, k);
-        if (local >= params.count) {
-            break;
-        }
-        let u = rng_uniforms(params.seed, add64(params.base, local));
+    let first = sample_of(at, 0u);
+    let n = samples_of(at, params.count);
+    for (var k = 0u; k < n; k++) {
+        let u = rng_uniforms(params.seed, add64(params.base, first + k * WG_SIZE));
         let s = effect_sample(u.xy);
         let reason = classify(s.wr, s.pdf_r);
         let w = effect_weight(s);

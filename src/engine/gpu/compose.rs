@@ -244,14 +244,17 @@ pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_node
 }
 
 /// `lobes::kernel` with the job's constants, the math of `precision` and the counting that
-/// `ceil(tile_bins / 2)` words of workgroup memory allow; the draw is the caller's.
+/// `workgroup_words` words of workgroup memory allow: a u32 counter per bin where `tile_bins`
+/// fit, else two 16-bit counters a word where `ceil(tile_bins / 2)` fit, else global counters
+/// (`shaders/passes/counting_workgroup.wgsl`, `counting_global.wgsl`); the draw is the caller's.
 fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> Kernel {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
         Job::Discrete { .. } => (1, bins),
     };
-    let wg_words = tile_bins.div_ceil(2);
+    let bins_per_word = if tile_bins <= workgroup_words { 1 } else { 2 };
+    let wg_words = tile_bins.div_ceil(bins_per_word);
     let mut chosen = library::precision_files(precision);
     if wg_words > workgroup_words {
         chosen.push(library::COUNTING_GLOBAL);
@@ -259,7 +262,8 @@ fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: P
     let mut job_module = JobModule::new(describe(job));
     job_module.push(&format!(
         "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n{}",
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n\
+         const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\n{}",
         layout::consts_wgsl()
     ));
     Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module }

@@ -7,7 +7,7 @@ use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
 use crate::stats::weighted::{SQUARE_SCALE, WEIGHT_LIMIT, WEIGHT_SCALE};
 
-/// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 16384,
+/// Samples drawn by each invocation of `sample_histogram`; a workgroup of 256 draws 65280,
 /// under the 65535 that a 16-bit packed workgroup counter holds.
 pub const SAMPLES_PER_THREAD: u32 = 255;
 /// Invocations per workgroup of every kernel (`@workgroup_size(WG_SIZE)`).
