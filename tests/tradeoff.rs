@@ -83,7 +83,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         .map(|i| {
             let t = i as f64 * 0.7548776662466927 % 1.0;
             let m = 1.0 + t * (1.0 - f64::EPSILON);
-            [m * 10f64.powi(-(i % 21)), -m / 3.0, (t * 6.283185307179586).sin(), 0.0]
+            [m * 10f64.powi(-(i % 21)), -m / 3.0, (t * std::f64::consts::TAU).sin(), 0.0]
         })
         .collect();
     let xb = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&xs), usage: wgpu::BufferUsages::STORAGE });
