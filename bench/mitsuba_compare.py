@@ -173,22 +173,29 @@ def run_lobes_bench(args, env):
     return out["adapter"], by
 
 
+def case_toml(args, lobe, method, theta):
+    """A lobes scene's [[case]] of `lobe` and `method` at incidence `theta` (degrees)."""
+    return f"""
+[[case]]
+name = "{lobe}-{method}"
+lobe = "{lobe}"
+method = "{method}"
+alpha = {args.alpha!r}
+incident_theta = {theta!r}
+incident_phi = {args.incident_phi!r}
+"""
+
+
+def scene_toml(args, bins, cases):
+    return f"[defaults]\nsamples = {args.samples}\nbins = [{bins[0]}, {bins[1]}]\nseed = 1\n" + cases
+
+
 def run_lobes_case(args, lobe, method, workdir, bins, env):
     import numpy as np
     name = f"{lobe}-{method}"
     scene = os.path.join(workdir, f"{name}.toml")
     with open(scene, "w") as f:
-        f.write(f"""[[case]]
-name = "{name}"
-lobe = "{lobe}"
-method = "{method}"
-alpha = {args.alpha!r}
-incident_theta = {args.incident_theta!r}
-incident_phi = {args.incident_phi!r}
-samples = {args.samples}
-bins = [{bins[0]}, {bins[1]}]
-seed = 1
-""")
+        f.write(scene_toml(args, bins, case_toml(args, lobe, method, args.incident_theta)))
     quad, whole, hist_wall = [], [], []
     d = None
     for i in range(args.runs):
@@ -220,18 +227,8 @@ seed = 1
 
 
 def batch_scene(args, bins):
-    cases = ""
-    for lobe, method, _ in CASES:
-        cases += f"""
-[[case]]
-name = "{lobe}-{method}"
-lobe = "{lobe}"
-method = "{method}"
-alpha = {args.alpha!r}
-incident_theta = {args.batch_incident_theta!r}
-incident_phi = {args.incident_phi!r}
-"""
-    return f"[defaults]\nsamples = {args.samples}\nbins = [{bins[0]}, {bins[1]}]\nseed = 1\n" + cases
+    return scene_toml(args, bins, "".join(case_toml(args, lobe, method, args.batch_incident_theta)
+                                          for lobe, method, _ in CASES))
 
 
 MITSUBA_BATCH = """
