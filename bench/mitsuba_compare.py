@@ -13,9 +13,18 @@ sampling, at the same alpha, incident direction and sample count, this measures
              (Dr.Jit compiles its kernels on first use); median of --runs.
   lobes      `lobes bench --json --gpu-only` (sampling + histogram, GPU
              timestamps, median of --runs), and per case a one-case scene through
-             `lobes run SCENE --out DIR --json`: `quadrature.seconds` from
-             DIR/<case>/histogram.json (the f64 expected histogram) and the wall
+             `lobes run SCENE --out DIR --json`: `quadrature_seconds` from
+             DIR/<case>/timing.json (the f64 expected histogram) and the wall
              time of the whole process (the whole test); median of --runs.
+
+The whole batch (issue 14): the four cases as ONE process each, from process start to
+verdicts, with warm caches (one untimed run first), median of --runs: `lobes run` of a
+4-case scene against a Python process that imports Mitsuba and runs the four
+ChiSquareTest(..., res, ires=32).run(), at --batch-incident-theta (default 40 deg).
+
+The Mesa version of lobes' adapter is printed (from its adapter line). --mesa-env FILE
+(a shell file that exports VK_DRIVER_FILES / LD_LIBRARY_PATH for a private lavapipe, see
+docs/install-mesa.md) repeats every lobes measurement on that driver in the same run.
 
 The lobes scenes use bins = [2*res/2, res/2] = [128, 64] for res = 128, i.e. 128
 rows over cos(theta) by 64 columns over phi: exactly Mitsuba's grid (its sphere
@@ -32,11 +41,15 @@ import json
 import math
 import os
 import platform
+import re
+import shlex
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+
+BATCH_IRES = 32  # the batch's Mitsuba trapezoid points per cell side (its rough-conductor tests' value)
 
 CASES = [  # (lobe, lobes method, Mitsuba sample_visible)
     ("ggx", "ndf", False),
@@ -134,11 +147,25 @@ def measure_mitsuba(mi, dr, chi2, args, lobe, visible, ires):
     }
 
 
-def run_lobes_bench(args):
+def mesa_version(adapter):
+    """'25.0.7-2~bpo12+1' from lavapipe's adapter line ('... llvmpipe Mesa 25.0.7-2~bpo12+1 (LLVM ...)')."""
+    m = re.search(r"Mesa ([0-9][^ )]*)", adapter)
+    return m.group(1) if m else "n/a"
+
+
+def env_from_file(path):
+    """The environment after sourcing the shell file `path` (e.g. /work/mesa25/env.sh)."""
+    p = subprocess.run(["bash", "-c", f". {shlex.quote(path)} && env -0"], capture_output=True, text=True)
+    if p.returncode != 0:
+        die(f"cannot source {path}: {p.stderr.strip()}")
+    return dict(kv.split("=", 1) for kv in p.stdout.split("\0") if "=" in kv)
+
+
+def run_lobes_bench(args, env):
     cmd = [args.lobes, "bench", "--json", "--gpu-only", "--samples", str(args.samples),
            "--runs", str(args.runs), "--alpha", repr(args.alpha)]
     print("# " + " ".join(cmd), file=sys.stderr)
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
         die(f"{' '.join(cmd)} exited with {p.returncode}:\n{p.stderr}")
     out = json.loads(p.stdout)
@@ -146,22 +173,29 @@ def run_lobes_bench(args):
     return out["adapter"], by
 
 
-def run_lobes_case(args, lobe, method, workdir, bins):
+def case_toml(args, lobe, method, theta):
+    """A lobes scene's [[case]] of `lobe` and `method` at incidence `theta` (degrees)."""
+    return f"""
+[[case]]
+name = "{lobe}-{method}"
+lobe = "{lobe}"
+method = "{method}"
+alpha = {args.alpha!r}
+incident_theta = {theta!r}
+incident_phi = {args.incident_phi!r}
+"""
+
+
+def scene_toml(args, bins, cases):
+    return f"[defaults]\nsamples = {args.samples}\nbins = [{bins[0]}, {bins[1]}]\nseed = 1\n" + cases
+
+
+def run_lobes_case(args, lobe, method, workdir, bins, env):
     import numpy as np
     name = f"{lobe}-{method}"
     scene = os.path.join(workdir, f"{name}.toml")
     with open(scene, "w") as f:
-        f.write(f"""[[case]]
-name = "{name}"
-lobe = "{lobe}"
-method = "{method}"
-alpha = {args.alpha!r}
-incident_theta = {args.incident_theta!r}
-incident_phi = {args.incident_phi!r}
-samples = {args.samples}
-bins = [{bins[0]}, {bins[1]}]
-seed = 1
-""")
+        f.write(scene_toml(args, bins, case_toml(args, lobe, method, args.incident_theta)))
     quad, whole, hist_wall = [], [], []
     d = None
     for i in range(args.runs):
@@ -170,14 +204,16 @@ seed = 1
         if i == 0:
             print("# " + " ".join(cmd), file=sys.stderr)
         t0 = time.perf_counter()
-        p = subprocess.run(cmd, capture_output=True, text=True)
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
         t1 = time.perf_counter()
         if p.returncode not in (0, 1):  # 1 = a case failed its test; still a measurement
             die(f"{' '.join(cmd)} exited with {p.returncode}:\n{p.stderr}")
         with open(os.path.join(out, name, "histogram.json")) as f:
             d = json.load(f)
-        quad.append(d["quadrature"]["seconds"])
-        hist_wall.append(d["timing"].get("histogram_wall_seconds", float("nan")))
+        with open(os.path.join(out, name, "timing.json")) as f:
+            timing = json.load(f)
+        quad.append(timing["quadrature_seconds"])
+        hist_wall.append(timing["histogram"].get("histogram_wall_seconds", float("nan")))
         whole.append(t1 - t0)
     expected = np.array(d["expected"], dtype=np.float64).reshape(d["rows"], d["cols"])
     return {
@@ -188,6 +224,81 @@ seed = 1
         "quad_error_estimate": d["quadrature"]["error_estimate"],
         "expected": expected, "rows": d["rows"], "cols": d["cols"],
     }
+
+
+def batch_scene(args, bins):
+    return scene_toml(args, bins, "".join(case_toml(args, lobe, method, args.batch_incident_theta)
+                                          for lobe, method, _ in CASES))
+
+
+MITSUBA_BATCH = """
+import math, sys
+import drjit as dr
+import mitsuba as mi
+mi.set_variant({variant!r})
+import mitsuba.chi2 as chi2
+th, ph = math.radians({theta!r}), math.radians({phi!r})
+wi = [math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)]
+verdicts = []
+for lobe, visible in {cases!r}:
+    spec = {{"type": "roughconductor", "distribution": lobe, "alpha": {alpha!r}, "sample_visible": visible}}
+    sample_func, pdf_func = chi2.BSDFAdapter("roughconductor", spec, wi=wi)
+    t = chi2.ChiSquareTest(domain=chi2.SphericalDomain(), sample_func=sample_func, pdf_func=pdf_func,
+                           sample_dim=3, sample_count={samples}, res={res}, ires={ires})
+    verdicts.append(bool(t.run(significance_level=0.01, quiet=True)))
+print(" ".join("pass" if v else "FAIL" for v in verdicts))
+"""
+
+
+def time_process(cmd, env, runs, what):
+    """Wall seconds of `cmd` from start to exit: one untimed warm-up, then `runs` timed; (median, all, stdout)."""
+    print("# " + what + ": " + " ".join(shlex.quote(c) for c in cmd), file=sys.stderr)
+    ts, out = [], ""
+    for i in range(runs + 1):
+        t0 = time.perf_counter()
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        t1 = time.perf_counter()
+        if p.returncode not in (0, 1):  # 1 = lobes: a case failed its test; still a measurement
+            die(f"{what} exited with {p.returncode}:\n{p.stderr}")
+        out = p.stdout
+        if i > 0:
+            ts.append(t1 - t0)
+    return median(ts), ts, out
+
+
+def run_mitsuba_batch(args, workdir):
+    script = os.path.join(workdir, "mitsuba_batch.py")
+    with open(script, "w") as f:
+        f.write(MITSUBA_BATCH.format(variant=args.variant, theta=args.batch_incident_theta, phi=args.incident_phi,
+                                     cases=[(lobe, vis) for lobe, _, vis in CASES], alpha=args.alpha,
+                                     samples=args.samples, res=args.res, ires=BATCH_IRES))
+    s, ts, out = time_process([sys.executable, script], dict(os.environ), args.runs, "Mitsuba batch")
+    return {"seconds": s, "all": ts, "verdicts": out.strip()}
+
+
+def run_lobes_batch(args, workdir, bins, env, label):
+    scene = os.path.join(workdir, "batch.toml")
+    with open(scene, "w") as f:
+        f.write(batch_scene(args, bins))
+    out = os.path.join(workdir, f"batch-out-{label}")
+    s, ts, _ = time_process([args.lobes, "run", scene, "--out", out], env, args.runs, f"lobes batch ({label})")
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    verdicts = " ".join("pass" if c["passed"] else "FAIL" for c in summary["cases"])
+    return {"seconds": s, "all": ts, "verdicts": verdicts}
+
+
+def measure_lobes(args, workdir, bins, env, label):
+    """Every lobes measurement on one driver (`env`): bench, the one-case scenes, the batch."""
+    print(f"# load average before lobes ({label}): {loadavg()}", file=sys.stderr)
+    os.makedirs(os.path.join(workdir, label), exist_ok=True)
+    adapter, bench = run_lobes_bench(args, env)
+    cases = {}
+    for lobe, method, _ in CASES:
+        cases[(lobe, method)] = run_lobes_case(args, lobe, method, os.path.join(workdir, label), bins, env)
+    batch = run_lobes_batch(args, os.path.join(workdir, label), bins, env, label)
+    print(f"# lobes adapter ({label}): {adapter}", file=sys.stderr)
+    return {"label": label, "adapter": adapter, "mesa": mesa_version(adapter), "bench": bench, "cases": cases, "batch": batch}
 
 
 def compare_expected(m, l):
@@ -230,12 +341,17 @@ def main():
     ap.add_argument("--alpha", type=float, default=0.3)
     ap.add_argument("--incident-theta", type=float, default=45.0, help="degrees from the normal")
     ap.add_argument("--incident-phi", type=float, default=0.0, help="degrees from +x towards +y")
+    ap.add_argument("--batch-incident-theta", type=float, default=40.0,
+                    help="degrees from the normal in the whole-batch measurement (issue 14's batch: 40)")
     ap.add_argument("--runs", type=int, default=3, help="timed runs per measurement; medians are reported")
     ap.add_argument("--res", type=int, default=128,
                     help="Mitsuba res: res cells over cos(theta) x res/2 over phi (even; 128 -> 8192 cells)")
     ap.add_argument("--ires", type=int, nargs="+", default=[4, 32],
                     help="Mitsuba trapezoid points per cell side (default 4 = ChiSquareTest's default, 32 = its rough-conductor tests)")
     ap.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant (llvm_ad_rgb or scalar_rgb)")
+    ap.add_argument("--mesa-env", metavar="FILE",
+                    help="also measure lobes with the environment this shell file exports (a private lavapipe, "
+                         "e.g. Mesa 25 from bookworm-backports: docs/install-mesa.md)")
     ap.add_argument("--json", metavar="FILE", help="also write all measurements to FILE")
     args = ap.parse_args()
     if args.res % 2:
@@ -243,6 +359,11 @@ def main():
     args.lobes = os.path.abspath(args.lobes)
     if not os.access(args.lobes, os.X_OK):
         die(f"lobes binary not found at {args.lobes}; run `cargo build --release` in the repository root")
+    drivers = [("system", dict(os.environ))]
+    if args.mesa_env:
+        if not os.path.isfile(args.mesa_env):
+            die(f"--mesa-env {args.mesa_env}: no such file")
+        drivers.append(("mesa-env", env_from_file(args.mesa_env)))
 
     mi, dr, chi2 = import_mitsuba(args.variant)
     bins = (args.res, args.res // 2)
@@ -250,9 +371,9 @@ def main():
     print(f"# machine: {platform.node()} {platform.machine()}, {os.cpu_count()} logical CPUs; "
           f"Python {platform.python_version()}; mitsuba {mi.__version__}, drjit {dr.__version__}, "
           f"variant {mi.variant()}, DRJIT_LIBLLVM_PATH={os.environ.get('DRJIT_LIBLLVM_PATH')}", file=sys.stderr)
-    print(f"# samples {args.samples}, alpha {args.alpha}, theta_i {args.incident_theta} deg, "
-          f"phi_i {args.incident_phi} deg, runs {args.runs}, Mitsuba res {args.res} "
-          f"({args.res // 2} phi x {args.res} cos theta), ires {args.ires}", file=sys.stderr)
+    print(f"# samples {args.samples}, alpha {args.alpha}, theta_i {args.incident_theta} deg "
+          f"(batch {args.batch_incident_theta} deg), phi_i {args.incident_phi} deg, runs {args.runs}, Mitsuba res {args.res} "
+          f"({args.res // 2} phi x {args.res} cos theta), ires {args.ires} (batch {BATCH_IRES})", file=sys.stderr)
 
     results = {}
     print(f"# load average before Mitsuba: {loadavg()}", file=sys.stderr)
@@ -260,81 +381,102 @@ def main():
         for ires in args.ires:
             print(f"# Mitsuba {lobe} sample_visible={vis} ires={ires} ...", file=sys.stderr)
             results[(lobe, method, "mitsuba", ires)] = measure_mitsuba(mi, dr, chi2, args, lobe, vis, ires)
-    print(f"# load average before lobes: {loadavg()}", file=sys.stderr)
-    adapter, bench = run_lobes_bench(args)
     with tempfile.TemporaryDirectory(prefix="lobes-mitsuba-") as wd:
-        for lobe, method, _ in CASES:
-            results[(lobe, method, "lobes")] = run_lobes_case(args, lobe, method, wd, bins)
+        mitsuba_batch = run_mitsuba_batch(args, wd)
+        lobes = [measure_lobes(args, wd, bins, env, label) for label, env in drivers]
     print(f"# load average after: {loadavg()}", file=sys.stderr)
-    print(f"# lobes adapter: {adapter}", file=sys.stderr)
 
     i0 = args.ires[0]
-    print()
-    print("Sampling + histogram (2^%g samples); expected histogram; whole test. Medians of %d runs; seconds. Ratios > 1: lobes faster."
-          % (math.log2(args.samples), args.runs))
-    print()
-    print("| lobe | method | Mitsuba samples/s | lobes samples/s | lobes / Mitsuba "
-          + "".join(f"| Mitsuba pdf s (ires {r}) " for r in args.ires)
-          + "| lobes quadrature s | lobes speed-up, pdf (Mitsuba ires %d s / lobes s) | Mitsuba whole s (ires %d) | lobes whole s | lobes speed-up, whole (Mitsuba s / lobes s) |" % (i0, i0))
-    print("|---|---|---|---|---" + "|---" * len(args.ires) + "|---|---|---|---|---|")
-    rows = []
-    for lobe, method, vis in CASES:
-        m = results[(lobe, method, "mitsuba", i0)]
-        l = results[(lobe, method, "lobes")]
-        b = bench.get((lobe, method))
-        m_sps = args.samples / m["hist_seconds"]
-        l_sps = b["samples_per_second"] if b else float("nan")
-        pdfs = [results[(lobe, method, "mitsuba", r)]["pdf_seconds"] for r in args.ires]
-        row = {
-            "lobe": lobe, "method": method, "mitsuba_sample_visible": vis,
-            "mitsuba_hist_seconds": m["hist_seconds"], "mitsuba_samples_per_second": m_sps,
-            "lobes_bench_seconds": b["seconds"] if b else None, "lobes_samples_per_second": l_sps,
-            "throughput_ratio_lobes_over_mitsuba": l_sps / m_sps,
-            "mitsuba_pdf_seconds": dict(zip(map(str, args.ires), pdfs)),
-            "lobes_quadrature_seconds": l["quad_seconds"],
-            "mitsuba_whole_seconds": m["whole_seconds"], "lobes_whole_seconds": l["whole_seconds"],
-            "lobes_run_histogram_wall_seconds": l["hist_wall_seconds"],
-            "mitsuba_passed": m["passed"], "mitsuba_p_value": m["p_value"],
-            "lobes_passed": l["passed"], "lobes_p_value": l["p_value"],
-            "lobes_quadrature_error_estimate": l["quad_error_estimate"],
-            "expected_vs_lobes": {str(r): compare_expected(results[(lobe, method, "mitsuba", r)], l)
-                                  for r in args.ires},
-            "raw": {"mitsuba": {str(r): {k: v for k, v in results[(lobe, method, "mitsuba", r)].items()
-                                         if k != "expected"} for r in args.ires},
-                    "lobes": {k: v for k, v in l.items() if k != "expected"}},
-        }
-        rows.append(row)
-        print(f"| {lobe} | {method} | {m_sps:.3g} | {l_sps:.3g} | {l_sps / m_sps:.2f} "
-              + "".join(f"| {p:.3g} " for p in pdfs)
-              + f"| {l['quad_seconds']:.3g} | {m['pdf_seconds'] / l['quad_seconds']:.3g} "
-              + f"| {m['whole_seconds']:.3g} | {l['whole_seconds']:.3g} | {m['whole_seconds'] / l['whole_seconds']:.2f} |")
+    out_drivers = []
+    for l in lobes:
+        print()
+        print(f"## lobes on Mesa {l['mesa']} ({l['adapter']})")
+        print()
+        print("Sampling + histogram (2^%g samples); expected histogram; whole test. Medians of %d runs; seconds. Ratios > 1: lobes faster."
+              % (math.log2(args.samples), args.runs))
+        print()
+        print("| lobe | method | Mitsuba samples/s | lobes samples/s | lobes / Mitsuba "
+              + "".join(f"| Mitsuba pdf s (ires {r}) " for r in args.ires)
+              + "| lobes quadrature s | lobes speed-up, pdf (Mitsuba ires %d s / lobes s) | Mitsuba whole s (ires %d) | lobes whole s | lobes speed-up, whole (Mitsuba s / lobes s) |" % (i0, i0))
+        print("|---|---|---|---|---" + "|---" * len(args.ires) + "|---|---|---|---|---|")
+        rows = []
+        for lobe, method, vis in CASES:
+            m = results[(lobe, method, "mitsuba", i0)]
+            c = l["cases"][(lobe, method)]
+            b = l["bench"].get((lobe, method))
+            m_sps = args.samples / m["hist_seconds"]
+            l_sps = b["samples_per_second"] if b else float("nan")
+            pdfs = [results[(lobe, method, "mitsuba", r)]["pdf_seconds"] for r in args.ires]
+            row = {
+                "lobe": lobe, "method": method, "mitsuba_sample_visible": vis,
+                "mitsuba_hist_seconds": m["hist_seconds"], "mitsuba_samples_per_second": m_sps,
+                "lobes_bench_seconds": b["seconds"] if b else None, "lobes_samples_per_second": l_sps,
+                "throughput_ratio_lobes_over_mitsuba": l_sps / m_sps,
+                "mitsuba_pdf_seconds": dict(zip(map(str, args.ires), pdfs)),
+                "lobes_quadrature_seconds": c["quad_seconds"],
+                "mitsuba_whole_seconds": m["whole_seconds"], "lobes_whole_seconds": c["whole_seconds"],
+                "lobes_run_histogram_wall_seconds": c["hist_wall_seconds"],
+                "mitsuba_passed": m["passed"], "mitsuba_p_value": m["p_value"],
+                "lobes_passed": c["passed"], "lobes_p_value": c["p_value"],
+                "lobes_quadrature_error_estimate": c["quad_error_estimate"],
+                "expected_vs_lobes": {str(r): compare_expected(results[(lobe, method, "mitsuba", r)], c)
+                                      for r in args.ires},
+                "raw": {"mitsuba": {str(r): {k: v for k, v in results[(lobe, method, "mitsuba", r)].items()
+                                             if k != "expected"} for r in args.ires},
+                        "lobes": {k: v for k, v in c.items() if k != "expected"}},
+            }
+            rows.append(row)
+            print(f"| {lobe} | {method} | {m_sps:.3g} | {l_sps:.3g} | {l_sps / m_sps:.2f} "
+                  + "".join(f"| {p:.3g} " for p in pdfs)
+                  + f"| {c['quad_seconds']:.3g} | {m['pdf_seconds'] / c['quad_seconds']:.3g} "
+                  + f"| {m['whole_seconds']:.3g} | {c['whole_seconds']:.3g} | {m['whole_seconds'] / c['whole_seconds']:.2f} |")
+
+        print()
+        print("Verdicts and accuracy of Mitsuba's expected histogram against lobes' f64 adaptive quadrature "
+              "(same %d x %d grid): relative L1 of the difference, and its largest |difference| / sqrt(expected) "
+              "over cells with expected > 5 (1 = one standard deviation of a count at this sample size)." %
+              (args.res, args.res // 2))
+        print()
+        print("| lobe | method | Mitsuba p (verdict) | lobes p (verdict) "
+              + "".join(f"| Mitsuba ires {r}: rel L1 | max dev/σ " for r in args.ires) + "|")
+        print("|---|---|---|---" + "|---|---" * len(args.ires) + "|")
+        for row in rows:
+            cells = ""
+            for r in args.ires:
+                c = row["expected_vs_lobes"][str(r)]
+                cells += f"| {fmt(c and c['rel_l1'], '.2e')} | {fmt(c and c['max_sigma'], '.3g')} "
+            print(f"| {row['lobe']} | {row['method']} | {row['mitsuba_p_value']:.3g} "
+                  f"({'pass' if row['mitsuba_passed'] else 'FAIL'}) | {row['lobes_p_value']:.3g} "
+                  f"({'pass' if row['lobes_passed'] else 'FAIL'}) " + cells + "|")
+        out_drivers.append({"label": l["label"], "lobes_adapter": l["adapter"], "mesa": l["mesa"], "rows": rows,
+                            "lobes_batch": l["batch"]})
 
     print()
-    print("Verdicts and accuracy of Mitsuba's expected histogram against lobes' f64 adaptive quadrature "
-          "(same %d x %d grid): relative L1 of the difference, and its largest |difference| / sqrt(expected) "
-          "over cells with expected > 5 (1 = one standard deviation of a count at this sample size)." %
-          (args.res, args.res // 2))
+    print("Whole batch: the 4 cases (alpha %g, theta_i %g deg, 2^%g samples, %d x %d bins), each tool as ONE process "
+          "from start to verdicts, warm caches; median of %d runs (min-max). Mitsuba: import + 4 x "
+          "ChiSquareTest(res=%d, ires=%d).run(). Ratio > 1: lobes faster."
+          % (args.alpha, args.batch_incident_theta, math.log2(args.samples), args.res, args.res // 2, args.runs,
+             args.res, BATCH_IRES))
     print()
-    print("| lobe | method | Mitsuba p (verdict) | lobes p (verdict) "
-          + "".join(f"| Mitsuba ires {r}: rel L1 | max dev/σ " for r in args.ires) + "|")
-    print("|---|---|---|---" + "|---|---" * len(args.ires) + "|")
-    for row in rows:
-        cells = ""
-        for r in args.ires:
-            c = row["expected_vs_lobes"][str(r)]
-            cells += f"| {fmt(c and c['rel_l1'], '.2e')} | {fmt(c and c['max_sigma'], '.3g')} "
-        print(f"| {row['lobe']} | {row['method']} | {row['mitsuba_p_value']:.3g} "
-              f"({'pass' if row['mitsuba_passed'] else 'FAIL'}) | {row['lobes_p_value']:.3g} "
-              f"({'pass' if row['lobes_passed'] else 'FAIL'}) " + cells + "|")
+    print("| process | Mesa | seconds | min-max | verdicts | Mitsuba s / lobes s |")
+    print("|---|---|---|---|---|---|")
+    mb = mitsuba_batch
+    print(f"| Mitsuba {mi.__version__} {mi.variant()} | - | {mb['seconds']:.3f} | {min(mb['all']):.3f}-{max(mb['all']):.3f} "
+          f"| {mb['verdicts']} | 1 |")
+    for l in lobes:
+        b = l["batch"]
+        print(f"| lobes run | {l['mesa']} | {b['seconds']:.3f} | {min(b['all']):.3f}-{max(b['all']):.3f} "
+              f"| {b['verdicts']} | {mb['seconds'] / b['seconds']:.2f} |")
 
     if args.json:
         with open(args.json, "w") as f:
             json.dump({"samples": args.samples, "alpha": args.alpha,
                        "incident_theta": args.incident_theta, "incident_phi": args.incident_phi,
+                       "batch_incident_theta": args.batch_incident_theta, "batch_ires": BATCH_IRES,
                        "runs": args.runs, "res": args.res, "ires": args.ires,
                        "variant": mi.variant(), "mitsuba": mi.__version__, "drjit": dr.__version__,
                        "drjit_libllvm_path": os.environ.get("DRJIT_LIBLLVM_PATH"),
-                       "lobes": args.lobes, "lobes_adapter": adapter, "rows": rows}, f, indent=1)
+                       "lobes": args.lobes, "mitsuba_batch": mitsuba_batch, "drivers": out_drivers}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -7,6 +7,8 @@
 //! The folders are the layers, from the math up; each imports only layers listed before it
 //! (`tests/layout.rs` checks that no two import each other):
 //!
+//! - [`atomic`]: the one way lobes writes a file (the outputs, and the GPU engine's pipeline
+//!   cache).
 //! - [`reference`](mod@reference): the f64 math, one module per lobe, each the twin of a WGSL
 //!   file in `shaders/`.
 //! - [`stats`]: binning, expected counts by quadrature, the χ² test, weighted sums.
@@ -31,6 +33,8 @@
 //! [`reference::discrete`]), and depends on wgpu, naga, naga_oil, bytemuck, thiserror and
 //! pollster only.
 
+#[cfg(feature = "check")]
+pub mod atomic;
 #[cfg(feature = "check")]
 pub mod check;
 #[cfg(feature = "cli")]

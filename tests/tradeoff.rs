@@ -48,6 +48,69 @@ fn f64_kernels_match_the_f64_reference() {
     }
 }
 
+/// The f64 kernels' results come back through f32 buffers as pairs (hi, lo), `f32_pair` of
+/// `shaders/math/f64.wgsl`: hi + lo must equal x to 2^-48 relative, with hi exact in f32. The
+/// obvious pair (f32(x), f32(x - f64(f32(x)))) fails this on Mesa 25.0.7's lavapipe, whose NIR
+/// folds f2f64(f2f32(x)) to x and so returns lo = 0 (printed below as "folded"); the f64
+/// kernels then looked 4.6e-8 rad (2^-24) off the reference while their f64 results were right.
+#[test]
+fn f64_pairs_survive_the_driver() {
+    use lobes::engine::gpu::dispatch::{Pass, Step};
+    use wgpu::util::DeviceExt;
+    let e = engine();
+    let gpu = &e.gpu;
+    assert!(gpu.has_f64(), "this test needs SHADER_F64 (lavapipe has it); adapter {}", gpu.adapter_name());
+    let math = lobes::engine::gpu::library::wgsl(&["lobes::math"], Precision::F64).expect("f64 math");
+    let source = format!(
+        "{math}
+@group(0) @binding(0) var<storage, read> xs: array<vec4<f64>>;
+@group(0) @binding(1) var<storage, read_write> out: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
+    let i = gid.x;
+    if (i >= arrayLength(&xs)) {{ return; }}
+    let x = xs[i].xyz;
+    let p = f32_pair(x);
+    out[3u * i] = vec4<f32>(p[0], 0.0);
+    out[3u * i + 1u] = vec4<f32>(p[1], 0.0);
+    out[3u * i + 2u] = vec4<f32>(vec3<f32>(x - vec3<f64>(vec3<f32>(x))), 0.0);
+}}
+"
+    );
+    // Components of every size the kernels return (unit vectors' components, down to 1e-20),
+    // both signs, and f64 values with all 53 bits set.
+    let xs: Vec<[f64; 4]> = (0..256)
+        .map(|i| {
+            let t = i as f64 * 0.7548776662466927 % 1.0;
+            let m = 1.0 + t * (1.0 - f64::EPSILON);
+            [m * 10f64.powi(-(i % 21)), -m / 3.0, (t * std::f64::consts::TAU).sin(), 0.0]
+        })
+        .collect();
+    let xb = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: None, contents: bytemuck::cast_slice(&xs), usage: wgpu::BufferUsages::STORAGE });
+    let size = xs.len() as u64 * 48;
+    let ob = gpu.buffer("pairs", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+    let module = gpu.module("f32_pair probe", &source).expect("probe shader");
+    let pipeline = gpu.pipeline(&module, None, "main", &[]);
+    let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: xb.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: ob.as_entire_binding() }],
+    });
+    gpu.dispatch(&[Pass { label: "f32_pair", bind: &bind, offset: None, steps: vec![Step { pipeline: &pipeline, groups: 4 }] }]).expect("dispatch");
+    let out: Vec<[f32; 4]> = bytemuck::cast_slice(&gpu.read(&ob, size).expect("readback")).to_vec();
+    let mut folded = 0;
+    for (i, x) in xs.iter().enumerate() {
+        for c in 0..3 {
+            let (hi, lo, naive) = (out[3 * i][c], out[3 * i + 1][c], out[3 * i + 2][c]);
+            let err = (x[c] - (hi as f64 + lo as f64)).abs();
+            assert!(err <= x[c].abs() * 2f64.powi(-48), "x {:e}: hi {hi:e} lo {lo:e}, off by {err:e}", x[c]);
+            assert!((hi as f64 - x[c]).abs() <= x[c].abs() * 2f64.powi(-24), "x {:e}: hi {hi:e} is not x to f32", x[c]);
+            folded += usize::from(naive == 0.0 && x[c] != x[c] as f32 as f64);
+        }
+    }
+    eprintln!("{}: f32_pair exact; x - f64(f32(x)) folded to 0 in {folded} of {} components", gpu.adapter_name(), 3 * xs.len());
+}
+
 const WARD: Sampler = Sampler { kind: LobeKind::Ward, method: Method::Ndf };
 
 /// The fast approximations (sin/cos ~1e-3, atan2 1.5e-3, ln/exp ~1e-4) cost accuracy: every

@@ -2,7 +2,7 @@
 
 // The arithmetic of the samplers and the binning, which are written once over `Real`: this
 // module makes `Real` f32 and defines the functions they call (math_log, math_exp, math_sin,
-// math_cos, math_atan2, neg_ln, math_is_finite) and the limits of the precision, as the WGSL
+// math_cos, math_atan2, neg_ln, math_is_finite, f32_pair) and the limits of the precision, as the WGSL
 // builtins plus an accurate -ln u. shaders/math/f32_fast.wgsl defines the same names with cheap
 // approximations (`lobes tradeoff`'s f32-fast kernels), shaders/math/f64.wgsl over f64; the
 // composing host (src/engine/gpu/library.rs) includes one of the three as lobes::math.
@@ -31,6 +31,11 @@ fn math_cos(x: Real) -> Real {
 
 fn math_atan2(y: Real, x: Real) -> Real {
     return atan2(y, x);
+}
+
+// x as two f32 (hi, lo) summing to x: (x, 0) here (shaders/math/f64.wgsl splits an f64).
+fn f32_pair(x: vec3<Real>) -> mat2x3<f32> {
+    return mat2x3<f32>(x, vec3<f32>(0.0));
 }
 
 // x is neither NaN nor +-infinity, from the bit pattern (without relying on IEEE comparisons of

@@ -13,6 +13,11 @@ alias Real = f32;
 // e^-x is below the smallest normal f32 past x = 87 (shaders/math/f32.wgsl).
 const UNDERFLOW_EXPONENT: Real = 87.0;
 
+// x as two f32 (hi, lo) summing to x: (x, 0) (shaders/math/f32.wgsl).
+fn f32_pair(x: vec3<Real>) -> mat2x3<f32> {
+    return mat2x3<f32>(x, vec3<f32>(0.0));
+}
+
 // x is neither NaN nor +-infinity, from the bit pattern (shaders/math/f32.wgsl).
 fn math_is_finite(x: Real) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;

@@ -151,6 +151,19 @@ fn math_atan2(y: Real, x: Real) -> Real {
     return t0 + d * (1.0 - d2 * (1.0 / 3.0 - d2 * 0.2));
 }
 
+// x as two f32 (columns hi, lo) with hi + lo = x to ~2^-48 relative, for reading f64 results
+// back through f32 buffers. hi = x rounded to 24 bits by Veltkamp's split (Dekker 1971, "A
+// floating-point technique for extending the available precision", mul12's splitting:
+// g = (2^29 + 1) x, hi = g - (g - x)), so hi is exact in f32 and x - hi exact in f64. Not
+// x - f64(f32(x)): Mesa 25's NIR folds f2f64(f2f32(x)) to x, which made that residual 0
+// (tests/tradeoff.rs, f64_pairs_survive_the_driver). |x| >= 1e30 (and inf, NaN): (f32(x), 0).
+fn f32_pair(x: vec3<Real>) -> mat2x3<f32> {
+    let g = x * 536870913.0lf;
+    let hi = g - (g - x);
+    let big = !(abs(x) < vec3<Real>(1.0e30));
+    return mat2x3<f32>(select(vec3<f32>(hi), vec3<f32>(x), big), select(vec3<f32>(x - hi), vec3<f32>(0.0), big));
+}
+
 // x is neither NaN nor +-infinity. By comparisons: WGSL has no bitcast of 64-bit values. A NaN
 // fails them where the driver keeps IEEE comparisons (not guaranteed; no NaN occurred in
 // tests/tradeoff.rs).

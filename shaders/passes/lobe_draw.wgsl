@@ -1,5 +1,5 @@
 #define_import_path lobes::draw
-#import lobes::math::Real
+#import lobes::math::{Real, f32_pair}
 #import lobes::job::{BINS, WG_SIZE}
 #import lobes::bindings::{params, directions_out}
 #import lobes::histogram::{classify, bin_of}
@@ -17,8 +17,9 @@ fn draw(index: vec2<u32>) -> u32 {
 }
 
 // Sample i uses explicit_u[i] (shaders/passes/lobe_kernel.wgsl; any u a caller can pass, 0 and 1
-// included) and writes (wr, reason code), (h, pdf_r) and (wr - f32(wr), 0): the part of wr
-// that f32 rounds off, 0 in the f32 kernels, with which the f64 kernels' wr comes back to ~2^-48.
+// included) and writes (wr_hi, reason code), (h, pdf_r) and (wr_lo, 0): wr as an f32 pair
+// (lobes::math's f32_pair; wr_lo is 0 in the f32 kernels), with which the f64 kernels' wr comes
+// back to ~2^-48.
 @compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -26,8 +27,8 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = lobe_sample_u(explicit_u[i]);
-    let wr = vec3<f32>(s.wr);
-    directions_out[3u * i] = vec4<f32>(wr, f32(classify(s.wr, s.pdf_r)));
+    let wr = f32_pair(s.wr);
+    directions_out[3u * i] = vec4<f32>(wr[0], f32(classify(s.wr, s.pdf_r)));
     directions_out[3u * i + 1u] = vec4<f32>(vec3<f32>(s.h), f32(s.pdf_r));
-    directions_out[3u * i + 2u] = vec4<f32>(vec3<f32>(s.wr - vec3<Real>(wr)), 0.0);
+    directions_out[3u * i + 2u] = vec4<f32>(wr[1], 0.0);
 }

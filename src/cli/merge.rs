@@ -4,7 +4,7 @@
 
 use super::{ChecksFailed, FileArgs, OutputArgs, emit, emit_json, parse_level, prepare_out};
 use crate::report::output::{self, CaseSummary, RunSummary};
-use crate::run::judge;
+use crate::run::{Expected, judge};
 use crate::run::merge::{merge, read_shards};
 use crate::stats::chi2::sidak;
 use clap::Args;
@@ -47,7 +47,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut summary = RunSummary { shard_files: Some(shards.len()), ..RunSummary::new(adapter.clone(), backend.clone(), args.significance, level) };
     for (case, sampled, parts) in merged.iter() {
-        let result = judge(case, sampled.clone(), level)?;
+        let result = judge(case, sampled.clone(), Expected::of(case), level)?;
         output::write_case(&args.out, &result, adapter, backend, args.files.style())?;
         rows.push(output::table_row(&result));
         summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });

@@ -6,7 +6,7 @@ use super::{ChecksFailed, FileArgs, Interrupted, OutputArgs, emit, emit_json, in
 use crate::report::output::{self, CaseSummary, JsonStyle, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
-use crate::run::{Backend, CaseResult, device_lost, judge, run_case};
+use crate::run::{Backend, CaseResult, Expected, device_lost, judge, run_case};
 use crate::scene::{Case, DEFAULT_SCENE, Entry, Overrides, Scene, UserCase};
 use crate::stats::chi2::sidak;
 use clap::Args;
@@ -117,11 +117,17 @@ fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
 }
 
 /// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
-/// first, so a case that fails here leaves no complete-looking `histogram.json` behind.
+/// first, so a case that fails here leaves no complete-looking `histogram.json` behind. The
+/// expected counts (f64 quadrature on the CPU) are computed on another thread while the GPU
+/// samples.
 fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, style: JsonStyle, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
     remove_stale(out, &case.name)?;
-    let sampled = run_case(backend, case, 0..case.samples, progress)?;
-    let result = judge(case, sampled, level)?;
+    let (sampled, expected) = std::thread::scope(|s| {
+        let quadrature = s.spawn(|| Expected::of(case));
+        let sampled = run_case(backend, case, 0..case.samples, progress);
+        (sampled, quadrature.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
+    });
+    let result = judge(case, sampled?, expected, level)?;
     let adapter = backend.adapter();
     output::write_case(out, &result, &adapter, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;

@@ -21,6 +21,7 @@
 use super::heatmap::{self, Heatmap, Mapping, Scale};
 use super::marginals::{self, Panel};
 use crate::stats::chi2::MIN_EXPECTED;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::ops::Range;
 use std::path::Path;
@@ -187,9 +188,11 @@ fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::R
             Mapping::Symmetric { lim: RESIDUAL_LIMIT },
         ),
     ];
-    for (file, title, values, scale, mapping) in maps {
-        heatmap::write_png_scaled(&Heatmap { title: &title, values, scale, ..base }, mapping, &dir.join(file))?;
-    }
+    // The maps are independent: encoded in parallel; the marginals follow once all three are
+    // written (a map that cannot be written stops the case's pictures there, as before).
+    maps.par_iter().try_for_each(|(file, title, values, scale, mapping)| {
+        heatmap::write_png_scaled(&Heatmap { title, values, scale: *scale, ..base }, *mapping, &dir.join(file))
+    })?;
 
     // the marginals: sums over the columns of each drawn row, and over the drawn rows of each column
     let row_sums = |v: &[f64]| -> Vec<f64> { v.chunks(cols).map(|row| row.iter().sum()).collect() };

@@ -8,7 +8,7 @@
 //! `lobes check`), titled by [`caption`]; [`table`] prints terminal tables; [`output`] writes a
 //! case's files (its arrays as NumPy [`npy`]), [`check`] those of `lobes check`; [`html`] writes the run's `index.html`.
 
-pub mod atomic;
+pub use crate::atomic;
 pub mod caption;
 pub mod check;
 pub mod colour;

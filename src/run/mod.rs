@@ -164,10 +164,26 @@ pub fn run_case(backend: &mut Backend, case: &Case, range: Range<u64>, progress:
     Ok(sampled)
 }
 
-/// Judges all samples of a case (one range `0 .. samples`, or its shards added up): the
-/// expected counts in f64, the χ² test at per-case `significance`, and the albedo checks of a
-/// weighted case.
-pub fn judge(case: &Case, sampled: Sampled, significance: f64) -> anyhow::Result<CaseResult> {
+/// A case's expected counts in f64 (the adaptive quadrature of its pdf over the bins) and the
+/// seconds they took. They depend on the case only, not on its samples: `lobes run` computes
+/// them on another thread while the GPU samples.
+pub struct Expected {
+    pub counts: ExpectedCounts,
+    pub seconds: f64,
+}
+
+impl Expected {
+    pub fn of(case: &Case) -> Self {
+        let t = Instant::now();
+        let counts = compare::expected_counts(&case.job, case.samples, &Quadrature::default());
+        Self { counts, seconds: t.elapsed().as_secs_f64() }
+    }
+}
+
+/// Judges all samples of a case (one range `0 .. samples`, or its shards added up) against
+/// its [`Expected`] counts: the χ² test at per-case `significance`, and the albedo checks of
+/// a weighted case.
+pub fn judge(case: &Case, sampled: Sampled, expected: Expected, significance: f64) -> anyhow::Result<CaseResult> {
     let Sampled { counts, gpu_seconds, wall_seconds, workgroup_counting, angle, weighted } = sampled;
     anyhow::ensure!(
         counts.total() == case.samples,
@@ -176,9 +192,7 @@ pub fn judge(case: &Case, sampled: Sampled, significance: f64) -> anyhow::Result
         counts.total(),
         case.samples
     );
-    let t = Instant::now();
-    let expected = compare::expected_counts(&case.job, case.samples, &Quadrature::default());
-    let quadrature_seconds = t.elapsed().as_secs_f64();
+    let Expected { counts: expected, seconds: quadrature_seconds } = expected;
     let chi2 = compare::chi2_test(&counts, &expected, significance);
     let weighted = match (&case.effects, weighted) {
         (None, _) => None,

@@ -1,6 +1,8 @@
 //! Adapter and device: the one place that talks to wgpu's instance, and where the device's
 //! errors are collected.
 
+#[cfg(feature = "check")]
+use super::pipeline_cache::{self, DiskCache};
 use std::sync::{Arc, Mutex};
 use thiserror::Error;
 
@@ -42,6 +44,11 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
     pub features: wgpu::Features,
+    /// The driver's compiled pipelines, loaded from and saved to the user's cache folder
+    /// ([`super::pipeline_cache`]); None where the adapter has no PIPELINE_CACHE or it is off.
+    /// (Not in lobes::embed alone, which opens no device of its own for rendering.)
+    #[cfg(feature = "check")]
+    pub pipeline_cache: Option<DiskCache>,
     /// The first error the device reported outside a call that returns one (validation, out
     /// of memory, loss), until [`Gpu::check_errors`] takes it.
     errors: Arc<Mutex<Option<String>>>,
@@ -50,7 +57,8 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the default adapter (honouring WGPU_BACKEND, WGPU_ADAPTER_NAME, WGPU_POWER_PREF),
     /// asking for its full limits (lavapipe offers 32 KiB of workgroup storage where wgpu's
-    /// default is 16 KiB) and for timestamp queries where it has them.
+    /// default is 16 KiB), for timestamp queries where it has them, and for a pipeline cache
+    /// kept on disk where it has one ([`super::pipeline_cache`]).
     pub fn new() -> Result<Self, GpuError> {
         Self::with_limits(|adapter| adapter)
     }
@@ -71,7 +79,14 @@ impl Gpu {
             .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
         let info = adapter.get_info();
         // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
-        let features = adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::SHADER_F64);
+        #[cfg(feature = "check")]
+        let cache_file = pipeline_cache::folder().filter(|_| !pipeline_cache::disabled()).and_then(|f| pipeline_cache::file(&f, &info));
+        #[cfg(not(feature = "check"))]
+        let cache_file: Option<()> = None;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::SHADER_F64
+            | if cache_file.is_some() { wgpu::Features::PIPELINE_CACHE } else { wgpu::Features::empty() };
+        let features = adapter.features() & wanted;
         let limits = shrink(adapter.limits());
         let desc = wgpu::DeviceDescriptor {
             label: Some("lobes"),
@@ -81,12 +96,23 @@ impl Gpu {
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
             .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
+        #[cfg(feature = "check")]
+        let pipeline_cache = cache_file.filter(|_| features.contains(wgpu::Features::PIPELINE_CACHE)).map(|path| DiskCache::open(&device, path));
         let errors = Arc::new(Mutex::new(None));
         let sink = errors.clone();
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap().get_or_insert_with(|| e.to_string());
         }));
-        Ok(Self { device, queue, info, limits, features, errors })
+        Ok(Self {
+            device,
+            queue,
+            info,
+            limits,
+            features,
+            #[cfg(feature = "check")]
+            pipeline_cache,
+            errors,
+        })
     }
 
     /// The error the device reported since the last check, as [`GpuError::Lost`].
@@ -111,6 +137,17 @@ impl Gpu {
     /// Whether the device runs WGSL `f64` (the adapter has SHADER_F64).
     pub fn has_f64(&self) -> bool {
         self.features.contains(wgpu::Features::SHADER_F64)
+    }
+}
+
+#[cfg(feature = "check")]
+impl Drop for Gpu {
+    /// Saves the pipeline cache; a cache that cannot be written costs the next process time,
+    /// not this one its results, so that is a note.
+    fn drop(&mut self) {
+        if let Some(Err(e)) = self.pipeline_cache.as_ref().map(DiskCache::save) {
+            eprintln!("lobes: note: pipeline cache not saved ({e}); set {}=off to stop using it", pipeline_cache::DISABLE_VAR);
+        }
     }
 }
 

@@ -54,7 +54,7 @@ impl Gpu {
             module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            cache: None,
+            cache: self.pipeline_cache.as_ref().map(|c| &c.cache),
         })
     }
 

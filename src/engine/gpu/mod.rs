@@ -8,6 +8,7 @@ pub mod engine;
 pub mod layout;
 pub mod library;
 pub mod params;
+pub mod pipeline_cache;
 pub mod precision;
 pub mod weighted;
 

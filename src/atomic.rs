@@ -11,7 +11,7 @@ use std::path::Path;
 /// ```
 /// let dir = tempfile::tempdir().unwrap();
 /// let path = dir.path().join("a.txt");
-/// lobes::report::atomic::write_atomic(&path, b"hello").unwrap();
+/// lobes::atomic::write_atomic(&path, b"hello").unwrap();
 /// assert_eq!(std::fs::read(&path).unwrap(), b"hello");
 /// ```
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
