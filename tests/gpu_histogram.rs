@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect, ward};
 use lobes::stats::chi2::{self, sidak};
@@ -20,7 +20,7 @@ const N: u64 = 10_000_000;
 
 fn lobe_job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, phi_deg: f64) -> Job {
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
-    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), phi_deg.to_radians()), grid: GRID }
+    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), phi_deg.to_radians()), grid: GRID, scatter: Scatter::Reflect }
 }
 
 fn run(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> Counts {

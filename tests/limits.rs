@@ -7,7 +7,7 @@
 
 use lobes::engine::gpu::engine::Tiling;
 use lobes::engine::gpu::{Gpu, GpuEngine, GpuError};
-use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::histogram::SphereGrid;
@@ -39,6 +39,7 @@ fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, rows: 
         lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 },
         incident: reflect::spherical(theta_deg.to_radians(), 0.3),
         grid: SphereGrid { rows, cols },
+        scatter: Scatter::Reflect,
     }
 }
 

@@ -2,7 +2,7 @@
 //! formulas break, on the GPU (f32) and the CPU (f64), plus the discrete hard cases.
 
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::run::compare;
 use lobes::stats::expected::Quadrature;
@@ -85,7 +85,7 @@ fn binning_at_edges_poles_and_the_seam() {
     let mut e = engine();
     let grid = SphereGrid { rows: 64, cols: 128 };
     let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
-    let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid };
+    let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid, scatter: Scatter::Reflect };
     let mut dirs: Vec<[f32; 3]> = Vec::new();
     for z in grid.cos_theta_edges() {
         for phi in grid.phi_edges() {

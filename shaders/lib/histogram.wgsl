@@ -12,11 +12,19 @@ const F32_MAX: f32 = 3.40282347e38;
 // 0 for a valid sample, else the reason code; the order matches reference::Invalid::check.
 // Over Real, as the samplers (lobes::math), so that the f64 kernels bin in f64.
 fn classify(wr: vec3<Real>, pdf: Real) -> u32 {
-    if (!(math_is_finite(wr.x) && math_is_finite(wr.y) && math_is_finite(wr.z))) {
-        return REASON_NON_FINITE_DIRECTION;
-    }
-    if (wr.z <= 0.0) {
+    let reason = classify_scattered(wr, pdf);
+    if (reason != REASON_NON_FINITE_DIRECTION && wr.z <= 0.0) {
         return REASON_BELOW_HORIZON;
+    }
+    return reason;
+}
+
+// The same for a sample that may leave on either side (a dielectric, shaders/lib/dielectric.wgsl):
+// its sampler gives a wrong-side sample density 0, counted as zero pdf; the order matches
+// reference::Invalid::check_scattered.
+fn classify_scattered(wo: vec3<Real>, pdf: Real) -> u32 {
+    if (!(math_is_finite(wo.x) && math_is_finite(wo.y) && math_is_finite(wo.z))) {
+        return REASON_NON_FINITE_DIRECTION;
     }
     if (!math_is_finite(pdf)) {
         return REASON_NON_FINITE_PDF;

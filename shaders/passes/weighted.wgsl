@@ -80,7 +80,7 @@ fn weighted_histogram(at: Invocation) {
             break;
         }
         let u = rng_uniforms(params.seed, add64(params.base, local));
-        let s = effect_sample(u.xy);
+        let s = effect_sample(u.xyz);
         let reason = classify(s.wr, s.pdf_r);
         let w = effect_weight(s);
         if (!(w >= 0.0 && w < WEIGHT_LIMIT)) {

@@ -14,9 +14,9 @@ const BLOCK: u64 = 1 << 16;
 /// Histograms the samples of `range`.
 ///
 /// ```
-/// use lobes::{engine::job::{Job, SampleRange}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
+/// use lobes::{engine::job::{Job, SampleRange, Scatter}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
 /// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
-/// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } };
+/// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Reflect };
 /// let counts = lobes::engine::cpu::histogram(&job, SampleRange::whole(1, 10_000));
 /// assert_eq!(counts.total(), 10_000);
 /// ```
@@ -48,7 +48,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
 /// in f64: the same fixed-point sums as `shaders/passes/weighted.wgsl`, and per bin the largest
 /// relative difference between the weight and eval · cos θr / pdf.
 pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSums {
-    let Job::Lobe { lobe, incident, grid } = job else { panic!("weighted histograms are for lobe jobs") };
+    let Job::Lobe { lobe, incident, grid, .. } = job else { panic!("weighted histograms are for lobe jobs") };
     let bins = job.bins();
     (0..range.chunk_count(BLOCK))
         .into_par_iter()

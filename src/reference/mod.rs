@@ -103,13 +103,17 @@ impl Invalid {
 
     /// Classifies a sampled direction and its density.
     pub fn check(wr: DVec3, pdf_r: f64) -> Option<Invalid> {
-        if !wr.is_finite() {
+        if wr.is_finite() && wr.z <= 0.0 { Some(Invalid::BelowHorizon) } else { Invalid::check_scattered(wr, pdf_r) }
+    }
+
+    /// Classifies a direction that may leave on either side (a rough dielectric's, whose
+    /// density is 0 on the wrong side of its event, counted as [`Invalid::ZeroPdf`]).
+    pub fn check_scattered(wo: DVec3, pdf_o: f64) -> Option<Invalid> {
+        if !wo.is_finite() {
             Some(Invalid::NonFiniteDirection)
-        } else if wr.z <= 0.0 {
-            Some(Invalid::BelowHorizon)
-        } else if !pdf_r.is_finite() {
+        } else if !pdf_o.is_finite() {
             Some(Invalid::NonFinitePdf)
-        } else if pdf_r <= 0.0 {
+        } else if pdf_o <= 0.0 {
             Some(Invalid::ZeroPdf)
         } else {
             None

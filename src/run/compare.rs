@@ -3,7 +3,8 @@
 //! check of a weighted histogram. (Here, above the engine, because they take its [`Job`]; the
 //! statistics they use, in [`crate::stats`], know nothing of jobs.)
 
-use crate::engine::job::{Counts, Job};
+use crate::engine::job::{Counts, Job, Scatter};
+use crate::reference::dielectric::RoughDielectric;
 use crate::reference::Invalid;
 use crate::reference::effects::Effects;
 use crate::stats::chi2::{self, Chi2};
@@ -26,7 +27,7 @@ pub struct ExpectedCounts {
 pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCounts {
     let n = samples as f64;
     match job {
-        Job::Lobe { lobe, incident, grid } => {
+        Job::Lobe { lobe, incident, grid, .. } => {
             let e = expected::lobe_probabilities(lobe, *incident, *grid, q);
             let mut invalid = [0.0; 4];
             invalid[Invalid::BelowHorizon.code() as usize - 1] = n * e.below_horizon;
@@ -96,13 +97,27 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
 }
 
 /// Compares the GPU's directions of samples `first ..` (each `[x, y, z, reason]`) with f64.
+/// A dielectric's GPU sample pairs with [`RoughDielectric::sample`] of the same three uniforms.
 pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleCheck {
-    let Job::Lobe { lobe, incident, .. } = job else { return AngleCheck::default() };
+    let Job::Lobe { lobe, incident, scatter, .. } = job else { return AngleCheck::default() };
+    let glass = match *scatter {
+        Scatter::Reflect => None,
+        Scatter::Dielectric { eta } => Some(RoughDielectric::new(*lobe, eta).expect("a dielectric job is checked when made")),
+    };
     AngleCheck::from_pairs(gpu.iter().enumerate().map(|(k, g)| {
         let u = crate::reference::rng::uniforms(seed, first + k as u64);
-        let s = lobe.sample(*incident, [u[0], u[1]]);
+        let reference = match glass {
+            None => {
+                let s = lobe.sample(*incident, [u[0], u[1]]);
+                s.invalid.is_none().then_some(s.omega_r)
+            }
+            Some(glass) => {
+                let s = glass.sample(*incident, [u[0], u[1], u[2]]);
+                s.valid.then_some(s.omega_o)
+            }
+        };
         let gpu = (g[3] == 0.0).then(|| DVec3::new(g[0] as f64, g[1] as f64, g[2] as f64));
-        (gpu, s.invalid.is_none().then_some(s.omega_r))
+        (gpu, reference)
     }))
 }
 
@@ -111,10 +126,10 @@ pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleC
 /// value where there is one, the per-bin weight check, and no overflow.
 ///
 /// ```
-/// use lobes::{engine::job::{Job, SampleRange}, run::compare::albedo_check, stats::{histogram::SphereGrid, expected::Quadrature}};
+/// use lobes::{engine::job::{Job, SampleRange, Scatter}, run::compare::albedo_check, stats::{histogram::SphereGrid, expected::Quadrature}};
 /// use lobes::reference::{Lobe, LobeKind, Method, effects::Effects, masking::Masking, fresnel::Fresnel, reflect::spherical};
 /// let lobe = Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
-/// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 } };
+/// let job = Job::Lobe { lobe, incident: spherical(1.0, 0.0), grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Reflect };
 /// let effects = Effects { fresnel: Fresnel::None, masking: Masking::G1 };
 /// let sums = lobes::engine::cpu::weighted(&job, &effects, SampleRange::whole(1, 200_000));
 /// let check = albedo_check(&job, &effects, &sums, 200_000, 0.01, &Quadrature::default());
@@ -129,7 +144,7 @@ pub fn albedo_check(
     significance: f64,
     q: &Quadrature,
 ) -> AlbedoCheck {
-    let Job::Lobe { lobe, incident, grid } = job else { panic!("albedo of a lobe job") };
+    let Job::Lobe { lobe, incident, grid, .. } = job else { panic!("albedo of a lobe job") };
     let wi = *incident;
     let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
     let f_cos = |w: glam::DVec3| effects.eval(lobe, wi, w) * w.z;

@@ -46,7 +46,7 @@ mod user;
 
 pub use user::UserCase;
 
-use crate::engine::job::{DiscreteMethod, Job};
+use crate::engine::job::{DiscreteMethod, Job, Scatter};
 use crate::reference::discrete::{Distribution, WeightsError};
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
@@ -706,7 +706,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         };
         return Err(ctx.err(span, format!("samples = {samples}{given} is too many for a weighted case; at most 2^32 (4294967296)")));
     }
-    Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi), effects })
+    Ok(Case { name, job: Job::Lobe { lobe, incident, grid, scatter: Scatter::Reflect }, samples, seed, incident_deg: (theta, phi), effects })
 }
 
 /// `incident_phi` of a case (0 unless given).
