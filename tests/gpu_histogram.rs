@@ -155,7 +155,7 @@ fn totals_carry_past_32_bits() {
     let mut e = engine();
     let job = Job::Discrete { dist: Distribution::new(&[1.0, 1.0]).unwrap(), method: DiscreteMethod::Cdf };
     let near = (1u64 << 32) - 100;
-    let initial = Counts { bins: vec![near, (1 << 33) + 5], invalid: [0, 0, 0, u32::MAX as u64] };
+    let initial = Counts { bins: vec![near, (1 << 33) + 5], invalid: [0, 0, 0, u32::MAX as u64, 7] };
     let add = run(&mut e, &job, 3, 100_000);
     let got = e.histogram_onto(&job, SampleRange::whole(3, 100_000), Some(&initial), &mut |_| {}).unwrap().counts;
     let mut want = initial.clone();

@@ -150,7 +150,7 @@ fn broken_rotation_counts(job: &Job, seed: u64, n: u64) -> Counts {
     let Job::Lobe { lobe, incident, grid, .. } = job else { unreachable!("lobe jobs") };
     let plain = Lobe { alpha_angle: 0.0, ..*lobe };
     let local_wi = lobe.to_local(*incident);
-    let mut cells = vec![0u64; grid.bins() + 4];
+    let mut cells = vec![0u64; grid.bins() + lobes::reference::Invalid::COUNT];
     for i in 0..n {
         let u = rng::uniforms(seed, i);
         let s = plain.sample(local_wi, [u[0], u[1]]);

@@ -27,7 +27,7 @@ fn gpu_counts(e: &mut GpuEngine, weights: &[f64], method: DiscreteMethod, n: u64
     let job = Job::Discrete { dist: dist.clone(), method };
     let r = e.histogram(&job, SampleRange::whole(17, n), &mut |_| {}).unwrap();
     assert_eq!(r.counts.total(), n);
-    assert_eq!(r.counts.invalid, [0; 4]);
+    assert_eq!(r.counts.invalid, [0; lobes::reference::Invalid::COUNT]);
     (dist, r.counts.bins)
 }
 
@@ -65,7 +65,7 @@ fn tables_beyond_f32_resolution() {
         let (dist, c) = gpu_counts(&mut e, &w, method, samples);
         let job = Job::Discrete { dist, method };
         let exp = compare::expected_counts(&job, samples, &Quadrature::default());
-        let counts = lobes::engine::job::Counts { bins: c, invalid: [0; 4] };
+        let counts = lobes::engine::job::Counts { bins: c, invalid: [0; lobes::reference::Invalid::COUNT] };
         let t = compare::chi2_test(&counts, &exp, 0.001);
         assert!(t.passed, "{method:?}: χ² {} / {} p {}", t.statistic, t.dof, t.p_value);
         // the last entry, beyond 2^24, is reached

@@ -1,30 +1,35 @@
 #define_import_path lobes::histogram
-#import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF}
+#import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF, REASON_REFRACTED_NEAR_SIDE}
 #import lobes::math::{Real, math_atan2, math_is_finite}
 #import lobes::reflect::PI
 
 // Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
 // grid and REASON_* the codes of src/engine/gpu/layout.rs, from the generated `lobes::job`.
 // Cell layout: BINS bins, then one counter per invalid reason (codes 1..N_REASONS, in the order of
-// reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf.
+// reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf,
+// refracted near side.
 const F32_MAX: f32 = 3.40282347e38;
 
 // 0 for a valid sample, else the reason code; the order matches reference::Invalid::check.
 // Over Real, as the samplers (lobes::math), so that the f64 kernels bin in f64.
 fn classify(wr: vec3<Real>, pdf: Real) -> u32 {
-    let reason = classify_scattered(wr, pdf);
-    if (reason != REASON_NON_FINITE_DIRECTION && wr.z <= 0.0) {
-        return REASON_BELOW_HORIZON;
-    }
-    return reason;
+    return classify_scattered(vec3<Real>(0.0, 0.0, 1.0), wr, pdf, true);
 }
 
-// The same for a sample that may leave on either side (a dielectric, shaders/lib/dielectric.wgsl):
-// its sampler gives a wrong-side sample density 0, counted as zero pdf; the order matches
-// reference::Invalid::check_scattered.
-fn classify_scattered(wo: vec3<Real>, pdf: Real) -> u32 {
+// The same for a direction that may leave on either side, seen from wi (a rough dielectric's,
+// shaders/lib/dielectric.wgsl), with its event: a reflection on the far side of the surface is
+// below the horizon, a refraction on wi's side (or either on the surface) refracted near side;
+// the order matches reference::Invalid::check_scattered.
+fn classify_scattered(wi: vec3<Real>, wo: vec3<Real>, pdf: Real, reflected: bool) -> u32 {
+    let side = select(wo.z, -wo.z, wi.z < 0.0);
     if (!(math_is_finite(wo.x) && math_is_finite(wo.y) && math_is_finite(wo.z))) {
         return REASON_NON_FINITE_DIRECTION;
+    }
+    if (reflected && side <= 0.0) {
+        return REASON_BELOW_HORIZON;
+    }
+    if (!reflected && side >= 0.0) {
+        return REASON_REFRACTED_NEAR_SIDE;
     }
     if (!math_is_finite(pdf)) {
         return REASON_NON_FINITE_PDF;

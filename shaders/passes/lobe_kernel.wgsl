@@ -21,10 +21,13 @@ fn lobe_sample_u(u: vec3<f32>) -> LobeSample {
 }
 
 // 0 for a valid sample, else its reason code: a reflection's (classify), or a dielectric's
-// (lobe_eta() != 0), whose samples leave on either side (classify_scattered).
+// (lobe_eta() != 0), whose samples leave on either side (classify_scattered). A dielectric
+// sample's event is read from its h, on wi's side: a reflection keeps the sign of wi.h in wr.h
+// (wr.h = wi.h), a refraction turns it (wt.h = -cos th_t).
 fn lobe_classify(s: LobeSample) -> u32 {
     if (lobe_eta() != 0.0) {
-        return classify_scattered(s.wr, s.pdf_r);
+        let wi = lobe_wi();
+        return classify_scattered(wi, s.wr, s.pdf_r, dot(wi, s.h) * dot(s.wr, s.h) >= 0.0);
     }
     return classify(s.wr, s.pdf_r);
 }

@@ -5,6 +5,7 @@
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
+use crate::reference::Invalid;
 use crate::reference::discrete::AliasTable;
 use rayon::prelude::*;
 
@@ -29,7 +30,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
     let cells = (0..range.chunk_count(BLOCK))
         .into_par_iter()
         .fold(
-            || vec![0u64; bins + 4],
+            || vec![0u64; bins + Invalid::COUNT],
             |mut cells, b| {
                 for i in range.chunk(b, BLOCK).indices() {
                     cells[job.cell_f64(range.seed, i, alias.as_ref())] += 1;
@@ -37,7 +38,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
                 cells
             },
         )
-        .reduce(|| vec![0u64; bins + 4], |mut a, b| {
+        .reduce(|| vec![0u64; bins + Invalid::COUNT], |mut a, b| {
             a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
             a
         });

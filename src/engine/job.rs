@@ -2,7 +2,7 @@
 //! and the CPU reference engine ([`crate::engine::cpu`]).
 
 use crate::reference::discrete::{AliasTable, Distribution};
-use crate::reference::dielectric::RoughDielectric;
+use crate::reference::dielectric::{Event, RoughDielectric};
 use crate::reference::{Invalid, Lobe};
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
@@ -115,7 +115,7 @@ impl Job {
             }
             Job::Lobe { lobe, incident, grid, scatter: Scatter::Dielectric { eta } } => {
                 let s = RoughDielectric::new(*lobe, *eta).expect("a dielectric job is checked when made").sample(*incident, [u[0], u[1], u[2]]);
-                match Invalid::check_scattered(s.omega_o, s.pdf_o) {
+                match Invalid::check_scattered(*incident, s.omega_o, s.pdf_o, s.event == Event::Reflection) {
                     None => grid.bin_of(s.omega_o),
                     Some(r) => self.bins() + r.code() as usize - 1,
                 }
@@ -133,17 +133,17 @@ impl Job {
 pub struct Counts {
     pub bins: Vec<u64>,
     /// Indexed like [`Invalid::ALL`].
-    pub invalid: [u64; 4],
+    pub invalid: [u64; Invalid::COUNT],
 }
 
 impl Counts {
     pub fn zeros(bins: usize) -> Self {
-        Self { bins: vec![0; bins], invalid: [0; 4] }
+        Self { bins: vec![0; bins], invalid: [0; Invalid::COUNT] }
     }
     /// Splits a cell vector (bins followed by the reasons) as laid out by the kernels.
     pub fn from_cells(cells: &[u64]) -> Self {
-        let n = cells.len() - 4;
-        Self { bins: cells[..n].to_vec(), invalid: [cells[n], cells[n + 1], cells[n + 2], cells[n + 3]] }
+        let n = cells.len() - Invalid::COUNT;
+        Self { bins: cells[..n].to_vec(), invalid: cells[n..].try_into().expect("one cell per reason") }
     }
     pub fn total(&self) -> u64 {
         self.bins.iter().sum::<u64>() + self.invalid.iter().sum::<u64>()

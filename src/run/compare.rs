@@ -18,7 +18,7 @@ use serde::Serialize;
 pub struct ExpectedCounts {
     pub bins: Vec<f64>,
     /// Indexed like [`Invalid::ALL`]: only "below horizon" has a nonzero expectation.
-    pub invalid: [f64; 4],
+    pub invalid: [f64; Invalid::COUNT],
     /// The quadrature's accuracy (lobes).
     pub quadrature: Option<Expected>,
 }
@@ -29,12 +29,12 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
     match job {
         Job::Lobe { lobe, incident, grid, .. } => {
             let e = expected::lobe_probabilities(lobe, *incident, *grid, q);
-            let mut invalid = [0.0; 4];
+            let mut invalid = [0.0; Invalid::COUNT];
             invalid[Invalid::BelowHorizon.code() as usize - 1] = n * e.below_horizon;
             ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e) }
         }
         Job::Discrete { dist, .. } => {
-            ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; 4], quadrature: None }
+            ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; Invalid::COUNT], quadrature: None }
         }
     }
 }

@@ -72,7 +72,7 @@ impl WeightedPipelines {
     ) -> Result<WeightedRun, GpuError> {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
-        // 2 words (lo, hi) per cell: the bins, the 4 invalid reasons, then Σw² over the bins,
+        // 2 words (lo, hi) per cell: the bins, one per invalid reason, then Σw² over the bins,
         // Σw² over all samples and the overflow count (`shaders/passes/weighted.wgsl`).
         let words = 2 * (bins + (N_REASONS + WEIGHT_EXTRA_CELLS) as u64);
         if words * 4 > gpu.limits.max_storage_buffer_binding_size {
@@ -112,7 +112,7 @@ impl WeightedPipelines {
         let extra = n + N_REASONS as usize;
         let sums = WeightedSums {
             bins: cells[..n].to_vec(),
-            invalid: cells[n..extra].try_into().expect("four reasons"),
+            invalid: cells[n..extra].try_into().expect("one cell per reason"),
             squares_bins: cells[extra],
             squares_all: cells[extra + 1],
             overflow: cells[extra + 2],
