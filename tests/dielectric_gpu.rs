@@ -8,7 +8,8 @@
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::job::{Counts, Job, SampleRange, Scatter};
-use lobes::reference::dielectric::RoughDielectric;
+use lobes::reference::dielectric::{RoughDielectric, refraction_half_vector};
+use lobes::reference::fresnel;
 use lobes::reference::reflect::spherical;
 use lobes::reference::{Invalid, Lobe, LobeKind, Method};
 use lobes::run::compare;
@@ -101,23 +102,34 @@ fn the_gpu_sampler_matches_the_f64_density_over_the_sphere_and_sample_by_sample(
     assert!(failures.is_empty(), "rejected: {failures:?}");
 }
 
-/// The refraction density without eq. 17's η² (what a sampler with that bug would be judged
-/// against, or equivalently what it would draw): the correct GPU histogram tells them apart.
+/// The two refraction densities that go wrong most often: without eq. 17's η², and with the
+/// reflection Jacobian 1/(4|ωt·h|) in place of eq. 17's (what a sampler with either bug would be
+/// judged against, or would draw): the GPU histogram of the correct sampler rejects both.
 #[test]
-fn a_refraction_density_without_eta_squared_is_rejected_by_the_gpu_histogram() {
+fn broken_refraction_densities_are_rejected_by_the_gpu_histogram() {
     let mut e = engine();
     let g = glass(LobeKind::Ggx, Method::Vndf, 0.3, 1.5);
     let job = job(&g, 40.0);
     let Job::Lobe { incident, .. } = job else { unreachable!() };
     let c = gpu_counts(&mut e, &job, 7);
-    let broken = |wo: DVec3| if wo.z < 0.0 { g.pdf(incident, wo) / (g.eta * g.eta) } else { g.pdf(incident, wo) };
-    let mut exp = expected(&broken, 0.18);
-    // keep the total: only the shape is wrong
-    let total: f64 = exp.iter().sum();
-    exp.iter_mut().for_each(|x| *x *= N as f64 / total);
-    let t = chi2::test(&observed(&c), &exp, 1e-12);
-    println!("without η²: χ² {:.1}/{} p = {:.3e}", t.statistic, t.dof, t.p_value);
-    assert!(!t.passed && t.p_value < 1e-12, "p = {}", t.p_value);
+    let without_eta2 = |wo: DVec3| if wo.z < 0.0 { g.pdf(incident, wo) / (g.eta * g.eta) } else { g.pdf(incident, wo) };
+    let reflection_jacobian = |wo: DVec3| {
+        if wo.z >= 0.0 {
+            return g.pdf(incident, wo);
+        }
+        let Some(h) = refraction_half_vector(incident, wo, g.eta) else { return 0.0 };
+        fresnel::dielectric_transmittance(incident.dot(h), g.eta) * g.lobe.pdf_h(incident, h) / (4.0 * wo.dot(h).abs())
+    };
+    let brokens: [(&str, &(dyn Fn(DVec3) -> f64 + Sync)); 2] = [("without η²", &without_eta2), ("reflection Jacobian", &reflection_jacobian)];
+    for (what, broken) in brokens {
+        let mut exp = expected(broken, 0.18);
+        // keep the total: only the shape is wrong
+        let total: f64 = exp.iter().sum();
+        exp.iter_mut().for_each(|x| *x *= N as f64 / total);
+        let t = chi2::test(&observed(&c), &exp, 1e-12);
+        println!("{what}: χ² {:.1}/{} p = {:.3e}", t.statistic, t.dof, t.p_value);
+        assert!(!t.passed && t.p_value < 1e-12, "{what}: p = {}", t.p_value);
+    }
 }
 
 /// The CPU engine draws the same samples in f64 (`Job::cell_f64`): the histograms differ only
@@ -140,3 +152,26 @@ fn gpu_and_cpu_engines_agree_sample_by_sample() {
     }
 }
 
+
+/// `lobes run`'s expectation of a dielectric case (`run::compare::expected_counts`): the bins
+/// from the density over the sphere, each wrong-side reason from its density over h; the two
+/// reasons' shares add up to the sphere's 1 − Σ (two independent quadratures), and the GPU's
+/// counts, reasons included, pass `lobes run`'s χ².
+#[test]
+fn lobes_run_judges_a_dielectric_case_with_its_reasons() {
+    let mut e = engine();
+    let g = glass(LobeKind::Beckmann, Method::Vndf, 0.4, 1.5);
+    let job = job(&g, 130.0);
+    let c = gpu_counts(&mut e, &job, 11);
+    let exp = compare::expected_counts(&job, N, &Quadrature::default());
+    let q = exp.quadrature.as_ref().unwrap();
+    let wrong: f64 = WRONG_SIDE.iter().map(|&r| exp.invalid[r.code() as usize - 1]).sum();
+    println!("wrong side: by h {:.1} {:?}, by 1 − Σ {:.1}; observed {:?}", wrong, exp.invalid, q.below_horizon * N as f64, c.invalid);
+    assert!((wrong / N as f64 - q.below_horizon).abs() < 1e-4, "{wrong} against {}", q.below_horizon * N as f64);
+    for r in WRONG_SIDE {
+        assert!(exp.invalid[r.code() as usize - 1] > 1000.0, "the case has samples of {}", r.name());
+    }
+    let t = compare::chi2_test(&c, &exp, 1e-4);
+    println!("χ² {:.1}/{} p = {:.3e}", t.statistic, t.dof, t.p_value);
+    assert!(t.passed, "p = {}", t.p_value);
+}

@@ -3,7 +3,7 @@
 //! counts by invalid reason, and the histogram's timing. Writers and readers use the same
 //! structs; `docs/schema/` holds their JSON Schema ([`crate::report::schema`]).
 
-use crate::engine::job::Job;
+use crate::engine::job::{Job, Scatter};
 use crate::reference::Invalid;
 use crate::check::Domain;
 use crate::scene::{Case, UserCase};
@@ -37,6 +37,9 @@ pub enum Params {
         alpha_angle: f64,
         incident_theta_deg: f64,
         incident_phi_deg: f64,
+        /// A rough dielectric's η (`scatter = "dielectric"`); absent for a reflection.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<f64>,
     },
     Discrete { weights: Vec<f64> },
     /// A user's WGSL sampler ([`crate::check`]).
@@ -61,7 +64,7 @@ pub enum Params {
 impl CaseDescription {
     pub fn of(case: &Case) -> Self {
         match &case.job {
-            Job::Lobe { lobe, grid, .. } => CaseDescription {
+            Job::Lobe { lobe, grid, scatter, .. } => CaseDescription {
                 lobe: lobe.kind.name().into(),
                 method: lobe.method.name().into(),
                 params: Params::Lobe {
@@ -70,6 +73,10 @@ impl CaseDescription {
                     alpha_angle: lobe.alpha_angle,
                     incident_theta_deg: case.incident_deg.0,
                     incident_phi_deg: case.incident_deg.1,
+                    eta: match scatter {
+                        Scatter::Reflect => None,
+                        Scatter::Dielectric { eta } => Some(*eta),
+                    },
                 },
                 rows: grid.rows as usize,
                 cols: grid.cols as usize,
