@@ -10,7 +10,7 @@
 
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::chi2::sidak;
@@ -35,7 +35,7 @@ pub struct Verdict {
 pub fn cases() -> Vec<(String, Job)> {
     let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
     let incident: DVec3 = reflect::spherical(45f64.to_radians(), 0.0);
-    let ggx = Job::Lobe { lobe, incident, grid: SphereGrid { rows: 32, cols: 64 } };
+    let ggx = Job::Lobe { lobe, incident, grid: SphereGrid { rows: 32, cols: 64 }, scatter: Scatter::Reflect };
     let dist = Distribution::new(&[15.0, 5.0, 5.0, 25.0, 5.0, 10.0, 15.0, 5.0, 5.0, 10.0]).expect("valid weights");
     let alias = Job::Discrete { dist, method: DiscreteMethod::Alias };
     vec![("ggx-vndf-45".into(), ggx), ("tutorial-alias".into(), alias)]

@@ -480,3 +480,24 @@ fn effects() {
     scene_error(&discrete("weights = [1, 2]\nmasking = ⟦\"g1\"\n"), &["masking does not apply to lobe = \"discrete\""]);
     scene_error(&ggx("alpha = 0.2\nweighted = true\nsamples = ⟦8_000_000_000\n"), &["too many for a weighted case", "2^32"]);
 }
+
+/// `scatter = "dielectric"` (rough glass) and its `eta`: where each applies, with what values.
+#[test]
+fn dielectric_scatter_keys() {
+    let glass = |extra: &str| ggx(&format!("alpha = 0.3\nmethod = \"vndf\"\n{extra}"));
+    let ok = Scene::parse("s.toml", &glass("scatter = \"dielectric\"\neta = 1.5\nincident_theta = 140\n")).unwrap();
+    assert!(matches!(ok.cases[0].job, lobes::engine::job::Job::Lobe { scatter: lobes::engine::job::Scatter::Dielectric { eta: 1.5 }, .. }));
+    scene_error(&glass("scatter = ⟦\"glass\"\neta = 1.5\n"), &["scatter 'glass' is unknown", "reflect or dielectric"]);
+    scene_error(&glass("scatter = ⟦\"dielectric\"\n"), &["needs eta", "≠ 1"]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = ⟦1.0\n"), &["eta", "> 0 and ≠ 1"]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = ⟦-1.5\n"), &["eta", "> 0 and ≠ 1"]);
+    scene_error(&glass("eta = ⟦1.5\n"), &["eta applies to scatter = \"dielectric\"", "fresnel"]);
+    scene_error(&glass("scatter = \"reflect\"\neta = ⟦1.5\n"), &["eta applies to scatter = \"dielectric\""]);
+    scene_error(&glass("incident_theta = ⟦140\n"), &["0 ≤ θ < 90"]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nincident_theta = ⟦180\n"), &["0 ≤ θ < 180"]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nfresnel = ⟦\"schlick\"\n"), &["fresnel does not apply to scatter = \"dielectric\""]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nmasking = ⟦\"g1\"\n"), &["masking does not apply to scatter = \"dielectric\""]);
+    scene_error(&ggx("alpha = 0.3\nmethod = ⟦\"bounded\"\nscatter = \"dielectric\"\neta = 1.5\n"), &["ggx bounded has no dielectric sampler", "ndf or vndf"]);
+    scene_error("[[case]]\nname = \"w\"\nlobe = ⟦\"ward\"\nalpha = 0.2\nscatter = \"dielectric\"\neta = 1.5\n", &["ward has no dielectric sampler"]);
+    scene_error(&discrete("weights = [1, 2]\nscatter = ⟦\"dielectric\"\n"), &["scatter does not apply to lobe = \"discrete\""]);
+}

@@ -75,7 +75,7 @@ fn reruns_write_identical_histograms_and_npy_arrays_hold_its_counts() {
         let (shape, expected) = npy::decode::<f64>(&file("a", "expected.npy")).unwrap();
         assert_eq!((shape, expected), (vec![rows, cols], h.expected.concat()), "{case}: expected.npy");
         // independent of the writer: the total of the counts and the invalid samples is N
-        let invalid: u64 = <[u64; 4]>::from(h.invalid.unwrap()).iter().sum();
+        let invalid: u64 = <[u64; lobes::reference::Invalid::COUNT]>::from(h.invalid.unwrap()).iter().sum();
         assert_eq!(h.counts.concat().iter().sum::<u64>() + invalid, 30_000, "{case}");
         assert_eq!(file("a", "counts.npy"), file("b", "counts.npy"), "{case}");
     }

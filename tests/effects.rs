@@ -4,7 +4,7 @@
 
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::gpu::effects::{self, Composed, Specialisation};
-use lobes::engine::job::{Job, SampleRange};
+use lobes::engine::job::{Job, SampleRange, Scatter};
 use lobes::reference::effects::Effects;
 use lobes::reference::fresnel::Fresnel;
 use lobes::reference::masking::Masking;
@@ -25,7 +25,7 @@ const N: u64 = 1 << 22;
 
 fn job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64) -> Job {
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
-    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), 0.3), grid: GRID }
+    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), 0.3), grid: GRID, scatter: Scatter::Reflect }
 }
 
 /// The names of the functions in a module, as naga parses it.

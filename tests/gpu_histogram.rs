@@ -3,7 +3,7 @@
 
 use glam::DVec3;
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect, ward};
 use lobes::stats::chi2::{self, sidak};
@@ -20,7 +20,7 @@ const N: u64 = 10_000_000;
 
 fn lobe_job(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, phi_deg: f64) -> Job {
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 };
-    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), phi_deg.to_radians()), grid: GRID }
+    Job::Lobe { lobe, incident: reflect::spherical(theta_deg.to_radians(), phi_deg.to_radians()), grid: GRID, scatter: Scatter::Reflect }
 }
 
 fn run(engine: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> Counts {
@@ -155,7 +155,7 @@ fn totals_carry_past_32_bits() {
     let mut e = engine();
     let job = Job::Discrete { dist: Distribution::new(&[1.0, 1.0]).unwrap(), method: DiscreteMethod::Cdf };
     let near = (1u64 << 32) - 100;
-    let initial = Counts { bins: vec![near, (1 << 33) + 5], invalid: [0, 0, 0, u32::MAX as u64] };
+    let initial = Counts { bins: vec![near, (1 << 33) + 5], invalid: [0, 0, 0, u32::MAX as u64, 7] };
     let add = run(&mut e, &job, 3, 100_000);
     let got = e.histogram_onto(&job, SampleRange::whole(3, 100_000), Some(&initial), &mut |_| {}).unwrap().counts;
     let mut want = initial.clone();

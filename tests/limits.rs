@@ -7,7 +7,7 @@
 
 use lobes::engine::gpu::engine::Tiling;
 use lobes::engine::gpu::{Gpu, GpuEngine, GpuError};
-use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{Counts, DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::reference::{Lobe, LobeKind, Method, reflect};
 use lobes::stats::histogram::SphereGrid;
@@ -39,6 +39,7 @@ fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, rows: 
         lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 },
         incident: reflect::spherical(theta_deg.to_radians(), 0.3),
         grid: SphereGrid { rows, cols },
+        scatter: Scatter::Reflect,
     }
 }
 
@@ -54,9 +55,11 @@ fn run(e: &mut GpuEngine, job: &Job, seed: u64, n: u64) -> lobes::engine::gpu::G
     r
 }
 
-/// 64-bit words of 8 bytes, four invalid reasons: a binding of `bytes` holds `bytes/8 - 4` bins.
-const ODD_TILE_BYTES: u64 = 8 * (509 + 4); // 509 bins a tile: odd, so tiles split packed words
-const GLOBAL_TILE_BYTES: u64 = 8 * (3001 + 4); // 3001 bins: too many for 1 KiB, global atomics
+/// 64-bit words of 8 bytes, one per invalid reason after the bins: a binding of `bytes` holds
+/// `bytes/8 - REASONS` bins.
+const REASONS: u64 = lobes::reference::Invalid::COUNT as u64;
+const ODD_TILE_BYTES: u64 = 8 * (509 + REASONS); // 509 bins a tile: odd, so tiles split packed words
+const GLOBAL_TILE_BYTES: u64 = 8 * (3001 + REASONS); // 3001 bins: too many for 1 KiB, global atomics
 
 #[test]
 fn tiled_and_chunked_histograms_equal_the_untiled_ones_bit_for_bit() {
@@ -129,7 +132,7 @@ fn the_largest_scene_histogram_runs_at_the_adapters_own_limits() {
     eprintln!("2^24 bins on {}: {tiling:?}, {:.2} s", e.gpu.adapter_name(), r.wall_seconds);
     // the same samples counted in bands of 1536 rows (the last one partial) give the same counts
     let mut banded = open(|mut l| {
-        l.max_storage_buffer_binding_size = 8 * (4096 * 1536 + 4);
+        l.max_storage_buffer_binding_size = 8 * (4096 * 1536 + REASONS);
         l
     });
     assert_eq!(banded.tiling(&job).unwrap().tiles, 3);
@@ -138,12 +141,14 @@ fn the_largest_scene_histogram_runs_at_the_adapters_own_limits() {
 
 #[test]
 fn a_discrete_table_beyond_a_storage_binding_is_a_clear_error() {
-    let job = discrete(2000, DiscreteMethod::Cdf); // 8000 bytes of CDF, binding 4104 bytes
+    let job = discrete(2000, DiscreteMethod::Cdf); // 8000 bytes of CDF, binding 4112 bytes
     let mut e = small(ODD_TILE_BYTES);
     let err = e.histogram(&job, SampleRange::whole(1, 1000), &mut |_| {}).expect_err("the table cannot be bound");
     assert!(matches!(err, GpuError::TooLarge(_)), "{err:?}");
     let msg = err.to_string();
-    for want in ["too large for this GPU adapter", "8000 bytes", "max_storage_buffer_binding_size 4104", "at most 1026 weights"] {
+    // 4-byte CDF entries
+    let (binding, weights) = (format!("max_storage_buffer_binding_size {ODD_TILE_BYTES}"), format!("at most {} weights", ODD_TILE_BYTES / 4));
+    for want in ["too large for this GPU adapter", "8000 bytes", &binding, &weights] {
         assert!(msg.contains(want), "{msg}");
     }
 }

@@ -8,7 +8,7 @@
 use glam::{DQuat, DVec3};
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::gpu::effects::Specialisation;
-use lobes::engine::job::{Counts, Job, SampleRange};
+use lobes::engine::job::{Counts, Job, SampleRange, Scatter};
 use lobes::reference::effects::Effects;
 use lobes::reference::fresnel::Fresnel;
 use lobes::reference::masking::Masking;
@@ -134,22 +134,23 @@ fn rotated_cases() -> Vec<Job> {
         lobe: lobe(kind, method, ax, ay, angle),
         incident: reflect::spherical(theta.to_radians(), phi.to_radians()),
         grid: GRID,
+        scatter: Scatter::Reflect,
     })
     .collect()
 }
 
 fn unrotated(job: &Job) -> Job {
-    let Job::Lobe { lobe, incident, grid } = *job else { unreachable!("lobe jobs") };
-    Job::Lobe { lobe: Lobe { alpha_angle: 0.0, ..lobe }, incident, grid }
+    let Job::Lobe { lobe, incident, grid, scatter } = *job else { unreachable!("lobe jobs") };
+    Job::Lobe { lobe: Lobe { alpha_angle: 0.0, ..lobe }, incident, grid, scatter }
 }
 
 /// The histogram a sampler would give if it turned ωi into the lobe's frame but never turned
 /// ωr back: the unrotated lobe's samples for R⁻¹ωi, binned as they are.
 fn broken_rotation_counts(job: &Job, seed: u64, n: u64) -> Counts {
-    let Job::Lobe { lobe, incident, grid } = job else { unreachable!("lobe jobs") };
+    let Job::Lobe { lobe, incident, grid, .. } = job else { unreachable!("lobe jobs") };
     let plain = Lobe { alpha_angle: 0.0, ..*lobe };
     let local_wi = lobe.to_local(*incident);
-    let mut cells = vec![0u64; grid.bins() + 4];
+    let mut cells = vec![0u64; grid.bins() + lobes::reference::Invalid::COUNT];
     for i in 0..n {
         let u = rng::uniforms(seed, i);
         let s = plain.sample(local_wi, [u[0], u[1]]);

@@ -112,7 +112,7 @@ fn three_shards_merge_to_exactly_the_unsharded_run() {
         assert_eq!(a.per_sample_check, b.per_sample_check, "{}", what("per_sample_check"));
         assert_eq!(a.description, b.description, "{}", what("params, rows, cols"));
         assert_eq!((&a.adapter, &a.backend), (&b.adapter, &b.backend), "{}", what("adapter, backend"));
-        let total: u64 = b.counts.iter().flatten().sum::<u64>() + <[u64; 4]>::from(b.invalid.expect("a lobe case counts invalid samples by reason")).iter().sum::<u64>();
+        let total: u64 = b.counts.iter().flatten().sum::<u64>() + <[u64; lobes::reference::Invalid::COUNT]>::from(b.invalid.expect("a lobe case counts invalid samples by reason")).iter().sum::<u64>();
         assert_eq!(total, a.samples);
         let pictures: &[&str] = if case == "alias" { &["bars.png"] } else { &["measured.png", "expected.png", "residual.png", "marginals.png"] };
         for png in pictures {

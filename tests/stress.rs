@@ -2,7 +2,7 @@
 //! formulas break, on the GPU (f32) and the CPU (f64), plus the discrete hard cases.
 
 use lobes::engine::gpu::GpuEngine;
-use lobes::engine::job::{DiscreteMethod, Job, SampleRange};
+use lobes::engine::job::{DiscreteMethod, Job, SampleRange, Scatter};
 use lobes::reference::discrete::Distribution;
 use lobes::run::compare;
 use lobes::stats::expected::Quadrature;
@@ -27,7 +27,7 @@ fn gpu_counts(e: &mut GpuEngine, weights: &[f64], method: DiscreteMethod, n: u64
     let job = Job::Discrete { dist: dist.clone(), method };
     let r = e.histogram(&job, SampleRange::whole(17, n), &mut |_| {}).unwrap();
     assert_eq!(r.counts.total(), n);
-    assert_eq!(r.counts.invalid, [0; 4]);
+    assert_eq!(r.counts.invalid, [0; lobes::reference::Invalid::COUNT]);
     (dist, r.counts.bins)
 }
 
@@ -65,7 +65,7 @@ fn tables_beyond_f32_resolution() {
         let (dist, c) = gpu_counts(&mut e, &w, method, samples);
         let job = Job::Discrete { dist, method };
         let exp = compare::expected_counts(&job, samples, &Quadrature::default());
-        let counts = lobes::engine::job::Counts { bins: c, invalid: [0; 4] };
+        let counts = lobes::engine::job::Counts { bins: c, invalid: [0; lobes::reference::Invalid::COUNT] };
         let t = compare::chi2_test(&counts, &exp, 0.001);
         assert!(t.passed, "{method:?}: χ² {} / {} p {}", t.statistic, t.dof, t.p_value);
         // the last entry, beyond 2^24, is reached
@@ -85,7 +85,7 @@ fn binning_at_edges_poles_and_the_seam() {
     let mut e = engine();
     let grid = SphereGrid { rows: 64, cols: 128 };
     let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
-    let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid };
+    let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid, scatter: Scatter::Reflect };
     let mut dirs: Vec<[f32; 3]> = Vec::new();
     for z in grid.cos_theta_edges() {
         for phi in grid.phi_edges() {

@@ -13,6 +13,7 @@ struct Params {
     tile_first: u32,
     alpha: vec2<f32>,
     frame: vec2<f32>,
+    // wi in xyz, a dielectric's eta in w (0 for a reflection)
     wi: vec4<f32>,
 }
 

@@ -19,7 +19,7 @@ fn effect_alpha() -> vec2<f32> {
     return select(params.alpha.xx, params.alpha, effect_anisotropic());
 }
 
-fn effect_sample(u: vec2<f32>) -> LobeSample {
+fn effect_sample(u: vec3<f32>) -> LobeSample {
     return sampler_sample(effect_alpha(), params.wi.xyz, u);
 }
 

@@ -1,5 +1,5 @@
 #define_import_path lobes::kernel
-#import lobes::job::{BINS, CELLS, N_REASONS, SAMPLES_PER_THREAD, TILE_BINS, WG_SIZE}
+#import lobes::job::{BINS, CELLS, SAMPLES_PER_THREAD, TILE_BINS, WG_SIZE}
 #import lobes::bindings::{params, counts, totals}
 #import lobes::rng::add64
 #import lobes::counting::{count_bin, flush_bins}
@@ -43,9 +43,11 @@ fn samples_of(at: Invocation, count: u32) -> u32 {
 
 @compute @workgroup_size(WG_SIZE)
 fn sample_histogram(at: Invocation) {
-    // Per-reason counts in four registers, updated without branches (a dynamically indexed
-    // private array costs a scatter per SIMD lane on CPU drivers).
+    // Per-reason counts in registers, updated without branches (a dynamically indexed
+    // private array costs a scatter per SIMD lane on CPU drivers): reasons 1-4 in a vec4, the
+    // fifth (REASON_REFRACTED_NEAR_SIDE) on its own.
     var invalid = vec4<u32>(0u);
+    var invalid_5 = 0u;
     let base = params.base;
     let first = sample_of(at, 0u);
     let n = samples_of(at, params.count);
@@ -64,13 +66,17 @@ fn sample_histogram(at: Invocation) {
             }
         } else {
             invalid += select(vec4<u32>(0u), vec4<u32>(1u), vec4<u32>(cell - BINS) == vec4<u32>(0u, 1u, 2u, 3u));
+            invalid_5 += select(0u, 1u, cell - BINS == 4u);
         }
     }
     flush_bins(at.lid);
-    for (var r = 0u; r < N_REASONS; r++) {
+    for (var r = 0u; r < 4u; r++) {
         if (invalid[r] != 0u) {
             atomicAdd(&counts[TILE_BINS + r], invalid[r]);
         }
+    }
+    if (invalid_5 != 0u) {
+        atomicAdd(&counts[TILE_BINS + 4u], invalid_5);
     }
 }
 

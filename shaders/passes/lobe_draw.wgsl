@@ -2,8 +2,8 @@
 #import lobes::math::{Real, f32_pair}
 #import lobes::job::{BINS, WG_SIZE}
 #import lobes::bindings::{params, directions_out}
-#import lobes::histogram::{classify, bin_of}
-#import lobes::lobe_kernel::{explicit_u, lobe_sample_at, lobe_sample_u}
+#import lobes::histogram::bin_of
+#import lobes::lobe_kernel::{explicit_u, lobe_classify, lobe_sample_at, lobe_sample_u}
 
 // The draw of a lobe job in the kernel's precision (Real, lobes::math: f32, or f64 for
 // `lobes tradeoff`; discrete_draw.wgsl has a discrete job's): `draw`, which the counting kernel
@@ -12,7 +12,7 @@
 
 fn draw(index: vec2<u32>) -> u32 {
     let s = lobe_sample_at(index);
-    let reason = classify(s.wr, s.pdf_r);
+    let reason = lobe_classify(s);
     return select(bin_of(s.wr), BINS + reason - 1u, reason != 0u);
 }
 
@@ -26,9 +26,10 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.count) {
         return;
     }
-    let s = lobe_sample_u(explicit_u[i]);
+    // u.z = 0: a dielectric reflects wherever F > 0
+    let s = lobe_sample_u(vec3<f32>(explicit_u[i], 0.0));
     let wr = f32_pair(s.wr);
-    directions_out[3u * i] = vec4<f32>(wr[0], f32(classify(s.wr, s.pdf_r)));
+    directions_out[3u * i] = vec4<f32>(wr[0], f32(lobe_classify(s)));
     directions_out[3u * i + 1u] = vec4<f32>(vec3<f32>(s.h), f32(s.pdf_r));
     directions_out[3u * i + 2u] = vec4<f32>(wr[1], 0.0);
 }

@@ -1,10 +1,10 @@
 #define_import_path lobes::lobe_kernel
 #import lobes::math::Real
-#import lobes::job::{WG_SIZE, sampler_sample, lobe_alpha, lobe_wi}
+#import lobes::job::{WG_SIZE, sampler_sample, lobe_alpha, lobe_wi, lobe_eta}
 #import lobes::bindings::{params, directions_out}
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::reflect::LobeSample
-#import lobes::histogram::{classify, bin_of}
+#import lobes::histogram::{classify, classify_scattered, bin_of}
 
 // The draw of a lobe job: sampler_sample(alpha, wi, u) -> LobeSample is the generated call site
 // of the case's sampler in `lobes::job` (ward_sample, ggx_sample_vndf, ...: src/reference/sampler.rs),
@@ -14,13 +14,26 @@
 // kernels have them as f64 constants). The entry points draw and explicit_samples are in
 // shaders/passes/lobe_draw.wgsl.
 
-// The sample of the f32 uniforms u (the RNG's, exact in either precision).
-fn lobe_sample_u(u: vec2<f32>) -> LobeSample {
-    return sampler_sample(lobe_alpha(), lobe_wi(), vec2<Real>(u));
+// The sample of the f32 uniforms u (the RNG's, exact in either precision): u.xy draw h, u.z a
+// dielectric's event.
+fn lobe_sample_u(u: vec3<f32>) -> LobeSample {
+    return sampler_sample(lobe_alpha(), lobe_wi(), vec3<Real>(u));
+}
+
+// 0 for a valid sample, else its reason code: a reflection's (classify), or a dielectric's
+// (lobe_eta() != 0), whose samples leave on either side (classify_scattered). A dielectric
+// sample's event is read from its h, on wi's side: a reflection keeps the sign of wi.h in wr.h
+// (wr.h = wi.h), a refraction turns it (wt.h = -cos th_t).
+fn lobe_classify(s: LobeSample) -> u32 {
+    if (lobe_eta() != 0.0) {
+        let wi = lobe_wi();
+        return classify_scattered(wi, s.wr, s.pdf_r, dot(wi, s.h) * dot(s.wr, s.h) >= 0.0);
+    }
+    return classify(s.wr, s.pdf_r);
 }
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
-    return lobe_sample_u(rng_uniforms(params.seed, index).xy);
+    return lobe_sample_u(rng_uniforms(params.seed, index).xyz);
 }
 
 // Writes (wr, reason code) of samples base .. base + count, for the per-sample check against f64.
@@ -31,7 +44,7 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let s = lobe_sample_at(add64(params.base, i));
-    directions_out[i] = vec4<f32>(vec3<f32>(s.wr), f32(classify(s.wr, s.pdf_r)));
+    directions_out[i] = vec4<f32>(vec3<f32>(s.wr), f32(lobe_classify(s)));
 }
 
 // Explicit uniforms for the stability suite (explicit_samples, shaders/passes/lobe_draw.wgsl), or

@@ -78,7 +78,7 @@ fn weighted_histogram(at: Invocation) {
     let n = samples_of(at, params.count);
     for (var k = 0u; k < n; k++) {
         let u = rng_uniforms(params.seed, add64(params.base, first + k * WG_SIZE));
-        let s = effect_sample(u.xy);
+        let s = effect_sample(u.xyz);
         let reason = classify(s.wr, s.pdf_r);
         let w = effect_weight(s);
         if (!(w >= 0.0 && w < WEIGHT_LIMIT)) {

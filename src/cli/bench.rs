@@ -4,7 +4,7 @@
 use super::{OutputArgs, emit, emit_json};
 use crate::engine::cpu;
 use crate::engine::gpu::GpuEngine;
-use crate::engine::job::{Job, SampleRange};
+use crate::engine::job::{Job, SampleRange, Scatter};
 use crate::reference::{Lobe, SAMPLERS, reflect};
 use crate::report::table;
 use crate::stats::histogram::SphereGrid;
@@ -61,6 +61,7 @@ pub fn bench_jobs(alpha: f64) -> Vec<Job> {
             lobe: Lobe { kind, method, alpha_x: alpha, alpha_y: alpha, alpha_angle: 0.0 },
             incident: reflect::spherical(45f64.to_radians(), 0.0),
             grid: SphereGrid { rows: 64, cols: 128 },
+            scatter: Scatter::Reflect,
         })
         .collect()
 }

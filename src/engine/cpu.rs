@@ -5,6 +5,7 @@
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
+use crate::reference::Invalid;
 use crate::reference::discrete::AliasTable;
 use rayon::prelude::*;
 
@@ -14,9 +15,9 @@ const BLOCK: u64 = 1 << 16;
 /// Histograms the samples of `range`.
 ///
 /// ```
-/// use lobes::{engine::job::{Job, SampleRange}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
+/// use lobes::{engine::job::{Job, SampleRange, Scatter}, reference::{Lobe, LobeKind, Method}, stats::histogram::SphereGrid};
 /// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Ndf, alpha_x: 0.5, alpha_y: 0.5, alpha_angle: 0.0 };
-/// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 } };
+/// let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Reflect };
 /// let counts = lobes::engine::cpu::histogram(&job, SampleRange::whole(1, 10_000));
 /// assert_eq!(counts.total(), 10_000);
 /// ```
@@ -29,7 +30,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
     let cells = (0..range.chunk_count(BLOCK))
         .into_par_iter()
         .fold(
-            || vec![0u64; bins + 4],
+            || vec![0u64; bins + Invalid::COUNT],
             |mut cells, b| {
                 for i in range.chunk(b, BLOCK).indices() {
                     cells[job.cell_f64(range.seed, i, alias.as_ref())] += 1;
@@ -37,7 +38,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
                 cells
             },
         )
-        .reduce(|| vec![0u64; bins + 4], |mut a, b| {
+        .reduce(|| vec![0u64; bins + Invalid::COUNT], |mut a, b| {
             a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
             a
         });
@@ -48,7 +49,7 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
 /// in f64: the same fixed-point sums as `shaders/passes/weighted.wgsl`, and per bin the largest
 /// relative difference between the weight and eval · cos θr / pdf.
 pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSums {
-    let Job::Lobe { lobe, incident, grid } = job else { panic!("weighted histograms are for lobe jobs") };
+    let Job::Lobe { lobe, incident, grid, .. } = job else { panic!("weighted histograms are for lobe jobs") };
     let bins = job.bins();
     (0..range.chunk_count(BLOCK))
         .into_par_iter()

@@ -2,6 +2,7 @@
 //! and the CPU reference engine ([`crate::engine::cpu`]).
 
 use crate::reference::discrete::{AliasTable, Distribution};
+use crate::reference::dielectric::{Event, RoughDielectric};
 use crate::reference::{Invalid, Lobe};
 use crate::stats::histogram::SphereGrid;
 use glam::DVec3;
@@ -63,10 +64,31 @@ impl SampleRange {
 /// needs no engine).
 pub use crate::reference::discrete::DiscreteMethod;
 
+/// What a lobe job's surface does with light.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Scatter {
+    /// Reflects it: the lobe's BRDF.
+    #[default]
+    Reflect,
+    /// Reflects and refracts it as a rough dielectric whose lower medium has relative index
+    /// `eta` ([`RoughDielectric`](crate::reference::dielectric::RoughDielectric)).
+    Dielectric { eta: f64 },
+}
+
+impl Scatter {
+    /// The dielectric's η, 0 for a reflection (the kernels' `lobe_eta()`).
+    pub fn eta(self) -> f64 {
+        match self {
+            Scatter::Reflect => 0.0,
+            Scatter::Dielectric { eta } => eta,
+        }
+    }
+}
+
 /// A sampling job: a lobe seen from one incident direction, or a discrete distribution.
 #[derive(Debug, Clone)]
 pub enum Job {
-    Lobe { lobe: Lobe, incident: DVec3, grid: SphereGrid },
+    Lobe { lobe: Lobe, incident: DVec3, grid: SphereGrid, scatter: Scatter },
     Discrete { dist: Distribution, method: DiscreteMethod },
 }
 
@@ -84,10 +106,17 @@ impl Job {
     pub fn cell_f64(&self, seed: u64, index: u64, alias: Option<&AliasTable>) -> usize {
         let u = crate::reference::rng::uniforms(seed, index);
         match self {
-            Job::Lobe { lobe, incident, grid } => {
+            Job::Lobe { lobe, incident, grid, scatter: Scatter::Reflect } => {
                 let s = lobe.sample(*incident, [u[0], u[1]]);
                 match s.invalid {
                     None => grid.bin_of(s.omega_r),
+                    Some(r) => self.bins() + r.code() as usize - 1,
+                }
+            }
+            Job::Lobe { lobe, incident, grid, scatter: Scatter::Dielectric { eta } } => {
+                let s = RoughDielectric::new(*lobe, *eta).expect("a dielectric job is checked when made").sample(*incident, [u[0], u[1], u[2]]);
+                match Invalid::check_scattered(*incident, s.omega_o, s.pdf_o, s.event == Event::Reflection) {
+                    None => grid.bin_of(s.omega_o),
                     Some(r) => self.bins() + r.code() as usize - 1,
                 }
             }
@@ -104,17 +133,17 @@ impl Job {
 pub struct Counts {
     pub bins: Vec<u64>,
     /// Indexed like [`Invalid::ALL`].
-    pub invalid: [u64; 4],
+    pub invalid: [u64; Invalid::COUNT],
 }
 
 impl Counts {
     pub fn zeros(bins: usize) -> Self {
-        Self { bins: vec![0; bins], invalid: [0; 4] }
+        Self { bins: vec![0; bins], invalid: [0; Invalid::COUNT] }
     }
     /// Splits a cell vector (bins followed by the reasons) as laid out by the kernels.
     pub fn from_cells(cells: &[u64]) -> Self {
-        let n = cells.len() - 4;
-        Self { bins: cells[..n].to_vec(), invalid: [cells[n], cells[n + 1], cells[n + 2], cells[n + 3]] }
+        let n = cells.len() - Invalid::COUNT;
+        Self { bins: cells[..n].to_vec(), invalid: cells[n..].try_into().expect("one cell per reason") }
     }
     pub fn total(&self) -> u64 {
         self.bins.iter().sum::<u64>() + self.invalid.iter().sum::<u64>()

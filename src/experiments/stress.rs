@@ -8,7 +8,7 @@
 //! opposite sides) and on the direction to within [`DIRECTION_BOUND`].
 
 use crate::engine::gpu::GpuEngine;
-use crate::engine::job::Job;
+use crate::engine::job::{Job, Scatter};
 use crate::reference::{Invalid, Lobe, reflect, rng};
 use crate::run::compare::angle_between;
 use crate::stats::histogram::SphereGrid;
@@ -136,7 +136,7 @@ pub fn run_case(case: &StressCase, gpu: Option<&mut GpuEngine>) -> anyhow::Resul
     row.passed = row.bad_values == 0 && row.worst_unit_error <= UNIT_BOUND_F64;
     rows.push(row);
     if let Some(engine) = gpu {
-        let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 } };
+        let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 }, scatter: Scatter::Reflect };
         let u32s: Vec<[f32; 2]> = us.iter().map(|u| [u[0] as f32, u[1] as f32]).collect();
         let out = engine.explicit(&job, &u32s)?;
         let mut row = StressRow::new(&case.name, "gpu f32", us.len());
@@ -176,7 +176,7 @@ pub fn run_all(mut gpu: Option<&mut GpuEngine>) -> anyhow::Result<Vec<StressRow>
 /// Per-sample listing of one case (u, CPU and GPU ωr, validity, pdf), for diagnosis.
 pub fn details(case: &StressCase, engine: &mut GpuEngine) -> anyhow::Result<String> {
     let us = uniforms();
-    let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 } };
+    let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 }, scatter: Scatter::Reflect };
     let u32s: Vec<[f32; 2]> = us.iter().map(|u| [u[0] as f32, u[1] as f32]).collect();
     let out = engine.explicit(&job, &u32s)?;
     let mut t = format!("{}\n", case.name);

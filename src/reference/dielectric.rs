@@ -173,6 +173,28 @@ impl RoughDielectric {
         DielectricSample { h: back(h), omega_o: back(wo), event, fresnel: f, pdf_h, pdf_o, valid }
     }
 
+    /// The densities over h (per unit solid angle of h, for ωi on the upper side) of the two
+    /// kinds of wrong-side samples of [`sample`](Self::sample): a reflection that leaves
+    /// through the surface (p(h) F, or p(h) where refraction is impossible) and a refraction
+    /// that stays on the incident side (p(h) (1 − F)). Their integrals are the expected shares
+    /// of [`Invalid::BelowHorizon`](super::Invalid) and [`Invalid::RefractedNearSide`](super::Invalid).
+    pub fn wrong_side_h(&self, wi: DVec3, h: DVec3) -> (f64, f64) {
+        let (wi, eta) = self.upper_side(wi);
+        let pdf_h = self.lobe.pdf_h(wi, h);
+        if pdf_h <= 0.0 || pdf_h.is_nan() {
+            return (0.0, 0.0);
+        }
+        let c = wi.dot(h);
+        match refract(wi, h, eta) {
+            Some(wt) => {
+                let reflected = if reflect(wi, h).z > 0.0 { 0.0 } else { fresnel::dielectric(c, eta) * pdf_h };
+                let refracted = if wt.z < 0.0 { 0.0 } else { fresnel::dielectric_transmittance(c, eta) * pdf_h };
+                (reflected, refracted)
+            }
+            None => (if reflect(wi, h).z > 0.0 { 0.0 } else { pdf_h }, 0.0),
+        }
+    }
+
     /// The microfacet normal of the pair (ωi, ωo) on the upper side, its event and η seen from
     /// ωi, with both directions moved there; `None` where no microfacet connects them.
     fn connect(&self, wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3, DVec3, Event, f64)> {

@@ -47,6 +47,11 @@ pub struct Wgsl {
     /// sampler composes in f64 for `lobes tradeoff`'s f64 kernels; a sampler written in f32
     /// has no f64 kernel.
     pub f64: bool,
+    /// The rough dielectric over this sampler's half vectors (`shaders/lib/dielectric.wgsl`,
+    /// f64 twin [`RoughDielectric`](super::dielectric::RoughDielectric)):
+    /// `fn (a, wi, u: vec3<Real>, eta) -> LobeSample`, u.xy drawing h and u.z the event, the
+    /// sample's `wr` the scattered direction on either side. `None`: no dielectric sampler.
+    pub dielectric: Option<&'static str>,
 }
 
 /// The f64 reference of a sampler (`src/reference`).
@@ -79,6 +84,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: "ward_weight(wi, s.h, s.wr)",
             g1: None,
             f64: true,
+            dielectric: None,
         },
         reference: Some(Reference {
             sample_h: |l, _, u| ward::sample_h(l.alpha_x, l.alpha_y, u),
@@ -98,6 +104,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: MICROFACET_NDF_WEIGHT,
             g1: Some("beckmann_g1(a, w)"),
             f64: true,
+            dielectric: Some("dielectric_beckmann_ndf"),
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.beckmann().sample_ndf(u),
@@ -117,6 +124,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: "beckmann_vndf_weight(a, wi)",
             g1: Some("beckmann_g1(a, w)"),
             f64: true,
+            dielectric: Some("dielectric_beckmann_vndf"),
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.beckmann().sample_vndf(wi, u),
@@ -136,6 +144,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: MICROFACET_NDF_WEIGHT,
             g1: Some("ggx_g1(a, w)"),
             f64: true,
+            dielectric: Some("dielectric_ggx_ndf"),
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.ggx().sample_ndf(u),
@@ -155,6 +164,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: "ggx_vndf_weight(a, wi)",
             g1: Some("ggx_g1(a, w)"),
             f64: true,
+            dielectric: Some("dielectric_ggx_vndf"),
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_vndf(wi, u),
@@ -174,6 +184,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             weight: "ggx_bounded_weight(a, wi)",
             g1: Some("ggx_g1(a, w)"),
             f64: true,
+            dielectric: None,
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_bounded(wi, u),

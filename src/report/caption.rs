@@ -8,12 +8,13 @@ use crate::run::record::{CaseDescription, Params};
 pub fn parameters(d: &CaseDescription) -> String {
     let angles = |theta: f64, phi: f64| if phi == 0.0 { format!("θi {}°", compact(theta)) } else { format!("θi {}°, φi {}°", compact(theta), compact(phi)) };
     match &d.params {
-        Params::Lobe { alpha_x, alpha_y, alpha_angle, incident_theta_deg, incident_phi_deg } => {
+        Params::Lobe { alpha_x, alpha_y, alpha_angle, incident_theta_deg, incident_phi_deg, eta } => {
             let mut alpha = if alpha_x == alpha_y { compact(*alpha_x) } else { format!("{} × {}", compact(*alpha_x), compact(*alpha_y)) };
             if *alpha_angle != 0.0 {
                 alpha += &format!(" turned {}°", compact(*alpha_angle));
             }
-            format!("{} {}, α {alpha}, {}", d.lobe, d.method, angles(*incident_theta_deg, *incident_phi_deg))
+            let glass = eta.map_or(String::new(), |eta| format!(" dielectric η {}", compact(eta)));
+            format!("{} {}{glass}, α {alpha}, {}", d.lobe, d.method, angles(*incident_theta_deg, *incident_phi_deg))
         }
         Params::Discrete { weights } => {
             let shown: Vec<String> = weights.iter().take(12).map(|&w| compact(w)).collect();
@@ -43,7 +44,7 @@ mod tests {
         CaseDescription {
             lobe: "ggx".into(),
             method: "vndf".into(),
-            params: Params::Lobe { alpha_x, alpha_y, alpha_angle: 0.0, incident_theta_deg: 40.0, incident_phi_deg: phi },
+            params: Params::Lobe { alpha_x, alpha_y, alpha_angle: 0.0, incident_theta_deg: 40.0, incident_phi_deg: phi, eta: None },
             rows: 64,
             cols: 128,
         }
@@ -58,6 +59,11 @@ mod tests {
             *alpha_angle = 30.0;
         }
         assert_eq!(parameters(&turned), "ggx vndf, α 0.05 × 0.3 turned 30°, θi 40°");
+        let mut glass = lobe(0.3, 0.3, 0.0);
+        if let Params::Lobe { eta, .. } = &mut glass.params {
+            *eta = Some(1.5);
+        }
+        assert_eq!(parameters(&glass), "ggx vndf dielectric η 1.5, α 0.3, θi 40°");
         let d = CaseDescription { lobe: "discrete".into(), method: "alias".into(), params: Params::Discrete { weights: vec![0.0, 3.0, 1e-3] }, rows: 1, cols: 3 };
         assert_eq!(parameters(&d), "discrete alias, weights [0, 3, 1e-3]");
         assert_eq!(verdict(false, 1.5e-7), "FAIL, χ² p = 1.5e-7");

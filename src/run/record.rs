@@ -3,7 +3,7 @@
 //! counts by invalid reason, and the histogram's timing. Writers and readers use the same
 //! structs; `docs/schema/` holds their JSON Schema ([`crate::report::schema`]).
 
-use crate::engine::job::Job;
+use crate::engine::job::{Job, Scatter};
 use crate::reference::Invalid;
 use crate::check::Domain;
 use crate::scene::{Case, UserCase};
@@ -37,6 +37,9 @@ pub enum Params {
         alpha_angle: f64,
         incident_theta_deg: f64,
         incident_phi_deg: f64,
+        /// A rough dielectric's η (`scatter = "dielectric"`); absent for a reflection.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        eta: Option<f64>,
     },
     Discrete { weights: Vec<f64> },
     /// A user's WGSL sampler ([`crate::check`]).
@@ -61,7 +64,7 @@ pub enum Params {
 impl CaseDescription {
     pub fn of(case: &Case) -> Self {
         match &case.job {
-            Job::Lobe { lobe, grid, .. } => CaseDescription {
+            Job::Lobe { lobe, grid, scatter, .. } => CaseDescription {
                 lobe: lobe.kind.name().into(),
                 method: lobe.method.name().into(),
                 params: Params::Lobe {
@@ -70,6 +73,10 @@ impl CaseDescription {
                     alpha_angle: lobe.alpha_angle,
                     incident_theta_deg: case.incident_deg.0,
                     incident_phi_deg: case.incident_deg.1,
+                    eta: match scatter {
+                        Scatter::Reflect => None,
+                        Scatter::Dielectric { eta } => Some(*eta),
+                    },
                 },
                 rows: grid.rows as usize,
                 cols: grid.cols as usize,
@@ -115,24 +122,28 @@ impl CaseDescription {
 
 /// One value per invalid reason ([`Invalid::ALL`], whose names are the keys).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[schemars(bound = "T: JsonSchema + Default")]
 pub struct ByReason<T> {
     pub non_finite_direction: T,
     pub below_horizon: T,
     pub non_finite_pdf: T,
     pub zero_pdf: T,
+    /// Absent in records written before the rough dielectric (read as 0).
+    #[serde(default)]
+    pub refracted_near_side: T,
 }
 
-impl<T: Copy> From<[T; 4]> for ByReason<T> {
+impl<T: Copy> From<[T; Invalid::COUNT]> for ByReason<T> {
     /// From values in the order of [`Invalid::ALL`].
-    fn from([non_finite_direction, below_horizon, non_finite_pdf, zero_pdf]: [T; 4]) -> Self {
-        ByReason { non_finite_direction, below_horizon, non_finite_pdf, zero_pdf }
+    fn from([non_finite_direction, below_horizon, non_finite_pdf, zero_pdf, refracted_near_side]: [T; Invalid::COUNT]) -> Self {
+        ByReason { non_finite_direction, below_horizon, non_finite_pdf, zero_pdf, refracted_near_side }
     }
 }
 
-impl<T: Copy> From<ByReason<T>> for [T; 4] {
+impl<T: Copy> From<ByReason<T>> for [T; Invalid::COUNT] {
     /// To values in the order of [`Invalid::ALL`].
     fn from(r: ByReason<T>) -> Self {
-        [r.non_finite_direction, r.below_horizon, r.non_finite_pdf, r.zero_pdf]
+        [r.non_finite_direction, r.below_horizon, r.non_finite_pdf, r.zero_pdf, r.refracted_near_side]
     }
 }
 
@@ -144,6 +155,7 @@ impl<T> ByReason<T> {
             Invalid::BelowHorizon => &self.below_horizon,
             Invalid::NonFinitePdf => &self.non_finite_pdf,
             Invalid::ZeroPdf => &self.zero_pdf,
+            Invalid::RefractedNearSide => &self.refracted_near_side,
         }
     }
 }
@@ -169,13 +181,16 @@ mod tests {
 
     #[test]
     fn reasons_are_keyed_by_their_names_in_order() {
-        let v = serde_json::to_value(ByReason::from([10u64, 11, 12, 13])).unwrap();
+        let v = serde_json::to_value(ByReason::from([10u64, 11, 12, 13, 14])).unwrap();
         for (i, r) in Invalid::ALL.into_iter().enumerate() {
             assert_eq!(v[r.name()], 10 + i as u64, "{}", r.name());
-            assert_eq!(*ByReason::from([10u64, 11, 12, 13]).get(r), 10 + i as u64);
+            assert_eq!(*ByReason::from([10u64, 11, 12, 13, 14]).get(r), 10 + i as u64);
         }
-        assert_eq!(v.as_object().unwrap().len(), 4);
-        let back: [u64; 4] = serde_json::from_value::<ByReason<u64>>(v).unwrap().into();
-        assert_eq!(back, [10, 11, 12, 13]);
+        assert_eq!(v.as_object().unwrap().len(), 5);
+        let back: [u64; 5] = serde_json::from_value::<ByReason<u64>>(v).unwrap().into();
+        assert_eq!(back, [10, 11, 12, 13, 14]);
+        // a record from before the rough dielectric has four reasons
+        let old = serde_json::json!({"non_finite_direction": 1, "below_horizon": 2, "non_finite_pdf": 3, "zero_pdf": 4});
+        assert_eq!(<[u64; 5]>::from(serde_json::from_value::<ByReason<u64>>(old).unwrap()), [1, 2, 3, 4, 0]);
     }
 }

@@ -15,6 +15,7 @@ use super::record::{ByReason, CaseDescription, Timing, WeightedTiming};
 use super::Sampled;
 use crate::engine::gpu::WeightedRun;
 use crate::engine::job::Counts;
+use crate::reference::Invalid;
 use crate::scene::Case;
 use crate::run::compare::AngleCheck;
 use crate::stats::weighted::WeightedSums;
@@ -238,7 +239,7 @@ impl ShardFile {
         if s.first > s.end || s.end > s.samples {
             return Err(bad(format!("sample range {}..{} is not within 0..{}", s.first, s.end, s.samples)));
         }
-        let total = s.counts.iter().sum::<u64>() + <[u64; 4]>::from(s.invalid).iter().sum::<u64>();
+        let total = s.counts.iter().sum::<u64>() + <[u64; Invalid::COUNT]>::from(s.invalid).iter().sum::<u64>();
         if total != s.end - s.first {
             return Err(bad(format!(
                 "counts add up to {total} but the range {}..{} has {} samples (a damaged file?)",
@@ -311,7 +312,7 @@ pub(crate) mod tests {
             first,
             end,
             counts: vec![end - first],
-            invalid: ByReason::from([0; 4]),
+            invalid: ByReason::from([0; Invalid::COUNT]),
             adapter: "a".into(),
             backend: "gpu".into(),
             timing: Timing { gpu_seconds: None, histogram_wall_seconds: 0.0 },

@@ -13,8 +13,9 @@
 //! method = "vndf"       # ndf | vndf | bounded (lobes); cdf | alias (discrete)
 //! alpha = 0.2           # or alpha_x and alpha_y
 //! alpha_angle = 30.0    # degrees from +x to the alpha_x axis about the normal (default 0)
-//! incident_theta = 45.0 # degrees from the normal, [0, 90)
+//! incident_theta = 45.0 # degrees from the normal, [0, 90) ([0, 180) for a dielectric)
 //! incident_phi = 0.0    # degrees
+//! # scatter = "dielectric"  # rough glass (ggx or beckmann, ndf or vndf) with eta = n_below / n_above
 //! # effects (any of them makes the case weighted: Σ f cos θ / pdf per bin)
 //! fresnel = "schlick"   # none | schlick (f0) | conductor (eta, k) | dielectric (eta)
 //! f0 = 0.04
@@ -46,7 +47,7 @@ mod user;
 
 pub use user::UserCase;
 
-use crate::engine::job::{DiscreteMethod, Job};
+use crate::engine::job::{DiscreteMethod, Job, Scatter};
 use crate::reference::discrete::{Distribution, WeightsError};
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
@@ -145,6 +146,7 @@ struct RawCase {
     eta: Option<Sweep>,
     k: Option<Sweep>,
     masking: Option<Sweep>,
+    scatter: Option<Sweep>,
     sampler: Option<Spanned<user::RawSampler>>,
     params: Option<Sweep>,
     domain: Option<Val>,
@@ -167,6 +169,7 @@ impl RawCase {
             &self.eta,
             &self.k,
             &self.masking,
+            &self.scatter,
             &self.params,
             &self.bins,
             &self.samples,
@@ -614,7 +617,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         reject_keys(ctx, &roughness_keys(point), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
         reject_keys(
             ctx,
-            &[("incident_theta", point.get("incident_theta")), ("incident_phi", point.get("incident_phi")), ("bins", point.get("bins"))],
+            &[("incident_theta", point.get("incident_theta")), ("incident_phi", point.get("incident_phi")), ("bins", point.get("bins")), ("scatter", point.get("scatter"))],
             "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
         )?;
         reject_keys(ctx, &effect_keys(c, point), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
@@ -682,9 +685,17 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
             return Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})")));
         }
     };
-    let theta = match point.get("incident_theta") {
-        Some(t) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
-        None => DEFAULT_INCIDENT_THETA,
+    let scatter = scatter(ctx, c, point, kind, method, lobe_v, &method_span)?;
+    let theta = match (point.get("incident_theta"), scatter) {
+        (Some(t), Scatter::Reflect) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
+        (Some(t), Scatter::Dielectric { .. }) => number(
+            ctx,
+            t,
+            "incident_theta",
+            |x| (0.0..180.0).contains(&x),
+            "incident_theta is in degrees from the normal, 0 ≤ θ < 180 for scatter = \"dielectric\" (θ > 90: light from inside)",
+        )?,
+        (None, _) => DEFAULT_INCIDENT_THETA,
     };
     let phi = incident_phi(ctx, point)?;
     let grid = match point.get("bins") {
@@ -698,7 +709,8 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         None => DEFAULT_ALPHA_ANGLE,
     };
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: angle };
-    let effects = effects(ctx, c, point, kind)?;
+    // a dielectric case has no effect keys (`scatter` rejects them) and reads eta itself
+    let effects = if scatter == Scatter::Reflect { effects(ctx, c, point, kind)? } else { None };
     if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
         let (span, given) = match (d.overrides.samples, point.get("samples").or(d.samples.map(|(_, v)| v))) {
             (Some(_), _) => (spanned.span(), " (--samples)"),
@@ -706,7 +718,48 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         };
         return Err(ctx.err(span, format!("samples = {samples}{given} is too many for a weighted case; at most 2^32 (4294967296)")));
     }
-    Ok(Case { name, job: Job::Lobe { lobe, incident, grid }, samples, seed, incident_deg: (theta, phi), effects })
+    Ok(Case { name, job: Job::Lobe { lobe, incident, grid, scatter }, samples, seed, incident_deg: (theta, phi), effects })
+}
+
+/// `scatter` of a lobe case (reflect unless given) with a dielectric's `eta`: only for a
+/// sampler of the registry with a dielectric twin, and without the weighted pass's keys.
+fn scatter(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, method: Method, lobe_v: &Val, method_span: &Range<usize>) -> Result<Scatter, SceneError> {
+    let allowed = "use reflect or dielectric (with eta)";
+    let form = match p.get("scatter") {
+        None => None,
+        Some(v) => match string(ctx, v, "scatter", allowed)? {
+            "reflect" => None,
+            "dielectric" => Some(v),
+            other => return Err(ctx.err(v.span(), format!("scatter '{other}' is unknown; {allowed}{}", did_you_mean(other, ["reflect", "dielectric"])))),
+        },
+    };
+    let Some(form) = form else {
+        if let (Some(v), None) = (p.get("eta"), p.get("fresnel")) {
+            return Err(ctx.err(
+                v.span(),
+                "eta applies to scatter = \"dielectric\" or to fresnel = \"conductor\" or \"dielectric\"; remove it or set one of them",
+            ));
+        }
+        return Ok(Scatter::Reflect);
+    };
+    if crate::reference::sampler::find(kind, method).wgsl.dielectric.is_none() {
+        let (span, what) = match kind {
+            LobeKind::Ward => (lobe_v.span(), "ward has no dielectric sampler".to_string()),
+            _ => (method_span.clone(), format!("{} {} has no dielectric sampler", kind.name(), method.name())),
+        };
+        return Err(ctx.err(span, format!("{what}; scatter = \"dielectric\" needs lobe ggx or beckmann with method ndf or vndf")));
+    }
+    reject_keys(
+        ctx,
+        &effect_keys(c, p).into_iter().filter(|(k, _)| *k != "eta").collect::<Vec<_>>(),
+        "does not apply to scatter = \"dielectric\" (a dielectric case counts samples, with its own Fresnel term); remove it",
+    )?;
+    let eta_allowed = "eta is the index of the medium below the surface relative to the one above, > 0 and ≠ 1";
+    let eta = match p.get("eta") {
+        Some(v) => number(ctx, v, "eta", |x| x > 0.0 && x != 1.0, eta_allowed)?,
+        None => return Err(ctx.err(form.span(), format!("scatter = \"dielectric\" needs eta; add eta = ... ({eta_allowed})"))),
+    };
+    Ok(Scatter::Dielectric { eta })
 }
 
 /// `incident_phi` of a case (0 unless given).

@@ -112,7 +112,7 @@ const fn key(name: &'static str, label: &'static str, list: bool) -> Key {
 
 /// Every sweepable key, in the order of the product (and of the name suffixes). The label of a
 /// name key (method, fresnel, masking) is empty: the name alone is readable (`ggx-vndf`).
-pub(super) const KEYS: [Key; 16] = [
+pub(super) const KEYS: [Key; 17] = [
     key("method", "", false),
     key("alpha", "alpha", false),
     key("alpha_x", "ax", false),
@@ -125,6 +125,7 @@ pub(super) const KEYS: [Key; 16] = [
     key("eta", "eta", false),
     key("k", "k", false),
     key("masking", "", false),
+    key("scatter", "", false),
     key("params", "params", true),
     key("bins", "bins", true),
     key("samples", "n", false),

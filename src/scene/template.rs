@@ -29,15 +29,18 @@ alpha = 0.3               # roughness > 0, required; or anisotropic:
 # alpha_x = 0.3
 # alpha_y = 0.1
 # alpha_angle = {angle:?}       # degrees from +x to the alpha_x axis about the normal, [-360, 360]
-incident_theta = {theta:?}      # degrees from the normal, 0 ≤ θ < 90
+incident_theta = {theta:?}      # degrees from the normal, 0 ≤ θ < 90 (dielectric: < 180, > 90 from inside)
 incident_phi = {phi:?}        # degrees, −360 ≤ φ ≤ 360
+# scatter = "reflect"     # reflect | dielectric: rough glass, reflection and refraction over the
+#                         # whole sphere (ggx or beckmann, ndf or vndf; with eta, no effects)
 # samples, bins, seed     # as in [defaults], for this case only
 # Effects: any of fresnel and masking makes the case weighted (Σ f cos θ / pdf per bin,
 # judged against the albedo); without them the case counts samples only.
 # weighted = false        # true: a weighted histogram without Fresnel or masking
 # fresnel = "none"        # none | schlick (f0) | conductor (eta, k) | dielectric (eta)
 # f0 = 0.04               # schlick: reflectance at normal incidence, 0 ≤ f0 ≤ 1
-# eta = 1.5               # conductor: index of refraction > 0; dielectric: n_t / n_i > 0
+# eta = 1.5               # conductor: index of refraction > 0; dielectric: n_t / n_i > 0;
+#                         # scatter = "dielectric": n_below / n_above, > 0 and ≠ 1
 # k = 0.0                 # conductor: absorption ≥ 0
 # masking = "none"        # none | g1 | separable | height-correlated (not for ward)
 

@@ -38,7 +38,7 @@ const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers wit
 /// The sampler of a `[[case]]` table: its files read and checked against the contract.
 pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSampler>) -> Result<Arc<UserSampler>, SceneError> {
     let not_here = "does not apply to a user sampler (its WGSL is the whole sampler); remove it";
-    reject_keys(ctx, &[("lobe", c.lobe.as_ref()), ("method", p.get("method"))], not_here)?;
+    reject_keys(ctx, &[("lobe", c.lobe.as_ref()), ("method", p.get("method")), ("scatter", p.get("scatter"))], not_here)?;
     reject_keys(ctx, &roughness_keys(p), not_here)?;
     if let Some(w) = &c.weights {
         return Err(ctx.err(w.span(), format!("weights {not_here}")));

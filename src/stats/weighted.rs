@@ -18,7 +18,7 @@ pub struct WeightedSums {
     /// Σ w per bin, in units of 2⁻²⁰.
     pub bins: Vec<u64>,
     /// Σ w per invalid reason (the order of [`crate::reference::Invalid::ALL`]), in units of 2⁻²⁰.
-    pub invalid: [u64; 4],
+    pub invalid: [u64; crate::reference::Invalid::COUNT],
     /// Σ w² over the bins' samples, in units of 2⁻¹⁶.
     pub squares_bins: u64,
     /// Σ w² over all samples whose weight was summed, in units of 2⁻¹⁶.
@@ -37,7 +37,7 @@ pub fn to_fixed(w: f64, scale: f64) -> u64 {
 
 impl WeightedSums {
     pub fn zeros(bins: usize) -> Self {
-        Self { bins: vec![0; bins], invalid: [0; 4], squares_bins: 0, squares_all: 0, overflow: 0, max_error: vec![0.0; bins] }
+        Self { bins: vec![0; bins], invalid: [0; crate::reference::Invalid::COUNT], squares_bins: 0, squares_all: 0, overflow: 0, max_error: vec![0.0; bins] }
     }
 
     /// Adds one sample's weight in cell `cell` (a bin, or `bins + reason − 1`), as the kernel does.

@@ -33,7 +33,7 @@ use super::context::GpuError;
 use super::layout;
 use super::library::{self, File};
 use super::precision::{self, Precision};
-use crate::engine::job::{DiscreteMethod, Job};
+use crate::engine::job::{DiscreteMethod, Job, Scatter};
 use crate::reference::sampler::{self, SamplerSpec};
 
 pub use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
@@ -115,8 +115,8 @@ impl Kernel {
 /// run-time switch on the sampler id `effect.modes.x` (the uber-kernel, `shaders/passes/effect_uniform.wgsl`).
 ///
 /// With `rotated` (a lobe whose tangent frame is turned, [`Lobe::alpha_angle`](crate::reference::Lobe::alpha_angle))
-/// the call site takes world directions and hands the sampler its own frame: each `vec3` and
-/// `LobeSample` argument is turned by `lobe_frame()` first ([`in_lobe_frame`]), and a returned
+/// the call site takes world directions and hands the sampler its own frame: each `vec3`
+/// argument but the uniforms `u`, and each `LobeSample`, is turned by `lobe_frame()` first ([`in_lobe_frame`]), and a returned
 /// `LobeSample` is turned back (`shaders/lib/reflect.wgsl`, f64 twin `src/reference/frame.rs`),
 /// so no sampler knows about the rotation.
 pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerSpec], rotated: bool, expr: impl Fn(&sampler::Wgsl) -> String) -> String {
@@ -134,7 +134,7 @@ pub(crate) fn call_site(name: &str, args: &str, ret: &str, samplers: &[&SamplerS
 }
 
 /// The parameters of a rotated lobe's call site and the prologue that turns its directions into
-/// the lobe's frame: a `w: vec3<…>` argument arrives as `w_world` and is `frame_to_local`'d into
+/// the lobe's frame: a `w: vec3<…>` argument (but `u`) arrives as `w_world` and is `frame_to_local`'d into
 /// `w`, a `s: LobeSample` likewise by `sample_to_local`; other arguments pass as they are.
 fn in_lobe_frame(args: &str) -> (String, String) {
     let mut params = Vec::new();
@@ -143,7 +143,8 @@ fn in_lobe_frame(args: &str) -> (String, String) {
         let (name, ty) = arg.split_once(": ").expect("call-site arguments are `name: type`");
         let turn = match ty {
             "LobeSample" => "sample_to_local",
-            _ if ty.starts_with("vec3<") => "frame_to_local",
+            // every vec3 but the uniforms `u` is a direction
+            _ if ty.starts_with("vec3<") && name != "u" => "frame_to_local",
             _ => {
                 params.push(arg.to_string());
                 continue;
@@ -205,31 +206,44 @@ pub(crate) fn lobe_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, preci
     if samplers.len() > 1 {
         k.job.uses("lobes::effect_uniform");
     }
-    let Job::Lobe { lobe, .. } = job else { panic!("a lobe kernel is for a lobe job") };
-    let sample = |w: &sampler::Wgsl| format!("{}(a, wi, u)", w.sample);
-    k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>", "LobeSample", samplers, lobe.is_rotated(), sample));
+    let Job::Lobe { lobe, scatter, .. } = job else { panic!("a lobe kernel is for a lobe job") };
+    // u: the RNG's first three uniforms of the sample; a reflection draws with u.xy, a
+    // dielectric also chooses its event with u.z (shaders/lib/dielectric.wgsl)
+    let sample = |w: &sampler::Wgsl| match scatter {
+        Scatter::Reflect => format!("{}(a, wi, u.xy)", w.sample),
+        Scatter::Dielectric { .. } => {
+            format!("{}(a, wi, u, lobe_eta())", w.dielectric.unwrap_or_else(|| panic!("{} has no dielectric sampler", w.sample)))
+        }
+    };
+    if let Scatter::Dielectric { .. } = scatter {
+        k.job.uses("lobes::dielectric");
+    }
+    k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>", "LobeSample", samplers, lobe.is_rotated(), sample));
     k.job.uses("lobes::bindings");
     k.job.push(&lobe_parameters(job, precision));
     k
 }
 
-/// `lobe_alpha()`, `lobe_wi()` and `lobe_frame()`, a lobe job's α, ωi and (cos, sin) of its
-/// frame angle in the kernel's precision (`shaders/passes/lobe_kernel.wgsl`, [`call_site`]):
-/// f32 from the uniform block, f64 as constants of the job's values (the block carries f32
-/// only, and f32(0.3) is not 0.3).
+/// `lobe_alpha()`, `lobe_wi()`, `lobe_frame()` and `lobe_eta()`, a lobe job's α, ωi, (cos, sin)
+/// of its frame angle and a dielectric's η (0 for a reflection) in the kernel's precision
+/// (`shaders/passes/lobe_kernel.wgsl`, [`call_site`]): f32 from the uniform block, f64 as
+/// constants of the job's values (the block carries f32 only, and f32(0.3) is not 0.3).
 fn lobe_parameters(job: &Job, precision: Precision) -> String {
-    let Job::Lobe { lobe, incident, .. } = job else { return String::new() };
-    let (alpha, wi, frame) = match precision {
+    let Job::Lobe { lobe, incident, scatter, .. } = job else { return String::new() };
+    let (alpha, wi, frame, eta) = match precision {
         Precision::F64 => {
             let f = lobe.frame();
-            let [ax, ay, x, y, z, c, s] = [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z, f.cos, f.sin].map(precision::lit);
-            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"), format!("vec2<f64>({c}, {s})"))
+            let [ax, ay, x, y, z, c, s, eta] =
+                [lobe.alpha_x, lobe.alpha_y, incident.x, incident.y, incident.z, f.cos, f.sin, scatter.eta()].map(precision::lit);
+            (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"), format!("vec2<f64>({c}, {s})"), eta)
         }
-        Precision::F32Accurate | Precision::F32Fast => ("params.alpha".to_string(), "params.wi.xyz".to_string(), "params.frame".to_string()),
+        Precision::F32Accurate | Precision::F32Fast => {
+            ("params.alpha".to_string(), "params.wi.xyz".to_string(), "params.frame".to_string(), "params.wi.w".to_string())
+        }
     };
     format!(
         "fn lobe_alpha() -> vec2<Real> {{\n    return {alpha};\n}}\n\nfn lobe_wi() -> vec3<Real> {{\n    return {wi};\n}}\n\n\
-         fn lobe_frame() -> vec2<Real> {{\n    return {frame};\n}}\n"
+         fn lobe_frame() -> vec2<Real> {{\n    return {frame};\n}}\n\nfn lobe_eta() -> Real {{\n    return {eta};\n}}\n"
     )
 }
 
@@ -289,7 +303,7 @@ mod tests {
 
     fn lobe_job(kind: LobeKind, method: Method) -> Job {
         let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle: 0.0 };
-        Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 } }
+        Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Reflect }
     }
 
     #[test]
@@ -321,7 +335,7 @@ mod tests {
         assert!(src.contains("// ---- lobes::job, generated for ggx vndf ----"));
         // the call site of the job's sampler, after the file that defines it
         let at = |s: &str| src.find(s).unwrap_or_else(|| panic!("no {s}"));
-        assert!(at("fn ggx_sample_vndf(") < at("return ggx_sample_vndf(a, wi, u);"));
+        assert!(at("fn ggx_sample_vndf(") < at("return ggx_sample_vndf(a, wi, u.xy);"));
         assert!(!src.contains("#import") && !src.contains("beckmann"));
     }
 
@@ -337,6 +351,32 @@ mod tests {
         assert!(message.contains("no_such_value"), "{message}");
     }
 
+    /// Every dielectric sampler's counting module composes and validates in each precision, and
+    /// calls the registry's dielectric sampler with the three uniforms and the job's η; rotated,
+    /// its call site turns ωi but not the uniforms.
+    #[test]
+    fn every_dielectric_sampler_composes_in_every_precision() {
+        let dielectrics: Vec<_> = crate::reference::sampler::REGISTRY.iter().filter(|s| s.wgsl.dielectric.is_some()).collect();
+        assert_eq!(dielectrics.len(), 4, "GGX and Beckmann × NDF and VNDF");
+        for spec in dielectrics {
+            for alpha_angle in [0.0, 30.0] {
+                let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle };
+                let incident = crate::reference::reflect::spherical(2.2, 0.1);
+                let job = Job::Lobe { lobe, incident, grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Dielectric { eta: 1.5 } };
+                for precision in Precision::ALL {
+                    let src = compose_precision(&job, 4096, job.bins() as u32, precision);
+                    validate(&format!("{} dielectric {} {alpha_angle}°", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
+                    let call = format!("{}(a, wi, u, lobe_eta())", spec.wgsl.dielectric.unwrap());
+                    assert!(src.contains(&call), "{} {}", spec.name(), precision.name());
+                    assert_eq!(src.contains("let wi = frame_to_local(lobe_frame(), wi_world);"), lobe.is_rotated());
+                    assert!(!src.contains("u_world"), "the uniforms are no direction");
+                    let eta = if precision == Precision::F64 { format!("return {};", precision::lit(1.5)) } else { "return params.wi.w;".into() };
+                    assert!(src.contains(&eta), "{} {}", spec.name(), precision.name());
+                }
+            }
+        }
+    }
+
     /// Every sampler's counting module composes and validates in each precision (without a
     /// device: naga's check), and declares `Real` as that precision's type once; rotated, its
     /// call site turns ωi into the lobe's frame and the sample back, and unrotated it holds no
@@ -346,13 +386,13 @@ mod tests {
         for spec in &crate::reference::sampler::REGISTRY {
             for alpha_angle in [0.0, 30.0] {
                 let lobe = Lobe { kind: spec.kind, method: spec.method, alpha_x: 0.3, alpha_y: 0.2, alpha_angle };
-                let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 } };
+                let job = Job::Lobe { lobe, incident: crate::reference::reflect::spherical(0.7, 0.1), grid: SphereGrid { rows: 8, cols: 16 }, scatter: Scatter::Reflect };
                 for precision in Precision::ALL.into_iter().filter(|&p| spec.wgsl.f64 || p != Precision::F64) {
                     let src = compose_precision(&job, 4096, job.bins() as u32, precision);
                     assert_eq!(src.matches("alias Real").count(), 1, "{} {}", spec.name(), precision.name());
                     assert!(src.contains(&format!("alias Real = {};", precision.scalar())));
                     validate(&format!("{} {} {alpha_angle}°", spec.name(), precision.name()), &src).unwrap_or_else(|e| panic!("{e}"));
-                    let turned = format!("    let wi = frame_to_local(lobe_frame(), wi_world);\n    return sample_to_world(lobe_frame(), {}(a, wi, u));", spec.wgsl.sample);
+                    let turned = format!("    let wi = frame_to_local(lobe_frame(), wi_world);\n    return sample_to_world(lobe_frame(), {}(a, wi, u.xy));", spec.wgsl.sample);
                     assert_eq!(src.contains(&turned), lobe.is_rotated(), "{} {alpha_angle}°", spec.name());
                     assert_eq!(src.contains("frame_to_local(lobe_frame()"), lobe.is_rotated());
                 }

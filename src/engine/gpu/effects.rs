@@ -172,7 +172,7 @@ mod tests {
 
     fn job(kind: LobeKind, method: Method, anisotropic: bool) -> Job {
         let lobe = Lobe { kind, method, alpha_x: 0.3, alpha_y: if anisotropic { 0.1 } else { 0.3 }, alpha_angle: 0.0 };
-        Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 } }
+        Job::Lobe { lobe, incident: DVec3::new(0.6, 0.0, 0.8), grid: SphereGrid { rows: 8, cols: 16 }, scatter: crate::engine::job::Scatter::Reflect }
     }
 
     #[test]
@@ -193,8 +193,8 @@ mod tests {
         // a rotated lobe's weight, BRDF, density and G1 take world directions into its frame
         let effects = Effects { fresnel: Fresnel::Schlick { f0: 0.04 }, masking: Masking::HeightCorrelated };
         for (kind, method) in SAMPLERS {
-            let Job::Lobe { lobe, incident, grid } = job(kind, method, true) else { unreachable!() };
-            let rotated = Job::Lobe { lobe: Lobe { alpha_angle: 57.0, ..lobe }, incident, grid };
+            let Job::Lobe { lobe, incident, grid, scatter } = job(kind, method, true) else { unreachable!() };
+            let rotated = Job::Lobe { lobe: Lobe { alpha_angle: 57.0, ..lobe }, incident, grid, scatter };
             for how in [Specialisation::Specialised, Specialisation::Uber] {
                 let c = compose_effects(&rotated, &effects, 4096, how);
                 compose::validate("rotated effects", &c.source).unwrap_or_else(|e| panic!("{kind:?} {method:?} {how:?}: {e}"));

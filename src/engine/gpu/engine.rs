@@ -10,6 +10,7 @@ use super::effects::{self, Composed, Specialisation};
 use super::params::{Params, storage_entry};
 use super::weighted::{WeightedPipelines, WeightedRun};
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use crate::reference::Invalid;
 use crate::reference::discrete::{self, AliasTable};
 use crate::reference::effects::Effects;
 use std::collections::HashMap;
@@ -260,7 +261,7 @@ impl GpuEngine {
             let cells64 = gpu.read_u64(&totals, cells)?;
             gpu.check_errors()?;
             result.bins[tile_first as usize..(tile_first + tile_len) as usize].copy_from_slice(&cells64[..tile_len as usize]);
-            let invalid: [u64; 4] = cells64[tile_bins as usize..].try_into().expect("four invalid reasons");
+            let invalid: [u64; Invalid::COUNT] = cells64[tile_bins as usize..].try_into().expect("one cell per invalid reason");
             if tile == 0 {
                 result.invalid = invalid;
             } else if invalid != result.invalid {

@@ -19,6 +19,7 @@ pub struct Params {
     alpha: [f32; 2],
     /// (cos, sin) of the lobe's frame angle (rotated anisotropy, `lobe_frame()` of the kernels).
     frame: [f32; 2],
+    /// ωi in xyz, a dielectric's η in w (0 for a reflection).
     wi: [f32; 4],
 }
 
@@ -38,11 +39,11 @@ impl Params {
             wi: [0.0; 4],
         };
         match job {
-            Job::Lobe { lobe, incident, .. } => {
+            Job::Lobe { lobe, incident, scatter, .. } => {
                 let frame = lobe.frame();
                 p.alpha = [lobe.alpha_x as f32, lobe.alpha_y as f32];
                 p.frame = [frame.cos as f32, frame.sin as f32];
-                p.wi = [incident.x as f32, incident.y as f32, incident.z as f32, 0.0];
+                p.wi = [incident.x as f32, incident.y as f32, incident.z as f32, scatter.eta() as f32];
             }
             Job::Discrete { dist, .. } => {
                 p.n_items = dist.len() as u32;

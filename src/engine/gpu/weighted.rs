@@ -72,7 +72,7 @@ impl WeightedPipelines {
     ) -> Result<WeightedRun, GpuError> {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
-        // 2 words (lo, hi) per cell: the bins, the 4 invalid reasons, then Σw² over the bins,
+        // 2 words (lo, hi) per cell: the bins, one per invalid reason, then Σw² over the bins,
         // Σw² over all samples and the overflow count (`shaders/passes/weighted.wgsl`).
         let words = 2 * (bins + (N_REASONS + WEIGHT_EXTRA_CELLS) as u64);
         if words * 4 > gpu.limits.max_storage_buffer_binding_size {
@@ -112,7 +112,7 @@ impl WeightedPipelines {
         let extra = n + N_REASONS as usize;
         let sums = WeightedSums {
             bins: cells[..n].to_vec(),
-            invalid: cells[n..extra].try_into().expect("four reasons"),
+            invalid: cells[n..extra].try_into().expect("one cell per reason"),
             squares_bins: cells[extra],
             squares_all: cells[extra + 1],
             overflow: cells[extra + 2],
@@ -139,7 +139,7 @@ mod tests {
     #[test]
     fn effect_layout() {
         let lobe = crate::reference::Lobe { kind: crate::reference::LobeKind::Ggx, method: crate::reference::Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
-        let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: crate::stats::histogram::SphereGrid { rows: 4, cols: 8 } };
+        let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: crate::stats::histogram::SphereGrid { rows: 4, cols: 8 }, scatter: crate::engine::job::Scatter::Reflect };
         let source = effects::compose_effects(&job, &Effects::NONE, 4096, effects::Specialisation::Uber).source;
         let members = [("modes", offset_of!(EffectUniform, modes)), ("fresnel", offset_of!(EffectUniform, fresnel))];
         super::super::layout::check_struct(&source, "Effect", size_of::<EffectUniform>(), align_of::<EffectUniform>(), &members).unwrap();

@@ -11,7 +11,7 @@ pub mod quadrature;
 pub use crate::engine::gpu::precision::Precision;
 
 use crate::engine::gpu::GpuEngine;
-use crate::engine::job::{Counts, Job, SampleRange};
+use crate::engine::job::{Counts, Job, SampleRange, Scatter};
 use crate::reference::{Invalid, Lobe, LobeKind, Method, SAMPLERS, reflect, rng, sampler};
 use crate::stats::chi2;
 use crate::run::compare::{self, AngleCheck, ExpectedCounts};
@@ -237,7 +237,7 @@ pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32) -> anyh
 
 /// The job of a sampler at the sweep's α and θi.
 pub fn sweep_job(s: Sampler, alpha: f64, theta_deg: f64) -> Job {
-    Job::Lobe { lobe: s.lobe(alpha), incident: reflect::spherical(theta_deg.to_radians(), 0.0), grid: GRID }
+    Job::Lobe { lobe: s.lobe(alpha), incident: reflect::spherical(theta_deg.to_radians(), 0.0), grid: GRID, scatter: Scatter::Reflect }
 }
 
 /// Runs the sample-count × precision sweep; `log` receives progress lines.
@@ -424,7 +424,7 @@ pub fn compare_methods(engine: &mut GpuEngine, set: &MethodSettings, log: &mut d
                 .sum();
             for method in [Method::Vndf, Method::Bounded] {
                 let lobe = Sampler { kind: LobeKind::Ggx, method }.lobe(alpha);
-                let job = Job::Lobe { lobe, incident: wi, grid: GRID };
+                let job = Job::Lobe { lobe, incident: wi, grid: GRID, scatter: Scatter::Reflect };
                 engine.histogram(&job, SampleRange::whole(set.seed ^ 0x5eed, 1 << 16), &mut |_| {})?;
                 let (_, wall, gpu) = timed_histogram(engine, &job, set.seed, set.gpu_samples, set.runs)?;
                 let seconds = gpu.unwrap_or(wall);

@@ -1,0 +1,112 @@
+#define_import_path lobes::dielectric
+#import lobes::math::Real
+#import lobes::reflect::{LobeSample, reflect_about}
+#import lobes::ggx::{ggx_d, ggx_sample_ndf, ggx_sample_vndf}
+#import lobes::beckmann::{beckmann_d, beckmann_g1_over_cos, beckmann_sample_ndf, beckmann_sample_vndf_h}
+
+// The rough dielectric (Walter, Marschner, Li & Torrance 2007); f64 twin:
+// src/reference/dielectric.rs (RoughDielectric::sample), whose module notes give the equations.
+// eta = eta_below / eta_above. Light from inside (wi.z < 0) is mirrored in the tangent plane
+// (z -> -z) with 1/eta, sampled on the upper side and mirrored back. u.xy draw h with the lobe's
+// sampler, u.z chooses reflection (u.z < F) or refraction. The returned LobeSample holds the
+// scattered direction in `wr` and its density in `pdf_r`: 0 for a sample on the wrong side of its
+// event (a reflection through the surface, a refraction that stays on the incident side).
+
+// Snell's cos th_t for cos th_i = c in [0, 1], or -1 past the critical angle
+// (reference::fresnel::cos_transmitted).
+fn dielectric_cos_t(c: Real, eta: Real) -> Real {
+    let s2 = (1.0 - c * c) / (eta * eta);
+    if (s2 >= 1.0) {
+        return -1.0;
+    }
+    return sqrt(1.0 - s2);
+}
+
+// F of the dielectric seen from wi's side (reference::fresnel::dielectric): 1 past the critical angle.
+fn dielectric_fresnel(c: Real, eta: Real) -> Real {
+    let ci = clamp(c, 0.0, 1.0);
+    let ct = dielectric_cos_t(ci, eta);
+    if (ct < 0.0) {
+        return 1.0;
+    }
+    let rp = (eta * ci - ct) / (eta * ci + ct);
+    let rs = (ci - eta * ct) / (ci + eta * ct);
+    return 0.5 * (rp * rp + rs * rs);
+}
+
+// T = 1 - F without its cancellation as F -> 1: 1 - r^2 = 4ab / (a + b)^2
+// (reference::fresnel::dielectric_transmittance).
+fn dielectric_transmittance(c: Real, eta: Real) -> Real {
+    let ci = clamp(c, 0.0, 1.0);
+    let ct = dielectric_cos_t(ci, eta);
+    if (ct < 0.0) {
+        return 0.0;
+    }
+    let p = eta * ci + ct;
+    let s = ci + eta * ct;
+    return 2.0 * eta * ci * ct * (1.0 / (p * p) + 1.0 / (s * s));
+}
+
+// dw_h/dw_t of Walter 2007, eq. 17, as eta^2 ct (c + eta ct)^2 / (1 - eta^2)^2: the denominator
+// c - eta ct vanishes as eta -> 1 and is formed as a quotient instead
+// (reference::dielectric::jacobian_transmitted).
+fn dielectric_jacobian_t(c: Real, ct: Real, eta: Real) -> Real {
+    let s = c + eta * ct;
+    let k = (1.0 - eta) * (1.0 + eta);
+    return eta * eta * ct * s * s / (k * k);
+}
+
+// wi on its upper side: (x, y, |z|).
+fn dielectric_upper(wi: vec3<Real>) -> vec3<Real> {
+    return vec3<Real>(wi.xy, abs(wi.z));
+}
+
+// Scatters wi (either side) about h, drawn with density pdf_h for dielectric_upper(wi): reflection
+// with probability F, refraction otherwise, as RoughDielectric::sample.
+fn dielectric_scatter(wi: vec3<Real>, h: vec3<Real>, pdf_h: Real, u: Real, eta_outside: Real) -> LobeSample {
+    let flip = wi.z < 0.0;
+    let i = dielectric_upper(wi);
+    let eta = select(eta_outside, 1.0 / eta_outside, flip);
+    let c = dot(i, h);
+    let ct = dielectric_cos_t(min(c, 1.0), eta);
+    var o: vec3<Real>;
+    var pdf: Real;
+    var on_its_side: bool;
+    if (c <= 0.0 || ct < 0.0 || u < dielectric_fresnel(c, eta)) {
+        o = reflect_about(i, h);
+        pdf = dielectric_fresnel(c, eta) * pdf_h / (4.0 * abs(dot(o, h)));
+        on_its_side = o.z > 0.0;
+    } else {
+        o = (c / eta - ct) * h - i / eta;
+        pdf = dielectric_transmittance(c, eta) * pdf_h * dielectric_jacobian_t(c, -dot(o, h), eta);
+        on_its_side = o.z < 0.0;
+    }
+    let m = select(Real(1.0), Real(-1.0), flip);
+    return LobeSample(vec3<Real>(h.xy, h.z * m), vec3<Real>(o.xy, o.z * m), select(0.0, pdf, on_its_side));
+}
+
+// The samplers: h by the lobe's own sampler for the upper-side wi, p(h) as its f64 twin's pdf_h.
+
+fn dielectric_ggx_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
+    let h = ggx_sample_ndf(a, dielectric_upper(wi), u.xy).h;
+    return dielectric_scatter(wi, h, ggx_d(a, h) * h.z, u.z, eta);
+}
+
+// p(h) = G1(wi) max(0, wi.h) D(h) / wi.z, with G1/wi.z = 2 / (wi.z + t) (shaders/lib/ggx.wgsl).
+fn dielectric_ggx_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
+    let i = dielectric_upper(wi);
+    let h = ggx_sample_vndf(a, i, u.xy).h;
+    let t = length(vec3<Real>(a * i.xy, i.z));
+    return dielectric_scatter(wi, h, 2.0 * max(dot(i, h), 0.0) * ggx_d(a, h) / (i.z + t), u.z, eta);
+}
+
+fn dielectric_beckmann_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
+    let h = beckmann_sample_ndf(a, dielectric_upper(wi), u.xy).h;
+    return dielectric_scatter(wi, h, beckmann_d(a, h) * h.z, u.z, eta);
+}
+
+fn dielectric_beckmann_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
+    let i = dielectric_upper(wi);
+    let h = beckmann_sample_vndf_h(a, i, u.xy);
+    return dielectric_scatter(wi, h, beckmann_g1_over_cos(a, i) * max(dot(i, h), 0.0) * beckmann_d(a, h), u.z, eta);
+}
