@@ -87,26 +87,35 @@ fn dielectric_scatter(wi: vec3<Real>, h: vec3<Real>, pdf_h: Real, u: Real, eta_o
 
 // The samplers: h by the lobe's own sampler for the upper-side wi, p(h) as its f64 twin's pdf_h.
 
+// u.xy for the h draw, at least 2^-25 (reference::dielectric::U_FLOOR): the RNG's u = 0 (one value
+// of its lattice k 2^-24, probability 2^-24) draws Beckmann's visible slope at -infinity, an h on
+// the horizon with D(h) = 0, and a refraction about it would have no density at all (a zero_pdf
+// sample that the expected counts cannot hold). Half a lattice step moves that atom to a
+// direction of positive density; every other u is unchanged.
+fn dielectric_u(u: vec3<Real>) -> vec2<Real> {
+    return max(u.xy, vec2<Real>(2.98023223876953125e-8));
+}
+
 fn dielectric_ggx_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
-    let h = ggx_sample_ndf(a, dielectric_upper(wi), u.xy).h;
+    let h = ggx_sample_ndf(a, dielectric_upper(wi), dielectric_u(u)).h;
     return dielectric_scatter(wi, h, ggx_d(a, h) * h.z, u.z, eta);
 }
 
 // p(h) = G1(wi) max(0, wi.h) D(h) / wi.z, with G1/wi.z = 2 / (wi.z + t) (shaders/lib/ggx.wgsl).
 fn dielectric_ggx_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
-    let h = ggx_sample_vndf(a, i, u.xy).h;
+    let h = ggx_sample_vndf(a, i, dielectric_u(u)).h;
     let t = length(vec3<Real>(a * i.xy, i.z));
     return dielectric_scatter(wi, h, 2.0 * max(dot(i, h), 0.0) * ggx_d(a, h) / (i.z + t), u.z, eta);
 }
 
 fn dielectric_beckmann_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
-    let h = beckmann_sample_ndf(a, dielectric_upper(wi), u.xy).h;
+    let h = beckmann_sample_ndf(a, dielectric_upper(wi), dielectric_u(u)).h;
     return dielectric_scatter(wi, h, beckmann_d(a, h) * h.z, u.z, eta);
 }
 
 fn dielectric_beckmann_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
-    let h = beckmann_sample_vndf_h(a, i, u.xy);
+    let h = beckmann_sample_vndf_h(a, i, dielectric_u(u));
     return dielectric_scatter(wi, h, beckmann_g1_over_cos(a, i) * max(dot(i, h), 0.0) * beckmann_d(a, h), u.z, eta);
 }
