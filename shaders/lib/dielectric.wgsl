@@ -1,6 +1,7 @@
 #define_import_path lobes::dielectric
 #import lobes::math::Real
 #import lobes::reflect::{LobeSample, reflect_about}
+#import lobes::fresnel::{fresnel_cos_transmitted, fresnel_dielectric, fresnel_dielectric_transmittance}
 #import lobes::ggx::{ggx_d, ggx_sample_ndf, ggx_sample_vndf}
 #import lobes::beckmann::{beckmann_d, beckmann_g1_over_cos, beckmann_sample_ndf, beckmann_sample_vndf_h}
 
@@ -11,41 +12,6 @@
 // sampler, u.z chooses reflection (u.z < F) or refraction. The returned LobeSample holds the
 // scattered direction in `wr` and its density in `pdf_r`: 0 for a sample on the wrong side of its
 // event (a reflection through the surface, a refraction that stays on the incident side).
-
-// Snell's cos th_t for cos th_i = c in [0, 1], or -1 past the critical angle
-// (reference::fresnel::cos_transmitted).
-fn dielectric_cos_t(c: Real, eta: Real) -> Real {
-    let s2 = (1.0 - c * c) / (eta * eta);
-    if (s2 >= 1.0) {
-        return -1.0;
-    }
-    return sqrt(1.0 - s2);
-}
-
-// F of the dielectric seen from wi's side (reference::fresnel::dielectric): 1 past the critical angle.
-fn dielectric_fresnel(c: Real, eta: Real) -> Real {
-    let ci = clamp(c, 0.0, 1.0);
-    let ct = dielectric_cos_t(ci, eta);
-    if (ct < 0.0) {
-        return 1.0;
-    }
-    let rp = (eta * ci - ct) / (eta * ci + ct);
-    let rs = (ci - eta * ct) / (ci + eta * ct);
-    return 0.5 * (rp * rp + rs * rs);
-}
-
-// T = 1 - F without its cancellation as F -> 1: 1 - r^2 = 4ab / (a + b)^2
-// (reference::fresnel::dielectric_transmittance).
-fn dielectric_transmittance(c: Real, eta: Real) -> Real {
-    let ci = clamp(c, 0.0, 1.0);
-    let ct = dielectric_cos_t(ci, eta);
-    if (ct < 0.0) {
-        return 0.0;
-    }
-    let p = eta * ci + ct;
-    let s = ci + eta * ct;
-    return 2.0 * eta * ci * ct * (1.0 / (p * p) + 1.0 / (s * s));
-}
 
 // dw_h/dw_t of Walter 2007, eq. 17, as eta^2 ct (c + eta ct)^2 / (1 - eta^2)^2: the denominator
 // c - eta ct vanishes as eta -> 1 and is formed as a quotient instead
@@ -68,17 +34,18 @@ fn dielectric_scatter(wi: vec3<Real>, h: vec3<Real>, pdf_h: Real, u: Real, eta_o
     let i = dielectric_upper(wi);
     let eta = select(eta_outside, 1.0 / eta_outside, flip);
     let c = dot(i, h);
-    let ct = dielectric_cos_t(min(c, 1.0), eta);
+    let ct = fresnel_cos_transmitted(min(c, 1.0), eta);
+    let f = fresnel_dielectric(c, eta);
     var o: vec3<Real>;
     var pdf: Real;
     var on_its_side: bool;
-    if (c <= 0.0 || ct < 0.0 || u < dielectric_fresnel(c, eta)) {
+    if (c <= 0.0 || ct < 0.0 || u < f) {
         o = reflect_about(i, h);
-        pdf = dielectric_fresnel(c, eta) * pdf_h / (4.0 * abs(dot(o, h)));
+        pdf = f * pdf_h / (4.0 * abs(dot(o, h)));
         on_its_side = o.z > 0.0;
     } else {
         o = (c / eta - ct) * h - i / eta;
-        pdf = dielectric_transmittance(c, eta) * pdf_h * dielectric_jacobian_t(c, -dot(o, h), eta);
+        pdf = fresnel_dielectric_transmittance(c, eta) * pdf_h * dielectric_jacobian_t(c, -dot(o, h), eta);
         on_its_side = o.z < 0.0;
     }
     let m = select(Real(1.0), Real(-1.0), flip);

@@ -1,4 +1,5 @@
 #define_import_path lobes::fresnel
+#import lobes::math::Real
 
 // Fresnel reflectance of the microfacet (or Ward half-vector) at cos th = wi.h; CPU twin:
 // src/reference/fresnel.rs. Every form returns a reflectance in [0, 1].
@@ -10,18 +11,41 @@ fn fresnel_schlick(c: f32, f0: f32) -> f32 {
     return f0 + (1.0 - f0) * (m2 * m2 * m);
 }
 
-// A dielectric seen from outside, relative index eta = n_t / n_i (pbrt-v4 FrDielectric, eq. 9.5):
-// 1 past the critical angle (total internal reflection, eta < 1).
-fn fresnel_dielectric(c: f32, eta: f32) -> f32 {
-    let ci = clamp(c, 0.0, 1.0);
-    let sin2_t = (1.0 - ci * ci) / (eta * eta);
+// Snell's cos th_t for cos th_i = c in [0, 1] and relative index eta = n_t / n_i, or -1 past the
+// critical angle (total internal reflection, eta < 1); CPU twin: reference::fresnel::cos_transmitted.
+fn fresnel_cos_transmitted(c: Real, eta: Real) -> Real {
+    let sin2_t = (1.0 - c * c) / (eta * eta);
     if (sin2_t >= 1.0) {
+        return -1.0;
+    }
+    return sqrt(1.0 - sin2_t);
+}
+
+// A dielectric seen from outside, relative index eta = n_t / n_i (pbrt-v4 FrDielectric, eq. 9.5):
+// 1 past the critical angle. Over Real: the rough dielectric (shaders/lib/dielectric.wgsl) also
+// runs in f64 kernels.
+fn fresnel_dielectric(c: Real, eta: Real) -> Real {
+    let ci = clamp(c, 0.0, 1.0);
+    let ct = fresnel_cos_transmitted(ci, eta);
+    if (ct < 0.0) {
         return 1.0;
     }
-    let ct = sqrt(1.0 - sin2_t);
     let r_parl = (eta * ci - ct) / (eta * ci + ct);
     let r_perp = (ci - eta * ct) / (ci + eta * ct);
     return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+// T = 1 - F of fresnel_dielectric without its cancellation as F -> 1: 1 - r^2 = 4ab / (a + b)^2
+// for r = (a - b)/(a + b) (reference::fresnel::dielectric_transmittance).
+fn fresnel_dielectric_transmittance(c: Real, eta: Real) -> Real {
+    let ci = clamp(c, 0.0, 1.0);
+    let ct = fresnel_cos_transmitted(ci, eta);
+    if (ct < 0.0) {
+        return 0.0;
+    }
+    let p = eta * ci + ct;
+    let s = ci + eta * ct;
+    return 2.0 * eta * ci * ct * (1.0 / (p * p) + 1.0 / (s * s));
 }
 
 // Complex numbers as vec2 (re, im).
