@@ -35,7 +35,7 @@ use glam::DVec3;
 /// density (a `zero_pdf` sample that no expected count holds, once in 2²⁴ samples); the floor
 /// moves that atom to a direction of positive density and leaves every other u as it is.
 /// `shaders/lib/dielectric.wgsl`'s `dielectric_u` is its twin.
-pub const U_FLOOR: f64 = 2.98023223876953125e-8;
+pub const U_FLOOR: f64 = 1.0 / 33_554_432.0; // 2⁻²⁵
 
 /// A rough dielectric: a microfacet lobe (GGX or Beckmann, NDF or visible-normal sampling) and
 /// the relative index η of the medium below.
