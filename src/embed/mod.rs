@@ -124,7 +124,9 @@ pub enum Module {
     ///
     /// - `fresnel_schlick(c: f32, f0: f32) -> f32` (Schlick 1994, eq. 24);
     /// - `fresnel_dielectric(c: f32, eta: f32) -> f32` (relative index η = nt / ni; 1 past the
-    ///   critical angle);
+    ///   critical angle), `fresnel_dielectric_transmittance(c, eta)` (1 − F without its
+    ///   cancellation near the critical angle), `fresnel_cos_transmitted(c, eta)` (Snell's
+    ///   cos θt, −1 past the critical angle);
     /// - `fresnel_conductor(c: f32, eta: f32, k: f32) -> f32` (complex index η + ik).
     Fresnel,
     /// `shaders/lib/masking.wgsl`: Smith masking-shadowing G2 from the two masking terms G1(ωi),
