@@ -410,6 +410,21 @@ fn without_an_adapter_run_and_bench_fail_and_run_cpu_uses_the_cpu() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// WGPU_ADAPTER_NAME picks an adapter by part of its name, case ignored; a name that matches none
+/// fails (3) listing the adapters there are, rather than silently taking another one.
+#[test]
+fn wgpu_adapter_name_selects_or_fails_listing_the_adapters() {
+    let bench = ["bench", "--gpu-only", "--runs", "1", "--samples", "1000"];
+    let out = lobes_cmd().env("WGPU_ADAPTER_NAME", "no-such-gpu").args(bench).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("WGPU_ADAPTER_NAME='no-such-gpu' matches no adapter") && stderr.contains("llvmpipe"), "{stderr}");
+    assert!(out.stdout.is_empty());
+
+    let out = lobes_cmd().env("WGPU_ADAPTER_NAME", "LLVMPIPE").args(bench).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
 fn tree(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();

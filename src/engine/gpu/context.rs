@@ -14,6 +14,8 @@ pub enum GpuError {
          `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe), or a vendor driver"
     )]
     NoAdapter(String),
+    #[error("WGPU_ADAPTER_NAME='{wanted}' matches no adapter; the adapters here are: {found}. Set it to part of one of these names (case does not matter), or unset it")]
+    AdapterNotNamed { wanted: String, found: String },
     #[error("the adapter '{adapter}' refused a device: {source}")]
     Device { adapter: String, source: wgpu::RequestDeviceError },
     #[error("shader for {what} failed naga validation: {message}")]
@@ -54,6 +56,18 @@ pub struct Gpu {
     errors: Arc<Mutex<Option<String>>>,
 }
 
+/// The first adapter whose name contains `wanted`, ignoring case (what `WGPU_ADAPTER_NAME` means
+/// to wgpu's own `util::initialize_adapter_from_env`, which panics where none matches).
+fn named_adapter(instance: &wgpu::Instance, wanted: &str) -> Result<wgpu::Adapter, GpuError> {
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    let names: Vec<String> = adapters.iter().map(|a| a.get_info()).map(|i| format!("'{}' ({:?})", i.name, i.backend)).collect();
+    let key = wanted.to_lowercase();
+    adapters.into_iter().find(|a| a.get_info().name.to_lowercase().contains(&key)).ok_or_else(|| GpuError::AdapterNotNamed {
+        wanted: wanted.to_string(),
+        found: if names.is_empty() { "none".to_string() } else { names.join(", ") },
+    })
+}
+
 impl Gpu {
     /// Opens the default adapter (honouring WGPU_BACKEND, WGPU_ADAPTER_NAME, WGPU_POWER_PREF),
     /// asking for its full limits (lavapipe offers 32 KiB of workgroup storage where wgpu's
@@ -75,8 +89,10 @@ impl Gpu {
             power_preference: wgpu::PowerPreference::from_env().unwrap_or(wgpu::PowerPreference::HighPerformance),
             ..Default::default()
         };
-        let adapter = pollster::block_on(instance.request_adapter(&options))
-            .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
+            Ok(wanted) if !wanted.is_empty() => named_adapter(&instance, &wanted)?,
+            _ => pollster::block_on(instance.request_adapter(&options)).map_err(|e| GpuError::NoAdapter(e.to_string()))?,
+        };
         let info = adapter.get_info();
         // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
         #[cfg(feature = "check")]
@@ -164,6 +180,7 @@ mod tests {
         assert!(!tile.is_device_lost());
         for e in [
             GpuError::NoAdapter("none".into()),
+            GpuError::AdapterNotNamed { wanted: "x".into(), found: "none".into() },
             GpuError::Shader { what: "w".into(), message: "m".into() },
             GpuError::Readback("r".into()),
             GpuError::TooLarge("t".into()),
