@@ -4,15 +4,15 @@
 //! | check | rejects | test |
 //! |---|---|---|
 //! | `pdf_consistency` | a pdf function that forgot the table of a 2-D warp | `piecewise_constant_2d_warp_on_the_plane` |
-//! | `jacobian` | a pdf without the reflection Jacobian 1/(4\|d·h\|); a rough dielectric's refraction density without η² or with the reflection Jacobian | `missing_reflection_jacobian_is_rejected`, `broken_dielectric_refraction_densities_are_rejected` |
+//! | `jacobian` | a pdf without the reflection Jacobian 1/(4\|d·h\|); a rough dielectric's refraction density without η² or with the reflection Jacobian; a mixture's pdf with the wrong weight | `missing_reflection_jacobian_is_rejected`, `broken_dielectric_refraction_densities_are_rejected`, `a_wrong_mixture_weight_is_rejected` |
 //! | `pdf_values` | a pdf that is negative on a cap | `bad_pdf_values_are_counted_by_reason` |
 //! | `normalization` | Mitsuba's rational Beckmann G1 (0.3 % off) | `mitsuba_rational_g1_is_rejected` |
 //! | `chi2` | the missing Jacobian; a wrong g in an f64 reference | `missing_reflection_jacobian_is_rejected`, `an_f64_reference_pdf_from_rust` |
 //! | `weights`, `albedo` | a sampler that reports twice its pdf | `a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo` |
 //! | `hard_cases` | a pdf that is 0/0 at u.x = 1 only | `a_nan_at_u_equal_to_one_is_caught_by_the_hard_cases_alone` |
 //!
-//! and the correct samplers (GGX and Beckmann visible normals, Henyey–Greenstein, the 2-D warp)
-//! pass all of them.
+//! and the correct samplers (GGX and Beckmann visible normals, Henyey–Greenstein, the 2-D warp,
+//! a GGX + diffuse mixture chosen with u.z) pass all of them.
 
 use lobes::check::hard::HardRow;
 use lobes::check::jacobian::JacobianCheck;
@@ -107,6 +107,37 @@ fn broken_dielectric_refraction_densities_are_rejected() {
             assert!((j.median_ratio.unwrap() - 1.0 / 2.25).abs() < 1e-3, "{j:?}");
         }
     }
+}
+
+/// A 50/50 (and a 25/75) mixture of GGX visible normals and a cosine lobe chosen with u.z, with
+/// the mixture's pdf, passes every check: the lobes overlap, so p · |J| / share exceeds 1 where
+/// the other lobe adds density, and only a ratio below 1 is off.
+#[test]
+fn a_mixture_chosen_with_u_z_passes() {
+    let gpu = gpu();
+    let s = ggx(&["ggx_diffuse_mixture.wgsl"], "mix_sample", "mix_pdf", None);
+    for (alpha, w) in [(0.3, 0.5), (0.2, 0.25)] {
+        let r = check(&gpu, &s, &Settings { params: vec![alpha, alpha, w], incident_theta: 40.0, ..Settings::default() }).unwrap();
+        show(&r);
+        r.assert_passed();
+        let j = jacobian(&r);
+        assert!(j.compared_events == j.compared && j.compared * 10 > j.probed * 9 && j.above_events > 0, "{j:?}");
+    }
+}
+
+/// The mixture's pdf with the weights fixed at ½ while the sampler picks GGX with probability ¼:
+/// a cosine-lobe sample's ratio is (½ p_diffuse + ½ p_ggx) / (¾ p_diffuse) ≥ ⅔, and ⅔ where GGX
+/// adds nothing. The jacobian check rejects it; pdf_consistency passes (the sampler reports the
+/// same wrong pdf).
+#[test]
+fn a_wrong_mixture_weight_is_rejected() {
+    let gpu = gpu();
+    let s = ggx(&["ggx_diffuse_mixture.wgsl", "broken_mixture_weight.wgsl"], "broken_mix_sample", "broken_mix_pdf", None);
+    let r = check(&gpu, &s, &Settings { params: vec![0.2, 0.2, 0.25], incident_theta: 40.0, ..Settings::default() }).unwrap();
+    show(&r);
+    let j = jacobian(&r);
+    assert!(!r.get("jacobian").unwrap().passed && r.get("pdf_consistency").unwrap().passed, "{j:?}");
+    assert!(j.worst_ratio > 2.0 / 3.0 - 1e-2 && j.worst_ratio < 0.8, "{j:?}");
 }
 
 fn temp_wgsl(name: &str, text: &str) -> PathBuf {
