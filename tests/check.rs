@@ -4,17 +4,18 @@
 //! | check | rejects | test |
 //! |---|---|---|
 //! | `pdf_consistency` | a pdf function that forgot the table of a 2-D warp | `piecewise_constant_2d_warp_on_the_plane` |
-//! | `jacobian` | a pdf without the reflection Jacobian 1/(4\|d·h\|) | `missing_reflection_jacobian_is_rejected` |
+//! | `jacobian` | a pdf without the reflection Jacobian 1/(4\|d·h\|); a rough dielectric's refraction density without η² or with the reflection Jacobian; a mixture's pdf with the wrong weight | `missing_reflection_jacobian_is_rejected`, `broken_dielectric_refraction_densities_are_rejected`, `a_wrong_mixture_weight_is_rejected` |
 //! | `pdf_values` | a pdf that is negative on a cap | `bad_pdf_values_are_counted_by_reason` |
 //! | `normalization` | Mitsuba's rational Beckmann G1 (0.3 % off) | `mitsuba_rational_g1_is_rejected` |
 //! | `chi2` | the missing Jacobian; a wrong g in an f64 reference | `missing_reflection_jacobian_is_rejected`, `an_f64_reference_pdf_from_rust` |
 //! | `weights`, `albedo` | a sampler that reports twice its pdf | `a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo` |
 //! | `hard_cases` | a pdf that is 0/0 at u.x = 1 only | `a_nan_at_u_equal_to_one_is_caught_by_the_hard_cases_alone` |
 //!
-//! and the correct samplers (GGX and Beckmann visible normals, Henyey–Greenstein, the 2-D warp)
-//! pass all of them.
+//! and the correct samplers (GGX and Beckmann visible normals, Henyey–Greenstein, the 2-D warp,
+//! a GGX + diffuse mixture chosen with u.z) pass all of them.
 
 use lobes::check::hard::HardRow;
+use lobes::check::jacobian::JacobianCheck;
 use lobes::check::report::{AlbedoFigures, NormalizationFigures, WeightFigures};
 use lobes::check::{Domain, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
@@ -63,6 +64,9 @@ fn ggx_vndf_from_scratch_passes() {
         let r = check(&gpu, &s, &Settings { params: vec![a.0, a.1], incident_theta: theta, ..Settings::default() }).unwrap();
         show(&r);
         r.assert_passed();
+        // u.z and u.w unused: every sample a plain 2-D map
+        let j = jacobian(&r);
+        assert!(j.compared_events == 0 && j.skipped_selection == 0, "{j:?}");
     }
 }
 
@@ -79,6 +83,63 @@ fn missing_reflection_jacobian_is_rejected() {
     assert!(r.get("pdf_consistency").unwrap().passed, "the sampler reports the same (wrong) pdf");
 }
 
+fn jacobian(r: &lobes::check::Report) -> JacobianCheck {
+    r.figures::<JacobianCheck>().unwrap().clone()
+}
+
+/// The rough dielectric's samples (GGX visible normals, reflection with probability F chosen
+/// with u.z) with the refraction density of two classic bugs: without eq. 17's η², where every
+/// refracted sample's p · |J| / share is 1/η² = 0.4444, and with the reflection Jacobian
+/// 1/(4|ωo·h|) in place of eq. 17's. The jacobian check compares them event by event and rejects
+/// both, as it passes the correct sampler (tests/dielectric.rs).
+#[test]
+fn broken_dielectric_refraction_densities_are_rejected() {
+    let gpu = gpu();
+    let settings = Settings { params: vec![0.3, 0.3, 1.5], incident_theta: 30.0, ..Settings::default() };
+    for (sample, pdf) in [("brd_no_eta2_sample", "brd_no_eta2_pdf"), ("brd_reflection_j_sample", "brd_reflection_j_pdf")] {
+        let s = ggx(&["rough_dielectric.wgsl", "broken_dielectric.wgsl"], sample, pdf, None);
+        let r = check(&gpu, &s, &settings).unwrap();
+        show(&r);
+        let j = jacobian(&r);
+        assert!(!r.get("jacobian").unwrap().passed && j.applicable, "{sample}: {j:?}");
+        assert!(j.compared_events * 10 > j.probed * 9, "{sample}: F < 1 at every h from 30°: {j:?}");
+        if sample == "brd_no_eta2_sample" {
+            assert!((j.median_ratio.unwrap() - 1.0 / 2.25).abs() < 1e-3, "{j:?}");
+        }
+    }
+}
+
+/// A 50/50 (and a 25/75) mixture of GGX visible normals and a cosine lobe chosen with u.z, with
+/// the mixture's pdf, passes every check: the lobes overlap, so p · |J| / share exceeds 1 where
+/// the other lobe adds density, and only a ratio below 1 is off.
+#[test]
+fn a_mixture_chosen_with_u_z_passes() {
+    let gpu = gpu();
+    let s = ggx(&["ggx_diffuse_mixture.wgsl"], "mix_sample", "mix_pdf", None);
+    for (alpha, w) in [(0.3, 0.5), (0.2, 0.25)] {
+        let r = check(&gpu, &s, &Settings { params: vec![alpha, alpha, w], incident_theta: 40.0, ..Settings::default() }).unwrap();
+        show(&r);
+        r.assert_passed();
+        let j = jacobian(&r);
+        assert!(j.compared_events == j.compared && j.compared * 10 > j.probed * 9 && j.above_events > 0, "{j:?}");
+    }
+}
+
+/// The mixture's pdf with the weights fixed at ½ while the sampler picks GGX with probability ¼:
+/// a cosine-lobe sample's ratio is (½ p_diffuse + ½ p_ggx) / (¾ p_diffuse) ≥ ⅔, and ⅔ where GGX
+/// adds nothing. The jacobian check rejects it; pdf_consistency passes (the sampler reports the
+/// same wrong pdf).
+#[test]
+fn a_wrong_mixture_weight_is_rejected() {
+    let gpu = gpu();
+    let s = ggx(&["ggx_diffuse_mixture.wgsl", "broken_mixture_weight.wgsl"], "broken_mix_sample", "broken_mix_pdf", None);
+    let r = check(&gpu, &s, &Settings { params: vec![0.2, 0.2, 0.25], incident_theta: 40.0, ..Settings::default() }).unwrap();
+    show(&r);
+    let j = jacobian(&r);
+    assert!(!r.get("jacobian").unwrap().passed && r.get("pdf_consistency").unwrap().passed, "{j:?}");
+    assert!(j.worst_ratio > 2.0 / 3.0 - 1e-2 && j.worst_ratio < 0.8, "{j:?}");
+}
+
 fn temp_wgsl(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("lobes-check-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -93,6 +154,45 @@ const UNIFORM_DIRECTION: &str = "fn uniform_direction(u: vec4<f32>) -> vec3<f32>
      return vec3<f32>(r * cos(phi), r * sin(phi), z);\n}\n";
 
 const GOOD_SAMPLE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n    return vec4<f32>(0.0, 0.0, 1.0, 1.0);\n}\n";
+
+/// Events chosen with u.w are judged like those of u.z: the upper hemisphere with probability 0.3
+/// (z = ±(1 − u.x), φ = 2π u.y: |J| = 2π on either side), so p = 0.3/(2π) above and 0.7/(2π)
+/// below (a handful of probes above 1 by f32 differences near the pole); a pdf of 0.5/(2π) on both
+/// sides is ⁵⁄₇ of the density below and is off. A map that moves
+/// with u.z continuously (φ = 2π (u.y + u.z)) is skipped, as before events were judged.
+#[test]
+fn events_chosen_with_u_w_and_maps_moving_with_u_z() {
+    let gpu = gpu();
+    let hemispheres = |pdf_above: f64, pdf_below: f64| {
+        format!(
+            "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+             let r = sqrt(max(0.0, u.x * (2.0 - u.x)));\n let phi = 6.2831853 * u.y;\n\
+             let z = select(u.x - 1.0, 1.0 - u.x, u.w < 0.3);\n\
+             let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n return vec4<f32>(d, p(wi, d, params));\n}}\n\
+             fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n\
+             return select({pdf_below:.8}, {pdf_above:.8}, d.z > 0.0) / 6.2831853;\n}}\n"
+        )
+    };
+    let settings = Settings { samples: 1 << 18, bins: Some((16, 32)), ..Settings::default() };
+    let run = |name: &str, text: &str| {
+        let s = UserSampler::from_files(&[temp_wgsl(name, text)], "s", "p", None, Domain::Sphere).unwrap();
+        let r = check(&gpu, &s, &settings).unwrap();
+        show(&r);
+        (r.get("jacobian").unwrap().passed, jacobian(&r))
+    };
+    let (passed, j) = run("by_u_w.wgsl", &hemispheres(0.3, 0.7));
+    assert!(passed && j.compared * 10 > j.probed * 9 && j.compared_events == j.compared && j.above_events * 100 < j.compared, "{j:?}");
+    assert!((j.median_ratio.unwrap() - 1.0).abs() < 1e-3, "{j:?}");
+    let (passed, j) = run("by_u_w_wrong.wgsl", &hemispheres(0.5, 0.5));
+    assert!(!passed && (j.worst_ratio - 5.0 / 7.0).abs() < 1e-2, "{j:?}");
+    let moving = format!(
+        "{UNIFORM_DIRECTION}fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         return vec4<f32>(uniform_direction(vec4<f32>(u.x, fract(u.y + u.z), 0.0, 0.0)), 0.0795775);\n}}\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n return 0.0795775;\n}}\n"
+    );
+    let (passed, j) = run("moving.wgsl", &moving);
+    assert!(passed && !j.applicable && j.compared == 0 && j.skipped_selection * 10 > j.probed * 9, "{j:?}");
+}
 
 /// WGSL errors point at the user's file, line and column; a missing function or a wrong
 /// signature names the expected signature.

@@ -258,11 +258,12 @@ fn settings(ax: f64, ay: f64, eta: f64, theta: f64) -> Settings {
     Settings { params: vec![ax, ay, eta], incident_theta: theta, reference: Some(Reference::new(move |wi, wo| d.pdf(wi, wo))), ..Settings::default() }
 }
 
-/// Every check of `lobes check` but one passes for the f32 sampler (pdf consistency,
+/// Every check of `lobes check` passes for the f32 sampler (pdf consistency, the Jacobian,
 /// normalisation, χ² against the f64 reference's density, weights, albedo, hard cases), from
-/// outside and inside, η above and below 1 (TIR), anisotropic. The one is `jacobian`: it
-/// differentiates the map (u.x, u.y) → d at fixed u.z, whose density is p(d)/F on the reflected
-/// side and p(d)/T across (the event chosen by u.z scales it), so pdf · |J| is F or T there, not 1.
+/// outside and inside, η above and below 1 (TIR), anisotropic. The Jacobian of the map
+/// (u.x, u.y) → d at fixed u.z is the density p(d)/F on the reflected side and p(d)/T across (the
+/// event chosen by u.z scales it): the check compares p · |J| with the share of u.z that chose
+/// the event (F or T, measured on the GPU), at every probe where both events are possible.
 #[test]
 fn the_wgsl_twin_passes_lobes_check_against_the_f64_density() {
     let gpu = lobes::engine::gpu::Gpu::new().unwrap_or_else(|e| panic!("lobes check needs a GPU adapter: {e}"));
@@ -272,14 +273,16 @@ fn the_wgsl_twin_passes_lobes_check_against_the_f64_density() {
         for c in &r.checks {
             eprintln!("α ({ax}, {ay}) η {eta} θi {theta}: {} {} {}", c.name(), c.passed, c.summary);
         }
-        let failed: Vec<&str> = r.checks.iter().filter(|c| !c.passed && c.name() != "jacobian").map(|c| c.name()).collect();
+        let failed: Vec<&str> = r.checks.iter().filter(|c| !c.passed).map(|c| c.name()).collect();
         assert!(failed.is_empty() && r.checks.len() == 8, "α ({ax}, {ay}) η {eta} θi {theta}: {failed:?}");
+        let j = r.figures::<lobes::check::jacobian::JacobianCheck>().unwrap();
+        assert!(j.applicable && j.compared_events * 10 > j.compared && (j.median_ratio.unwrap() - 1.0).abs() < 1e-3, "{j:?}");
     }
 }
 
 /// The same sampler with eq. 17's η² dropped from its Jacobian (in its reported pdf and its pdf
-/// function alike, so the samples are unchanged) fails χ² against its own pdf, normalisation
-/// and the albedo.
+/// function alike, so the samples are unchanged) fails χ² against its own pdf, normalisation,
+/// the albedo and the Jacobian.
 #[test]
 fn the_wgsl_twin_without_eta_squared_is_rejected() {
     let gpu = lobes::engine::gpu::Gpu::new().unwrap_or_else(|e| panic!("lobes check needs a GPU adapter: {e}"));
@@ -290,7 +293,7 @@ fn the_wgsl_twin_without_eta_squared_is_rejected() {
     for c in &r.checks {
         eprintln!("broken: {} {} {}", c.name(), c.passed, c.summary);
     }
-    for name in ["chi2", "normalization", "albedo"] {
+    for name in ["chi2", "normalization", "albedo", "jacobian"] {
         assert!(!r.get(name).unwrap().passed, "{name} passed the broken sampler");
     }
 }

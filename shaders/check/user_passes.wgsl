@@ -78,10 +78,126 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (hw.x * hw.y);
 }
 
+// Whether sample s is valid and lands on d0: within 1e-6 relative, the tolerance of "moves d"
+// in src/check/jacobian.rs (a sampler that chooses an event gives the same bits throughout it).
+fn lobes_same(s: vec4<f32>, d0: vec3<f32>) -> bool {
+    var diff = s.xyz - d0;
+    var scale = max(length(d0), 1.0);
+    if (LOBES_DOMAIN_PLANE) {
+        diff.z = 0.0;
+        scale = max(length(d0.xy), 1.0);
+    }
+    return lobes_positive(s.w) && length(diff) <= 1e-6 * scale;
+}
+
+// u with component `axis` set to t.
+fn lobes_at(u: vec4<f32>, axis: u32, t: f32) -> vec4<f32> {
+    var v = u;
+    v[axis] = t;
+    return v;
+}
+
+// Nodes of the coarse scan of lobes_share, and the smallest share of an event it reports (the
+// finite-difference step's 2⁻¹²: below it d is taken to move with the axis).
+const LOBES_SCAN: u32 = 256u;
+const LOBES_MIN_SHARE: f32 = 1.0 / 4096.0;
+
+// The point where the sample stops landing on d0 between t_in (it does) and t_out (it does
+// not), by bisection to f32 resolution (2⁻²⁴ from a cell of 2⁻⁸: 16 halvings, 18 at most).
+fn lobes_transition(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>, t_in: f32, t_out: f32) -> f32 {
+    var a = t_in;
+    var b = t_out;
+    for (var k = 0u; k < 18u; k++) {
+        let m = 0.5 * (a + b);
+        if (m == a || m == b) {
+            break;
+        }
+        if (lobes_same(lobes_user_sample(wi, lobes_at(u, axis, m)), d0)) {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    return 0.5 * (a + b);
+}
+
+// The share of t ∈ [0, 1) for which sample(u with component `axis` = t) is valid and lands on
+// d0 = sample(u): 1 where d does not depend on that component, the probability of the event the
+// sampler chose at u where it chooses one with it, and −1 where d moves with it (the run of t
+// around u[axis] that lands on d0 is shorter than LOBES_MIN_SHARE). A coarse scan at t = j/256
+// and at u[axis] itself, each change between neighbouring nodes bisected; a run narrower than
+// 2⁻⁸ between two nodes is not seen unless it holds u[axis] (at most 2⁻⁸ of share misread).
+fn lobes_share(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>) -> f32 {
+    let t0 = u[axis];
+    let step = 1.0 / f32(LOBES_SCAN);
+    var share = 0.0;
+    // the run of nodes landing on d0 that holds t0, and where the current run began (−1: none)
+    var own = 0.0;
+    var start = -1.0;
+    // whether any node missed d0 (else the share is exactly 1, whatever the sums round to)
+    var missed = false;
+    var a = 0.0;
+    var sa = lobes_same(lobes_user_sample(wi, lobes_at(u, axis, a)), d0);
+    if (sa) {
+        start = 0.0;
+    }
+    var j = 1u;
+    var split = false;
+    loop {
+        // the next node: t0 inside the cell, else the cell's end (the last one at 1 − 2⁻²⁴, its
+        // width counted to 1)
+        var b = f32(j) * step;
+        var at_t0 = false;
+        if (!split && a < t0 && t0 < b) {
+            b = t0;
+            at_t0 = true;
+            split = true;
+        }
+        let end = b;
+        if (j == LOBES_SCAN && !at_t0) {
+            b = 1.0 - 1.0 / 16777216.0;
+        }
+        let sb = lobes_same(lobes_user_sample(wi, lobes_at(u, axis, b)), d0);
+        missed = missed || !sa || !sb;
+        if (sa && sb) {
+            share += end - a;
+        } else if (sa) {
+            let t = lobes_transition(wi, u, axis, d0, a, b);
+            share += t - a;
+            if (start <= t0 && t0 <= t) {
+                own = t - start;
+            }
+            start = -1.0;
+        } else if (sb) {
+            let t = lobes_transition(wi, u, axis, d0, b, a);
+            share += end - t;
+            start = t;
+        }
+        a = end;
+        sa = sb;
+        if (!at_t0) {
+            if (j == LOBES_SCAN) {
+                break;
+            }
+            j++;
+        }
+    }
+    if (sa && start <= t0) {
+        own = 1.0 - start;
+    }
+    if (!missed) {
+        return 1.0;
+    }
+    if (own < LOBES_MIN_SHARE) {
+        return -1.0;
+    }
+    return share;
+}
+
 // The sample map around item i of lobes_in = (u, wi): per item 7 vec4s,
 //   0: sample(u) as (d, reported pdf)
 //   1, 2: sample(u ± eps in u.x); 3, 4: sample(u ± eps in u.y)
-//   5: sample(u with u.z and u.w moved by ½, mod 1): differs from 0 where the map branches on them
+//   5: (share of u.z, share of u.w, 0, 0): lobes_share along each
 //   6: (pdf(d), eval(d), |d|, 0) at d of 0
 // The host differentiates in f64 (src/check/jacobian.rs) and classifies (src/check/hard.rs).
 @compute @workgroup_size(64)
@@ -104,7 +220,7 @@ fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     lobes_out[o + 2u] = mx;
     lobes_out[o + 3u] = py;
     lobes_out[o + 4u] = my;
-    lobes_out[o + 5u] = lobes_user_sample(wi, vec4<f32>(u.xy, fract(u.zw + 0.5)));
+    lobes_out[o + 5u] = vec4<f32>(lobes_share(wi, u, 2u, s.xyz), lobes_share(wi, u, 3u, s.xyz), 0.0, 0.0);
     lobes_out[o + 6u] = vec4<f32>(lobes_user_pdf(wi, s.xyz), lobes_user_eval(wi, s.xyz), length(s.xyz), 0.0);
 }
 

@@ -356,17 +356,21 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let jac = jacobian::judge(&probes, &probe_u, plane);
     let summary = if jac.applicable {
         format!(
-            "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%)",
+            "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%){}",
             jac.median_ratio.unwrap_or(f64::NAN),
             jac.worst_ratio,
             100.0 * jac.share_off,
             jac.compared,
             100.0 * jac.tolerance,
-            100.0 * jacobian::MAX_SHARE_OFF
+            100.0 * jacobian::MAX_SHARE_OFF,
+            match jac.compared_events {
+                0 => String::new(),
+                k => format!("; {k} of them chose an event with u.z or u.w, judged by pdf · |J| / share ({} above 1)", jac.above_events),
+            }
         )
     } else {
         format!(
-            "not applicable: only {} of {} samples comparable ({} use u.z/u.w to choose, {} not smooth, {} invalid)",
+            "not applicable: only {} of {} samples comparable ({} move with u.z or u.w, {} not smooth, {} invalid)",
             jac.compared, jac.probed, jac.skipped_selection, jac.skipped_not_smooth, jac.skipped_invalid
         )
     };
