@@ -3,6 +3,7 @@
 //! GPU adapter, and a case that fails mid-way (no complete-looking `histogram.json` may be left).
 //! The scene parser and the tutorial commands are fuzzed with proptest for panics.
 
+use lobes::reference::{effects::Effects, fresnel::Fresnel, masking::Masking};
 use lobes::scene::{Scene, SceneError};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
@@ -511,7 +512,14 @@ fn dielectric_scatter_keys() {
     scene_error(&glass("incident_theta = ⟦140\n"), &["0 ≤ θ < 90"]);
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nincident_theta = ⟦180\n"), &["0 ≤ θ < 180"]);
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nfresnel = ⟦\"schlick\"\n"), &["fresnel does not apply to scatter = \"dielectric\""]);
-    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nmasking = ⟦\"g1\"\n"), &["masking does not apply to scatter = \"dielectric\""]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nf0 = ⟦0.04\n"), &["f0 does not apply to scatter = \"dielectric\""]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nmasking = ⟦\"height-correlated\"\n"), &["does not apply to scatter = \"dielectric\"", "Beta function", "g1 or separable"]);
+    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nweighted = false\nmasking = ⟦\"g1\"\n"), &["weighted = false"]);
+    // the weighted pass: masking g1 or separable, or weighted = true alone; the Fresnel term is the dielectric's
+    for (extra, masking) in [("masking = \"g1\"\n", Masking::G1), ("masking = \"separable\"\n", Masking::Separable), ("weighted = true\n", Masking::None)] {
+        let s = Scene::parse("s.toml", &glass(&format!("scatter = \"dielectric\"\neta = 1.5\n{extra}"))).unwrap();
+        assert_eq!(s.cases[0].effects, Some(Effects { fresnel: Fresnel::None, masking }), "{extra}");
+    }
     scene_error(&ggx("alpha = 0.3\nmethod = ⟦\"bounded\"\nscatter = \"dielectric\"\neta = 1.5\n"), &["ggx bounded has no dielectric sampler", "ndf or vndf"]);
     scene_error("[[case]]\nname = \"w\"\nlobe = ⟦\"ward\"\nalpha = 0.2\nscatter = \"dielectric\"\neta = 1.5\n", &["ward has no dielectric sampler"]);
     scene_error(&discrete("weights = [1, 2]\nscatter = ⟦\"dielectric\"\n"), &["scatter does not apply to lobe = \"discrete\""]);

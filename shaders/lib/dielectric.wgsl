@@ -63,26 +63,46 @@ fn dielectric_u(u: vec3<Real>) -> vec2<Real> {
     return max(u.xy, vec2<Real>(2.98023223876953125e-8));
 }
 
-fn dielectric_ggx_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
-    let h = ggx_sample_ndf(a, dielectric_upper(wi), dielectric_u(u)).h;
-    return dielectric_scatter(wi, h, ggx_d(a, h) * h.z, u.z, eta);
+// p(h) of each sampler for the upper-side i, as its f64 twin's pdf_h (also the densities of
+// shaders/lib/dielectric_eval.wgsl). NDF: D(h) cos th_h.
+fn dielectric_ggx_ndf_pdf_h(a: vec2<Real>, i: vec3<Real>, h: vec3<Real>) -> Real {
+    return ggx_d(a, h) * h.z;
 }
 
-// p(h) = G1(wi) max(0, wi.h) D(h) / wi.z, with G1/wi.z = 2 / (wi.z + t) (shaders/lib/ggx.wgsl).
+// Visible normals: G1(i) max(0, i.h) D(h) / i.z, with G1/i.z = 2 / (i.z + t) (shaders/lib/ggx.wgsl).
+fn dielectric_ggx_vndf_pdf_h(a: vec2<Real>, i: vec3<Real>, h: vec3<Real>) -> Real {
+    let t = length(vec3<Real>(a * i.xy, i.z));
+    return 2.0 * max(dot(i, h), 0.0) * ggx_d(a, h) / (i.z + t);
+}
+
+fn dielectric_beckmann_ndf_pdf_h(a: vec2<Real>, i: vec3<Real>, h: vec3<Real>) -> Real {
+    return beckmann_d(a, h) * h.z;
+}
+
+fn dielectric_beckmann_vndf_pdf_h(a: vec2<Real>, i: vec3<Real>, h: vec3<Real>) -> Real {
+    return beckmann_g1_over_cos(a, i) * max(dot(i, h), 0.0) * beckmann_d(a, h);
+}
+
+fn dielectric_ggx_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
+    let i = dielectric_upper(wi);
+    let h = ggx_sample_ndf(a, i, dielectric_u(u)).h;
+    return dielectric_scatter(wi, h, dielectric_ggx_ndf_pdf_h(a, i, h), u.z, eta);
+}
+
 fn dielectric_ggx_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = ggx_sample_vndf(a, i, dielectric_u(u)).h;
-    let t = length(vec3<Real>(a * i.xy, i.z));
-    return dielectric_scatter(wi, h, 2.0 * max(dot(i, h), 0.0) * ggx_d(a, h) / (i.z + t), u.z, eta);
+    return dielectric_scatter(wi, h, dielectric_ggx_vndf_pdf_h(a, i, h), u.z, eta);
 }
 
 fn dielectric_beckmann_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
-    let h = beckmann_sample_ndf(a, dielectric_upper(wi), dielectric_u(u)).h;
-    return dielectric_scatter(wi, h, beckmann_d(a, h) * h.z, u.z, eta);
+    let i = dielectric_upper(wi);
+    let h = beckmann_sample_ndf(a, i, dielectric_u(u)).h;
+    return dielectric_scatter(wi, h, dielectric_beckmann_ndf_pdf_h(a, i, h), u.z, eta);
 }
 
 fn dielectric_beckmann_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = beckmann_sample_vndf_h(a, i, dielectric_u(u));
-    return dielectric_scatter(wi, h, beckmann_g1_over_cos(a, i) * max(dot(i, h), 0.0) * beckmann_d(a, h), u.z, eta);
+    return dielectric_scatter(wi, h, dielectric_beckmann_vndf_pdf_h(a, i, h), u.z, eta);
 }

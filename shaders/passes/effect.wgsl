@@ -30,11 +30,12 @@ fn effect_weight(s: LobeSample) -> f32 {
     return effect_fresnel(dot(wi, s.h)) * effect_masking(a, wi, s.wr) * sampler_weight(a, wi, s);
 }
 
-// eval(wi, wr) cos th_r / pdf(wr), each formed on its own from wr (h = normalize(wi + wr)).
+// eval(wi, wr) |cos th_r| / pdf(wr), each formed on its own from wr (h = normalize(wi + wr); a
+// rough dielectric's eval forms its own h, which may lie across the surface).
 fn effect_check(wr: vec3<f32>) -> f32 {
     let a = effect_alpha();
     let wi = params.wi.xyz;
     let h = normalize(wi + wr);
     let f = effect_fresnel(dot(wi, h)) * effect_masking(a, wi, wr) * sampler_eval(a, wi, wr, h);
-    return f * wr.z / sampler_pdf(a, wi, wr);
+    return f * abs(wr.z) / sampler_pdf(a, wi, wr);
 }

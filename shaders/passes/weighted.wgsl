@@ -2,14 +2,18 @@
 #import lobes::job::{BINS, CELLS, WG_SIZE, WEIGHT_LIMIT, WEIGHT_SCALE, SQUARE_SCALE}
 #import lobes::bindings::params
 #import lobes::rng::{rng_uniforms, add64}
-#import lobes::histogram::{classify, bin_of}
+#import lobes::histogram::bin_of
+#import lobes::lobe_kernel::lobe_classify
 #import lobes::kernel::{Invocation, sample_of, samples_of}
 #import lobes::effect::{effect_sample, effect_weight, effect_check}
 
-// The weighted histogram: per cell, the sum of the estimator weights w = f(wi, wr) cos th_r / p(wr)
+// The weighted histogram: per cell, the sum of the estimator weights w = f(wi, wr) |cos th_r| / p(wr)
 // of the samples that land there, so that sum / N estimates the directional albedo the cell
 // receives; and, per bin, the largest relative difference between the sampler's own weight and
-// eval(wi, wr) cos th_r / pdf(wr) formed independently. CPU twin: src/stats/weighted.rs.
+// eval(wi, wr) |cos th_r| / pdf(wr) formed independently. CPU twin: src/stats/weighted.rs. A rough
+// dielectric's samples land on both sides (lobe_classify tells a wrong-side sample by its event),
+// and the squares of the bins below the horizon are kept apart, for the transmitted albedo's
+// standard error (the reflected one's when light comes from inside).
 //
 // The estimator comes from shaders/passes/effect.wgsl: `effect_sample(u)`, `effect_weight(s)`
 // (the sampler's weight with the case's Fresnel and masking) and `effect_check(wr)`
@@ -21,7 +25,8 @@
 // WEIGHT_OVERFLOW), so no sample is dropped silently.
 
 // 2 words (lo, hi) per cell: CELLS cells of sum w, then sum w^2 over the bins, sum w^2 over all
-// samples, and the count of weights not summed.
+// samples, the count of weights not summed, and sum w^2 over the bins below the horizon (the
+// first BINS / 2: rows are even in number, from cos th = -1 up).
 @group(0) @binding(7) var<storage, read_write> weight_sums: array<atomic<u32>>;
 // Per bin: the f32 bits of the largest relative weight difference (non-negative f32 order as u32).
 @group(0) @binding(8) var<storage, read_write> weight_error: array<atomic<u32>>;
@@ -31,6 +36,7 @@
 const SQUARES_BINS: u32 = CELLS;
 const SQUARES_ALL: u32 = CELLS + 1u;
 const WEIGHT_OVERFLOW: u32 = CELLS + 2u;
+const SQUARES_LOWER: u32 = CELLS + 3u;
 
 // round(v * scale) as a 64-bit integer (lo, hi), for v * scale below 2^64: the rounded value has
 // 24 significant bits, so hi and lo split it exactly.
@@ -73,13 +79,14 @@ fn weighted_histogram(at: Invocation) {
     // per invocation instead of one per sample.
     var squares_bins = vec2<u32>(0u);
     var squares_all = vec2<u32>(0u);
+    var squares_lower = vec2<u32>(0u);
     var overflow = 0u;
     let first = sample_of(at, 0u);
     let n = samples_of(at, params.count);
     for (var k = 0u; k < n; k++) {
         let u = rng_uniforms(params.seed, add64(params.base, first + k * WG_SIZE));
         let s = effect_sample(u.xyz);
-        let reason = classify(s.wr, s.pdf_r);
+        let reason = lobe_classify(s);
         let w = effect_weight(s);
         if (!(w >= 0.0 && w < WEIGHT_LIMIT)) {
             overflow += 1u;
@@ -91,6 +98,9 @@ fn weighted_histogram(at: Invocation) {
             let bin = bin_of(s.wr);
             add_fixed(bin, fixed_parts(w, WEIGHT_SCALE));
             squares_bins = add_parts(squares_bins, sq);
+            if (bin < BINS / 2u) {
+                squares_lower = add_parts(squares_lower, sq);
+            }
             atomicMax(&weight_error[bin], relative_error_bits(w, effect_check(s.wr)));
         } else {
             add_fixed(BINS + reason - 1u, fixed_parts(w, WEIGHT_SCALE));
@@ -99,4 +109,5 @@ fn weighted_histogram(at: Invocation) {
     add_fixed(SQUARES_BINS, squares_bins);
     add_fixed(SQUARES_ALL, squares_all);
     add_fixed(WEIGHT_OVERFLOW, vec2<u32>(overflow, 0u));
+    add_fixed(SQUARES_LOWER, squares_lower);
 }

@@ -98,7 +98,9 @@ fn run_effects(args: &BenchArgs, scene: &std::path::PathBuf) -> anyhow::Result<(
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();
     let mut results = Vec::new();
-    for case in scene.cases.iter().filter(|c| c.effects.is_some()) {
+    // the uber-kernel draws reflections only (Ward and bounded VNDF have no rough dielectric)
+    let reflecting = |c: &&crate::scene::Case| matches!(c.job, Job::Lobe { scatter: Scatter::Reflect, .. });
+    for case in scene.cases.iter().filter(|c| c.effects.is_some()).filter(reflecting) {
         let effects = case.effects.as_ref().expect("filtered");
         let mut time = |how, seed: u64, n: u64| -> anyhow::Result<f64> {
             let r = engine.weighted(&case.job, effects, SampleRange::whole(seed, n), how)?;

@@ -2,10 +2,11 @@
 //! the reference samplers on all cores. It serves where no GPU adapter exists, and as the CPU
 //! backend of the benchmark.
 
-use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
+use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange, Scatter};
 use crate::reference::effects::Effects;
 use crate::stats::weighted::WeightedSums;
 use crate::reference::Invalid;
+use crate::reference::dielectric::{Event, RoughDielectric};
 use crate::reference::discrete::AliasTable;
 use rayon::prelude::*;
 
@@ -47,9 +48,29 @@ pub fn histogram(job: &Job, range: SampleRange) -> Counts {
 
 /// The weighted histogram of the samples of `range` of a lobe job with `effects`,
 /// in f64: the same fixed-point sums as `shaders/passes/weighted.wgsl`, and per bin the largest
-/// relative difference between the weight and eval · cos θr / pdf.
+/// relative difference between the weight and eval · |cos θo| / pdf. A rough dielectric's
+/// samples ([`RoughDielectric`]) land on both sides, its Fresnel term its own.
 pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSums {
-    let Job::Lobe { lobe, incident, grid, .. } = job else { panic!("weighted histograms are for lobe jobs") };
+    let Job::Lobe { lobe, incident, grid, scatter } = job else { panic!("weighted histograms are for lobe jobs") };
+    let wi = *incident;
+    let glass = match *scatter {
+        Scatter::Reflect => None,
+        Scatter::Dielectric { eta } => Some(RoughDielectric::new(*lobe, eta).expect("a dielectric job is checked when made")),
+    };
+    // one sample: its direction, its reason if invalid, its weight, and eval · |cos θo| / pdf
+    let draw = |u: [f64; 4]| match &glass {
+        None => {
+            let s = lobe.sample(wi, [u[0], u[1]]);
+            let check = || effects.eval(lobe, wi, s.omega_r) * s.omega_r.z / lobe.pdf_r(wi, s.omega_r);
+            (s.omega_r, s.invalid, effects.weight(lobe, wi, &s), s.invalid.is_none().then(check))
+        }
+        Some(glass) => {
+            let s = glass.sample(wi, [u[0], u[1], u[2]]);
+            let invalid = Invalid::check_scattered(wi, s.omega_o, s.pdf_o, s.event == Event::Reflection);
+            let check = || glass.eval(wi, s.omega_o, effects.masking) * s.omega_o.z.abs() / glass.pdf(wi, s.omega_o);
+            (s.omega_o, invalid, glass.weight(wi, &s, effects.masking), invalid.is_none().then(check))
+        }
+    };
     let bins = job.bins();
     (0..range.chunk_count(BLOCK))
         .into_par_iter()
@@ -57,18 +78,16 @@ pub fn weighted(job: &Job, effects: &Effects, range: SampleRange) -> WeightedSum
             || WeightedSums::zeros(bins),
             |mut sums, b| {
                 for i in range.chunk(b, BLOCK).indices() {
-                    let u = crate::reference::rng::uniforms(range.seed, i);
-                    let s = lobe.sample(*incident, [u[0], u[1]]);
-                    let w = effects.weight(lobe, *incident, &s);
-                    match s.invalid {
-                        None => {
-                            let bin = grid.bin_of(s.omega_r);
+                    let (wo, invalid, w, check) = draw(crate::reference::rng::uniforms(range.seed, i));
+                    match (invalid, check) {
+                        (Some(r), _) => sums.record(bins + r.code() as usize - 1, w),
+                        (None, check) => {
+                            let check = check.expect("a valid sample has its check");
+                            let bin = grid.bin_of(wo);
                             sums.record(bin, w);
-                            let check = effects.eval(lobe, *incident, s.omega_r) * s.omega_r.z / lobe.pdf_r(*incident, s.omega_r);
                             let e = if w == check { 0.0 } else { ((w - check).abs() / check) as f32 };
                             sums.max_error[bin] = sums.max_error[bin].max(if e.is_nan() { f32::INFINITY } else { e });
                         }
-                        Some(r) => sums.record(bins + r.code() as usize - 1, w),
                     }
                 }
                 sums

@@ -23,11 +23,11 @@
 //! near side, a microfacet tilted past the macro surface) are not directions of the BSDF; their
 //! density is 0 and [`DielectricSample::valid`] is false.
 
-use super::effects::{d, g1};
-use super::fresnel;
+use super::effects::{Effects, d, g1};
+use super::fresnel::{self, Fresnel};
 use super::masking::Masking;
 use super::reflect::{pdf_reflected, reflect};
-use super::{Lobe, LobeKind, Method};
+use super::{Lobe, LobeKind, LobeSample, Method};
 use glam::DVec3;
 
 /// The least u₀, u₁ the h draw takes, 2⁻²⁵ (half a step of the RNG's lattice k·2⁻²⁴): u = 0 draws
@@ -230,6 +230,20 @@ impl RoughDielectric {
         }
     }
 
+    /// The estimator weight f |cos θo| / p(ωo) of a sample with masking `masking` (f as
+    /// [`eval`](Self::eval)), in the sampler's closed form, the same for both events (F or 1 − F
+    /// is in f and p alike): [`Effects::weight`] without Fresnel on the upper side, G (ωi·h)⁺ /
+    /// (cos θi cos θh) by the NDF and G / G1(ωi) by visible normals, G1(ωo) of |cos θo|. It
+    /// depends on h alone for G = G1(ωi), so over every sample, the wrong-side ones included,
+    /// Σ w / N estimates the white furnace's ∫ p(h) w dh = G1(ωi) (1 + Λ(ωi)) = 1
+    /// ([`Effects::furnace`]).
+    pub fn weight(&self, wi: DVec3, s: &DielectricSample, masking: Masking) -> f64 {
+        let (flip, wi, _) = self.incident(wi);
+        let up = |w: DVec3| if flip { mirror(w) } else { w };
+        let upper = LobeSample { h: up(s.h), omega_r: up(s.omega_o), pdf_h: s.pdf_h, pdf_r: s.pdf_o, invalid: None };
+        Effects { fresnel: Fresnel::None, masking }.weight(&self.lobe, wi, &upper)
+    }
+
     /// The BSDF f(ωi, ωo) with the dielectric's own Fresnel term and masking `masking` of
     /// G1(ωi), G1(ωo) (Walter 2007, eqs. 20 and 21). The height-correlated form is Heitz 2014's
     /// eq. 99 for both events, as pbrt-v4 uses it (for transmission it is the common
@@ -399,6 +413,32 @@ mod tests {
                 assert!((r1 / r2 - 1.0).abs() < 1e-12);
             }
         }
+    }
+
+    /// The closed-form weight of every valid sample equals eval · |cos θo| / pdf formed from ωo
+    /// alone, for both events, from both sides, with each masking term the weighted pass takes.
+    #[test]
+    fn weights_equal_eval_cos_over_pdf() {
+        let mut events = [0; 2];
+        for (kind, method) in KINDS {
+            let d = RoughDielectric::new(Lobe { alpha_angle: 30.0, ..lobe(kind, method, 0.5, 0.3) }, 1.5).unwrap();
+            for wi in [spherical(0.5, 0.2), spherical(2.3, 0.7)] {
+                for k in 0..40 {
+                    let u = crate::reference::rng::uniforms(5, k);
+                    let s = d.sample(wi, [u[0], u[1], u[2]]);
+                    if !s.valid {
+                        continue;
+                    }
+                    events[s.event as usize] += 1;
+                    for masking in [Masking::None, Masking::G1, Masking::Separable] {
+                        let direct = d.eval(wi, s.omega_o, masking) * s.omega_o.z.abs() / d.pdf(wi, s.omega_o);
+                        let w = d.weight(wi, &s, masking);
+                        assert!((w / direct - 1.0).abs() < 1e-9, "{kind:?} {method:?} {wi} {masking:?} {:?}: {w} vs {direct}", s.event);
+                    }
+                }
+            }
+        }
+        assert!(events[0] > 20 && events[1] > 100, "{events:?}");
     }
 
     /// Every sample's density equals [`RoughDielectric::pdf`] of its direction, formed from ωo

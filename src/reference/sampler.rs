@@ -52,6 +52,18 @@ pub struct Wgsl {
     /// `fn (a, wi, u: vec3<Real>, eta) -> LobeSample`, u.xy drawing h and u.z the event, the
     /// sample's `wr` the scattered direction on either side. `None`: no dielectric sampler.
     pub dielectric: Option<&'static str>,
+    /// The weighted pass of that dielectric (`shaders/lib/dielectric_eval.wgsl`, f64 twins
+    /// `RoughDielectric::pdf`, `eval` and `weight`); `None` exactly where `dielectric` is.
+    pub dielectric_eval: Option<DielectricEval>,
+}
+
+/// A rough dielectric's density, BSDF (without G) and weight (without G), as expressions like
+/// [`Wgsl`]'s in `a`, `wi`, `wr` (on either side), `s` and the job's η, `lobe_eta()`.
+#[derive(Debug, Clone, Copy)]
+pub struct DielectricEval {
+    pub pdf: &'static str,
+    pub eval: &'static str,
+    pub weight: &'static str,
 }
 
 /// The f64 reference of a sampler (`src/reference`).
@@ -69,6 +81,8 @@ pub struct Reference {
 const MICROFACET_NDF_WEIGHT: &str = "microfacet_ndf_weight(wi, s.h)";
 const GGX_EVAL: &str = "ggx_d(a, h) / (4.0 * wi.z * wr.z)";
 const BECKMANN_EVAL: &str = "beckmann_d(a, h) / (4.0 * wi.z * wr.z)";
+const DIELECTRIC_GGX_EVAL: &str = "dielectric_ggx_eval(a, wi, wr, lobe_eta())";
+const DIELECTRIC_BECKMANN_EVAL: &str = "dielectric_beckmann_eval(a, wi, wr, lobe_eta())";
 
 /// Every sampler; an uber-kernel's sampler id is its index here.
 pub const REGISTRY: [SamplerSpec; 6] = [
@@ -85,6 +99,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: None,
             f64: true,
             dielectric: None,
+            dielectric_eval: None,
         },
         reference: Some(Reference {
             sample_h: |l, _, u| ward::sample_h(l.alpha_x, l.alpha_y, u),
@@ -105,6 +120,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: Some("beckmann_g1(a, w)"),
             f64: true,
             dielectric: Some("dielectric_beckmann_ndf"),
+            dielectric_eval: Some(DielectricEval { pdf: "dielectric_beckmann_ndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_BECKMANN_EVAL, weight: MICROFACET_NDF_WEIGHT }),
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.beckmann().sample_ndf(u),
@@ -125,6 +141,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: Some("beckmann_g1(a, w)"),
             f64: true,
             dielectric: Some("dielectric_beckmann_vndf"),
+            dielectric_eval: Some(DielectricEval { pdf: "dielectric_beckmann_vndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_BECKMANN_EVAL, weight: "dielectric_beckmann_vndf_weight(a, wi)" }),
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.beckmann().sample_vndf(wi, u),
@@ -145,6 +162,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: Some("ggx_g1(a, w)"),
             f64: true,
             dielectric: Some("dielectric_ggx_ndf"),
+            dielectric_eval: Some(DielectricEval { pdf: "dielectric_ggx_ndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_GGX_EVAL, weight: MICROFACET_NDF_WEIGHT }),
         },
         reference: Some(Reference {
             sample_h: |l, _, u| l.ggx().sample_ndf(u),
@@ -165,6 +183,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: Some("ggx_g1(a, w)"),
             f64: true,
             dielectric: Some("dielectric_ggx_vndf"),
+            dielectric_eval: Some(DielectricEval { pdf: "dielectric_ggx_vndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_GGX_EVAL, weight: "dielectric_ggx_vndf_weight(a, wi)" }),
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_vndf(wi, u),
@@ -185,6 +204,7 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             g1: Some("ggx_g1(a, w)"),
             f64: true,
             dielectric: None,
+            dielectric_eval: None,
         },
         reference: Some(Reference {
             sample_h: |l, wi, u| l.ggx().sample_bounded(wi, u),

@@ -9,7 +9,7 @@ use crate::reference::Invalid;
 use crate::reference::effects::Effects;
 use crate::stats::chi2::{self, Chi2};
 use crate::stats::expected::{self, Expected, Quadrature};
-use crate::stats::weighted::{AlbedoCheck, WEIGHT_ERROR_LIMIT, WeightedSums, two_sided};
+use crate::stats::weighted::{AlbedoCheck, AlbedoTest, WEIGHT_ERROR_LIMIT, WeightedSums, two_sided};
 use glam::DVec3;
 use serde::Serialize;
 
@@ -44,16 +44,20 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
     }
 }
 
+/// The narrowest feature of a rough dielectric's density and BSDF, for the quadrature's initial
+/// split: light leaving from inside near grazing is confined to a band far narrower than α (at
+/// θi = 95°, GGX α 0.5, η 1.5: 0.126 < cos θo < 0.131), which the split follows.
+fn dielectric_width(glass: &RoughDielectric, wi: DVec3) -> f64 {
+    let alpha = glass.lobe.alpha_x.min(glass.lobe.alpha_y).min(1.0);
+    if wi.z.abs() < 0.2 { alpha.min(0.02) } else { 0.6 * alpha }
+}
+
 /// A rough dielectric's expected counts: the bins from its density over the whole sphere, the
 /// samples on the wrong side of their event by reason from their densities over h
 /// ([`RoughDielectric::wrong_side_h`]), two integrals independent of the bins' (together they
 /// make the sphere's 1 − Σ, to the quadratures' accuracy).
 fn dielectric_expected(glass: &RoughDielectric, wi: DVec3, grid: crate::stats::histogram::SphereGrid, n: f64, q: &Quadrature) -> ExpectedCounts {
-    // Light leaving from inside near grazing is confined to a band far narrower than α (at
-    // θi = 95°, GGX α 0.5, η 1.5: 0.126 < cos θo < 0.131): the initial split follows it.
-    let alpha = glass.lobe.alpha_x.min(glass.lobe.alpha_y).min(1.0);
-    let width = if wi.z.abs() < 0.2 { alpha.min(0.02) } else { 0.6 * alpha };
-    let e = expected::sphere_probabilities(&|wo| glass.pdf(wi, wo), grid, width, q);
+    let e = expected::sphere_probabilities(&|wo| glass.pdf(wi, wo), grid, dielectric_width(glass, wi), q);
     // The wrong-side sets are slivers of h space bounded by the refraction's and reflection's
     // horizons (indicator edges, not smooth peaks): split at 0.02 rad whatever α. At 0.6 α
     // (Beckmann VNDF α 0.4, η 1.5, θi 130°) refracted_near_side came out at 45 % of its count.
@@ -147,8 +151,9 @@ pub fn angle_check(job: &Job, seed: u64, first: u64, gpu: &[[f32; 4]]) -> AngleC
 }
 
 /// Judges `sums` of `n` samples of a lobe case with `effects` at per-case `significance`:
-/// the albedo against the f64 quadrature of f cos θr, the sphere total against the furnace
-/// value where there is one, the per-bin weight check, and no overflow.
+/// the albedo against the f64 quadrature of f |cos θr| (a rough dielectric's reflected and
+/// transmitted albedos each), the sphere total against the furnace value where there is one,
+/// the per-bin weight check, and no overflow.
 ///
 /// ```
 /// use lobes::{engine::job::{Job, SampleRange, Scatter}, run::compare::albedo_check, stats::{histogram::SphereGrid, expected::Quadrature}};
@@ -169,31 +174,51 @@ pub fn albedo_check(
     significance: f64,
     q: &Quadrature,
 ) -> AlbedoCheck {
-    let Job::Lobe { lobe, incident, grid, .. } = job else { panic!("albedo of a lobe job") };
+    let Job::Lobe { lobe, incident, grid, scatter } = job else { panic!("albedo of a lobe job") };
     let wi = *incident;
-    let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
-    let f_cos = |w: glam::DVec3| effects.eval(lobe, wi, w) * w.z;
-    let reference_bins = expected::probabilities(&f_cos, *grid, width, q).probabilities;
-    let reference: f64 = reference_bins.iter().sum();
-    let albedo = sums.albedo(n);
-    let std_error = sums.std_error(n, true);
-    let (z, p_value) = two_sided(albedo - reference, std_error, reference);
+    // per bin, the quadrature of f |cos θo|; a dielectric's over the whole sphere, its furnace
+    // seen from the upper side (where the closed forms of Λ hold)
+    let (reference_bins, furnace_wi) = match *scatter {
+        Scatter::Reflect => {
+            let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
+            let f_cos = |w: DVec3| effects.eval(lobe, wi, w) * w.z;
+            (expected::probabilities(&f_cos, *grid, width, q).probabilities, wi)
+        }
+        Scatter::Dielectric { eta } => {
+            let glass = RoughDielectric::new(*lobe, eta).expect("a dielectric job is checked when made");
+            let f_cos = |w: DVec3| glass.eval(wi, w, effects.masking) * w.z.abs();
+            (expected::sphere_probabilities(&f_cos, *grid, dielectric_width(&glass, wi), q).probabilities, glass.upper_side(wi).0)
+        }
+    };
+    // the incident side's bins (a reflection's: the lower half holds nothing), and across the
+    // surface a dielectric's transmitted ones
+    let half = reference_bins.len() / 2;
+    let side = |lower: bool| {
+        let bins = if lower { &reference_bins[..half] } else { &reference_bins[half..] };
+        AlbedoTest::new(sums.hemisphere_albedo(n, lower), sums.hemisphere_std_error(n, lower), bins.iter().sum())
+    };
+    let below = wi.z < 0.0;
+    let reflected = side(below);
+    let transmitted = matches!(scatter, Scatter::Dielectric { .. }).then(|| side(!below));
     let sphere_total = sums.sphere_total(n);
     let sphere_std_error = sums.std_error(n, false);
-    let furnace = effects.furnace(lobe, wi);
+    let furnace = effects.furnace(lobe, furnace_wi);
     let furnace_p_value = furnace.map(|f| two_sided(sphere_total - f, sphere_std_error, f).1);
     let max_weight_error = sums.max_weight_error();
-    let passed = p_value >= significance
+    let passed = reflected.p_value >= significance
+        && transmitted.as_ref().is_none_or(|t| t.p_value >= significance)
         && furnace_p_value.is_none_or(|p| p >= significance)
         && max_weight_error <= WEIGHT_ERROR_LIMIT
         && sums.overflow == 0;
+    let AlbedoTest { albedo, std_error, reference, relative_error, z, p_value } = reflected;
     AlbedoCheck {
         albedo,
         std_error,
         reference,
-        relative_error: (albedo - reference) / reference,
+        relative_error,
         z,
         p_value,
+        transmitted,
         sphere_total,
         sphere_std_error,
         furnace,

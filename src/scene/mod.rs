@@ -709,8 +709,8 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         None => DEFAULT_ALPHA_ANGLE,
     };
     let lobe = Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: angle };
-    // a dielectric case has no effect keys (`scatter` rejects them) and reads eta itself
-    let effects = if scatter == Scatter::Reflect { effects(ctx, c, point, kind)? } else { None };
+    // a dielectric case has no Fresnel keys (`scatter` rejects them) and reads eta itself
+    let effects = effects(ctx, c, point, kind, scatter)?;
     if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
         let (span, given) = match (d.overrides.samples, point.get("samples").or(d.samples.map(|(_, v)| v))) {
             (Some(_), _) => (spanned.span(), " (--samples)"),
@@ -722,7 +722,8 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
 }
 
 /// `scatter` of a lobe case (reflect unless given) with a dielectric's `eta`: only for a
-/// sampler of the registry with a dielectric twin, and without the weighted pass's keys.
+/// sampler of the registry with a dielectric twin, and without Fresnel keys (its Fresnel term
+/// is its own).
 fn scatter(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, method: Method, lobe_v: &Val, method_span: &Range<usize>) -> Result<Scatter, SceneError> {
     let allowed = "use reflect or dielectric (with eta)";
     let form = match p.get("scatter") {
@@ -751,8 +752,8 @@ fn scatter(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, method: Method, lo
     }
     reject_keys(
         ctx,
-        &effect_keys(c, p).into_iter().filter(|(k, _)| *k != "eta").collect::<Vec<_>>(),
-        "does not apply to scatter = \"dielectric\" (a dielectric case counts samples, with its own Fresnel term); remove it",
+        &effect_keys(c, p).into_iter().filter(|(k, _)| ["fresnel", "f0", "k"].contains(k)).collect::<Vec<_>>(),
+        "does not apply to scatter = \"dielectric\" (the dielectric's Fresnel term is its own, from eta); remove it",
     )?;
     let eta_allowed = "eta is the index of the medium below the surface relative to the one above, > 0 and ≠ 1";
     let eta = match p.get("eta") {
@@ -778,8 +779,11 @@ fn effect_keys<'a>(c: &'a RawCase, p: &'a Point) -> [(&'static str, Option<&'a V
     [("weighted", c.weighted.as_ref()), ("fresnel", p.get("fresnel")), ("f0", p.get("f0")), ("eta", p.get("eta")), ("k", p.get("k")), ("masking", p.get("masking"))]
 }
 
-/// The effects of a lobe case: `None` unless it asks for a weighted histogram.
-fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<Effects>, SceneError> {
+/// The effects of a lobe case: `None` unless it asks for a weighted histogram. A rough
+/// dielectric (`scatter`) has masking only: `scatter` has rejected the Fresnel keys, and its
+/// `eta` is its own.
+fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, scatter: Scatter) -> Result<Option<Effects>, SceneError> {
+    let dielectric = scatter != Scatter::Reflect;
     let fresnel_allowed = "use none, schlick (with f0), conductor (with eta and k) or dielectric (with eta)";
     let fresnel = match p.get("fresnel") {
         None => Fresnel::None,
@@ -807,7 +811,7 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<E
         _ => Ok(()),
     };
     unused("f0", p.get("f0"), matches!(fresnel, Fresnel::Schlick { .. }))?;
-    unused("eta", p.get("eta"), matches!(fresnel, Fresnel::Conductor { .. } | Fresnel::Dielectric { .. }))?;
+    unused("eta", p.get("eta"), dielectric || matches!(fresnel, Fresnel::Conductor { .. } | Fresnel::Dielectric { .. }))?;
     unused("k", p.get("k"), matches!(fresnel, Fresnel::Conductor { .. }))?;
     let masking_allowed = "use none, g1, separable or height-correlated";
     let masking = match p.get("masking") {
@@ -825,6 +829,13 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind) -> Result<Option<E
             };
             if kind == LobeKind::Ward && m != Masking::None {
                 return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));
+            }
+            if dielectric && m == Masking::HeightCorrelated {
+                return Err(ctx.err(
+                    v.span(),
+                    "masking = \"height-correlated\" does not apply to scatter = \"dielectric\": across the surface the height-correlated G2 \
+                     (Heitz 2014, eq. 99) is a Beta function of Λ(ωi) and Λ(ωo), which lobes does not evaluate; use g1 or separable",
+                ));
             }
             m
         }

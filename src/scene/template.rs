@@ -32,7 +32,8 @@ alpha = 0.3               # roughness > 0, required; or anisotropic:
 incident_theta = {theta:?}      # degrees from the normal, 0 ≤ θ < 90 (dielectric: < 180, > 90 from inside)
 incident_phi = {phi:?}        # degrees, −360 ≤ φ ≤ 360
 # scatter = "reflect"     # reflect | dielectric: rough glass, reflection and refraction over the
-#                         # whole sphere (ggx or beckmann, ndf or vndf; with eta, no effects)
+#                         # whole sphere (ggx or beckmann, ndf or vndf; with eta; masking
+#                         # none, g1 or separable, no fresnel)
 # samples, bins, seed     # as in [defaults], for this case only
 # Effects: any of fresnel and masking makes the case weighted (Σ f cos θ / pdf per bin,
 # judged against the albedo); without them the case counts samples only.
@@ -42,7 +43,8 @@ incident_phi = {phi:?}        # degrees, −360 ≤ φ ≤ 360
 # eta = 1.5               # conductor: index of refraction > 0; dielectric: n_t / n_i > 0;
 #                         # scatter = "dielectric": n_below / n_above, > 0 and ≠ 1
 # k = 0.0                 # conductor: absorption ≥ 0
-# masking = "none"        # none | g1 | separable | height-correlated (not for ward)
+# masking = "none"        # none | g1 | separable | height-correlated (not for ward; a dielectric:
+#                         # not height-correlated)
 
 [[case]]
 name = "discrete"

@@ -25,6 +25,10 @@ pub struct WeightedSums {
     pub squares_all: u64,
     /// Samples whose weight was not summed: not finite, negative, or ≥ 2²³.
     pub overflow: u64,
+    /// Σ w² over the samples of the bins below the horizon (the first half: rows are even in
+    /// number, from cos θ = −1 up), in units of 2⁻¹⁶: a rough dielectric's other side.
+    #[serde(default)]
+    pub squares_lower: u64,
     /// Per bin, the largest relative difference between a sample's weight and
     /// eval · cos θr / pdf formed independently (0 for an empty bin).
     pub max_error: Vec<f32>,
@@ -37,7 +41,15 @@ pub fn to_fixed(w: f64, scale: f64) -> u64 {
 
 impl WeightedSums {
     pub fn zeros(bins: usize) -> Self {
-        Self { bins: vec![0; bins], invalid: [0; crate::reference::Invalid::COUNT], squares_bins: 0, squares_all: 0, overflow: 0, max_error: vec![0.0; bins] }
+        Self {
+            bins: vec![0; bins],
+            invalid: [0; crate::reference::Invalid::COUNT],
+            squares_bins: 0,
+            squares_all: 0,
+            overflow: 0,
+            squares_lower: 0,
+            max_error: vec![0.0; bins],
+        }
     }
 
     /// Adds one sample's weight in cell `cell` (a bin, or `bins + reason − 1`), as the kernel does.
@@ -50,6 +62,9 @@ impl WeightedSums {
             self.squares_all += sq;
             if cell < n {
                 self.squares_bins += sq;
+            }
+            if cell < n / 2 {
+                self.squares_lower += sq;
             }
         } else {
             self.overflow += 1;
@@ -67,6 +82,7 @@ impl WeightedSums {
         self.squares_bins += other.squares_bins;
         self.squares_all += other.squares_all;
         self.overflow += other.overflow;
+        self.squares_lower += other.squares_lower;
         for (a, b) in self.max_error.iter_mut().zip(&other.max_error) {
             *a = a.max(*b);
         }
@@ -82,6 +98,20 @@ impl WeightedSums {
         self.bins.iter().map(|&b| b as u128).sum::<u128>() as f64 / WEIGHT_SCALE / n as f64
     }
 
+    /// Σ w / N over the bins of one hemisphere, `lower` (z < 0) or upper: a rough dielectric's
+    /// reflected or transmitted albedo.
+    pub fn hemisphere_albedo(&self, n: u64, lower: bool) -> f64 {
+        let half = self.bins.len() / 2;
+        let bins = if lower { &self.bins[..half] } else { &self.bins[half..] };
+        bins.iter().map(|&b| b as u128).sum::<u128>() as f64 / WEIGHT_SCALE / n as f64
+    }
+
+    /// The standard error of [`hemisphere_albedo`](Self::hemisphere_albedo).
+    pub fn hemisphere_std_error(&self, n: u64, lower: bool) -> f64 {
+        let squares = if lower { self.squares_lower } else { self.squares_bins - self.squares_lower };
+        mean_std_error(self.hemisphere_albedo(n, lower), squares, n)
+    }
+
     /// Σ w / N over every sample, the reflections below the horizon included with |cos θr|:
     /// the whole sphere's ∫ f |cos θr| dωr (the weak white furnace).
     pub fn sphere_total(&self, n: u64) -> f64 {
@@ -93,14 +123,19 @@ impl WeightedSums {
     /// the horizon weigh 0) or of the sphere total.
     pub fn std_error(&self, n: u64, hemisphere: bool) -> f64 {
         let (mean, squares) = if hemisphere { (self.albedo(n), self.squares_bins) } else { (self.sphere_total(n), self.squares_all) };
-        let second = squares as f64 / SQUARE_SCALE / n as f64;
-        ((second - mean * mean).max(0.0) / n as f64).sqrt()
+        mean_std_error(mean, squares, n)
     }
 
     /// The largest per-bin weight difference.
     pub fn max_weight_error(&self) -> f32 {
         self.max_error.iter().copied().fold(0.0, f32::max)
     }
+}
+
+/// √((E(w²) − E(w)²) / N) from the mean E(w) and Σ w² in units of 2⁻¹⁶.
+fn mean_std_error(mean: f64, squares: u64, n: u64) -> f64 {
+    let second = squares as f64 / SQUARE_SCALE / n as f64;
+    ((second - mean * mean).max(0.0) / n as f64).sqrt()
 }
 
 #[cfg(test)]
@@ -137,20 +172,46 @@ mod tests {
     }
 }
 
+/// One albedo's z-test: Σ w / N over some bins against the f64 quadrature of f |cos θo| over them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct AlbedoTest {
+    pub albedo: f64,
+    pub std_error: f64,
+    pub reference: f64,
+    /// (albedo − reference) / reference.
+    pub relative_error: f64,
+    /// (albedo − reference) / std_error, and its two-sided p-value ([`two_sided`]).
+    pub z: f64,
+    pub p_value: f64,
+}
+
+impl AlbedoTest {
+    pub fn new(albedo: f64, std_error: f64, reference: f64) -> Self {
+        let (z, p_value) = two_sided(albedo - reference, std_error, reference);
+        Self { albedo, std_error, reference, relative_error: (albedo - reference) / reference, z, p_value }
+    }
+}
+
 /// The verdict on a weighted histogram.
 #[derive(Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct AlbedoCheck {
-    /// Σ w / N over the bins.
+    /// Σ w / N over the bins on the incident side (for a rough dielectric, the reflected albedo).
     pub albedo: f64,
     pub std_error: f64,
-    /// ∫ over the hemisphere of f cos θr by f64 quadrature (the sum of the per-bin integrals).
+    /// ∫ over the incident hemisphere of f |cos θr| by f64 quadrature (the sum of the per-bin
+    /// integrals).
     pub reference: f64,
     /// (albedo − reference) / reference.
     pub relative_error: f64,
     /// (albedo − reference) / std_error, and its two-sided p-value.
     pub z: f64,
     pub p_value: f64,
-    /// Σ w / N over every sample (reflections below the horizon with |cos θr|).
+    /// A rough dielectric's transmitted albedo: the bins across the surface, tested like the
+    /// reflected one (`None` for a reflection lobe).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmitted: Option<AlbedoTest>,
+    /// Σ w / N over every sample (reflections below the horizon, a dielectric's wrong-side
+    /// samples, with |cos θr|).
     pub sphere_total: f64,
     pub sphere_std_error: f64,
     /// The closed form of the sphere total, where the effects have one (the weak white furnace).
@@ -173,12 +234,16 @@ impl std::fmt::Debug for AlbedoCheck {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "albedo {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); sphere {:.6} ± {:.1e} vs furnace {:?} (p {:?}); weight error {:.1e}; overflow {}; {}",
+            "albedo {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); {}sphere {:.6} ± {:.1e} vs furnace {:?} (p {:?}); weight error {:.1e}; overflow {}; {}",
             self.albedo,
             self.std_error,
             self.reference,
             self.relative_error,
             self.p_value,
+            self.transmitted.as_ref().map_or(String::new(), |t| format!(
+                "transmitted {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); ",
+                t.albedo, t.std_error, t.reference, t.relative_error, t.p_value
+            )),
             self.sphere_total,
             self.sphere_std_error,
             self.furnace,

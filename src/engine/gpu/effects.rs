@@ -20,7 +20,7 @@
 use super::compose::{self, Kernel, call_site};
 use super::library;
 use super::precision::Precision;
-use crate::engine::job::Job;
+use crate::engine::job::{Job, Scatter};
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
@@ -59,11 +59,16 @@ pub fn sampler_id(kind: LobeKind, method: Method) -> u32 {
 
 /// The call sites of the samplers' weight, BRDF, density and (with masking) G1 that
 /// `shaders/passes/effect.wgsl` calls (one sampler in a specialised module, all in the uber-kernel;
-/// `sampler_sample` comes with the counting kernels, [`compose::lobe_kernel`]).
-fn samplers_glue(samplers: &[&SamplerSpec], rotated: bool, masking: bool) -> String {
-    let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, rotated, |w| w.weight.into());
-    src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, rotated, |w| w.eval.into());
-    src += &call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", samplers, rotated, |w| w.pdf.into());
+/// `sampler_sample` comes with the counting kernels, [`compose::lobe_kernel`]); for a rough
+/// `dielectric`, its weight, BSDF and density (`shaders/lib/dielectric_eval.wgsl`) and the same G1.
+fn samplers_glue(samplers: &[&SamplerSpec], rotated: bool, masking: bool, dielectric: bool) -> String {
+    let of = |w: &sampler::Wgsl| w.dielectric_eval.unwrap_or_else(|| panic!("{} has no dielectric", w.sample));
+    let pick = |reflect: fn(&sampler::Wgsl) -> &'static str, glass: fn(sampler::DielectricEval) -> &'static str| {
+        move |w: &sampler::Wgsl| String::from(if dielectric { glass(of(w)) } else { reflect(w) })
+    };
+    let mut src = call_site("sampler_weight", "a: vec2<f32>, wi: vec3<f32>, s: LobeSample", "f32", samplers, rotated, pick(|w| w.weight, |d| d.weight));
+    src += &call_site("sampler_eval", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>, h: vec3<f32>", "f32", samplers, rotated, pick(|w| w.eval, |d| d.eval));
+    src += &call_site("sampler_pdf", "a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>", "f32", samplers, rotated, pick(|w| w.pdf, |d| d.pdf));
     if masking {
         src += &call_site("sampler_g1", "a: vec2<f32>, w: vec3<f32>", "f32", samplers, rotated, |w| w.g1.unwrap_or("1.0").into());
     }
@@ -95,11 +100,15 @@ fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
 }
 
 /// `kernel` with the weighted pass over `samplers`, its effects chosen by `sel`: the samplers'
-/// density and weight modules, the effect files (or those without the effect), the call sites.
-fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rotated: bool, fresnel: bool, masking: bool) -> String {
+/// density and weight modules (a rough `dielectric`'s too), the effect files (or those without
+/// the effect), the call sites.
+fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rotated: bool, fresnel: bool, masking: bool, dielectric: bool) -> String {
     kernel.roots.push("lobes::weighted");
     for spec in samplers {
         kernel.job.uses(compose::sampler_module(spec, true));
+    }
+    if dielectric {
+        kernel.job.uses("lobes::dielectric_eval");
     }
     if !fresnel {
         kernel.chosen.push(library::NO_FRESNEL);
@@ -107,7 +116,7 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rota
     if !masking {
         kernel.chosen.push(library::NO_MASKING);
     }
-    kernel.job.push(&samplers_glue(samplers, rotated, masking));
+    kernel.job.push(&samplers_glue(samplers, rotated, masking, dielectric));
     kernel.job.push(&effect_call_sites(sel, fresnel, masking));
     kernel.source()
 }
@@ -116,7 +125,8 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rota
 /// that one module serves both passes of the case) and `shaders/passes/weighted.wgsl` with the
 /// effect files it needs.
 pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: Specialisation) -> Composed {
-    let Job::Lobe { lobe, .. } = job else { panic!("effects apply to lobe jobs only") };
+    let Job::Lobe { lobe, scatter, .. } = job else { panic!("effects apply to lobe jobs only") };
+    let dielectric = matches!(scatter, Scatter::Dielectric { .. });
     match how {
         Specialisation::Specialised => {
             let spec = sampler::find(lobe.kind, lobe.method);
@@ -133,9 +143,12 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
                 kernel.job.push("override MASKING: u32 = 1u;\n");
                 constants.push(("MASKING", effects.masking.mode() as f64));
             }
-            Composed { source: weighted(kernel, &[spec], &OVERRIDES, lobe.is_rotated(), fresnel, masking), constants }
+            Composed { source: weighted(kernel, &[spec], &OVERRIDES, lobe.is_rotated(), fresnel, masking, dielectric), constants }
         }
-        Specialisation::Uber => Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() },
+        Specialisation::Uber => {
+            assert!(!dielectric, "the uber-kernel draws reflections only (Ward and bounded VNDF have no dielectric)");
+            Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() }
+        }
     }
 }
 
@@ -154,7 +167,7 @@ fn compose_uber(job: &Job, workgroup_words: u32) -> String {
     let Job::Lobe { lobe, .. } = job else { panic!("the uber-kernel draws lobes") };
     let all: Vec<&SamplerSpec> = REGISTRY.iter().collect();
     let kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &all);
-    weighted(kernel, &all, &UNIFORM, lobe.is_rotated(), true, true)
+    weighted(kernel, &all, &UNIFORM, lobe.is_rotated(), true, true, false)
 }
 
 /// The `effect` uniform of a case (`Effect` in `shaders/passes/weighted.wgsl`).
@@ -187,6 +200,21 @@ mod tests {
                 }
             }
         }
+        // a rough dielectric's weighted pass: its own density, BSDF and weight, plain and rotated
+        for spec in REGISTRY.iter().filter(|s| s.wgsl.dielectric.is_some()) {
+            for masking in [Masking::None, Masking::G1, Masking::Separable] {
+                for alpha_angle in [0.0, 30.0] {
+                    let Job::Lobe { lobe, incident, grid, .. } = job(spec.kind, spec.method, true) else { unreachable!() };
+                    let glass = Job::Lobe { lobe: Lobe { alpha_angle, ..lobe }, incident, grid, scatter: crate::engine::job::Scatter::Dielectric { eta: 1.5 } };
+                    let c = compose_effects(&glass, &Effects { fresnel: Fresnel::None, masking }, 4096, Specialisation::Specialised);
+                    compose::validate("dielectric effects", &c.source).unwrap_or_else(|e| panic!("{} {masking:?}: {e}", spec.name()));
+                    let d = spec.wgsl.dielectric_eval.unwrap();
+                    for expr in [d.pdf, d.eval, d.weight] {
+                        assert!(c.source.contains(&format!("return {expr};")), "{}: {expr}", spec.name());
+                    }
+                }
+            }
+        }
         let c = compose_effects(&job(LobeKind::Ggx, Method::Vndf, false), &Effects::NONE, 4096, Specialisation::Uber);
         compose::validate("uber", &c.source).unwrap();
         assert!(c.constants.is_empty());
@@ -201,5 +229,13 @@ mod tests {
                 assert!(c.source.contains("    let s = sample_to_local(lobe_frame(), s_world);\n"));
             }
         }
+    }
+
+    /// The dielectric's density, BSDF and weight are written over `Real`: they compose in f64 too.
+    #[test]
+    fn the_dielectric_eval_composes_in_f64() {
+        let src = library::wgsl(&["lobes::dielectric_eval"], Precision::F64).unwrap();
+        compose::validate("dielectric_eval f64", &src).unwrap();
+        assert!(src.contains("alias Real = f64;") && src.contains("fn dielectric_ggx_vndf_pdf(a: vec2<Real>"));
     }
 }

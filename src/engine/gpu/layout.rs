@@ -19,8 +19,9 @@ const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
 pub const N_REASONS: u32 = Invalid::ALL.len() as u32;
 
 /// Cells after a weighted histogram's bins and reasons (`shaders/passes/weighted.wgsl`): Σw² over the
-/// bins, Σw² over all samples, and the count of weights not summed.
-pub const WEIGHT_EXTRA_CELLS: u32 = 3;
+/// bins, Σw² over all samples, the count of weights not summed, and Σw² over the bins below the
+/// horizon.
+pub const WEIGHT_EXTRA_CELLS: u32 = 4;
 
 /// `SCREAMING_CASE` of a kebab or snake name.
 fn constant_name(prefix: &str, name: &str) -> String {

@@ -75,7 +75,7 @@ macro_rules! shader {
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 30] = [
+static FILES: [File; 31] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -87,6 +87,7 @@ static FILES: [File; 30] = [
     shader!("lib/beckmann.wgsl"),
     shader!("lib/beckmann_eval.wgsl"),
     shader!("lib/dielectric.wgsl"),
+    shader!("lib/dielectric_eval.wgsl"),
     shader!("lib/fresnel.wgsl"),
     shader!("lib/masking.wgsl"),
     shader!("lib/discrete.wgsl"),

@@ -73,7 +73,8 @@ impl WeightedPipelines {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
         let bins = job.bins() as u64;
         // 2 words (lo, hi) per cell: the bins, one per invalid reason, then Σw² over the bins,
-        // Σw² over all samples and the overflow count (`shaders/passes/weighted.wgsl`).
+        // Σw² over all samples, the overflow count and Σw² over the bins below the horizon
+        // (`shaders/passes/weighted.wgsl`).
         let words = 2 * (bins + (N_REASONS + WEIGHT_EXTRA_CELLS) as u64);
         if words * 4 > gpu.limits.max_storage_buffer_binding_size {
             return Err(GpuError::TooLarge(format!(
@@ -116,6 +117,7 @@ impl WeightedPipelines {
             squares_bins: cells[extra],
             squares_all: cells[extra + 1],
             overflow: cells[extra + 2],
+            squares_lower: cells[extra + 3],
             max_error,
         };
         Ok(WeightedRun { sums, gpu_seconds, wall_seconds })
