@@ -237,6 +237,52 @@ fn the_density_integrates_to_the_mass_of_valid_samples_and_the_furnace_to_one() 
     }
 }
 
+/// The expected shares of the two wrong-side reasons (`expected::dielectric_wrong_side`, a
+/// quadrature about ωi with the sets' edges as breakpoints) against the f64 sampler's own
+/// counts: reflections through the surface (`below_horizon`) and refractions back to the
+/// incident side (`refracted_near_side`), each a binomial z-test. The cases include TIR from
+/// inside and the one a 2-D rule over (cos θh, φh) cells got wrong, θi 125°, η 1.33, where that
+/// rule's refracted_near_side share is shown to fail the same test.
+#[test]
+fn the_wrong_side_shares_match_the_sampler_reason_by_reason() {
+    const M: u64 = 1_000_000;
+    let cases = [(0.3, 1.33, 125.0), (0.4, 1.5, 130.0), (0.3, 1.5, 30.0), (0.5, 1.0 / 1.5, 60.0), (0.2, 2.5, 80.0), (0.3, 1.33, 175.0)];
+    let z = |count: u64, share: f64, m: u64| (count as f64 - m as f64 * share) / (m as f64 * share * (1.0 - share)).sqrt().max(1.0);
+    let count = |d: &RoughDielectric, wi: DVec3, m: u64, seed: u64| {
+        let (mut below, mut near) = (0u64, 0u64);
+        for i in 0..m {
+            let u = rng::uniforms(seed, i);
+            let s = d.sample(wi, [u[0], u[1], u[2]]);
+            let side = s.omega_o.z * wi.z.signum();
+            match s.event {
+                Event::Reflection if side <= 0.0 => below += 1,
+                Event::Transmission if side >= 0.0 => near += 1,
+                _ => {}
+            }
+        }
+        (below, near)
+    };
+    for (kind, method) in KINDS {
+        for (k, (alpha, eta, theta)) in cases.into_iter().enumerate() {
+            let d = RoughDielectric::new(Lobe { kind, method, alpha_x: alpha, alpha_y: alpha * 0.5, alpha_angle: 25.0 }, eta).unwrap();
+            let wi = spherical(f64::to_radians(theta), 0.3);
+            let (below_share, near_share) = lobes::stats::expected::dielectric_wrong_side(&d, wi, &Quadrature::default());
+            let (below, near) = count(&d, wi, M, 40 + k as u64);
+            let what = format!("{kind:?} {method:?} α {alpha} η {eta} θi {theta}°");
+            assert!(z(below, below_share, M).abs() < 4.5, "{what}: below_horizon {below} of {M}, expected share {below_share:.6}");
+            assert!(z(near, near_share, M).abs() < 4.5, "{what}: refracted_near_side {near} of {M}, expected share {near_share:.6}");
+        }
+    }
+    // The 2-D rule over the bins' cells of h, at θi 125°, η 1.33: 8 % short, far outside the test.
+    let d = RoughDielectric::new(Lobe { kind: LobeKind::Beckmann, method: Method::Ndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 }, 1.33).unwrap();
+    let wi = spherical(f64::to_radians(125.0), 0.0);
+    let grid_rule = probabilities(&|h| d.wrong_side_h(wi, h).1, SphereGrid { rows: 32, cols: 64 }, 0.02, &Quadrature::default()).probabilities.iter().sum::<f64>();
+    let (_, near) = count(&d, wi, 4 * M, 7);
+    let (_, near_share) = lobes::stats::expected::dielectric_wrong_side(&d, wi, &Quadrature::default());
+    assert!(z(near, near_share, 4 * M).abs() < 4.5, "refracted_near_side {near} of {}, share {near_share}", 4 * M);
+    assert!(z(near, grid_rule, 4 * M) > 6.0, "the grid rule's share {grid_rule} against {near} of {}", 4 * M);
+}
+
 // ---- the f32 WGSL twin on the GPU, through `lobes check` ----
 
 use lobes::check::{Domain, Reference, Settings, UserSampler, check};

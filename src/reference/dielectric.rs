@@ -202,6 +202,24 @@ impl RoughDielectric {
         }
     }
 
+    /// The values of h.z at which [`wrong_side_h`](Self::wrong_side_h) can jump, over the
+    /// microfacets at c = ωi·h (ωi on the upper side, η seen from there, [`upper_side`](Self::upper_side)):
+    /// h.z = 0, below which no microfacet lies; the reflection's horizon, 2c h.z = ωi.z
+    /// (ωr = 2c h − ωi); the refraction's, (c/η − cos θt) h.z = ωi.z/η (ωt of [`refract`]).
+    /// At fixed c each indicator is monotone in h.z, so between these values the densities are
+    /// smooth: the expected counts integrate them piece by piece.
+    pub fn wrong_side_h_z_breaks(wi: DVec3, eta: f64, c: f64) -> Vec<f64> {
+        let mut breaks = vec![0.0];
+        if c > 0.0 {
+            breaks.push(wi.z / (2.0 * c));
+            if let Some(ct) = fresnel::cos_transmitted(c.min(1.0), eta) {
+                breaks.push(wi.z / (c - eta * ct));
+            }
+        }
+        breaks.retain(|t| t.is_finite());
+        breaks
+    }
+
     /// The microfacet normal of the pair (ωi, ωo) on the upper side, its event and η seen from
     /// ωi, with both directions moved there; `None` where no microfacet connects them.
     fn connect(&self, wi: DVec3, wo: DVec3) -> Option<(DVec3, DVec3, DVec3, Event, f64)> {
