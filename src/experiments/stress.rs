@@ -137,7 +137,7 @@ pub fn run_case(case: &StressCase, gpu: Option<&mut GpuEngine>) -> anyhow::Resul
     rows.push(row);
     if let Some(engine) = gpu {
         let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 }, scatter: Scatter::Reflect };
-        let u32s: Vec<[f32; 2]> = us.iter().map(|u| [u[0] as f32, u[1] as f32]).collect();
+        let u32s: Vec<[f32; 3]> = us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0]).collect();
         let out = engine.explicit(&job, &u32s)?;
         let mut row = StressRow::new(&case.name, "gpu f32", us.len());
         for (g, c) in out.iter().zip(&cpu) {
@@ -177,7 +177,7 @@ pub fn run_all(mut gpu: Option<&mut GpuEngine>) -> anyhow::Result<Vec<StressRow>
 pub fn details(case: &StressCase, engine: &mut GpuEngine) -> anyhow::Result<String> {
     let us = uniforms();
     let job = Job::Lobe { lobe: case.lobe, incident: case.incident, grid: SphereGrid { rows: 2, cols: 1 }, scatter: Scatter::Reflect };
-    let u32s: Vec<[f32; 2]> = us.iter().map(|u| [u[0] as f32, u[1] as f32]).collect();
+    let u32s: Vec<[f32; 3]> = us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0]).collect();
     let out = engine.explicit(&job, &u32s)?;
     let mut t = format!("{}\n", case.name);
     for ((u, g), c) in us.iter().zip(&out).zip(us.iter().map(|&u| case.lobe.sample(case.incident, u))) {

@@ -7,7 +7,7 @@ use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
-use super::params::{Params, storage_entry};
+use super::params::{ExplicitInput, Params, storage_entry};
 use super::weighted::{WeightedPipelines, WeightedRun};
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use crate::reference::Invalid;
@@ -290,19 +290,21 @@ impl GpuEngine {
         self.per_sample(pipeline, job, range, &tf, 1)
     }
 
-    /// The GPU's samples for explicit uniforms, in f32: per sample `[ωr, reason]`, `[h, pdf_r]`
-    /// and `[ωr − f32(ωr), 0]` (the rest of an f64 kernel's ωr; 0 in f32 kernels). As many
-    /// dispatches as the adapter's storage bindings and grid need.
-    pub fn explicit(&mut self, job: &Job, u: &[[f32; 2]]) -> Result<Vec<[[f32; 4]; 3]>, GpuError> {
+    /// The GPU's samples for explicit uniforms u.xyz (u.xy draw h, u.z chooses a dielectric's
+    /// event, as `RoughDielectric::sample`'s `u[2]`), in f32: per sample `[ωr, reason]`,
+    /// `[h, pdf_r]` and `[ωr − f32(ωr), 0]` (the rest of an f64 kernel's ωr; 0 in f32 kernels).
+    /// As many dispatches as the adapter's storage bindings and grid need.
+    pub fn explicit(&mut self, job: &Job, u: &[[f32; 3]]) -> Result<Vec<[[f32; 4]; 3]>, GpuError> {
         const PER: u64 = 3;
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.explicit else { return Ok(Vec::new()) };
         let most = (self.max_storage_bytes() / (16 * PER)).min(self.gpu.limits.max_compute_workgroups_per_dimension as u64 * WG_SIZE as u64);
         let mut out = Vec::with_capacity(u.len());
         for part in u.chunks(most.max(1) as usize) {
+            let part: Vec<ExplicitInput> = part.iter().map(|&u| ExplicitInput::new(u)).collect();
             let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("explicit u"),
-                contents: bytemuck::cast_slice(part),
+                contents: bytemuck::cast_slice(&part),
                 usage: wgpu::BufferUsages::STORAGE,
             });
             let samples = self.per_sample(pipeline, job, SampleRange::whole(0, part.len() as u64), &input, PER)?;
@@ -315,7 +317,7 @@ impl GpuEngine {
     pub fn bins_of(&mut self, job: &Job, dirs: &[[f32; 3]]) -> Result<Vec<u32>, GpuError> {
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.bin_explicit else { return Ok(Vec::new()) };
-        let packed: Vec<[f32; 2]> = dirs.iter().flat_map(|d| [[d[0], d[1]], [d[2], 0.0]]).collect();
+        let packed: Vec<ExplicitInput> = dirs.iter().map(|&d| ExplicitInput::new(d)).collect();
         let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("explicit directions"),
             contents: bytemuck::cast_slice(&packed),
