@@ -7,6 +7,7 @@ use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
+use super::library::File;
 use super::params::{ExplicitInput, Params, storage_entry};
 use super::weighted::{WeightedPipelines, WeightedRun};
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
@@ -69,6 +70,10 @@ pub struct GpuEngine {
     /// unless `lobes::experiments::tradeoff` sets another); pipelines are cached by the composed
     /// text, which differs by precision.
     pub precision: Precision,
+    /// Files put in place of the built-in ones with the same import path in the counting and
+    /// per-sample kernels this engine composes: a test's deliberately broken copy of a library
+    /// file (`tests/stress.rs`); empty otherwise.
+    pub replaced: Vec<File>,
 }
 
 impl GpuEngine {
@@ -83,7 +88,7 @@ impl GpuEngine {
         ];
         let (layout, pipeline_layout) = gpu.layout("lobes kernel", &entries);
         let weighted = WeightedPipelines::new(&gpu);
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate }
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate, replaced: Vec::new() }
     }
 
     /// Opens the default adapter.
@@ -97,7 +102,9 @@ impl GpuEngine {
 
     /// The composed WGSL for `job` on this adapter, counting `tile` bins (all when `None`).
     pub fn source(&self, job: &Job, tile: Option<u32>) -> String {
-        compose::compose_precision(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision)
+        let mut kernel = compose::kernel(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision);
+        kernel.chosen.extend(self.replaced.iter().cloned());
+        kernel.source()
     }
 
     /// The largest storage buffer of counters this adapter binds, in bytes.
