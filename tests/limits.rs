@@ -195,7 +195,7 @@ fn counts_from_tiles_keep_64_bit_carries() {
 #[test]
 fn explicit_samples_are_split_to_fit_a_storage_binding() {
     let job = lobe(LobeKind::Beckmann, Method::Vndf, 0.3, 0.2, 40.0, 8, 16);
-    let u: Vec<[f32; 2]> = (0..1000).map(|i| [(i as f32 + 0.5) / 1000.0, ((i * 7919) % 1000) as f32 / 1000.0]).collect();
+    let u: Vec<[f32; 3]> = (0..1000).map(|i| [(i as f32 + 0.5) / 1000.0, ((i * 7919) % 1000) as f32 / 1000.0, 0.0]).collect();
     let whole = full().explicit(&job, &u).unwrap();
     let split = small(4096).explicit(&job, &u).unwrap();
     assert_eq!(whole.len(), u.len());

@@ -1,5 +1,6 @@
 //! The stability suite (`lobes stress`) as tests: every sampler at the inputs where naive
-//! formulas break, on the GPU (f32) and the CPU (f64), plus the discrete hard cases.
+//! formulas break, on the GPU (f32) and the CPU (f64), the rough dielectric's hard cases and
+//! broken copies of its WGSL caught, plus the discrete hard cases.
 
 use lobes::engine::gpu::GpuEngine;
 use lobes::engine::job::{DiscreteMethod, Job, SampleRange, Scatter};
@@ -20,6 +21,11 @@ fn every_sampler_is_stable_at_the_hard_inputs() {
     assert!(failed.is_empty(), "unstable: {failed:?}");
     // the suite exercises invalid samples too (u at 0 and 1, grazing and below-horizon light)
     assert!(rows.iter().any(|r| r.valid < r.samples));
+    // the rough dielectric's rows: GGX and Beckmann × NDF and visible normals, 30 cases each, on
+    // the GPU and the CPU, every GPU row with densities compared
+    let glass: Vec<_> = rows.iter().filter(|r| r.case.contains(" glass ")).collect();
+    assert_eq!(glass.len(), 2 * 4 * 30);
+    assert!(glass.iter().filter(|r| r.kernel == "gpu f32").all(|r| r.worst_pdf_error > 0.0 && r.valid > 0));
 }
 
 fn gpu_counts(e: &mut GpuEngine, weights: &[f64], method: DiscreteMethod, n: u64) -> (Distribution, Vec<u64>) {
@@ -126,7 +132,7 @@ fn random_search_beyond_the_listed_cases() {
         // near the antipode of ωs loses the direction: seen at 25000:1, not handled yet)
         let ay = if i % 3 == 0 { ax } else { (ax * 10f64.powf(3.0 * (2.0 * r[1] - 1.0))).clamp(1e-6, 10.0) };
         let wi = reflect::spherical((90.0 * r[2]).to_radians(), 360f64.to_radians() * r[3]);
-        let case = StressCase { name: format!("random {i}: {kind:?} {method:?} α ({ax:.3e}, {ay:.3e}) ωi {wi:?}"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }, incident: wi };
+        let case = StressCase { name: format!("random {i}: {kind:?} {method:?} α ({ax:.3e}, {ay:.3e}) ωi {wi:?}"), lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 }, incident: wi, scatter: Scatter::Reflect };
         for row in run_case(&case, Some(&mut e)).unwrap() {
             if !row.passed {
                 failed.push(format!("{} [{}]: {:?}", row.case, row.kernel, row));
@@ -134,4 +140,52 @@ fn random_search_beyond_the_listed_cases() {
         }
     }
     assert!(failed.is_empty(), "{failed:#?}");
+}
+
+/// The suite catches a broken rough dielectric on the GPU: a copy of
+/// `shaders/lib/dielectric.wgsl` put in place of the built-in one fails the dielectric rows
+/// that its error shows in, by the check that should see it, while the built-in one passes
+/// them all (`every_sampler_is_stable_at_the_hard_inputs`).
+/// - Eq. 17 as Walter writes it, η² cos θt / (c − η cos θt)²: the difference cancels as η → 1,
+///   and at η = 1 ± 1e-6 the f32 density is off by ~25 %, 250 times what the density check
+///   allows (at 1 ± 1e-3 it keeps enough digits to pass).
+/// - A refraction without the test for total internal reflection: past the critical angle F = 1,
+///   so only u.z = 1 refracts, along a direction that is no unit vector and does not agree
+///   with f64's reflection.
+#[test]
+fn broken_dielectrics_are_caught() {
+    use lobes::engine::gpu::library::{self, File};
+    use lobes::experiments::stress::{dielectric_cases, run_case};
+    let text = library::source("lobes::dielectric").unwrap();
+    let edit = |from: &str, to: &str| {
+        assert!(text.contains(from), "shaders/lib/dielectric.wgsl no longer has `{from}`");
+        text.replace(from, to)
+    };
+    let naive = edit("return eta * eta * ct * s * s / (k * k);", "let d = c - eta * ct;\n    return eta * eta * ct / (d * d);");
+    let no_tir = edit("if (c <= 0.0 || ct < 0.0 || u < f) {", "if (c <= 0.0 || u < f) {");
+    let cases = dielectric_cases();
+    let mut e = engine();
+    for (what, broken, must_fail) in [("eq. 17 as written", naive, "1e-6 a"), ("no TIR test", no_tir, "past-critical")] {
+        e.replaced = vec![File::generated(format!("shaders/lib/dielectric.wgsl, {what}"), broken)];
+        let mut failed = Vec::new();
+        for case in &cases {
+            let rows = run_case(case, Some(&mut e)).unwrap();
+            let gpu = rows.iter().find(|r| r.kernel == "gpu f32").unwrap();
+            if !gpu.passed {
+                failed.push((case.name.clone(), gpu.clone()));
+            }
+        }
+        let names: Vec<&str> = failed.iter().map(|(n, _)| n.as_str()).collect();
+        for case in cases.iter().filter(|c| c.name.contains(must_fail)) {
+            assert!(names.contains(&case.name.as_str()), "{what}: `{}` passed; failed: {names:?}", case.name);
+        }
+        eprintln!("{what}: {} of {} dielectric rows fail: {names:?}", failed.len(), cases.len());
+        // and by the check that should see it
+        for (name, row) in failed.iter().filter(|(n, _)| n.contains(must_fail)) {
+            match what {
+                "eq. 17 as written" => assert!(row.worst_pdf_error > 1.0, "{what}: {name}: {row:?}"),
+                _ => assert!(row.worst_unit_error > lobes::experiments::stress::UNIT_BOUND_F32 && row.validity_mismatches > 0, "{what}: {name}: {row:?}"),
+            }
+        }
+    }
 }

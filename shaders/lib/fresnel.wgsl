@@ -23,15 +23,20 @@ fn fresnel_cos_transmitted(c: Real, eta: Real) -> Real {
 
 // A dielectric seen from outside, relative index eta = n_t / n_i (pbrt-v4 FrDielectric, eq. 9.5):
 // 1 past the critical angle. Over Real: the rough dielectric (shaders/lib/dielectric.wgsl) also
-// runs in f64 kernels.
+// runs in f64 kernels. The amplitudes are written as quotients by Snell's law, without the
+// cancellation of eta c - ct and c - eta ct as eta -> 1 (reference::fresnel::dielectric).
 fn fresnel_dielectric(c: Real, eta: Real) -> Real {
     let ci = clamp(c, 0.0, 1.0);
     let ct = fresnel_cos_transmitted(ci, eta);
-    if (ct < 0.0) {
+    // at grazing incidence (ci = 0) both amplitudes are -1, F = 1 exactly
+    if (ct < 0.0 || ci == 0.0) {
         return 1.0;
     }
-    let r_parl = (eta * ci - ct) / (eta * ci + ct);
-    let r_perp = (ci - eta * ct) / (ci + eta * ct);
+    let k = (eta - 1.0) * (eta + 1.0);
+    let p = eta * ci + ct;
+    let s = ci + eta * ct;
+    let r_parl = k * (ci * ci * (eta * eta + 1.0) - 1.0) / (eta * eta * p * p);
+    let r_perp = -k / (s * s);
     return 0.5 * (r_parl * r_parl + r_perp * r_perp);
 }
 

@@ -16,8 +16,8 @@ fn draw(index: vec2<u32>) -> u32 {
     return select(bin_of(s.wr), BINS + reason - 1u, reason != 0u);
 }
 
-// Sample i uses explicit_u[i] (shaders/passes/lobe_kernel.wgsl; any u a caller can pass, 0 and 1
-// included) and writes (wr_hi, reason code), (h, pdf_r) and (wr_lo, 0): wr as an f32 pair
+// Sample i uses the uniforms explicit_u[i].xyz (shaders/passes/lobe_kernel.wgsl; any u a caller
+// can pass, 0 and 1 included; u.z chooses a dielectric's event as in lobe_sample_at) and writes (wr_hi, reason code), (h, pdf_r) and (wr_lo, 0): wr as an f32 pair
 // (lobes::math's f32_pair; wr_lo is 0 in the f32 kernels), with which the f64 kernels' wr comes
 // back to ~2^-48.
 @compute @workgroup_size(WG_SIZE)
@@ -26,8 +26,7 @@ fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.count) {
         return;
     }
-    // u.z = 0: a dielectric reflects wherever F > 0
-    let s = lobe_sample_u(vec3<f32>(explicit_u[i], 0.0));
+    let s = lobe_sample_u(explicit_u[i].xyz);
     let wr = f32_pair(s.wr);
     directions_out[3u * i] = vec4<f32>(wr[0], f32(lobe_classify(s)));
     directions_out[3u * i + 1u] = vec4<f32>(vec3<f32>(s.h), f32(s.pdf_r));

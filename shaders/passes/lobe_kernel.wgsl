@@ -47,18 +47,24 @@ fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
     directions_out[i] = vec4<f32>(vec3<f32>(s.wr), f32(lobe_classify(s)));
 }
 
-// Explicit uniforms for the stability suite (explicit_samples, shaders/passes/lobe_draw.wgsl), or
-// explicit directions for bin_explicit.
-@group(0) @binding(3) var<storage, read> explicit_u: array<vec2<f32>>;
+// The per-sample passes' input, one element per sample (ExplicitInput in
+// src/engine/gpu/params.rs, whose layout a test checks against this one): explicit uniforms u.xyz
+// for the stability suite and the f64 angle check (explicit_samples,
+// shaders/passes/lobe_draw.wgsl), or explicit directions for bin_explicit.
+struct ExplicitInput {
+    xyz: vec3<f32>,
+    unused: f32,
+}
 
-// Binning of explicit directions for the stability suite: direction i is packed in explicit_u
-// as (x, y) at 2i and (z, unused) at 2i + 1; its bin is written to directions_out[i].x.
+@group(0) @binding(3) var<storage, read> explicit_u: array<ExplicitInput>;
+
+// Binning of explicit directions for the stability suite: direction i is explicit_u[i].xyz; its
+// bin is written to directions_out[i].x.
 @compute @workgroup_size(WG_SIZE)
 fn bin_explicit(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.count) {
         return;
     }
-    let w = vec3<f32>(explicit_u[2u * i], explicit_u[2u * i + 1u].x);
-    directions_out[i] = vec4<f32>(f32(bin_of(vec3<Real>(w))), 0.0, 0.0, 0.0);
+    directions_out[i] = vec4<f32>(f32(bin_of(vec3<Real>(explicit_u[i].xyz))), 0.0, 0.0, 0.0);
 }

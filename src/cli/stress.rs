@@ -15,8 +15,8 @@ pub struct StressArgs {
     /// Print only the rows that fail.
     #[arg(long)]
     pub failures: bool,
-    /// List every sample (u, CPU and GPU directions, pdfs, validity) of the cases whose name
-    /// contains this text, instead of the table.
+    /// List every sample (u, CPU and GPU directions, events, pdfs, validity) of the cases whose
+    /// name contains this text, instead of the table.
     #[arg(long, value_name = "TEXT")]
     pub case: Option<String>,
     #[command(flatten)]
@@ -39,7 +39,7 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
     } else {
         let shown = rows.iter().filter(|r| !args.failures || !r.passed);
         let mut t = table::render(
-            &["case", "kernel", "n", "valid", "unit err", "bad", "mism", "angle rad", "verdict"],
+            &["case", "kernel", "n", "valid", "unit err", "bad", "mism", "angle rad", "pdf err/bound", "verdict"],
             shown.map(|r| {
                 vec![
                     r.case.clone(),
@@ -50,6 +50,7 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
                     r.bad_values.to_string(),
                     r.validity_mismatches.to_string(),
                     format!("{:.2e}", r.worst_angle_rad),
+                    format!("{:.2e}", r.worst_pdf_error),
                     if r.passed { "pass" } else { "FAIL" }.to_string(),
                 ]
             }),

@@ -158,12 +158,21 @@ impl RoughDielectric {
     /// assert!((s.pdf_o / glass.pdf(wi, s.omega_o) - 1.0).abs() < 1e-9);
     /// ```
     pub fn sample(&self, wi: DVec3, u: [f64; 3]) -> DielectricSample {
+        let (upper, _) = self.upper_side(wi);
+        self.scatter(wi, self.lobe.sample_h(upper, [u[0].max(U_FLOOR), u[1].max(U_FLOOR)]), u[2])
+    }
+
+    /// Scatters ωi (either side) about the microfacet normal h, given on the upper side (where
+    /// [`upper_side`](Self::upper_side) puts ωi): reflection when `u2` < F(ωi·h), refraction
+    /// otherwise, with the densities of the module notes for h drawn by the lobe's sampler. The
+    /// second half of [`sample`](Self::sample); `shaders/lib/dielectric.wgsl`'s
+    /// `dielectric_scatter` is its twin.
+    pub fn scatter(&self, wi: DVec3, h: DVec3, u2: f64) -> DielectricSample {
         let (flip, wi, eta) = self.incident(wi);
-        let h = self.lobe.sample_h(wi, [u[0].max(U_FLOOR), u[1].max(U_FLOOR)]);
         let pdf_h = self.lobe.pdf_h(wi, h);
         let c = wi.dot(h);
         let f = fresnel::dielectric(c, eta);
-        let (event, wo, pdf) = match refract(wi, h, eta).filter(|_| u[2] >= f) {
+        let (event, wo, pdf) = match refract(wi, h, eta).filter(|_| u2 >= f) {
             Some(wt) => (Event::Transmission, wt, fresnel::dielectric_transmittance(c, eta) * pdf_h * jacobian_transmitted(c, -wt.dot(h), eta)),
             None => {
                 let wr = reflect(wi, h);

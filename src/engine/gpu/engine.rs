@@ -7,7 +7,8 @@ use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
-use super::params::{Params, storage_entry};
+use super::library::File;
+use super::params::{ExplicitInput, Params, storage_entry};
 use super::weighted::{WeightedPipelines, WeightedRun};
 use crate::engine::job::{Counts, DiscreteMethod, Job, SampleRange};
 use crate::reference::Invalid;
@@ -69,6 +70,10 @@ pub struct GpuEngine {
     /// unless `lobes::experiments::tradeoff` sets another); pipelines are cached by the composed
     /// text, which differs by precision.
     pub precision: Precision,
+    /// Files put in place of the built-in ones with the same import path in the counting and
+    /// per-sample kernels this engine composes: a test's deliberately broken copy of a library
+    /// file (`tests/stress.rs`); empty otherwise.
+    pub replaced: Vec<File>,
 }
 
 impl GpuEngine {
@@ -83,7 +88,7 @@ impl GpuEngine {
         ];
         let (layout, pipeline_layout) = gpu.layout("lobes kernel", &entries);
         let weighted = WeightedPipelines::new(&gpu);
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate }
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate, replaced: Vec::new() }
     }
 
     /// Opens the default adapter.
@@ -97,7 +102,9 @@ impl GpuEngine {
 
     /// The composed WGSL for `job` on this adapter, counting `tile` bins (all when `None`).
     pub fn source(&self, job: &Job, tile: Option<u32>) -> String {
-        compose::compose_precision(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision)
+        let mut kernel = compose::kernel(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision);
+        kernel.chosen.extend(self.replaced.iter().cloned());
+        kernel.source()
     }
 
     /// The largest storage buffer of counters this adapter binds, in bytes.
@@ -290,19 +297,21 @@ impl GpuEngine {
         self.per_sample(pipeline, job, range, &tf, 1)
     }
 
-    /// The GPU's samples for explicit uniforms, in f32: per sample `[ωr, reason]`, `[h, pdf_r]`
-    /// and `[ωr − f32(ωr), 0]` (the rest of an f64 kernel's ωr; 0 in f32 kernels). As many
-    /// dispatches as the adapter's storage bindings and grid need.
-    pub fn explicit(&mut self, job: &Job, u: &[[f32; 2]]) -> Result<Vec<[[f32; 4]; 3]>, GpuError> {
+    /// The GPU's samples for explicit uniforms u.xyz (u.xy draw h, u.z chooses a dielectric's
+    /// event, as `RoughDielectric::sample`'s `u[2]`), in f32: per sample `[ωr, reason]`,
+    /// `[h, pdf_r]` and `[ωr − f32(ωr), 0]` (the rest of an f64 kernel's ωr; 0 in f32 kernels).
+    /// As many dispatches as the adapter's storage bindings and grid need.
+    pub fn explicit(&mut self, job: &Job, u: &[[f32; 3]]) -> Result<Vec<[[f32; 4]; 3]>, GpuError> {
         const PER: u64 = 3;
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.explicit else { return Ok(Vec::new()) };
         let most = (self.max_storage_bytes() / (16 * PER)).min(self.gpu.limits.max_compute_workgroups_per_dimension as u64 * WG_SIZE as u64);
         let mut out = Vec::with_capacity(u.len());
         for part in u.chunks(most.max(1) as usize) {
+            let part: Vec<ExplicitInput> = part.iter().map(|&u| ExplicitInput::new(u)).collect();
             let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("explicit u"),
-                contents: bytemuck::cast_slice(part),
+                contents: bytemuck::cast_slice(&part),
                 usage: wgpu::BufferUsages::STORAGE,
             });
             let samples = self.per_sample(pipeline, job, SampleRange::whole(0, part.len() as u64), &input, PER)?;
@@ -315,7 +324,7 @@ impl GpuEngine {
     pub fn bins_of(&mut self, job: &Job, dirs: &[[f32; 3]]) -> Result<Vec<u32>, GpuError> {
         let kernel = self.kernel(job)?;
         let Some(pipeline) = &kernel.bin_explicit else { return Ok(Vec::new()) };
-        let packed: Vec<[f32; 2]> = dirs.iter().flat_map(|d| [[d[0], d[1]], [d[2], 0.0]]).collect();
+        let packed: Vec<ExplicitInput> = dirs.iter().map(|&d| ExplicitInput::new(d)).collect();
         let input = self.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("explicit directions"),
             contents: bytemuck::cast_slice(&packed),

@@ -85,6 +85,23 @@ impl Params {
     }
 }
 
+/// One element of the per-sample passes' input (`ExplicitInput` in
+/// `shaders/passes/lobe_kernel.wgsl`, binding 3; `tests::explicit_input_layout` checks the two
+/// layouts agree): a sample's uniforms u.xyz (`explicit_samples`: u.xy draw h, u.z a dielectric's
+/// event) or a direction (`bin_explicit`).
+#[repr(C, align(16))]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ExplicitInput {
+    pub xyz: [f32; 3],
+    unused: f32,
+}
+
+impl ExplicitInput {
+    pub fn new(xyz: [f32; 3]) -> Self {
+        Self { xyz, unused: 0.0 }
+    }
+}
+
 /// A compute storage buffer entry at `binding`.
 pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -121,5 +138,16 @@ mod tests {
         let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();
         let source = super::super::compose::compose(&Job::Discrete { dist, method: DiscreteMethod::Alias }, 4096);
         super::super::layout::check_struct(&source, "Params", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
+    }
+
+    #[test]
+    fn explicit_input_layout() {
+        use crate::reference::{Lobe, LobeKind, Method};
+        let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
+        let grid = crate::stats::histogram::SphereGrid { rows: 2, cols: 1 };
+        let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid, scatter: crate::engine::job::Scatter::Reflect };
+        let source = super::super::compose::compose(&job, 4096);
+        let members = [("xyz", offset_of!(ExplicitInput, xyz)), ("unused", offset_of!(ExplicitInput, unused))];
+        super::super::layout::check_struct(&source, "ExplicitInput", size_of::<ExplicitInput>(), align_of::<ExplicitInput>(), &members).unwrap();
     }
 }

@@ -215,10 +215,11 @@ pub fn unavailable(engine: &GpuEngine, sampler: Sampler, precision: Precision) -
 /// the f64 reference. The directions come back as f32 hi + lo pairs (lo = 0 in f32 kernels).
 pub fn angle_error(engine: &mut GpuEngine, job: &Job, seed: u64, n: u32) -> anyhow::Result<AngleCheck> {
     let Job::Lobe { lobe, incident, .. } = job else { anyhow::bail!("angle_error: a lobe job") };
-    let u: Vec<[f32; 2]> = (0..n as u64)
+    // u.z = 0: the sweep's jobs reflect, and u.z only chooses a dielectric's event
+    let u: Vec<[f32; 3]> = (0..n as u64)
         .map(|i| {
             let r = rng::uniforms(seed, i);
-            [r[0] as f32, r[1] as f32]
+            [r[0] as f32, r[1] as f32, 0.0]
         })
         .collect();
     let gpu = engine.explicit(job, &u)?;
