@@ -88,7 +88,9 @@ fn beckmann_sample_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSamp
     let d = a * vec2<Real>(math_cos(phi), math_sin(phi));
     let len = length(d);
     let h = from_tan_theta(sqrt(neg_ln(1.0 - u.x)) * len, d.x / len, d.y / len);
-    return reflect_sample(wi, h, beckmann_d(a, h) * h.z);
+    // D(h) h_z (beckmann_d) with its exponential e^{-tan^2 th / len^2} known: 1 - u.x; 0 at u.x = 1,
+    // the horizon
+    return reflect_sample(wi, h, select(0.0, (1.0 - u.x) / (PI * a.x * a.y * h.z * h.z * h.z), u.x < 1.0));
 }
 
 // Heitz & d'Eon 2014: the unnormalised CDF of the visible slope, C(x) = erfc(-x)/2 + tan e^{-x^2}/(2 sqrt(pi)),
