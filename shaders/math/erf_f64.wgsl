@@ -10,8 +10,9 @@ const INV_SQRT_PI: Real = 0.5641895835477563;
 const TWO_OVER_SQRT_PI: Real = 1.1283791670955126;
 
 // The visible-slope inversion (shaders/lib/beckmann.wgsl beckmann_visible_slope) as
-// src/reference/beckmann.rs does it: Newton inside the bisection bracket until a step is below
-// 4 ulps of x (up to 200 steps where C' -> 0 and only bisection helps); the CDF solved directly,
+// src/reference/beckmann.rs does it: steps (Halley's here, Newton's there) inside the bisection
+// bracket until a step is below 4 ulps of x (up to 200 steps where C' -> 0 and only bisection
+// helps); the CDF solved directly,
 // as the reference does (the f32 kernels' complement form is exact only to its 4-point
 // quadrature, ~1e-10 in f64); the grazing limit only past tan 1e15, where it is exact to f64.
 const SLOPE_NEWTON_STEPS: i32 = 200;
@@ -32,12 +33,18 @@ fn math_exp_neg_sq(x: Real) -> Real {
 // else the continued fraction erfc z = e^{-z^2}/sqrt(pi) / (z + (1/2)/(z + 1/(z + (3/2)/(z + ...))))
 // (A&S 7.1.14); erfc(-z) = 2 - erfc z.
 fn math_erfc(x: Real) -> Real {
+    return math_erfc_given(x, math_exp_neg_sq(x));
+}
+
+// erfc x from e = e^{-x^2} (math_exp_neg_sq(x)), which the visible-slope inversion has already
+// (shaders/lib/beckmann.wgsl); both forms of math_erfc are e times a function of |x|.
+fn math_erfc_given(x: Real, e: Real) -> Real {
     let z = abs(x);
     var r: Real;
     if (z < 2.5) {
-        r = 1.0 - TWO_OVER_SQRT_PI * math_exp_neg_sq(z) * z * erf_series_sum(z * z);
+        r = 1.0 - TWO_OVER_SQRT_PI * e * z * erf_series_sum(z * z);
     } else {
-        r = math_exp_neg_sq(z) * INV_SQRT_PI / erfc_cf_denominator(z);
+        r = e * INV_SQRT_PI / erfc_cf_denominator(z);
     }
     return select(r, 2.0 - r, x < 0.0);
 }
