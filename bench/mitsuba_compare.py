@@ -321,6 +321,31 @@ def compare_expected(m, l):
     return {"rel_l1": l1, "max_sigma": sig}
 
 
+PROBE_VARIANTS = [("A_wg", "sample + workgroup-atomic histogram"),
+                  ("B_none", "sample + bin, no histogram"),
+                  ("D_noatan", "sample + row only, no histogram")]
+
+
+def run_probe(args, workdir, env):
+    """bench/probe's kernels at 2^24 samples (1024 workgroups x 16384): samples/s per variant."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    binary = os.path.join(os.path.dirname(args.lobes), "examples", "kernel_probe")
+    if not os.access(binary, os.X_OK):
+        die(f"--probe: {binary} not found; run `cargo build --release --example kernel_probe`")
+    out = {}
+    for name, _ in PROBE_VARIANTS:
+        path = os.path.join(workdir, f"probe_{name}.wgsl")
+        with open(path, "w") as f:
+            for part in ("common.wgsl", f"{name}.wgsl"):
+                with open(os.path.join(here, "probe", part)) as src:
+                    f.write(src.read())
+        cmd = [binary, path, "1024", "8192", "16384", str(max(args.runs, 5))]
+        print("# " + " ".join(cmd), file=sys.stderr)
+        line = subprocess.run(cmd, env=env, check=True, capture_output=True, text=True).stdout
+        out[name] = float(line.split("samples/s")[0].split()[-1])
+    return out
+
+
 def fmt(x, spec=".3g"):
     return "n/a" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
@@ -352,6 +377,9 @@ def main():
     ap.add_argument("--mesa-env", metavar="FILE",
                     help="also measure lobes with the environment this shell file exports (a private lavapipe, "
                          "e.g. Mesa 25 from bookworm-backports: docs/install-mesa.md)")
+    ap.add_argument("--probe", action="store_true",
+                    help="also run bench/probe's plain kernels (A_wg, B_none, D_noatan; needs "
+                         "`cargo build --release --example kernel_probe`) on each driver, for the kernel ceiling")
     ap.add_argument("--json", metavar="FILE", help="also write all measurements to FILE")
     args = ap.parse_args()
     if args.res % 2:
@@ -384,6 +412,9 @@ def main():
     with tempfile.TemporaryDirectory(prefix="lobes-mitsuba-") as wd:
         mitsuba_batch = run_mitsuba_batch(args, wd)
         lobes = [measure_lobes(args, wd, bins, env, label) for label, env in drivers]
+        if args.probe:
+            for l, (label, env) in zip(lobes, drivers):
+                l["probe"] = run_probe(args, wd, env)
     print(f"# load average after: {loadavg()}", file=sys.stderr)
 
     i0 = args.ires[0]
@@ -448,7 +479,20 @@ def main():
             print(f"| {row['lobe']} | {row['method']} | {row['mitsuba_p_value']:.3g} "
                   f"({'pass' if row['mitsuba_passed'] else 'FAIL'}) | {row['lobes_p_value']:.3g} "
                   f"({'pass' if row['lobes_passed'] else 'FAIL'}) " + cells + "|")
-        out_drivers.append({"label": l["label"], "lobes_adapter": l["adapter"], "mesa": l["mesa"], "rows": rows,
+        if "probe" in l:
+            m_sps = args.samples / results[("ggx", "ndf", "mitsuba", i0)]["hist_seconds"]
+            l_sps = l["bench"][("ggx", "ndf")]["samples_per_second"]
+            print()
+            print("The kernel ceiling (bench/probe; GGX NDF, 2^24 samples, median of %d): plain kernels against "
+                  "Mitsuba's GGX NDF sampling + histogram in this run." % max(args.runs, 5))
+            print()
+            print("| kernel | samples/s | / Mitsuba GGX NDF |")
+            print("|---|---|---|")
+            print(f"| Mitsuba {mi.__version__} GGX NDF (sample + histogram) | {m_sps:.3g} | 1 |")
+            print(f"| lobes GGX NDF (sample + histogram) | {l_sps:.3g} | {l_sps / m_sps:.2f} |")
+            for name, what in PROBE_VARIANTS:
+                print(f"| probe {name}: {what} | {l['probe'][name]:.3g} | {l['probe'][name] / m_sps:.2f} |")
+        out_drivers.append({"label": l["label"], "probe": l.get("probe"), "lobes_adapter": l["adapter"], "mesa": l["mesa"], "rows": rows,
                             "lobes_batch": l["batch"]})
 
     print()
