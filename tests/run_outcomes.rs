@@ -161,6 +161,32 @@ fn a_passing_run_on_the_gpu_has_only_lobes_lines_on_stderr() {
     assert_eq!((suite.tests, suite.failures, suite.errors), (2, 0, 0));
 }
 
+/// A rough dielectric's weighted case reports both albedos where CI reads them: the table (R
+/// and T), summary.json's `transmitted`, and the verdict. With G = G1(ωi) the two references and
+/// the expected share of wrong-side samples make the white furnace, 1 (an identity none of the
+/// three quadratures is built from).
+#[test]
+fn a_glass_case_reports_its_reflected_and_transmitted_albedo() {
+    let dir = scratch("glass");
+    let scene = dir.join("glass.toml");
+    let text = "[[case]]\nname = \"glass\"\nlobe = \"ggx\"\nmethod = \"vndf\"\nalpha = 0.3\nscatter = \"dielectric\"\neta = 1.5\n\
+                incident_theta = 130\nmasking = \"g1\"\nsamples = 200000\nbins = [16, 32]\n";
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let output = Command::new(LOBES).args(["run", "--cpu", "--out"]).arg(&out).arg(&scene).output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(output.status.code(), Some(0), "{stdout}{}", String::from_utf8_lossy(&output.stderr));
+    assert!(stdout.lines().any(|l| l.starts_with("glass") && l.contains(" R 0.") && l.contains(" T 0.")), "{stdout}");
+    let summary = read_summary(&out);
+    let albedo = summary.cases[0].measured.as_ref().unwrap().albedo.unwrap();
+    let t = albedo.transmitted.expect("a dielectric's transmitted albedo");
+    let h: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("glass/histogram.json")).unwrap()).unwrap();
+    let wrong_side: f64 = h["expected_invalid"].as_object().unwrap().values().map(|v| v.as_f64().unwrap()).sum::<f64>() / 200_000.0;
+    let furnace = albedo.reference + t.reference + wrong_side;
+    assert!((furnace - 1.0).abs() < 1e-3, "reflected {} + transmitted {} + wrong side {wrong_side} = {furnace}", albedo.reference, t.reference);
+    assert!(albedo.passed && t.p_value > 1e-4, "{albedo:?}");
+}
+
 /// `lobes --help` and the help of the commands with verdicts list every exit code.
 #[test]
 fn help_lists_the_exit_codes() {

@@ -130,7 +130,11 @@ fn case_section(h: &mut String, out: &Path, c: &CaseSummary) {
         }
         if let Some(a) = &m.albedo {
             let verdict = if a.passed { "pass" } else { "FAIL" };
-            figures.push(("albedo", format!("{:.5} against {:.5} ({:+.1e}), p = {}: {verdict}", a.albedo, a.reference, a.relative_error, compact(a.p_value))));
+            let name = if a.transmitted.is_some() { "reflected albedo" } else { "albedo" };
+            figures.push((name, format!("{:.5} against {:.5} ({:+.1e}), p = {}: {verdict}", a.albedo, a.reference, a.relative_error, compact(a.p_value))));
+            if let Some(t) = &a.transmitted {
+                figures.push(("transmitted albedo", format!("{:.5} against {:.5} ({:+.1e}), p = {}", t.albedo, t.reference, t.relative_error, compact(t.p_value))));
+            }
         }
     }
     if let Some(checks) = c.failed_checks.as_ref().filter(|f| !f.is_empty()) {

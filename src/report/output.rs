@@ -19,6 +19,7 @@ use super::npy;
 use crate::check::Domain;
 use crate::engine::job::Job;
 use crate::stats::histogram::SphereGrid;
+use crate::stats::weighted::AlbedoTest;
 use crate::reference::effects::Effects;
 use crate::run::record::{ByReason, CaseDescription, Timing, WeightedTiming};
 use crate::run::shard::ShardFile;
@@ -479,6 +480,9 @@ pub struct AlbedoSummary {
     pub p_value: f64,
     pub max_weight_error: f32,
     pub passed: bool,
+    /// A rough dielectric's transmitted albedo (the reflected one is above).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmitted: Option<AlbedoTest>,
 }
 
 impl CaseSummary {
@@ -505,6 +509,7 @@ impl CaseSummary {
                     p_value: w.check.p_value,
                     max_weight_error: w.check.max_weight_error,
                     passed: w.check.passed,
+                    transmitted: w.check.transmitted,
                 }),
                 max_angle_rad: r.angle.as_ref().map(|a| a.max_angle_rad),
             }),
@@ -539,6 +544,7 @@ impl CaseSummary {
                     p_value: a.p_value,
                     max_weight_error: a.max_weight_error as f32,
                     passed: a.passed,
+                    transmitted: None,
                 }),
                 max_angle_rad: None,
             }),
@@ -576,10 +582,16 @@ fn failure(r: &CaseResult) -> Option<String> {
     }
     if let Some(w) = r.weighted.as_ref().filter(|w| !w.check.passed) {
         let a = &w.check;
-        why.push(format!(
-            "albedo {:.5} against {:.5} by quadrature (relative error {:+.1e}, p = {:.3e}, level {:.3e})",
-            a.albedo, a.reference, a.relative_error, a.p_value, a.significance
-        ));
+        let albedo = |what: &str, albedo: f64, reference: f64, relative_error: f64, p: f64| {
+            format!("{what} {albedo:.5} against {reference:.5} by quadrature (relative error {relative_error:+.1e}, p = {p:.3e}, level {:.3e})", a.significance)
+        };
+        let reflected = if a.transmitted.is_some() { "reflected albedo" } else { "albedo" };
+        if a.p_value < a.significance {
+            why.push(albedo(reflected, a.albedo, a.reference, a.relative_error, a.p_value));
+        }
+        if let Some(t) = a.transmitted.as_ref().filter(|t| t.p_value < a.significance) {
+            why.push(albedo("transmitted albedo", t.albedo, t.reference, t.relative_error, t.p_value));
+        }
         if let Some(p) = a.furnace_p_value.filter(|&p| p < a.significance) {
             why.push(format!("white furnace p = {p:.3e}"));
         }
@@ -649,7 +661,10 @@ pub fn table_row(r: &CaseResult) -> [String; 9] {
         format!("{:.4}", r.chi2.p_value),
         if r.passed() { "pass".into() } else { "FAIL".into() },
         angle,
-        r.weighted.as_ref().map_or("-".into(), |w| format!("{:.5} ({:+.1e})", w.check.albedo, w.check.relative_error)),
+        r.weighted.as_ref().map_or("-".into(), |w| match &w.check.transmitted {
+            None => format!("{:.5} ({:+.1e})", w.check.albedo, w.check.relative_error),
+            Some(t) => format!("R {:.5} ({:+.1e}) T {:.5} ({:+.1e})", w.check.albedo, w.check.relative_error, t.albedo, t.relative_error),
+        }),
     ]
 }
 

@@ -173,7 +173,7 @@ mod tests {
 }
 
 /// One albedo's z-test: Σ w / N over some bins against the f64 quadrature of f |cos θo| over them.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct AlbedoTest {
     pub albedo: f64,
     pub std_error: f64,
