@@ -513,10 +513,14 @@ fn dielectric_scatter_keys() {
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nincident_theta = ⟦180\n"), &["0 ≤ θ < 180"]);
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nfresnel = ⟦\"schlick\"\n"), &["fresnel does not apply to scatter = \"dielectric\""]);
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nf0 = ⟦0.04\n"), &["f0 does not apply to scatter = \"dielectric\""]);
-    scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nmasking = ⟦\"height-correlated\"\n"), &["does not apply to scatter = \"dielectric\"", "Beta function", "g1 or separable"]);
     scene_error(&glass("scatter = \"dielectric\"\neta = 1.5\nweighted = false\nmasking = ⟦\"g1\"\n"), &["weighted = false"]);
-    // the weighted pass: masking g1 or separable, or weighted = true alone; the Fresnel term is the dielectric's
-    for (extra, masking) in [("masking = \"g1\"\n", Masking::G1), ("masking = \"separable\"\n", Masking::Separable), ("weighted = true\n", Masking::None)] {
+    // the weighted pass: any masking, or weighted = true alone; the Fresnel term is the dielectric's
+    for (extra, masking) in [
+        ("masking = \"g1\"\n", Masking::G1),
+        ("masking = \"separable\"\n", Masking::Separable),
+        ("masking = \"height-correlated\"\n", Masking::HeightCorrelated),
+        ("weighted = true\n", Masking::None),
+    ] {
         let s = Scene::parse("s.toml", &glass(&format!("scatter = \"dielectric\"\neta = 1.5\n{extra}"))).unwrap();
         assert_eq!(s.cases[0].effects, Some(Effects { fresnel: Fresnel::None, masking }), "{extra}");
     }

@@ -12,7 +12,8 @@
 //!
 //! Also: the hard cases in f64, the density and the white furnace integrated over the sphere
 //! against masses formed in h space, and the f32 WGSL twin (`examples/samplers/rough_dielectric.wgsl`)
-//! judged by `lobes check` against the f64 density on the GPU.
+//! judged by `lobes check` against the f64 density on the GPU; the height-correlated G2 across
+//! the surface against Euler's integral.
 
 use glam::DVec3;
 use lobes::experiments::stress::HORIZON_BAND;
@@ -341,5 +342,17 @@ fn the_wgsl_twin_without_eta_squared_is_rejected() {
     }
     for name in ["chi2", "normalization", "albedo", "jacobian"] {
         assert!(!r.get(name).unwrap().passed, "{name} passed the broken sampler");
+    }
+}
+
+/// The f64 reference's transmitted G2 is Euler's integral B(x, y) = ∫₀¹ t^(x−1) (1 − t)^(y−1) dt
+/// (x = 1/G1(ωi), y = 1/G1(ωo)), by adaptive Gauss–Legendre at non-integer points, to 1e-11.
+#[test]
+fn transmitted_g2_is_eulers_integral() {
+    let rule = lobes::stats::gauss_legendre::GaussLegendre::new(8);
+    for (x, y) in [(1.3, 2.7), (2.25, 1.1), (4.6, 3.4), (1.05, 11.5)] {
+        let q = rule.integrate_adaptive(0.0, 1.0, 1e-14, &|t: f64| t.powf(x - 1.0) * (1.0 - t).powf(y - 1.0));
+        let g = Masking::HeightCorrelated.g_transmitted(1.0 / x, 1.0 / y);
+        assert!((g / q - 1.0).abs() < 1e-11, "B({x}, {y}): {g} vs quadrature {q}");
     }
 }

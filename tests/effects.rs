@@ -200,11 +200,11 @@ fn shader_command_prints_the_composed_module() {
     let names = functions(source);
     assert!(names.iter().any(|n| n == "effect_weight") && !names.iter().any(|n| n.starts_with("ggx_")));
     let all = run(&["shader", scene]);
-    assert_eq!(String::from_utf8_lossy(&all.stdout).matches("// ==== lobes module").count(), 9, "nine cases, nine effect sets");
+    assert_eq!(String::from_utf8_lossy(&all.stdout).matches("// ==== lobes module").count(), 10, "ten cases, ten effect sets");
     let json = run(&["shader", scene, "--json"]);
     let doc: serde_json::Value = serde_json::from_slice(&json.stdout).expect("one JSON object");
     let modules = doc["modules"].as_array().unwrap();
-    assert_eq!(modules.len(), 9);
+    assert_eq!(modules.len(), 10);
     assert_eq!(modules[5]["cases"][0], "ward-schlick");
     assert_eq!(modules[5]["constants"]["FRESNEL"], 1.0);
     assert!(modules[5]["source"].as_str().unwrap().contains("fn ward_weight"));

@@ -134,7 +134,10 @@ pub enum Module {
     ///
     /// - `masking_separable(gi: f32, gr: f32) -> f32`: G1(ωi) G1(ωr) (Heitz 2014, eq. 98);
     /// - `masking_height_correlated(gi: f32, gr: f32) -> f32`: 1 / (1 + Λ(ωi) + Λ(ωr))
-    ///   (Heitz 2014, eq. 99).
+    ///   (Heitz 2014, eq. 99);
+    /// - `masking_height_correlated_transmitted(gi: f32, go: f32) -> f32`: the same across a
+    ///   rough dielectric's surface, B(1 + Λ(ωi), 1 + Λ(ωo)), from `masking_ln_beta(x, y)`
+    ///   (ln of Euler's Beta function for x, y ≥ 1, without cancellation in f32).
     Masking,
     /// `shaders/lib/discrete.wgsl`: discrete 1D distributions. Declares two storage buffers,
     /// `discrete_f: array<f32>` and `discrete_u: array<u32>` (see [`DiscreteBindings`] for their
@@ -651,7 +654,7 @@ mod tests {
             ),
             (Module::Beckmann, &["beckmann_sample_ndf", "beckmann_sample_vndf", "beckmann_pdf_ndf", "beckmann_pdf_vndf", "beckmann_eval", "beckmann_g2"]),
             (Module::Fresnel, &["fresnel_schlick", "fresnel_dielectric", "fresnel_conductor"]),
-            (Module::Masking, &["masking_separable", "masking_height_correlated"]),
+            (Module::Masking, &["masking_separable", "masking_height_correlated", "masking_height_correlated_transmitted", "masking_ln_beta"]),
             (Module::Discrete, &["discrete_sample_cdf", "discrete_sample_cdf_blocks", "discrete_sample_alias", "discrete_f", "discrete_u"]),
         ];
         for (m, names) in wanted {

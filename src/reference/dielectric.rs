@@ -24,7 +24,7 @@
 //! density is 0 and [`DielectricSample::valid`] is false.
 
 use super::effects::{Effects, d, g1};
-use super::fresnel::{self, Fresnel};
+use super::fresnel;
 use super::masking::Masking;
 use super::reflect::{pdf_reflected, reflect};
 use super::{Lobe, LobeKind, LobeSample, Method};
@@ -259,8 +259,10 @@ impl RoughDielectric {
 
     /// The estimator weight f |cos θo| / p(ωo) of a sample with masking `masking` (f as
     /// [`eval`](Self::eval)), in the sampler's closed form, the same for both events (F or 1 − F
-    /// is in f and p alike): [`Effects::weight`] without Fresnel on the upper side, G (ωi·h)⁺ /
-    /// (cos θi cos θh) by the NDF and G / G1(ωi) by visible normals, G1(ωo) of |cos θo|. It
+    /// is in f and p alike): [`Effects::weight`] without Fresnel or masking on the upper side,
+    /// (ωi·h)⁺ / (cos θi cos θh) by the NDF and 1 / G1(ωi) by visible normals, times the G of
+    /// the pair that `eval` uses (G1(ωo) of |cos θo|; where ωo lies across the surface, the
+    /// transmitted form, for a wrong-side reflection too). It
     /// depends on h alone for G = G1(ωi), so over every sample, the wrong-side ones included,
     /// Σ w / N estimates the white furnace's ∫ p(h) w dh = G1(ωi) (1 + Λ(ωi)) = 1
     /// ([`Effects::furnace`]).
@@ -268,19 +270,28 @@ impl RoughDielectric {
         let (flip, wi, _) = self.incident(wi);
         let up = |w: DVec3| if flip { mirror(w) } else { w };
         let upper = LobeSample { h: up(s.h), omega_r: up(s.omega_o), pdf_h: s.pdf_h, pdf_r: s.pdf_o, invalid: None };
-        Effects { fresnel: Fresnel::None, masking }.weight(&self.lobe, wi, &upper)
+        Effects::NONE.weight(&self.lobe, wi, &upper) * self.masking(wi, upper.omega_r, masking)
+    }
+
+    /// G of the pair (ωi, ωo) moved to the upper side: `masking` of G1(ωi) and G1(ωo) (of
+    /// |cos θo|), in its transmitted form ([`Masking::g_transmitted`]) where ωo lies across the
+    /// surface.
+    fn masking(&self, wi: DVec3, wo: DVec3, masking: Masking) -> f64 {
+        let l = &self.lobe;
+        let (gi, go) = (g1(l, l.to_local(wi)), g1(l, l.to_local(wo)));
+        if wo.z < 0.0 { masking.g_transmitted(gi, go) } else { masking.g(gi, go) }
     }
 
     /// The BSDF f(ωi, ωo) with the dielectric's own Fresnel term and masking `masking` of
-    /// G1(ωi), G1(ωo) (Walter 2007, eqs. 20 and 21). The height-correlated form is Heitz 2014's
-    /// eq. 99 for both events, as pbrt-v4 uses it (for transmission it is the common
-    /// approximation of eq. 100).
+    /// G1(ωi), G1(ωo) (Walter 2007, eqs. 20 and 21). The height-correlated G2 is Heitz 2014's
+    /// 1 / (1 + Λ(ωi) + Λ(ωo)) on the incident side and B(1 + Λ(ωi), 1 + Λ(ωo)) across the
+    /// surface ([`Masking::g_transmitted`]; pbrt-v4 uses the reflection's form for both events).
     pub fn eval(&self, wi: DVec3, wo: DVec3, masking: Masking) -> f64 {
         let Some((wi, wo, h, event, eta)) = self.connect(wi, wo) else { return 0.0 };
         let l = &self.lobe;
         let c = wi.dot(h);
         let f = fresnel::dielectric(c, eta);
-        let dg = d(l, l.to_local(h)) * masking.g(g1(l, l.to_local(wi)), g1(l, l.to_local(wo)));
+        let dg = d(l, l.to_local(h)) * self.masking(wi, wo, masking);
         let cos = wi.z * wo.z.abs();
         match event {
             Event::Reflection => f * dg / (4.0 * cos),
@@ -457,7 +468,7 @@ mod tests {
                         continue;
                     }
                     events[s.event as usize] += 1;
-                    for masking in [Masking::None, Masking::G1, Masking::Separable] {
+                    for masking in Masking::ALL {
                         let direct = d.eval(wi, s.omega_o, masking) * s.omega_o.z.abs() / d.pdf(wi, s.omega_o);
                         let w = d.weight(wi, &s, masking);
                         assert!((w / direct - 1.0).abs() < 1e-9, "{kind:?} {method:?} {wi} {masking:?} {:?}: {w} vs {direct}", s.event);

@@ -830,13 +830,6 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, scatter: Scatter) 
             if kind == LobeKind::Ward && m != Masking::None {
                 return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));
             }
-            if dielectric && m == Masking::HeightCorrelated {
-                return Err(ctx.err(
-                    v.span(),
-                    "masking = \"height-correlated\" does not apply to scatter = \"dielectric\": across the surface the height-correlated G2 \
-                     (Heitz 2014, eq. 99) is a Beta function of Λ(ωi) and Λ(ωo), which lobes does not evaluate; use g1 or separable",
-                ));
-            }
             m
         }
     };

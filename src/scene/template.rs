@@ -43,8 +43,7 @@ incident_phi = {phi:?}        # degrees, −360 ≤ φ ≤ 360
 # eta = 1.5               # conductor: index of refraction > 0; dielectric: n_t / n_i > 0;
 #                         # scatter = "dielectric": n_below / n_above, > 0 and ≠ 1
 # k = 0.0                 # conductor: absorption ≥ 0
-# masking = "none"        # none | g1 | separable | height-correlated (not for ward; a dielectric:
-#                         # not height-correlated)
+# masking = "none"        # none | g1 | separable | height-correlated (not for ward)
 
 [[case]]
 name = "discrete"

@@ -87,14 +87,17 @@ const OVERRIDES: Selectors = Selectors { anisotropic: "ANISOTROPIC", fresnel: "F
 const UNIFORM: Selectors = Selectors { anisotropic: "effect.modes.w != 0u", fresnel: "effect.modes.y", masking: "effect.modes.z" };
 
 /// The generated call sites of `shaders/passes/effect.wgsl` and its effect files: whether α is
-/// anisotropic, and the mode of each effect the case has.
-fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool) -> String {
+/// anisotropic, the mode of each effect the case has, and with masking whether a pair lies
+/// across a `dielectric`'s surface (`masking_across`).
+fn effect_call_sites(sel: &Selectors, fresnel: bool, masking: bool, dielectric: bool) -> String {
     let mut src = format!("fn effect_anisotropic() -> bool {{\n    return {};\n}}\n", sel.anisotropic);
     if fresnel {
         src += &format!("fn fresnel_mode() -> u32 {{\n    return {};\n}}\n", sel.fresnel);
     }
     if masking {
         src += &format!("fn masking_mode() -> u32 {{\n    return {};\n}}\n", sel.masking);
+        let across = if dielectric { "wi.z * wr.z < 0.0" } else { "false" };
+        src += &format!("fn masking_across(wi: vec3<f32>, wr: vec3<f32>) -> bool {{\n    return {across};\n}}\n");
     }
     src
 }
@@ -117,7 +120,7 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rota
         kernel.chosen.push(library::NO_MASKING);
     }
     kernel.job.push(&samplers_glue(samplers, rotated, masking, dielectric));
-    kernel.job.push(&effect_call_sites(sel, fresnel, masking));
+    kernel.job.push(&effect_call_sites(sel, fresnel, masking, dielectric));
     kernel.source()
 }
 
@@ -202,7 +205,7 @@ mod tests {
         }
         // a rough dielectric's weighted pass: its own density, BSDF and weight, plain and rotated
         for spec in REGISTRY.iter().filter(|s| s.wgsl.dielectric.is_some()) {
-            for masking in [Masking::None, Masking::G1, Masking::Separable] {
+            for masking in Masking::ALL {
                 for alpha_angle in [0.0, 30.0] {
                     let Job::Lobe { lobe, incident, grid, .. } = job(spec.kind, spec.method, true) else { unreachable!() };
                     let glass = Job::Lobe { lobe: Lobe { alpha_angle, ..lobe }, incident, grid, scatter: crate::engine::job::Scatter::Dielectric { eta: 1.5 } };
