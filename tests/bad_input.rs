@@ -426,6 +426,21 @@ fn wgpu_adapter_name_selects_or_fails_listing_the_adapters() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
+/// `lobes bench --sampler LOBE-METHOD` measures only the named samplers; an unknown name is a
+/// usage error (2) that lists the names.
+#[test]
+fn bench_sampler_selects_and_rejects_unknown_names() {
+    let out = lobes_cmd().args(["bench", "--gpu-only", "--runs", "1", "--samples", "1000", "--json", "--sampler", "beckmann-vndf"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows: Vec<(&str, &str)> = v["results"].as_array().unwrap().iter().map(|r| (r["lobe"].as_str().unwrap(), r["method"].as_str().unwrap())).collect();
+    assert_eq!(rows, [("beckmann", "vndf")]);
+    let out = lobes_cmd().args(["bench", "--sampler", "ggx-vdnf"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--sampler ggx-vdnf: no such sampler") && stderr.contains("ggx-vndf"), "{stderr}");
+}
+
 fn tree(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     names.sort();

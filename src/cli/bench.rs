@@ -30,6 +30,9 @@ pub struct BenchArgs {
     /// Skip the CPU reference backend.
     #[arg(long)]
     pub gpu_only: bool,
+    /// Only this sampler, as LOBE-METHOD (e.g. beckmann-vndf); repeat for several. Default: all.
+    #[arg(long = "sampler", value_name = "LOBE-METHOD")]
+    pub samplers: Vec<String>,
     /// Instead of the lobe table: what generality costs. For each weighted case of this scene
     /// (e.g. scenes/effects.toml), the weighted pass with the case's specialised module against
     /// the uber-kernel with every lobe and effect switched at run time, alternating in one run.
@@ -64,6 +67,19 @@ pub fn bench_jobs(alpha: f64) -> Vec<Job> {
             scatter: Scatter::Reflect,
         })
         .collect()
+}
+
+/// The jobs named by `--sampler` (all without it); an unknown name is a usage error listing the names.
+fn chosen(jobs: Vec<Job>, names: &[String]) -> anyhow::Result<Vec<Job>> {
+    let name = |job: &Job| match job {
+        Job::Lobe { lobe, .. } => format!("{}-{}", lobe.kind.name(), lobe.method.name()),
+        _ => unreachable!("bench jobs are lobes"),
+    };
+    let all: Vec<String> = jobs.iter().map(name).collect();
+    if let Some(bad) = names.iter().find(|n| !all.contains(n)) {
+        return Err(super::usage(format!("--sampler {bad}: no such sampler; use one of {}", all.join(", "))));
+    }
+    Ok(jobs.into_iter().filter(|j| names.is_empty() || names.contains(&name(j))).collect())
 }
 
 fn result(job: &Job, backend: &str, samples: u64, seconds: f64, timing: &str, alpha: f64) -> BenchResult {
@@ -154,10 +170,11 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         return run_effects(args, scene);
     }
     let runs = args.runs.max(1);
+    let jobs = chosen(bench_jobs(args.alpha), &args.samplers)?;
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();
     let mut results = Vec::new();
-    for job in bench_jobs(args.alpha) {
+    for job in jobs {
         engine.histogram(&job, SampleRange::whole(0, 1 << 16), &mut |_| {})?; // compile and warm up
         let mut times = Vec::new();
         let mut timing = "wall";
