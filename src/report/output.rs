@@ -503,10 +503,10 @@ impl CaseSummary {
                 dof: r.chi2.dof,
                 p_value: r.chi2.p_value,
                 albedo: r.weighted.as_ref().map(|w| AlbedoSummary {
-                    albedo: w.check.albedo,
-                    reference: w.check.reference,
-                    relative_error: w.check.relative_error,
-                    p_value: w.check.p_value,
+                    albedo: w.check.reflected.albedo,
+                    reference: w.check.reflected.reference,
+                    relative_error: w.check.reflected.relative_error,
+                    p_value: w.check.reflected.p_value,
                     max_weight_error: w.check.max_weight_error,
                     passed: w.check.passed,
                     transmitted: w.check.transmitted,
@@ -586,8 +586,9 @@ fn failure(r: &CaseResult) -> Option<String> {
             format!("{what} {albedo:.5} against {reference:.5} by quadrature (relative error {relative_error:+.1e}, p = {p:.3e}, level {:.3e})", a.significance)
         };
         let reflected = if a.transmitted.is_some() { "reflected albedo" } else { "albedo" };
-        if a.p_value < a.significance {
-            why.push(albedo(reflected, a.albedo, a.reference, a.relative_error, a.p_value));
+        let r = &a.reflected;
+        if r.p_value < a.significance {
+            why.push(albedo(reflected, r.albedo, r.reference, r.relative_error, r.p_value));
         }
         if let Some(t) = a.transmitted.as_ref().filter(|t| t.p_value < a.significance) {
             why.push(albedo("transmitted albedo", t.albedo, t.reference, t.relative_error, t.p_value));
@@ -662,8 +663,8 @@ pub fn table_row(r: &CaseResult) -> [String; 9] {
         if r.passed() { "pass".into() } else { "FAIL".into() },
         angle,
         r.weighted.as_ref().map_or("-".into(), |w| match &w.check.transmitted {
-            None => format!("{:.5} ({:+.1e})", w.check.albedo, w.check.relative_error),
-            Some(t) => format!("R {:.5} ({:+.1e}) T {:.5} ({:+.1e})", w.check.albedo, w.check.relative_error, t.albedo, t.relative_error),
+            None => format!("{:.5} ({:+.1e})", w.check.reflected.albedo, w.check.reflected.relative_error),
+            Some(t) => format!("R {:.5} ({:+.1e}) T {:.5} ({:+.1e})", w.check.reflected.albedo, w.check.reflected.relative_error, t.albedo, t.relative_error),
         }),
     ]
 }

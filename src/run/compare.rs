@@ -211,14 +211,8 @@ pub fn albedo_check(
         && furnace_p_value.is_none_or(|p| p >= significance)
         && max_weight_error <= WEIGHT_ERROR_LIMIT
         && sums.overflow == 0;
-    let AlbedoTest { albedo, std_error, reference, relative_error, z, p_value } = reflected;
     AlbedoCheck {
-        albedo,
-        std_error,
-        reference,
-        relative_error,
-        z,
-        p_value,
+        reflected,
         transmitted,
         sphere_total,
         sphere_std_error,

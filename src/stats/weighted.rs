@@ -175,12 +175,14 @@ mod tests {
 /// One albedo's z-test: Σ w / N over some bins against the f64 quadrature of f |cos θo| over them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct AlbedoTest {
+    /// Σ w / N over the bins of one side.
     pub albedo: f64,
     pub std_error: f64,
+    /// ∫ over the same bins of f |cos θo| by f64 quadrature (the sum of the per-bin integrals).
     pub reference: f64,
     /// (albedo − reference) / reference.
     pub relative_error: f64,
-    /// (albedo − reference) / std_error, and its two-sided p-value ([`two_sided`]).
+    /// (albedo − reference) / std_error, and its two-sided p-value.
     pub z: f64,
     pub p_value: f64,
 }
@@ -195,17 +197,11 @@ impl AlbedoTest {
 /// The verdict on a weighted histogram.
 #[derive(Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct AlbedoCheck {
-    /// Σ w / N over the bins on the incident side (for a rough dielectric, the reflected albedo).
-    pub albedo: f64,
-    pub std_error: f64,
-    /// ∫ over the incident hemisphere of f |cos θr| by f64 quadrature (the sum of the per-bin
-    /// integrals).
-    pub reference: f64,
-    /// (albedo − reference) / reference.
-    pub relative_error: f64,
-    /// (albedo − reference) / std_error, and its two-sided p-value.
-    pub z: f64,
-    pub p_value: f64,
+    /// Σ w / N over the bins on the incident side (for a rough dielectric, the reflected albedo)
+    /// against ∫ over the incident hemisphere of f |cos θr| by f64 quadrature (the sum of the
+    /// per-bin integrals); its fields sit at the top level of the JSON.
+    #[serde(flatten)]
+    pub reflected: AlbedoTest,
     /// A rough dielectric's transmitted albedo: the bins across the surface, tested like the
     /// reflected one (`None` for a reflection lobe).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -235,11 +231,11 @@ impl std::fmt::Debug for AlbedoCheck {
         write!(
             f,
             "albedo {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); {}sphere {:.6} ± {:.1e} vs furnace {:?} (p {:?}); weight error {:.1e}; overflow {}; {}",
-            self.albedo,
-            self.std_error,
-            self.reference,
-            self.relative_error,
-            self.p_value,
+            self.reflected.albedo,
+            self.reflected.std_error,
+            self.reflected.reference,
+            self.reflected.relative_error,
+            self.reflected.p_value,
             self.transmitted.as_ref().map_or(String::new(), |t| format!(
                 "transmitted {:.6} ± {:.1e} vs {:.6} (rel {:+.1e}, p {:.3e}); ",
                 t.albedo, t.std_error, t.reference, t.relative_error, t.p_value
