@@ -241,7 +241,7 @@ pub fn dielectric_wrong_side(glass: &RoughDielectric, wi: DVec3, q: &Quadrature)
         ends.dedup();
         ends
     };
-    let over_psi = |c: f64| -> (f64, f64) {
+    let over_psi = |c: f64| -> [f64; 2] {
         let s = (1.0 - c * c).max(0.0).sqrt();
         let h_at = |psi: f64| c * w + s * (psi.cos() * e1 + psi.sin() * e2);
         let mut ends: Vec<f64> = RoughDielectric::wrong_side_h_z_breaks(w, eta, c)
@@ -252,11 +252,16 @@ pub fn dielectric_wrong_side(glass: &RoughDielectric, wi: DVec3, q: &Quadrature)
             .collect();
         graded(0.0, PI, 0.0, &mut ends);
         let ends = pieces(ends, 0.0, PI);
-        let side = |which: fn((f64, f64)) -> f64| -> f64 {
-            let g = |psi: f64| which(glass.wrong_side_h(wi, h_at(psi))) + which(glass.wrong_side_h(wi, h_at(2.0 * PI - psi)));
-            ends.windows(2).map(|p| rule.integrate_adaptive(p[0], p[1], tol_psi * (p[1] - p[0]), &g)).sum()
+        // both sets at once; ψ and its mirror 2π − ψ share every edge
+        let g = |psi: f64| {
+            let (r1, t1) = glass.wrong_side_h(wi, h_at(psi));
+            let (r2, t2) = glass.wrong_side_h(wi, h_at(2.0 * PI - psi));
+            [r1 + r2, t1 + t2]
         };
-        (side(|(r, _)| r), side(|(_, t)| t))
+        ends.windows(2).fold([0.0; 2], |acc, p| {
+            let v = rule.integrate_adaptive_n(p[0], p[1], tol_psi * (p[1] - p[0]), &g);
+            [acc[0] + v[0], acc[1] + v[1]]
+        })
     };
     let mut ends = vec![0.0];
     if eta < 1.0 {
@@ -264,16 +269,8 @@ pub fn dielectric_wrong_side(glass: &RoughDielectric, wi: DVec3, q: &Quadrature)
     }
     graded(-1.0, 1.0, w.z, &mut ends);
     let ends = pieces(ends, -1.0, 1.0);
-    let pairs: Vec<(f64, f64)> = ends
-        .par_windows(2)
-        .map(|p| {
-            let tol_c = 0.5 * tol * (p[1] - p[0]);
-            let below = rule.integrate_adaptive(p[0], p[1], tol_c, &|c| over_psi(c).0);
-            let near = rule.integrate_adaptive(p[0], p[1], tol_c, &|c| over_psi(c).1);
-            (below, near)
-        })
-        .collect();
-    pairs.iter().fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1))
+    let parts: Vec<[f64; 2]> = ends.par_windows(2).map(|p| rule.integrate_adaptive_n(p[0], p[1], 0.5 * tol * (p[1] - p[0]), &over_psi)).collect();
+    parts.iter().fold((0.0, 0.0), |a, b| (a.0 + b[0], a.1 + b[1]))
 }
 
 #[cfg(test)]

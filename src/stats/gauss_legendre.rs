@@ -66,18 +66,36 @@ impl GaussLegendre {
     /// assert!((v - 2.0 / 3.0).abs() < 1e-11);
     /// ```
     pub fn integrate_adaptive(&self, a: f64, b: f64, tol: f64, f: &impl Fn(f64) -> f64) -> f64 {
-        let whole = self.on(a, b).map(|(x, w)| w * f(x)).sum();
+        self.integrate_adaptive_n(a, b, tol, &|x| [f(x)])[0]
+    }
+
+    /// [`integrate_adaptive`](Self::integrate_adaptive) of N integrands at once, on the same
+    /// nodes (each f evaluated once per node), a part accepted when every component agrees.
+    pub fn integrate_adaptive_n<const N: usize>(&self, a: f64, b: f64, tol: f64, f: &impl Fn(f64) -> [f64; N]) -> [f64; N] {
+        let whole = self.sum_on(a, b, f);
         self.refine(a, b, whole, tol / (b - a).abs(), f, 0)
     }
 
-    fn refine(&self, a: f64, b: f64, whole: f64, tol_per_length: f64, f: &impl Fn(f64) -> f64, depth: u32) -> f64 {
-        let m = 0.5 * (a + b);
-        let left: f64 = self.on(a, m).map(|(x, w)| w * f(x)).sum();
-        let right: f64 = self.on(m, b).map(|(x, w)| w * f(x)).sum();
-        if (left + right - whole).abs() <= tol_per_length * (b - a).abs() || depth >= 30 {
-            return left + right;
+    fn sum_on<const N: usize>(&self, a: f64, b: f64, f: &impl Fn(f64) -> [f64; N]) -> [f64; N] {
+        let mut sum = [0.0; N];
+        for (x, w) in self.on(a, b) {
+            for (s, v) in sum.iter_mut().zip(f(x)) {
+                *s += w * v;
+            }
         }
-        self.refine(a, m, left, tol_per_length, f, depth + 1) + self.refine(m, b, right, tol_per_length, f, depth + 1)
+        sum
+    }
+
+    fn refine<const N: usize>(&self, a: f64, b: f64, whole: [f64; N], tol_per_length: f64, f: &impl Fn(f64) -> [f64; N], depth: u32) -> [f64; N] {
+        let m = 0.5 * (a + b);
+        let (left, right) = (self.sum_on(a, m, f), self.sum_on(m, b, f));
+        let both: [f64; N] = std::array::from_fn(|k| left[k] + right[k]);
+        let agree = (0..N).all(|k| (both[k] - whole[k]).abs() <= tol_per_length * (b - a).abs());
+        if agree || depth >= 30 {
+            return both;
+        }
+        let (l, r) = (self.refine(a, m, left, tol_per_length, f, depth + 1), self.refine(m, b, right, tol_per_length, f, depth + 1));
+        std::array::from_fn(|k| l[k] + r[k])
     }
 
     /// ∫∫ f(x, y) over [x.0, x.1] × [y.0, y.1] by the tensor-product rule.
