@@ -28,10 +28,10 @@
 //!
 //! Features: `cli` (default) is the command line and everything; `check` is the library
 //! without the command line (what a renderer's tests need for [`check`]); without either
-//! (`default-features = false`) the crate is [`embed`] alone, with the few modules it is made
-//! of ([`engine::gpu::library`], [`engine::gpu::context`], [`engine::gpu::precision`],
-//! [`reference::discrete`]), and depends on wgpu, naga, naga_oil, bytemuck, thiserror and
-//! pollster only.
+//! (`default-features = false`) the crate is [`embed`] alone, with [`reference::discrete`]
+//! for its tables, and depends on bytemuck and thiserror only (its texts are generated at build
+//! time); features `naga`, `naga-oil`, `wgpu` and `wesl` add [`embed`]'s helpers on those
+//! crates (docs/embedding.md lists the crate count of each).
 
 #[cfg(feature = "check")]
 pub mod atomic;
@@ -54,18 +54,6 @@ pub mod run;
 pub mod scene;
 #[cfg(feature = "check")]
 pub mod stats;
-
-/// What [`embed`] is made of, without the `check` feature (the same files as under it).
-#[cfg(not(feature = "check"))]
-pub mod engine {
-    /// The GPU engine's WGSL library and device context.
-    pub mod gpu {
-        pub mod context;
-        pub mod library;
-        pub mod precision;
-        pub use context::{Gpu, GpuError};
-    }
-}
 
 /// What [`embed`] is made of, without the `check` feature: the discrete distributions.
 #[cfg(not(feature = "check"))]

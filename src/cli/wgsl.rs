@@ -1,37 +1,118 @@
-//! `lobes wgsl MODULE...`: the WGSL of `lobes::embed` for a renderer, printed: the named
-//! modules with everything they use, every name prefixed ([`embed::wgsl`]); or with
-//! `--naga-oil` the same files as naga_oil modules ([`embed::naga_oil_modules`]).
+//! `lobes wgsl MODULE...`: lobes' WGSL for a renderer, in one of three forms: plain WGSL with
+//! every name prefixed ([`embed::wgsl_with`]), naga_oil modules (`--naga-oil`,
+//! [`Module::naga_oil_source`]) or the WESL package (`--wesl`, [`Module::wesl_source`]); on stdout,
+//! or one file per module in `--out-dir`.
 
 use super::{emit, usage};
-use crate::embed::{self, Module};
+use crate::embed::{self, DiscreteBindings, Module};
 use crate::scene::suggest::did_you_mean;
+use anyhow::Context;
 use clap::Args;
+use std::path::PathBuf;
 
 #[derive(Debug, Clone, Args)]
 pub struct WgslArgs {
-    /// Modules to print, with the modules they use: rng, reflect, microfacet, ward, ggx,
-    /// beckmann, fresnel, masking, discrete.
+    /// Modules to print, with the modules they use: rng, math, reflect, microfacet, ward, ggx,
+    /// beckmann, fresnel, masking, dielectric, discrete.
     #[arg(required = true, value_name = "MODULE")]
     pub modules: Vec<String>,
-    /// Print the files as naga_oil modules (`#define_import_path lobes::ggx`, `#import`s,
-    /// short names), each after those it imports, for a renderer that composes with naga_oil
-    /// or Bevy; without it, one plain WGSL source with every name prefixed `lobes_`.
-    #[arg(long)]
+    /// The files as naga_oil modules (`#define_import_path lobes::ggx`, `#import`s, short
+    /// names), each after those it imports, for a renderer that composes with naga_oil (Bevy
+    /// 0.19 and earlier); without it, plain WGSL with every name prefixed `lobes_`.
+    #[arg(long, conflicts_with = "wesl")]
     pub naga_oil: bool,
+    /// The WESL package `lobes` (`import lobes::ggx::ggx_sample_vndf;`, Bevy 0.20 and the
+    /// `wesl` crate): one `NAME.wesl` per module, so it needs --out-dir.
+    #[arg(long, requires = "out_dir")]
+    pub wesl: bool,
+    /// Write one file per module into DIR (created if missing): NAME.wgsl (plain or naga_oil)
+    /// or NAME.wesl; the plain files do not overlap, so include each once, in any order.
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
+    /// The bind group of the discrete module's two storage buffers (default 0).
+    #[arg(long, value_name = "G")]
+    pub group: Option<u32>,
+    /// The binding of the discrete module's table (`discrete_f`); its aliases
+    /// (`discrete_u`) take B + 1 (default 3, so 3 and 4).
+    #[arg(long, value_name = "B")]
+    pub binding: Option<u32>,
+}
+
+/// The form of the output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Form {
+    Plain,
+    NagaOil,
+    Wesl,
 }
 
 pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
     let modules = parse(&args.modules)?;
-    if !args.naga_oil {
-        return emit(&embed::wgsl(&modules));
+    let resolved = embed::resolve(&modules);
+    let bindings = bindings(args, &resolved)?;
+    let form = match (args.naga_oil, args.wesl) {
+        (true, _) => Form::NagaOil,
+        (_, true) => Form::Wesl,
+        _ => Form::Plain,
+    };
+    let Some(dir) = &args.out_dir else {
+        return emit(&match form {
+            Form::Plain => embed::wgsl_with(&modules, bindings),
+            _ => embed::naga_oil_modules(&modules)
+                .into_iter()
+                .map(|m| format!("// ==== naga_oil module {} ====\n{}\n", m.import_path, text(m.module, form, bindings).trim_end()))
+                .collect(),
+        });
+    };
+    let files: Vec<(String, String)> = match form {
+        Form::Plain => resolved.iter().map(|&m| (format!("{}.wgsl", m.name()), plain_file(m, bindings))).collect(),
+        _ => {
+            let ext = if form == Form::Wesl { "wesl" } else { "wgsl" };
+            embed::naga_oil_modules(&modules).into_iter().map(|m| (format!("{}.{ext}", m.module.name()), text(m.module, form, bindings))).collect()
+        }
+    };
+    std::fs::create_dir_all(dir).with_context(|| format!("--out-dir {}: cannot create the folder", dir.display()))?;
+    for (name, contents) in &files {
+        let path = dir.join(name);
+        crate::atomic::write_atomic(&path, contents.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
-    let files: Vec<&str> = embed::resolve(&modules).iter().flat_map(|m| m.import_paths()).copied().collect();
-    let text: String = embed::naga_oil_modules()
-        .into_iter()
-        .filter(|m| files.contains(&m.import_path))
-        .map(|m| format!("// ==== naga_oil module {} ====\n{}\n", m.import_path, m.source.trim_end()))
-        .collect();
-    emit(&text)
+    let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    eprintln!("wrote {} files to {}: {}", files.len(), dir.display(), names.join(", "));
+    Ok(())
+}
+
+/// The naga_oil or WESL text of `m`, with the discrete module's buffers at `bindings`.
+fn text(m: Module, form: Form, bindings: DiscreteBindings) -> String {
+    let source = if form == Form::Wesl { m.wesl_source() } else { m.naga_oil_source() };
+    if m == Module::Discrete { bindings.apply(source) } else { source.to_string() }
+}
+
+/// One module's plain file of `--out-dir`: a header naming the files it needs, then its text
+/// (the same text [`embed::wgsl_with`] writes for it).
+fn plain_file(m: Module, bindings: DiscreteBindings) -> String {
+    let needs: Vec<String> = embed::resolve(&[m]).into_iter().filter(|&d| d != m).map(|d| format!("{}.wgsl", d.name())).collect();
+    let needs = if needs.is_empty() { "nothing else".to_string() } else { needs.join(", ") };
+    let body = embed::module_wgsl(m, bindings);
+    format!(
+        "// lobes {} plain WGSL module {} (lobes wgsl --out-dir): needs {needs}, each included once;\n\
+         // every name lobes defines starts with lobes_, Lobes or LOBES_.\n{body}",
+        env!("CARGO_PKG_VERSION"),
+        m.name()
+    )
+}
+
+/// The discrete module's bindings from --group and --binding, which only it has.
+fn bindings(args: &WgslArgs, resolved: &[Module]) -> anyhow::Result<DiscreteBindings> {
+    let default = DiscreteBindings::default();
+    if args.group.is_none() && args.binding.is_none() {
+        return Ok(default);
+    }
+    if !resolved.contains(&Module::Discrete) {
+        return Err(usage("--group/--binding place the discrete module's storage buffers, and no module asked for has resources: add discrete, or drop them"));
+    }
+    let table = args.binding.unwrap_or(default.table);
+    let alias = table.checked_add(1).ok_or_else(|| usage(format!("--binding {table}: the aliases take binding B + 1, past u32")))?;
+    Ok(DiscreteBindings { group: args.group.unwrap_or(default.group), table, alias })
 }
 
 /// The modules named, or a usage error that lists them and suggests the closest.

@@ -6,6 +6,7 @@ use crate::reference::discrete::{self, AliasTable, DiscreteMethod, Distribution}
 /// (`crate::reference::discrete::BLOCK`; `DISCRETE_BLOCK` in the WGSL).
 pub const BLOCK: usize = discrete::BLOCK;
 use bytemuck::{Pod, Zeroable};
+#[cfg(feature = "wgpu")]
 use wgpu::util::DeviceExt;
 
 /// Where [`Module::Discrete`](super::Module::Discrete)'s two storage buffers are bound: both in
@@ -158,7 +159,9 @@ impl DiscreteTable {
 }
 
 /// A distribution's tables in two wgpu storage buffers (usage `STORAGE | COPY_DST`), laid out
-/// as [`DiscreteTable`] describes, ready to bind where [`DiscreteBindings`] says.
+/// as [`DiscreteTable`] describes, ready to bind where [`DiscreteBindings`] says. Feature
+/// `wgpu` (in `check` and the default): a renderer on another wgpu version, or none, uploads
+/// [`DiscreteTable`]'s vectors itself.
 ///
 /// This example needs a device, so it is only compiled here; `tests/embed.rs`
 /// (`embedded_discrete_sampling_counts_exactly_like_the_engine`) runs the same calls on the GPU.
@@ -185,6 +188,7 @@ impl DiscreteTable {
 /// # let _ = (group, embed::wgsl_with(&[Module::Discrete], bindings));
 /// # }
 /// ```
+#[cfg(feature = "wgpu")]
 #[derive(Debug, Clone)]
 pub struct DiscreteBuffers {
     /// Which sampler the tables are for.
@@ -197,6 +201,7 @@ pub struct DiscreteBuffers {
     pub info: DiscreteInfo,
 }
 
+#[cfg(feature = "wgpu")]
 impl DiscreteBuffers {
     /// Uploads the CDF of `dist` (see [`DiscreteTable::cdf`]).
     pub fn cdf(device: &wgpu::Device, dist: &Distribution) -> Self {
@@ -249,7 +254,7 @@ impl DiscreteBuffers {
     }
 }
 
-#[cfg(test)]
+#[cfg(all(test, feature = "check"))]
 mod tests {
     use super::*;
     use std::mem::{align_of, offset_of, size_of};

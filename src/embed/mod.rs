@@ -1,11 +1,19 @@
-//! lobes' WGSL samplers for your own wgpu shaders.
+//! lobes' WGSL samplers for your own shaders: a WESL package, naga_oil modules, or plain WGSL.
 //!
 //! The code that `lobes` tests (the counter-based RNG, every lobe's sampler, densities and BRDF,
-//! Fresnel and masking terms, discrete CDF and alias sampling) is plain WGSL. [`wgsl`] returns
-//! the files a list of [`Module`]s needs, each once and in dependency order, as one string that
-//! you prepend to (or concatenate with) your own shader source before `create_shader_module`.
-//! Every name it defines carries the `lobes` prefix ([`prefixed`]: `lobes_ggx_sample_vndf`,
-//! `LOBES_PI`, `LobesLobeSample`), so your shader may have its own `PI`, `sample` or `stretch`:
+//! the rough dielectric, Fresnel and masking terms, discrete CDF and alias sampling) comes in
+//! three forms, all generated at build time from the same files of `shaders/` (`build.rs`), as
+//! `&'static str` texts: nothing is parsed at run time.
+//!
+//! - **WESL** ([`Module::wesl_source`], [`wesl_files`], and with feature `wesl` the package
+//!   [`WESL_PACKAGE`] for the `wesl` crate 0.4): one module per [`Module`], importable as
+//!   `import lobes::ggx::ggx_sample_vndf;`. What Bevy 0.20 composes.
+//! - **naga_oil modules** ([`Module::naga_oil_source`], [`naga_oil_modules`], and with feature
+//!   `naga-oil` [`add_naga_oil_modules`]): `#define_import_path lobes::ggx`, for Bevy ≤ 0.19.
+//! - **plain WGSL** ([`wgsl`]): the files a list of [`Module`]s needs, each once and in
+//!   dependency order, as one string to prepend to your own shader source. Every name it defines
+//!   carries the `lobes` prefix ([`prefixed`]: `lobes_ggx_sample_vndf`, `LOBES_PI`,
+//!   `LobesLobeSample`), so your shader may have its own `PI`, `sample` or `stretch`:
 //!
 //! ```
 //! use lobes::embed::{self, Module};
@@ -22,35 +30,31 @@
 //!     out[id.x] = vec4<f32>(s.wr, lobes_ggx_eval(vec2<f32>(0.3), wi, s.wr) * s.wr.z / s.pdf_r);
 //! }";
 //! let source = embed::wgsl(&[Module::Rng, Module::Ggx]) + mine;
-//! // What wgpu does on `create_shader_module`: parse and validate with naga.
+//! // What wgpu does on `create_shader_module`: parse and validate with naga (feature `naga`).
 //! embed::validate(&source).unwrap();
-//! // Reflect and Microfacet came along as dependencies of Ggx.
+//! // Math, Reflect and Microfacet came along as dependencies of Ggx.
 //! assert_eq!(embed::resolve(&[Module::Ggx, Module::Rng]),
-//!            [Module::Rng, Module::Reflect, Module::Microfacet, Module::Ggx]);
+//!            [Module::Rng, Module::Math, Module::Reflect, Module::Microfacet, Module::Ggx]);
 //! ```
 //!
-//! The library files are naga_oil modules: each names its import path (`#define_import_path
-//! lobes::ggx`) and what it imports from the others (`#import lobes::reflect::{LobeSample, PI}`),
-//! and lobes composes them with naga_oil, Bevy's shader composer (see
-//! `crate::engine::gpu::library`). What [`wgsl`] returns is plain WGSL, since a `String` is what
-//! every wgpu renderer can take: the files in import order with their directive lines blanked,
-//! and every module-scope name prefixed. The prefix is added on export, by renaming identifier
-//! tokens of that text (see `namespace.rs`), not written into the files: the files stay the
-//! short-named naga_oil modules that lobes' kernels and tests compose, and a unit test parses
-//! the plain and the prefixed text with naga and finds the same IR up to the names. So what
-//! you embed is exactly the code the χ² tests judge (the test kernels are built from the same
-//! composition), plus the pdf, BRDF and estimator-weight functions of
-//! `shaders/lib/*_eval.wgsl` and the Fresnel and masking terms, which `tests/embed.rs` checks
-//! against the f64 reference on the GPU.
-//!
-//! A renderer that composes with naga_oil (or Bevy) takes the files as naga_oil modules instead,
-//! from [`naga_oil_modules`], and imports what it uses (`#import lobes::ggx::ggx_sample_vndf`):
-//! naga_oil namespaces by import path, so those keep their short names.
+//! The files of `shaders/` are naga_oil modules that lobes' own kernels compose (see
+//! `crate::engine::gpu::library`); a [`Module`] is what a renderer imports as one (a lobe's
+//! sampler, densities and BRDF: `ggx.wgsl` and `ggx_eval.wgsl` are both [`Module::Ggx`], import
+//! path `lobes::ggx` in the naga_oil and WESL forms). The plain text is the files in import
+//! order with their directive lines blanked and every module-scope name prefixed, by renaming
+//! identifier tokens (`namespace.rs`); the naga_oil and WESL forms keep the short names (both
+//! namespace by import path) and spell the files' type `Real` as `f32` (`text.rs`). Unit tests
+//! parse the plain text and the composition lobes' kernels run with naga and find the same IR
+//! up to the names, and compose the other two forms with naga_oil and the `wesl` crate; so
+//! what you embed is the code the χ² tests judge, plus the pdf, BRDF and estimator-weight
+//! functions of `shaders/lib/*_eval.wgsl` and the Fresnel and masking terms, which
+//! `tests/embed.rs` checks against the f64 reference on the GPU.
 //!
 //! Everything [`wgsl`] defines is in [`Module::symbols`]. Only [`Module::Discrete`] declares
-//! resource bindings; choose their group and binding numbers with [`wgsl_with`] or
-//! [`discrete_wgsl`], add more tables under names of your own with [`discrete_table_wgsl`], and
-//! upload tables with [`DiscreteBuffers`].
+//! resource bindings; choose their group and binding numbers with [`wgsl_with`],
+//! [`DiscreteBindings::apply`] (any form) or [`discrete_wgsl`], add more tables under names of
+//! your own with [`discrete_table_wgsl`], and upload tables with `DiscreteBuffers` (feature
+//! `wgpu`) or [`DiscreteTable`].
 //!
 //! Conventions (as everywhere in lobes): a local shading frame with the normal on +z, ωi (`wi`)
 //! the given direction and ωr (`wr`) the sampled one, both unit vectors pointing away from the
@@ -59,24 +63,30 @@
 
 mod discrete;
 mod namespace;
+// the text rules; besides `with_bindings` they are build.rs's (and the unit tests')
+#[allow(dead_code)]
+mod text;
 
-pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteBuffers, DiscreteInfo, DiscreteTable};
+#[cfg(feature = "wgpu")]
+pub use discrete::DiscreteBuffers;
+pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteInfo, DiscreteTable};
 pub use namespace::prefixed;
 
-use crate::engine::gpu::GpuError;
-use crate::engine::gpu::library;
-use crate::engine::gpu::precision::Precision;
+/// The texts, names and dependencies `build.rs` generates from `shaders/`, indexed by
+/// `Module as usize`.
+mod generated {
+    include!(concat!(env!("OUT_DIR"), "/embed_generated.rs"));
+}
 
-
-/// A WGSL module of lobes, as embedded by [`wgsl`]. The listed functions are the ones meant for
-/// callers, under the files' short names; [`wgsl`] exports each as [`prefixed`]`("lobes", name)`
-/// (`rng_uniforms` → `lobes_rng_uniforms`, `PI` → `LOBES_PI`, `LobeSample` →
-/// `LobesLobeSample`), the names naga_oil imports ([`naga_oil_modules`]) are the short ones.
-/// [`Module::symbols`] lists every name the module exports.
+/// A WGSL module of lobes: what a renderer imports as one. The listed functions are the ones
+/// meant for callers, under the files' short names, which the naga_oil and WESL forms keep
+/// (`import lobes::ggx::ggx_sample_vndf;`); [`wgsl`] exports each as [`prefixed`]`("lobes",
+/// name)` (`rng_uniforms` → `lobes_rng_uniforms`, `PI` → `LOBES_PI`, `LobeSample` →
+/// `LobesLobeSample`). [`Module::symbols`] lists every name the module defines.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Module {
-    /// `shaders/lib/rng.wgsl`: counter-based uniforms, bit-identical to
-    /// [`crate::reference::rng::uniforms`].
+    /// `shaders/lib/rng.wgsl`: counter-based uniforms, bit-identical to lobes' CPU twin
+    /// (`lobes::reference::rng::uniforms`).
     ///
     /// - `rng_uniforms(seed: vec2<u32>, index: vec2<u32>) -> vec4<f32>`: four uniforms of sample
     ///   `index` (a 64-bit counter as (lo, hi)) of the stream keyed by `seed` (lo, hi); each a
@@ -84,23 +94,30 @@ pub enum Module {
     /// - `pcg4d(v: vec4<u32>) -> vec4<u32>` (Jarzynski & Olano 2020), `rng_to_unit`,
     ///   `add64(a: vec2<u32>, b: u32) -> vec2<u32>` (64-bit counter plus offset).
     Rng,
+    /// `shaders/math/f32.wgsl`: the arithmetic the samplers are written over (`math_log`,
+    /// `math_exp`, `math_sin`, `math_cos`, `math_atan2`, `math_is_finite`, `neg_ln(u)` = −ln u
+    /// accurate near 1, `UNDERFLOW_EXPONENT`), as the WGSL builtins; in the plain text also
+    /// `alias Real = f32` (`LobesReal`), the type the files are written over.
+    Math,
     /// `shaders/lib/reflect.wgsl`: the half vector → reflected direction change of variables.
     ///
     /// - `struct LobeSample { h: vec3<f32>, wr: vec3<f32>, pdf_r: f32 }`: what every sampler
     ///   returns: the half vector, ωr, and p(ωr). ωr may be below the horizon (`wr.z <= 0`):
     ///   such a sample carries no energy and must be discarded (or counted as zero).
     /// - `reflect_about(wi, h) -> vec3<f32>`, `reflect_sample(wi, h, pdf_h) -> LobeSample`
-    ///   (p(ωr) = p(h) / (4 |ωr·h|)), `from_tan_theta`, `neg_ln`, `const PI: f32`.
+    ///   (p(ωr) = p(h) / (4 |ωr·h|)), `reflection_half_vector(wi, wr)`, `from_tan_theta`,
+    ///   `frame_to_local(r, w)` / `frame_to_world(r, w)` (rotated anisotropy), `const PI: f32`.
     Reflect,
-    /// `shaders/lib/microfacet.wgsl`: `stretch(a, w) -> vec3<f32>` = normalize(αx wx, αy wy, wz);
-    /// `shaders/lib/microfacet_eval.wgsl`: the BRDF and densities of every microfacet lobe from
-    /// its D and G terms (`microfacet_eval`, `microfacet_pdf_ndf`, `microfacet_pdf_vndf`).
+    /// `shaders/lib/microfacet.wgsl` and `shaders/lib/microfacet_eval.wgsl`: `stretch(a, w)` =
+    /// normalize(αx wx, αy wy, wz), `microfacet_ndf_weight(wi, h)`, and the BRDF and densities of
+    /// every microfacet lobe from its D and G terms (`microfacet_eval`, `microfacet_pdf_ndf`,
+    /// `microfacet_pdf_vndf`).
     Microfacet,
     /// `shaders/lib/ward.wgsl` and `shaders/lib/ward_eval.wgsl`: Ward's lobe, Walter 2005's pdf.
     ///
     /// - `ward_sample(a, wi, u: vec2<f32>) -> LobeSample`;
     /// - `ward_pdf(a, wi, wr) -> f32` (the density of `ward_sample`), `ward_eval(a, wi, wr) -> f32`
-    ///   (Ward's BRDF, ρs = 1), `ward_pdf_h(a, h)`, `ward_sample_h(a, u)`.
+    ///   (Ward's BRDF, ρs = 1), `ward_weight`, `ward_pdf_h(a, h)`, `ward_sample_h(a, u)`.
     Ward,
     /// `shaders/lib/ggx.wgsl` and `shaders/lib/ggx_eval.wgsl`: GGX (Trowbridge–Reitz).
     ///
@@ -109,18 +126,19 @@ pub enum Module {
     /// - their densities `ggx_pdf_ndf`, `ggx_pdf_vndf`, `ggx_pdf_bounded`, all
     ///   `(a, wi, wr) -> f32`;
     /// - `ggx_eval(a, wi, wr)`: D G2 / (4 cos θi cos θr) with height-correlated Smith G2;
-    ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`.
+    ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`, `ggx_vndf_weight`.
     Ggx,
-    /// `shaders/lib/beckmann.wgsl` and `shaders/lib/beckmann_eval.wgsl`: Beckmann.
+    /// `shaders/math/erf_f32.wgsl`, `shaders/lib/beckmann.wgsl` and
+    /// `shaders/lib/beckmann_eval.wgsl`: Beckmann.
     ///
     /// - samplers `beckmann_sample_ndf`, `beckmann_sample_vndf` (Heitz & d'Eon 2014),
     ///   `(a, wi, u: vec2<f32>) -> LobeSample`;
     /// - densities `beckmann_pdf_ndf`, `beckmann_pdf_vndf`, `(a, wi, wr) -> f32`;
     /// - `beckmann_eval(a, wi, wr)`, `beckmann_d`, `beckmann_g1`, `beckmann_lambda`,
-    ///   `beckmann_g2`.
+    ///   `beckmann_g2`; `math_erfc` and the other Gaussian integrals of `erf_f32.wgsl`.
     Beckmann,
     /// `shaders/lib/fresnel.wgsl`: Fresnel reflectance at cos θ = ωi·h (CPU twin:
-    /// [`crate::reference::fresnel`]), each in [0, 1].
+    /// `lobes::reference::fresnel`), each in [0, 1]. Needs [`Module::Math`] only.
     ///
     /// - `fresnel_schlick(c: f32, f0: f32) -> f32` (Schlick 1994, eq. 24);
     /// - `fresnel_dielectric(c: f32, eta: f32) -> f32` (relative index η = nt / ni; 1 past the
@@ -130,7 +148,7 @@ pub enum Module {
     /// - `fresnel_conductor(c: f32, eta: f32, k: f32) -> f32` (complex index η + ik).
     Fresnel,
     /// `shaders/lib/masking.wgsl`: Smith masking-shadowing G2 from the two masking terms G1(ωi),
-    /// G1(ωr) (CPU twin: [`crate::reference::masking`]).
+    /// G1(ωr) (CPU twin: `lobes::reference::masking`). Needs [`Module::Math`] only.
     ///
     /// - `masking_separable(gi: f32, gr: f32) -> f32`: G1(ωi) G1(ωr) (Heitz 2014, eq. 98);
     /// - `masking_height_correlated(gi: f32, gr: f32) -> f32`: 1 / (1 + Λ(ωi) + Λ(ωr))
@@ -139,6 +157,22 @@ pub enum Module {
     ///   rough dielectric's surface, B(1 + Λ(ωi), 1 + Λ(ωo)), from `masking_ln_beta(x, y)`
     ///   (ln of Euler's Beta function for x, y ≥ 1, without cancellation in f32).
     Masking,
+    /// `shaders/lib/dielectric.wgsl` and `shaders/lib/dielectric_eval.wgsl`: the rough
+    /// dielectric (Walter, Marschner, Li & Torrance 2007) on GGX or Beckmann, reflection and
+    /// refraction, light from either side; `eta` = η below / η above.
+    ///
+    /// - samplers `dielectric_ggx_ndf`, `dielectric_ggx_vndf`, `dielectric_beckmann_ndf`,
+    ///   `dielectric_beckmann_vndf`, all `(a, wi, u: vec3<f32>, eta: f32) -> LobeSample`: u.xy
+    ///   draw h, u.z chooses reflection (u.z < F) or refraction; `wr` is the scattered
+    ///   direction (either side), `pdf_r` its density, 0 for a sample on the wrong side of its
+    ///   event;
+    /// - their densities `dielectric_ggx_ndf_pdf`, `dielectric_ggx_vndf_pdf`,
+    ///   `dielectric_beckmann_ndf_pdf`, `dielectric_beckmann_vndf_pdf`, `(a, wi, wo, eta) -> f32`;
+    /// - the BSDF without G, `dielectric_ggx_eval`, `dielectric_beckmann_eval` (multiply by a
+    ///   masking term of [`Module::Masking`], e.g. `masking_height_correlated_transmitted`),
+    ///   and the VNDF estimator weights `dielectric_ggx_vndf_weight(a, wi)`,
+    ///   `dielectric_beckmann_vndf_weight(a, wi)`.
+    Dielectric,
     /// `shaders/lib/discrete.wgsl`: discrete 1D distributions. Declares two storage buffers,
     /// `discrete_f: array<f32>` and `discrete_u: array<u32>` (see [`DiscreteBindings`] for their
     /// numbers and [`DiscreteTable`] for their contents).
@@ -154,8 +188,9 @@ pub enum Module {
 
 impl Module {
     /// Every module, in dependency order.
-    pub const ALL: [Module; 9] = [
+    pub const ALL: [Module; 11] = [
         Module::Rng,
+        Module::Math,
         Module::Reflect,
         Module::Microfacet,
         Module::Ward,
@@ -163,26 +198,23 @@ impl Module {
         Module::Beckmann,
         Module::Fresnel,
         Module::Masking,
+        Module::Dielectric,
         Module::Discrete,
     ];
 
-    /// The file name of the module's main source (`"ggx"` for `shaders/lib/ggx.wgsl`).
+    /// The module's name: its import path under `lobes` (`lobes::ggx`), its file in the WESL
+    /// package and `--out-dir` (`ggx.wesl`), its name on `lobes wgsl`'s command line.
     ///
     /// ```
     /// assert_eq!(lobes::embed::Module::Ggx.name(), "ggx");
     /// ```
     pub fn name(self) -> &'static str {
-        match self {
-            Module::Rng => "rng",
-            Module::Reflect => "reflect",
-            Module::Microfacet => "microfacet",
-            Module::Ward => "ward",
-            Module::Ggx => "ggx",
-            Module::Beckmann => "beckmann",
-            Module::Fresnel => "fresnel",
-            Module::Masking => "masking",
-            Module::Discrete => "discrete",
-        }
+        generated::NAMES[self as usize]
+    }
+
+    /// The import path of the module in the naga_oil and WESL forms (`"lobes::ggx"`).
+    pub fn import_path(self) -> String {
+        format!("lobes::{}", self.name())
     }
 
     /// The modules this one uses directly (each earlier in [`Module::ALL`]), from the `#import`
@@ -190,114 +222,103 @@ impl Module {
     ///
     /// ```
     /// use lobes::embed::Module;
-    /// assert_eq!(Module::Beckmann.dependencies(), [Module::Reflect, Module::Microfacet]);
+    /// assert_eq!(Module::Beckmann.dependencies(), [Module::Math, Module::Reflect, Module::Microfacet]);
+    /// assert_eq!(Module::Fresnel.dependencies(), [Module::Math]);
     /// assert!(Module::Rng.dependencies().is_empty());
     /// ```
     pub fn dependencies(self) -> Vec<Module> {
-        let imported: Vec<String> = self.import_paths().iter().flat_map(|p| library::imports(p)).collect();
-        Module::ALL.into_iter().filter(|&m| m != self && m.import_paths().iter().any(|p| imported.iter().any(|i| i == p))).collect()
+        generated::DEPENDENCIES[self as usize].iter().map(|&i| Module::ALL[i]).collect()
     }
 
-    /// The import paths of the module's files (`#define_import_path` in `shaders/lib`), the
-    /// paths of its [`naga_oil_modules`].
-    ///
-    /// ```
-    /// assert_eq!(lobes::embed::Module::Ggx.import_paths(), ["lobes::ggx", "lobes::ggx_eval"]);
-    /// ```
-    pub fn import_paths(self) -> &'static [&'static str] {
-        match self {
-            Module::Rng => &["lobes::rng"],
-            Module::Reflect => &["lobes::math", "lobes::reflect"],
-            Module::Microfacet => &["lobes::microfacet", "lobes::microfacet_eval"],
-            Module::Ward => &["lobes::ward", "lobes::ward_eval"],
-            Module::Ggx => &["lobes::ggx", "lobes::ggx_eval"],
-            Module::Beckmann => &["lobes::erf", "lobes::beckmann", "lobes::beckmann_eval"],
-            Module::Fresnel => &["lobes::fresnel"],
-            Module::Masking => &["lobes::masking"],
-            Module::Discrete => &["lobes::discrete"],
-        }
+    /// The files of `shaders/` the module is made of (`["shaders/lib/ggx.wgsl",
+    /// "shaders/lib/ggx_eval.wgsl"]`).
+    pub fn files(self) -> &'static [&'static str] {
+        generated::FILES[self as usize]
     }
 
-    /// The module's files as naga_oil reads them (without its dependencies; [`wgsl`] adds
-    /// those): naga_oil modules, WGSL with `#define_import_path` and `#import` directives, for a
-    /// renderer that composes its shaders with naga_oil. They are the files of `shaders/` with
-    /// the type `Real` spelled `f32` (naga_oil cannot hold the files' `alias Real = f32;`: see
-    /// `engine::gpu::library`). [`Module::Discrete`] comes with its bindings at group 0, bindings
-    /// 3 and 4.
+    /// The module alone (without its dependencies; [`wgsl`] adds those) as plain WGSL with
+    /// every name prefixed, as [`wgsl`] writes it; [`Module::Discrete`] at its default bindings.
     ///
     /// ```
     /// use lobes::embed::Module;
-    /// assert!(Module::Ggx.source().contains("fn ggx_sample_vndf("));
-    /// assert!(Module::Ggx.source().contains("fn ggx_pdf_vndf("));
-    /// assert!(Module::Ggx.source().contains("#define_import_path lobes::ggx_eval"));
+    /// assert!(Module::Ggx.wgsl_source().contains("fn lobes_ggx_pdf_vndf("));
+    /// assert!(!Module::Ggx.wgsl_source().contains("fn lobes_reflect_about("));
     /// ```
-    pub fn source(self) -> String {
-        self.import_paths().iter().map(|p| library::naga_oil_source(p).expect("a library module")).collect::<Vec<_>>().join("\n")
+    pub fn wgsl_source(self) -> &'static str {
+        generated::WGSL[self as usize]
+    }
+
+    /// The module as a naga_oil module (without its dependencies): `#define_import_path
+    /// lobes::NAME`, `#import`s of the other modules, the files' short names, in f32.
+    /// [`Module::Discrete`] comes with its bindings at group 0, bindings 3 and 4
+    /// ([`DiscreteBindings::apply`] moves them).
+    ///
+    /// ```
+    /// use lobes::embed::Module;
+    /// let ggx = Module::Ggx.naga_oil_source();
+    /// assert!(ggx.starts_with("#define_import_path lobes::ggx\n"));
+    /// assert!(ggx.contains("fn ggx_sample_vndf(") && ggx.contains("fn ggx_pdf_vndf("));
+    /// assert!(!ggx.contains("Real") && !ggx.contains("f32 >"));
+    /// ```
+    pub fn naga_oil_source(self) -> &'static str {
+        generated::NAGA_OIL[self as usize]
+    }
+
+    /// The module as a WESL module (without its dependencies), `NAME.wesl` of the package
+    /// `lobes` ([`wesl_files`]): `import super::reflect::{LobeSample, PI};` lines (relative, so the
+    /// package works as an external package `lobes` and as a folder `lobes/` of your own
+    /// package), then the files' code under their short names, in f32.
+    ///
+    /// ```
+    /// use lobes::embed::Module;
+    /// let fresnel = Module::Fresnel.wesl_source();
+    /// assert!(fresnel.contains("fn fresnel_schlick(") && !fresnel.contains("import "));
+    /// assert!(Module::Ggx.wesl_source().starts_with("import super::math::{math_cos, math_sin};\n"));
+    /// ```
+    pub fn wesl_source(self) -> &'static str {
+        generated::WESL[self as usize]
     }
 
     /// The module named `name` (its [`Module::name`]).
     ///
     /// ```
     /// use lobes::embed::Module;
-    /// assert_eq!(Module::from_name("ggx"), Some(Module::Ggx));
+    /// assert_eq!(Module::from_name("dielectric"), Some(Module::Dielectric));
     /// assert_eq!(Module::from_name("GGX"), None);
     /// ```
     pub fn from_name(name: &str) -> Option<Module> {
         Module::ALL.into_iter().find(|m| m.name() == name)
     }
 
-    /// Every name the module exports at module scope (functions, constants, structs, type
+    /// Every name the module defines at module scope (functions, constants, structs, type
     /// aliases, globals), prefixed as [`wgsl`] writes them: the names your shader must not reuse.
-    /// The list is found by parsing the module's files with naga; it is the one list [`wgsl`]
-    /// renames by.
     ///
     /// ```
     /// use lobes::embed::Module;
-    /// assert!(Module::Reflect.symbols().contains(&"LOBES_PI".to_string()));
-    /// assert!(Module::Ggx.symbols().contains(&"lobes_ggx_eval".to_string()));
-    /// assert!(!Module::Ggx.symbols().contains(&"LOBES_PI".to_string())); // that one is Reflect's
+    /// assert!(Module::Reflect.symbols().contains(&"LOBES_PI"));
+    /// assert!(Module::Ggx.symbols().contains(&"lobes_ggx_eval"));
+    /// assert!(!Module::Ggx.symbols().contains(&"LOBES_PI")); // that one is Reflect's
     /// ```
-    pub fn symbols(self) -> Vec<String> {
-        self.short_names().iter().map(|n| prefixed(PREFIX, n)).collect()
+    pub fn symbols(self) -> &'static [&'static str] {
+        generated::SYMBOLS[self as usize]
     }
 
     /// The names the module's files declare at module scope (the short, unprefixed ones).
-    fn short_names(self) -> Vec<String> {
-        let deps: Vec<Module> = resolve(&[self]).into_iter().filter(|&m| m != self).collect();
-        let before = names(&short_wgsl(&deps));
-        names(&short_wgsl(&[self])).into_iter().filter(|n| !before.contains(n)).collect()
+    pub fn short_names(self) -> &'static [&'static str] {
+        generated::SHORT_NAMES[self as usize]
     }
 }
 
 /// The prefix of every exported name ([`prefixed`]).
 const PREFIX: &str = "lobes";
 
-/// Names declared at module scope of a WGSL source: parsed by naga (empty if it does not parse),
-/// and the `alias` declarations, which naga resolves away.
-fn names(source: &str) -> Vec<String> {
-    let Ok(m) = naga::front::wgsl::parse_str(source) else { return Vec::new() };
-    let mut out: Vec<String> = Vec::new();
-    out.extend(m.functions.iter().filter_map(|(_, f)| f.name.clone()));
-    out.extend(m.constants.iter().filter_map(|(_, c)| c.name.clone()));
-    out.extend(m.overrides.iter().filter_map(|(_, c)| c.name.clone()));
-    out.extend(m.global_variables.iter().filter_map(|(_, g)| g.name.clone()));
-    out.extend(m.types.iter().filter_map(|(_, t)| match t.inner {
-        naga::TypeInner::Struct { .. } => t.name.clone(),
-        _ => None,
-    }));
-    let alias = |l: &str| l.strip_prefix("alias ").and_then(|r| r.split(|c: char| !(c.is_alphanumeric() || c == '_')).next()).map(str::to_string);
-    out.extend(source.lines().filter_map(|l| alias(l.trim_start())));
-    out.sort();
-    out.dedup();
-    out
-}
-
 /// `modules` with all their dependencies, each once, in dependency order (the order of
 /// [`Module::ALL`]).
 ///
 /// ```
 /// use lobes::embed::{resolve, Module};
-/// assert_eq!(resolve(&[Module::Ward]), [Module::Reflect, Module::Ward]);
+/// assert_eq!(resolve(&[Module::Ward]), [Module::Math, Module::Reflect, Module::Ward]);
+/// assert_eq!(resolve(&[Module::Fresnel, Module::Masking]), [Module::Math, Module::Fresnel, Module::Masking]);
 /// assert_eq!(resolve(&[Module::Discrete, Module::Discrete]), [Module::Discrete]);
 /// ```
 pub fn resolve(modules: &[Module]) -> Vec<Module> {
@@ -319,6 +340,9 @@ pub fn resolve(modules: &[Module]) -> Vec<Module> {
 /// The WGSL of `modules` and their dependencies, each once, in dependency order, with
 /// [`Module::Discrete`]'s buffers at their default numbers ([`DiscreteBindings::default`]:
 /// group 0, bindings 3 and 4). Append your own code; see the [module documentation](self).
+/// Include it once per shader: two such texts concatenated define their common modules twice,
+/// which [`validate`] reports by file (ask for all modules in one call instead, or take one
+/// text per module, [`Module::wgsl_source`], and include each once).
 ///
 /// ```
 /// use lobes::embed::{self, Module};
@@ -350,31 +374,33 @@ pub fn wgsl_with(modules: &[Module], discrete: DiscreteBindings) -> String {
         env!("CARGO_PKG_VERSION"),
         listed.join(", ")
     );
-    // the library composes every module but Discrete, whose bindings and names are the caller's
-    let library: Vec<Module> = resolved.iter().copied().filter(|&m| m != Module::Discrete).collect();
-    let short = short_wgsl(&library);
-    let defined: Vec<String> = library.iter().flat_map(|m| m.short_names()).collect();
-    out.push_str(&namespace::rename(&short, |t| defined.iter().any(|d| d == t).then(|| prefixed(PREFIX, t))));
-    if resolved.contains(&Module::Discrete) {
-        out.push_str("// ---- shaders/lib/discrete.wgsl ----\n");
-        out.push_str(&discrete_wgsl(discrete));
+    for m in resolved {
+        out.push_str(&module_wgsl(m, discrete));
     }
     out
 }
 
-/// The files of `modules` and their dependencies as plain WGSL under their own short names
-/// (what lobes' kernels compose), [`Module::Discrete`] at its default bindings.
-fn short_wgsl(modules: &[Module]) -> String {
-    let resolved = resolve(modules);
-    let paths: Vec<&str> = resolved.iter().filter(|&&m| m != Module::Discrete).flat_map(|m| m.import_paths().iter().copied()).collect();
-    let mut out = String::new();
-    if !paths.is_empty() {
-        out.push_str(&library::wgsl(&paths, Precision::F32Accurate).unwrap_or_else(|e| panic!("{e}")));
+/// One module's plain prefixed text ([`Module::wgsl_source`]), [`Module::Discrete`] with its
+/// buffers at `discrete`: the pieces of [`wgsl_with`], for a renderer that includes one text per
+/// module (each once; they do not overlap).
+///
+/// ```
+/// use lobes::embed::{module_wgsl, DiscreteBindings, Module};
+/// let b = DiscreteBindings { group: 1, table: 0, alias: 1 };
+/// assert!(module_wgsl(Module::Discrete, b).contains("@group(1) @binding(1) var<storage, read> lobes_discrete_u"));
+/// assert_eq!(module_wgsl(Module::Ggx, b), Module::Ggx.wgsl_source());
+/// ```
+pub fn module_wgsl(m: Module, discrete: DiscreteBindings) -> std::borrow::Cow<'static, str> {
+    match m {
+        Module::Discrete => discrete.apply_wgsl(m.wgsl_source()).into(),
+        _ => m.wgsl_source().into(),
     }
-    if resolved.contains(&Module::Discrete) {
-        out.push_str(&discrete_file(DiscreteBindings::default()));
-    }
-    out
+}
+
+/// The plain, unprefixed `shaders/lib/discrete.wgsl` (directive lines blanked, no marker line).
+fn discrete_short() -> &'static str {
+    let s = generated::SHORT_WGSL[Module::Discrete as usize];
+    s.split_once('\n').map_or(s, |(_, rest)| rest)
 }
 
 /// `shaders/lib/discrete.wgsl` with its two storage buffers at `bindings`: the table named
@@ -397,8 +423,8 @@ pub fn discrete_wgsl(bindings: DiscreteBindings) -> String {
 /// `lobes_{name}` with the file's `discrete_` dropped (`discrete_sample_alias` →
 /// `lobes_{name}_sample_alias`, `discrete_f` → `lobes_{name}_f`, `DISCRETE_BLOCK` →
 /// `LOBES_{NAME}_BLOCK`). Append one per table to sample several distributions in one shader
-/// (each with its own [`DiscreteBuffers`] at its own bindings); the name `discrete` gives the
-/// names of [`wgsl_with`].
+/// (each with its own buffers at its own bindings); the name `discrete` gives the names of
+/// [`wgsl_with`].
 ///
 /// # Panics
 ///
@@ -417,96 +443,255 @@ pub fn discrete_table_wgsl(name: &str, bindings: DiscreteBindings) -> String {
     assert!(valid, "discrete table name {name:?}: expected a lower-case WGSL identifier ([a-z][a-z0-9_]*)");
     let prefix = format!("{PREFIX}_{name}");
     let defined = Module::Discrete.short_names();
-    namespace::rename(&discrete_file(bindings), |t| {
-        defined.iter().any(|d| d == t).then(|| prefixed(&prefix, t.strip_prefix("discrete_").or_else(|| t.strip_prefix("DISCRETE_")).unwrap_or(t)))
+    namespace::rename(&bindings.apply(discrete_short()), |t| {
+        defined.iter().any(|d| *d == t).then(|| prefixed(&prefix, t.strip_prefix("discrete_").or_else(|| t.strip_prefix("DISCRETE_")).unwrap_or(t)))
     })
 }
 
-/// The plain `shaders/lib/discrete.wgsl` (short names) with its two storage buffers at
-/// `bindings`: `discrete_f` at `@group(bindings.group) @binding(bindings.table)` and
-/// `discrete_u` at `@binding(bindings.alias)`.
-fn discrete_file(bindings: DiscreteBindings) -> String {
-    let mut found = [false; 2];
-    let file = library::plain(library::source("lobes::discrete").expect("shaders/lib/discrete.wgsl"));
-    let mut out = String::with_capacity(file.len() + 16);
-    for line in file.lines() {
-        let var = line.find("var<storage");
-        let which = [("discrete_f", bindings.table, 0), ("discrete_u", bindings.alias, 1)]
-            .into_iter()
-            .find(|(name, _, _)| var.is_some() && line.contains(&format!("> {name}:")));
-        match (var, which) {
-            (Some(at), Some((_, binding, k))) => {
-                found[k] = true;
-                out.push_str(&format!("@group({}) @binding({binding}) {}", bindings.group, &line[at..]));
-            }
-            _ => out.push_str(line),
-        }
-        out.push('\n');
+impl DiscreteBindings {
+    /// `source` (a text of [`Module::Discrete`] in any form: [`Module::naga_oil_source`],
+    /// [`Module::wesl_source`], or the unprefixed file) with the two storage buffers
+    /// `discrete_f` and `discrete_u` at these numbers.
+    ///
+    /// ```
+    /// use lobes::embed::{DiscreteBindings, Module};
+    /// let b = DiscreteBindings { group: 2, table: 0, alias: 5 };
+    /// let wesl = b.apply(Module::Discrete.wesl_source());
+    /// assert!(wesl.contains("@group(2) @binding(0) var<storage, read> discrete_f: array<f32>;"));
+    /// assert!(wesl.contains("@group(2) @binding(5) var<storage, read> discrete_u: array<u32>;"));
+    /// ```
+    ///
+    /// # Panics
+    ///
+    /// If `source` declares neither buffer (it is not a text of [`Module::Discrete`]).
+    pub fn apply(self, source: &str) -> String {
+        text::with_bindings(source, "discrete_f", "discrete_u", self.group, [self.table, self.alias]).expect("a text of Module::Discrete, which declares discrete_f and discrete_u")
     }
-    assert!(found == [true, true], "shaders/lib/discrete.wgsl no longer declares discrete_f and discrete_u");
-    out
+
+    /// The same for the prefixed text ([`Module::wgsl_source`]: `lobes_discrete_f`, `lobes_discrete_u`).
+    fn apply_wgsl(self, source: &str) -> String {
+        text::with_bindings(source, "lobes_discrete_f", "lobes_discrete_u", self.group, [self.table, self.alias]).expect("Module::Discrete's plain text declares its buffers")
+    }
 }
 
-/// One of lobes' files as a naga_oil module, for a renderer that composes its shaders with
-/// naga_oil (or Bevy, whose shader imports are naga_oil's): add each with
-/// `Composer::add_composable_module(m.descriptor())`, then `#import lobes::ggx::ggx_sample_vndf`
-/// (or any name of [`Module::source`]) in your shader. naga_oil keeps modules apart by import
-/// path, so these carry the files' short names.
+/// One of lobes' modules as a naga_oil module, for a renderer that composes its shaders with
+/// naga_oil (Bevy ≤ 0.19): add each with [`add_naga_oil_modules`] (feature `naga-oil`) or
+/// your own `Composer::add_composable_module`, then `#import lobes::ggx::ggx_sample_vndf` in
+/// your shader. naga_oil keeps modules apart by import path, so these carry the files' short
+/// names.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct NagaOilModule {
+    /// The module.
+    pub module: Module,
     /// The path its `#define_import_path` names (`"lobes::ggx"`).
-    pub import_path: &'static str,
-    /// The module's text: WGSL with naga_oil's `#define_import_path` and `#import` directives.
-    pub source: String,
+    pub import_path: String,
+    /// The module's text: WGSL with naga_oil's `#define_import_path` and `#import` directives
+    /// ([`Module::naga_oil_source`]).
+    pub source: &'static str,
 }
 
+#[cfg(feature = "naga-oil")]
 impl NagaOilModule {
     /// The descriptor for `naga_oil::compose::Composer::add_composable_module` (naga_oil 0.23),
     /// with the import path as the file path that naga_oil's messages name.
     pub fn descriptor(&self) -> naga_oil::compose::ComposableModuleDescriptor<'_> {
-        naga_oil::compose::ComposableModuleDescriptor { source: &self.source, file_path: self.import_path, ..Default::default() }
+        naga_oil::compose::ComposableModuleDescriptor { source: self.source, file_path: &self.import_path, ..Default::default() }
     }
 }
 
-/// Every file of every [`Module`] as a naga_oil module (see [`NagaOilModule`]), each after the
-/// modules it imports (the order naga_oil's `add_composable_module` needs). They are
-/// [`Module::source`]'s: spelled in f32 (naga_oil cannot import the files' `alias Real`), and
-/// [`Module::Discrete`] with its buffers at group 0, bindings 3 and 4.
+/// `modules` and their dependencies as naga_oil modules (see [`NagaOilModule`]), each after
+/// the modules it imports (the order naga_oil's `add_composable_module` needs).
 ///
 /// ```
-/// use naga_oil::compose::{Composer, NagaModuleDescriptor};
-/// let mut composer = Composer::default();
-/// for m in lobes::embed::naga_oil_modules() {
-///     composer.add_composable_module(m.descriptor()).unwrap();
-/// }
-/// let shader = "#import lobes::ggx::ggx_sample_vndf
-/// const PI: f32 = 3.0; // the renderer's own
-/// @compute @workgroup_size(1) fn main() {
-///     let s = ggx_sample_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), vec2(0.5 / PI));
-/// }";
-/// composer.make_naga_module(NagaModuleDescriptor { source: shader, file_path: "mine.wgsl", ..Default::default() }).unwrap();
+/// use lobes::embed::{naga_oil_modules, Module};
+/// let paths: Vec<String> = naga_oil_modules(&[Module::Fresnel]).into_iter().map(|m| m.import_path).collect();
+/// assert_eq!(paths, ["lobes::fresnel"]); // in f32, Fresnel needs nothing of lobes::math
 /// ```
-pub fn naga_oil_modules() -> Vec<NagaOilModule> {
-    Module::ALL
-        .iter()
-        .flat_map(|m| m.import_paths())
-        .map(|&p| NagaOilModule { import_path: p, source: library::naga_oil_source(p).expect("a library module") })
+pub fn naga_oil_modules(modules: &[Module]) -> Vec<NagaOilModule> {
+    resolve(modules)
+        .into_iter()
+        .filter(|m| !m.naga_oil_source().trim().is_empty() && (modules.contains(m) || needed_by_import(*m, modules)))
+        .map(|module| NagaOilModule { module, import_path: module.import_path(), source: module.naga_oil_source() })
         .collect()
 }
 
-/// Parses and validates WGSL with naga, as wgpu does on `create_shader_module`; the error
-/// carries naga's message with the source location.
-///
-/// ```
-/// assert!(lobes::embed::validate("fn f() -> f32 { return ggx_d(vec2(0.1), vec3(0.0, 0.0, 1.0)); }").is_err());
-/// ```
-pub fn validate(source: &str) -> Result<(), GpuError> {
-    library::validate_module("embedded lobes WGSL", source).map(|_| ())
+/// Whether `m` is imported (in the naga_oil and WESL forms, which import no `Real`) by one of
+/// `modules` or by what they import.
+fn needed_by_import(m: Module, modules: &[Module]) -> bool {
+    let imports = |k: Module| -> Vec<Module> {
+        let text = k.wesl_source();
+        Module::ALL.into_iter().filter(|d| text.lines().any(|l| l.starts_with(&format!("import super::{}::", d.name())))).collect()
+    };
+    let mut stack: Vec<Module> = modules.to_vec();
+    let mut seen = Vec::new();
+    while let Some(k) = stack.pop() {
+        if seen.contains(&k) {
+            continue;
+        }
+        seen.push(k);
+        for d in imports(k) {
+            if d == m {
+                return true;
+            }
+            stack.push(d);
+        }
+    }
+    false
 }
 
-#[cfg(test)]
+/// Adds `modules` and what they import to a naga_oil composer, each after those it imports,
+/// skipping any the composer already holds: calling it twice, or for overlapping module
+/// lists, adds each module once (naga_oil would otherwise replace a module that is added again
+/// and drop the modules that import it).
+///
+/// ```
+/// use naga_oil::compose::{Composer, NagaModuleDescriptor};
+/// use lobes::embed::{add_naga_oil_modules, Module};
+/// let mut composer = Composer::default();
+/// add_naga_oil_modules(&mut composer, &[Module::Ggx]).unwrap();
+/// add_naga_oil_modules(&mut composer, &[Module::Fresnel, Module::Ggx]).unwrap(); // no duplicates
+/// let shader = "#import lobes::ggx::{ggx_sample_vndf, ggx_pdf_vndf}
+/// #import lobes::fresnel::fresnel_schlick
+/// const PI: f32 = 3.0; // the renderer's own
+/// @compute @workgroup_size(1) fn main() {
+///     let s = ggx_sample_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), vec2(0.5 / PI));
+///     let w = fresnel_schlick(s.wr.z, 0.04) / ggx_pdf_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), s.wr);
+/// }";
+/// composer.make_naga_module(NagaModuleDescriptor { source: shader, file_path: "mine.wgsl", ..Default::default() }).unwrap();
+/// ```
+#[cfg(feature = "naga-oil")]
+pub fn add_naga_oil_modules(composer: &mut naga_oil::compose::Composer, modules: &[Module]) -> Result<(), naga_oil::compose::ComposerError> {
+    for m in naga_oil_modules(modules) {
+        if !composer.contains_module(&m.import_path) {
+            composer.add_composable_module(m.descriptor())?;
+        }
+    }
+    Ok(())
+}
+
+/// `modules` and what they import as the files of the WESL package `lobes`: (`"ggx.wesl"`,
+/// [`Module::wesl_source`]), each once. Write them into a folder `lobes/` beside your shaders,
+/// or hand them to your WESL resolver as the package `lobes`; then `import
+/// lobes::ggx::ggx_sample_vndf;`.
+///
+/// ```
+/// use lobes::embed::{wesl_files, Module};
+/// let files: Vec<String> = wesl_files(&[Module::Ggx]).into_iter().map(|(name, _)| name).collect();
+/// assert_eq!(files, ["math.wesl", "reflect.wesl", "microfacet.wesl", "ggx.wesl"]);
+/// ```
+pub fn wesl_files(modules: &[Module]) -> Vec<(String, &'static str)> {
+    naga_oil_modules(modules).into_iter().map(|m| (format!("{}.wesl", m.module.name()), m.module.wesl_source())).collect()
+}
+
+#[cfg(feature = "wesl")]
+mod wesl_package {
+    use super::generated::{NAMES, WESL};
+    use wesl::{CodegenModule, CodegenPkg};
+    macro_rules! modules {
+        ($($i:literal)*) => {
+            static SUBMODULES: [CodegenModule; 11] = [$(CodegenModule { name: NAMES[$i], source: WESL[$i], submodules: &[] }),*];
+            static REFS: [&CodegenModule; 11] = [$(&SUBMODULES[$i]),*];
+        };
+    }
+    modules!(0 1 2 3 4 5 6 7 8 9 10);
+    static ROOT: CodegenModule = CodegenModule { name: "lobes", source: "", submodules: &REFS };
+    pub static WESL_PACKAGE: CodegenPkg = CodegenPkg { crate_name: "lobes", root: &ROOT, dependencies: &[] };
+}
+
+/// Every [`Module`] as the WESL package `lobes` for the `wesl` crate 0.4 (feature `wesl`), for
+/// a build script or a run-time compiler: `Wesl::new("shaders").add_package(&WESL_PACKAGE)`,
+/// then `import lobes::ggx::ggx_sample_vndf;` in your WESL. (The `wesl` crate's package type
+/// is its own per version; with another version, e.g. Bevy 0.20's wesl 0.6, take
+/// [`wesl_files`] or `lobes wgsl --wesl --out-dir`.)
+///
+/// ```
+/// // in build.rs, beside `shaders/main.wesl` that says `import lobes::ggx::ggx_sample_vndf;`
+/// let mut compiler = wesl::Wesl::new("shaders");
+/// compiler.add_package(&lobes::embed::WESL_PACKAGE);
+/// // compiler.build_artifact(&"package::main".parse().unwrap(), "main");
+/// ```
+#[cfg(feature = "wesl")]
+pub use wesl_package::WESL_PACKAGE;
+
+/// A source given to [`validate`] that holds one of lobes' files twice (two texts of [`wgsl`]
+/// concatenated), or that naga rejects.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{message}")]
+pub struct InvalidWgsl {
+    /// naga's message with the source location, or which file is included twice.
+    pub message: String,
+}
+
+/// Parses and validates WGSL with naga, as wgpu does on `create_shader_module` (feature
+/// `naga`); the error carries naga's message with the source location. A source that includes
+/// one of lobes' files twice (two outputs of [`wgsl`] or `lobes wgsl` concatenated) is
+/// refused first, by file, rather than with naga's "redefinition of …".
+///
+/// ```
+/// use lobes::embed::{self, Module};
+/// assert!(embed::validate("fn f() -> f32 { return ggx_d(vec2(0.1), vec3(0.0, 0.0, 1.0)); }").is_err());
+/// let twice = embed::wgsl(&[Module::Ggx]) + &embed::wgsl(&[Module::Fresnel]);
+/// let e = embed::validate(&twice).unwrap_err();
+/// assert!(e.message.contains("shaders/math/f32.wgsl is included twice"), "{e}");
+/// ```
+#[cfg(feature = "naga")]
+pub fn validate(source: &str) -> Result<(), InvalidWgsl> {
+    let mut seen: Vec<&str> = Vec::new();
+    for marker in source.lines().filter_map(|l| l.strip_prefix("// ---- shaders/")).filter_map(|l| l.strip_suffix(" ----")) {
+        if seen.contains(&marker) {
+            return Err(InvalidWgsl {
+                message: format!(
+                    "shaders/{marker} is included twice (two texts of lobes::embed::wgsl or `lobes wgsl` concatenated?): \
+                     take all modules from one call, or one text per module (Module::wgsl_source, `lobes wgsl --out-dir`) and include each once"
+                ),
+            });
+        }
+        seen.push(marker);
+    }
+    let module = naga::front::wgsl::parse_str(source).map_err(|e| InvalidWgsl { message: format!("embedded lobes WGSL: {}", e.emit_to_string(source)) })?;
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+        .validate(&module)
+        .map_err(|e| InvalidWgsl { message: format!("embedded lobes WGSL: {e:?}") })?;
+    Ok(())
+}
+
+#[cfg(all(test, feature = "check"))]
 mod tests {
     use super::*;
+    use crate::engine::gpu::library;
+
+    /// Names declared at module scope of a WGSL source, by naga's parse (empty if it does not
+    /// parse), and the `alias` declarations, which naga resolves away.
+    fn names(source: &str) -> Vec<String> {
+        let Ok(m) = naga::front::wgsl::parse_str(source) else { return Vec::new() };
+        let mut out: Vec<String> = Vec::new();
+        out.extend(m.functions.iter().filter_map(|(_, f)| f.name.clone()));
+        out.extend(m.constants.iter().filter_map(|(_, c)| c.name.clone()));
+        out.extend(m.overrides.iter().filter_map(|(_, c)| c.name.clone()));
+        out.extend(m.global_variables.iter().filter_map(|(_, g)| g.name.clone()));
+        out.extend(m.types.iter().filter_map(|(_, t)| match t.inner {
+            naga::TypeInner::Struct { .. } => t.name.clone(),
+            _ => None,
+        }));
+        let alias = |l: &str| l.strip_prefix("alias ").and_then(|r| r.split(|c: char| !(c.is_alphanumeric() || c == '_')).next()).map(str::to_string);
+        out.extend(source.lines().filter_map(|l| alias(l.trim_start())));
+        out.sort();
+        out.dedup();
+        out
+    }
+
+    /// The unprefixed plain text of `modules` (no dependencies added), in the order given.
+    fn short(modules: &[Module]) -> String {
+        modules.iter().map(|&m| generated::SHORT_WGSL[m as usize]).collect()
+    }
+
+    #[test]
+    fn the_generated_table_is_the_enum() {
+        for (i, m) in Module::ALL.into_iter().enumerate() {
+            assert_eq!(m as usize, i);
+            assert_eq!(format!("{m:?}").to_lowercase(), m.name());
+        }
+    }
 
     #[test]
     fn every_module_composes_and_validates_alone_and_together() {
@@ -516,31 +701,54 @@ mod tests {
         validate(&wgsl(&Module::ALL)).unwrap();
     }
 
-    /// A renderer's naga_oil composes the modules of [`naga_oil_modules`] and a shader that
-    /// imports from them and has names of its own that lobes' files also use.
+    /// The embedded files are the ones lobes' engine composes: each module's text is, file by
+    /// file, the engine's plain piece of the same import path.
+    #[test]
+    fn the_embedded_files_are_the_engines() {
+        for m in Module::ALL {
+            let mut expected = String::new();
+            for file in m.files() {
+                let path = text::import_path(&std::fs::read_to_string(file).unwrap()).unwrap().to_string();
+                let pieces = library::pieces(&[&path], &[]).unwrap();
+                let (_, plain) = pieces.iter().find(|(p, _)| p == file).unwrap_or_else(|| panic!("{file} is not the engine's {path}"));
+                expected += &format!("// ---- {file} ----\n{plain}\n");
+            }
+            assert_eq!(generated::SHORT_WGSL[m as usize], expected, "{m:?}");
+        }
+    }
+
+    #[test]
+    fn declared_names_are_what_naga_finds() {
+        for m in Module::ALL {
+            let deps: Vec<Module> = resolve(&[m]).into_iter().filter(|&d| d != m).collect();
+            let before = names(&short(&deps));
+            let found: Vec<String> = names(&short(&resolve(&[m]))).into_iter().filter(|n| !before.contains(n)).collect();
+            assert_eq!(m.short_names(), found, "{m:?}");
+        }
+    }
+
+    /// A renderer's naga_oil composes lobes' modules and a shader that imports from them and has
+    /// names of its own that lobes' files also use.
     #[test]
     fn naga_oil_modules_compose_with_a_renderer_shader() {
         use naga_oil::compose::{Composer, NagaModuleDescriptor};
         let mut composer = Composer::default();
-        let modules = naga_oil_modules();
-        for m in &modules {
-            if let Err(e) = composer.add_composable_module(m.descriptor()) {
-                panic!("{}: {}", m.import_path, e.emit_to_string(&composer));
-            }
+        if let Err(e) = add_naga_oil_modules(&mut composer, &Module::ALL) {
+            panic!("{}", e.emit_to_string(&composer));
         }
-        let paths: Vec<&str> = modules.iter().map(|m| m.import_path).collect();
-        for wanted in ["lobes::rng", "lobes::ggx", "lobes::fresnel", "lobes::masking", "lobes::discrete"] {
-            assert!(paths.contains(&wanted), "{paths:?}");
-        }
-        let shader = "#import lobes::beckmann::beckmann_sample_vndf\n#import lobes::ggx_eval::ggx_eval\n#import lobes::ggx::ggx_g1\n\
+        add_naga_oil_modules(&mut composer, &[Module::Ggx, Module::Fresnel]).unwrap();
+        let shader = "#import lobes::beckmann::beckmann_sample_vndf\n#import lobes::ggx::{ggx_eval, ggx_g1, ggx_pdf_vndf}\n\
                       #import lobes::fresnel::fresnel_schlick\n#import lobes::masking::masking_height_correlated\n\
                       #import lobes::rng::rng_uniforms\n#import lobes::discrete::discrete_sample_alias\n\
+                      #import lobes::dielectric::{dielectric_ggx_vndf, dielectric_ggx_vndf_pdf}\n\
                       const PI: f32 = 3.0;\nfn stretch(x: f32) -> f32 { return x; }\nfn pcg4d(x: u32) -> u32 { return x; }\n\
                       @compute @workgroup_size(1) fn main() {\n\
                       let u = rng_uniforms(vec2(1u, 2u), vec2(3u, 0u));\n\
                       let s = beckmann_sample_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), u.xy);\n\
-                      let f = ggx_eval(vec2(0.3), vec3(0.0, 0.0, 1.0), s.wr) * fresnel_schlick(s.wr.z, 0.04 * PI);\n\
+                      let f = ggx_eval(vec2(0.3), vec3(0.0, 0.0, 1.0), s.wr) * fresnel_schlick(s.wr.z, 0.04 * PI) / ggx_pdf_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), s.wr);\n\
                       let g = masking_height_correlated(ggx_g1(vec2(0.3), s.wr), 0.5) + stretch(f);\n\
+                      let t = dielectric_ggx_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), u.xyz, 1.5);\n\
+                      let p = dielectric_ggx_vndf_pdf(vec2(0.3), vec3(0.0, 0.0, 1.0), t.wr, 1.5);\n\
                       let k = discrete_sample_alias(u.zw, pcg4d(4u));\n}\n";
         match composer.make_naga_module(NagaModuleDescriptor { source: shader, file_path: "renderer.wgsl", ..Default::default() }) {
             Ok(module) => {
@@ -548,6 +756,25 @@ mod tests {
                 naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).unwrap();
             }
             Err(e) => panic!("{}", e.emit_to_string(&composer)),
+        }
+    }
+
+    #[test]
+    fn naga_oil_and_wesl_texts_are_clean() {
+        for m in Module::ALL {
+            for text in [m.naga_oil_source(), m.wesl_source()] {
+                let code: String = text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n");
+                assert!(!code.contains("Real") && !code.contains("f32 >") && !code.contains("f32 )"), "{m:?}:\n{text}");
+                assert!(!text.contains("lobes::math::Real") && !code.contains("alias "), "{m:?}");
+            }
+            // each form imports only the modules the plain form depends on
+            for line in m.wesl_source().lines().filter(|l| l.starts_with("import ")) {
+                assert!(m.dependencies().iter().any(|d| line.starts_with(&format!("import super::{}::", d.name()))), "{m:?}: {line}");
+            }
+        }
+        for wanted in [Module::Fresnel, Module::Masking] {
+            let paths: Vec<Module> = naga_oil_modules(&[wanted]).into_iter().map(|m| m.module).collect();
+            assert!(!paths.contains(&Module::Reflect), "{wanted:?} brings {paths:?}");
         }
     }
 
@@ -567,7 +794,7 @@ mod tests {
 
     /// The IR of `plain` with every name `n` in it (functions, constants, globals, structs,
     /// and any local of the same name) read as `to(n)`, equals the IR of `renamed`.
-    fn assert_same_ir_up_to_names(plain: &str, renamed: &str, names: &[String], to: impl Fn(&str) -> String) {
+    fn assert_same_ir_up_to_names(plain: &str, renamed: &str, names: &[&str], to: impl Fn(&str) -> String) {
         let mut expected = ir(plain);
         for n in names {
             expected = expected.replace(&format!("\"{n}\""), &format!("\"{}\"", to(n)));
@@ -581,21 +808,21 @@ mod tests {
         }
     }
 
-    /// What [`wgsl`] exports is the composed code lobes' kernels run, with only the names changed:
+    /// What [`wgsl`] exports is the code lobes' kernels compose, with only the names changed:
     /// the same functions, constants, globals and types in the same order, and the same
     /// expressions and statements in each function.
     #[test]
     fn exported_wgsl_is_the_composed_code_up_to_names() {
         let library: Vec<Module> = Module::ALL.into_iter().filter(|&m| m != Module::Discrete).collect();
-        let names: Vec<String> = library.iter().flat_map(|m| m.short_names()).collect();
+        let names: Vec<&str> = library.iter().flat_map(|m| m.short_names().iter().copied()).collect();
         let exported = wgsl(&library);
-        assert_same_ir_up_to_names(&short_wgsl(&library), &exported, &names, |n| prefixed(PREFIX, n));
+        assert_same_ir_up_to_names(&short(&library), &exported, &names, |n| prefixed(PREFIX, n));
         assert!(exported.contains("fn lobes_ggx_sample_vndf(") && exported.contains("const LOBES_PI") && exported.contains("struct LobesLobeSample"));
         // a discrete table under a name of its own
         let names = Module::Discrete.short_names();
         let lights = discrete_table_wgsl("lights", DiscreteBindings::default());
         let table = |n: &str| prefixed("lobes_lights", n.strip_prefix("discrete_").or_else(|| n.strip_prefix("DISCRETE_")).unwrap_or(n));
-        assert_same_ir_up_to_names(&discrete_file(DiscreteBindings::default()), &lights, &names, table);
+        assert_same_ir_up_to_names(discrete_short(), &lights, names, table);
         assert!(lights.contains("fn lobes_lights_sample_alias(") && lights.contains("LOBES_LIGHTS_BLOCK"), "{lights}");
     }
 
@@ -605,9 +832,9 @@ mod tests {
     fn a_renderer_with_lobes_short_names_of_its_own_composes_with_the_export() {
         let mut mine = String::from("struct LobeSample { x: f32 }\nconst PI: f32 = 3.0;\nfn stretch(x: f32) -> f32 { return x * PI; }\n\
                                      fn sample(s: LobeSample) -> f32 { return stretch(s.x); }\nfn pcg4d(x: u32) -> u32 { return x; }\n\
-                                     fn rng_uniforms() -> f32 { return f32(pcg4d(1u)); }\n");
-        let special = ["LobeSample", "PI", "stretch", "pcg4d", "rng_uniforms"];
-        let all: Vec<String> = Module::ALL.iter().flat_map(|m| m.short_names()).filter(|n| !special.contains(&n.as_str())).collect();
+                                     fn rng_uniforms() -> f32 { return f32(pcg4d(1u)); }\nalias Real = f32;\n");
+        let special = ["LobeSample", "PI", "stretch", "pcg4d", "rng_uniforms", "Real"];
+        let all: Vec<&str> = Module::ALL.iter().flat_map(|m| m.short_names().iter().copied()).filter(|n| !special.contains(n)).collect();
         assert!(all.len() > 50, "{all:?}");
         for (i, n) in all.iter().enumerate() {
             mine += &format!("const {n}: u32 = {i}u;\n");
@@ -621,6 +848,17 @@ mod tests {
         validate(&source).unwrap_or_else(|e| panic!("{e}"));
     }
 
+    /// One text per module ([`Module::wgsl_source`]), each once, in any order, is the same
+    /// shader as [`wgsl`]'s.
+    #[test]
+    fn one_text_per_module_combines() {
+        let mut parts: Vec<&str> = resolve(&[Module::Dielectric, Module::Rng]).iter().map(|m| m.wgsl_source()).collect();
+        parts.reverse();
+        validate(&parts.concat()).unwrap();
+        let twice = wgsl(&[Module::Ward]) + &wgsl(&[Module::Ggx]);
+        assert!(validate(&twice).unwrap_err().message.contains("shaders/math/f32.wgsl is included twice"));
+    }
+
     #[test]
     fn dependencies_come_earlier() {
         for m in Module::ALL {
@@ -632,9 +870,9 @@ mod tests {
 
     #[test]
     fn no_name_is_declared_by_two_modules() {
-        let mut seen: Vec<(String, Module)> = Vec::new();
+        let mut seen: Vec<(&str, Module)> = Vec::new();
         for m in Module::ALL {
-            for s in m.symbols() {
+            for &s in m.symbols() {
                 assert!(!seen.iter().any(|(n, _)| *n == s), "{s} declared twice");
                 seen.push((s, m));
             }
@@ -646,7 +884,8 @@ mod tests {
     fn documented_functions_exist() {
         let wanted = [
             (Module::Rng, &["rng_uniforms", "pcg4d", "add64"][..]),
-            (Module::Reflect, &["LobeSample", "reflect_about", "reflect_sample", "PI"]),
+            (Module::Math, &["Real", "math_exp", "neg_ln"]),
+            (Module::Reflect, &["LobeSample", "reflect_about", "reflect_sample", "reflection_half_vector", "PI"]),
             (Module::Ward, &["ward_sample", "ward_pdf", "ward_eval"]),
             (
                 Module::Ggx,
@@ -655,19 +894,51 @@ mod tests {
             (Module::Beckmann, &["beckmann_sample_ndf", "beckmann_sample_vndf", "beckmann_pdf_ndf", "beckmann_pdf_vndf", "beckmann_eval", "beckmann_g2"]),
             (Module::Fresnel, &["fresnel_schlick", "fresnel_dielectric", "fresnel_conductor"]),
             (Module::Masking, &["masking_separable", "masking_height_correlated", "masking_height_correlated_transmitted", "masking_ln_beta"]),
+            (
+                Module::Dielectric,
+                &["dielectric_ggx_ndf", "dielectric_ggx_vndf", "dielectric_beckmann_ndf", "dielectric_beckmann_vndf", "dielectric_ggx_vndf_pdf", "dielectric_ggx_eval", "dielectric_ggx_vndf_weight"],
+            ),
             (Module::Discrete, &["discrete_sample_cdf", "discrete_sample_cdf_blocks", "discrete_sample_alias", "discrete_f", "discrete_u"]),
         ];
         for (m, names) in wanted {
             let s = m.short_names();
             for n in names {
-                assert!(s.iter().any(|x| x == n), "{m:?} lacks {n}: {s:?}");
+                assert!(s.contains(n), "{m:?} lacks {n}: {s:?}");
             }
         }
     }
 
     #[test]
     fn default_discrete_bindings_leave_the_file_unchanged() {
-        let file = library::plain(library::source("lobes::discrete").unwrap());
-        assert_eq!(discrete_file(DiscreteBindings::default()).trim_end(), file.trim_end());
+        assert_eq!(DiscreteBindings::default().apply(discrete_short()), discrete_short());
+        assert_eq!(module_wgsl(Module::Discrete, DiscreteBindings::default()), Module::Discrete.wgsl_source());
+    }
+
+    /// The WESL package compiles, with the `wesl` crate's own resolver and mangler, a renderer's
+    /// shader that imports from it and has lobes' short names of its own; naga validates the result.
+    #[cfg(feature = "wesl")]
+    #[test]
+    fn the_wesl_package_compiles_a_renderer_shader() {
+        use wesl::syntax::PathOrigin;
+        let shader = "import lobes::ggx::{ggx_sample_vndf, ggx_pdf_vndf, ggx_eval};\nimport lobes::rng::rng_uniforms;\n\
+                      import lobes::dielectric::dielectric_beckmann_vndf;\nimport lobes::discrete::discrete_sample_alias;\n\
+                      const PI: f32 = 3.0;\nfn stretch(x: f32) -> f32 { return x; }\n\
+                      @group(0) @binding(0) var<storage, read_write> out: array<f32>;\n\
+                      @compute @workgroup_size(1) fn main() {\n\
+                      let u = rng_uniforms(vec2(1u, 2u), vec2(3u, 0u));\n\
+                      let wi = vec3(0.0, 0.0, 1.0);\n\
+                      let s = ggx_sample_vndf(vec2(0.3), wi, u.xy);\n\
+                      let t = dielectric_beckmann_vndf(vec2(0.3), wi, u.xyz, 1.5);\n\
+                      out[0] = stretch(ggx_eval(vec2(0.3), wi, s.wr) / ggx_pdf_vndf(vec2(0.3), wi, s.wr)) * PI + t.pdf_r + f32(discrete_sample_alias(u.zw, 4u));\n}\n";
+        let mut local = wesl::VirtualResolver::new();
+        let root = wesl::ModulePath::new(PathOrigin::Absolute, vec!["main".into()]);
+        local.add_module(root.clone(), shader.into());
+        let mut packages = wesl::PkgResolver::new();
+        packages.add_package(&WESL_PACKAGE);
+        let mut router = wesl::Router::new();
+        router.mount_resolver(wesl::ModulePath::new(PathOrigin::Absolute, vec![]), local);
+        router.mount_fallback_resolver(packages);
+        let compiled = wesl::Wesl::new("").set_custom_resolver(router).compile(&root).unwrap_or_else(|e| panic!("{e}"));
+        validate(&compiled.to_string()).unwrap_or_else(|e| panic!("{e}\n{compiled}"));
     }
 }
