@@ -474,3 +474,144 @@ fn end_to_end_example_passes() {
     }
     assert!(verdicts[0].max_angle_rad.unwrap() < 1e-4);
 }
+
+/// The renderer's own kernel of the consumer tests: 2²⁰ GGX VNDF samples (α 0.3, θi 60°) drawn
+/// with lobes' RNG, each thread's sums of the estimator weight f cos θr / p and of its square.
+/// `RNG`, `SAMPLE` and `EVAL` are replaced by the names each form gives lobes' functions; the
+/// renderer's usual names (PI, saturate, D_GGX, fresnel_schlick, rand_f, pcg4d), which lobes'
+/// files also define or import, are the renderer's own and are used, with no effect on the sum.
+const ALBEDO_KERNEL: &str = r#"
+const PI: f32 = 3.14159265;
+fn saturate(x: f32) -> f32 { return clamp(x, 0.0, 1.0); }
+fn D_GGX(a: f32, nh: f32) -> f32 { let d = nh * nh * (a * a - 1.0) + 1.0; return a * a / (PI * d * d); }
+fn fresnel_schlick(c: f32, f0: f32) -> f32 { return f0 + (1.0 - f0) * pow(1.0 - c, 5.0); }
+fn pcg4d(v: vec4<u32>) -> vec4<u32> { return v * 1664525u + vec4<u32>(1013904223u); }
+fn rand_f(state: ptr<function, u32>) -> f32 { *state = *state * 747796405u + 2891336453u; return f32(*state >> 8u) / 16777216.0; }
+
+@group(0) @binding(0) var<storage, read_write> sums: array<vec2<f32>>;
+const PER_THREAD: u32 = 64u;
+
+@compute @workgroup_size(64)
+fn albedo(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= arrayLength(&sums)) {
+        return;
+    }
+    let a = vec2<f32>(0.3, 0.3);
+    let wi = vec3<f32>(0.8660254, 0.0, 0.5);
+    var state = i;
+    // the renderer's functions, which must stay its own: 0 and 1 here
+    let zero = (D_GGX(0.5, 1.0) + rand_f(&state) + f32(pcg4d(vec4<u32>(i)).x)) * 0.0;
+    let one = saturate(fresnel_schlick(1.0, 1.0));
+    var s1 = 0.0;
+    var s2 = 0.0;
+    for (var k = 0u; k < PER_THREAD; k++) {
+        let u = RNG(vec2<u32>(11u, 0u), vec2<u32>(i * PER_THREAD + k, 0u));
+        let s = SAMPLE(a, wi, u.xy);
+        var w = 0.0;
+        if (s.wr.z > 0.0 && s.pdf_r > 0.0) {
+            w = EVAL(a, wi, s.wr) * s.wr.z / s.pdf_r * one + zero;
+        }
+        s1 += w;
+        s2 += w * w;
+    }
+    sums[i] = vec2<f32>(s1, s2);
+}
+"#;
+
+/// Threads of [`ALBEDO_KERNEL`] (2¹⁴ × 64 = 2²⁰ samples).
+const ALBEDO_THREADS: u32 = 1 << 14;
+
+/// The albedo of the consumer kernel `source` run on the GPU: the mean weight and its standard
+/// error, over 2²⁰ samples.
+fn consumer_albedo(gpu: &Gpu, source: &str) -> (f64, f64) {
+    let d = &gpu.device;
+    let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: None, entries: &[storage_entry(0, false)] });
+    let out = d.create_buffer(&wgpu::BufferDescriptor { label: None, size: ALBEDO_THREADS as u64 * 8, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &layout, entries: &[wgpu::BindGroupEntry { binding: 0, resource: out.as_entire_binding() }] });
+    let bytes = dispatch(gpu, source, "albedo", &[&layout], &[&group], ALBEDO_THREADS, &out);
+    let sums: &[[f32; 2]] = bytemuck::cast_slice(&bytes);
+    let n = (ALBEDO_THREADS * 64) as f64;
+    let (s1, s2) = sums.iter().fold((0.0, 0.0), |(a, b), s| (a + s[0] as f64, b + s[1] as f64));
+    let mean = s1 / n;
+    (mean, ((s2 / n - mean * mean) / (n - 1.0)).sqrt())
+}
+
+/// The f64 albedo `lobes run` judges the same lobe against: the quadrature of f |cos θr| over
+/// its grid's bins (run::compare::albedo_check), f = D G2 / (4 cos θi cos θr), G2 height-correlated.
+fn run_albedo() -> f64 {
+    use lobes::reference::{LobeKind, Method, effects::Effects, fresnel::Fresnel, masking::Masking};
+    use lobes::stats::{expected, histogram::SphereGrid};
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
+    let wi = DVec3::new(0.8660254f32 as f64, 0.0, 0.5);
+    let wi = wi / wi.length();
+    let effects = Effects { fresnel: Fresnel::None, masking: Masking::HeightCorrelated };
+    let f_cos = |w: DVec3| effects.eval(&lobe, wi, w) * w.z;
+    expected::probabilities(&f_cos, SphereGrid { rows: 32, cols: 64 }, 0.3, &expected::Quadrature::default()).probabilities.iter().sum()
+}
+
+/// A consumer's albedo within 4 standard errors of the f64 one (p ≈ 6·10⁻⁵ for a correct
+/// sampler), and the standard error small enough that the test can tell (VNDF weights are
+/// G2/G1 ≤ 1).
+fn assert_albedo(what: &str, (mean, se): (f64, f64), reference: f64) {
+    let z = (mean - reference) / se;
+    println!("{what}: albedo {mean:.6} ± {se:.2e}, f64 {reference:.6}, z = {z:+.2}");
+    assert!(se < 1e-3, "{what}: standard error {se}");
+    assert!(z.abs() < 4.0, "{what}: albedo {mean} ± {se} against the f64 {reference} (z = {z:.2})");
+}
+
+/// Plain concatenation: lobes' prefixed text, then the renderer's shader with its own PI,
+/// saturate, D_GGX, fresnel_schlick, rand_f and pcg4d.
+#[test]
+fn a_plain_concatenation_consumer_matches_the_f64_albedo() {
+    let kernel = ALBEDO_KERNEL.replace("RNG(", "lobes_rng_uniforms(").replace("SAMPLE(", "lobes_ggx_sample_vndf(").replace("EVAL(", "lobes_ggx_eval(");
+    let source = embed::wgsl(&[Module::Rng, Module::Ggx, Module::Fresnel]) + &kernel;
+    let gpu = gpu();
+    let reference = run_albedo();
+    assert_albedo("plain WGSL", consumer_albedo(&gpu, &source), reference);
+    // the same check rejects a sampler whose density is 1 % off
+    let broken = "fn broken(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobesLobeSample {\n\
+                  var s = lobes_ggx_sample_vndf(a, wi, u);\n    s.pdf_r *= 1.01;\n    return s;\n}\n";
+    let source = embed::wgsl(&[Module::Rng, Module::Ggx]) + broken + &kernel.replace("lobes_ggx_sample_vndf(", "broken(");
+    let (mean, se) = consumer_albedo(&gpu, &source);
+    let z = (mean - reference) / se;
+    println!("pdf 1 % high: albedo {mean:.6} ± {se:.2e}, z = {z:+.1}");
+    assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
+}
+
+/// WESL: the renderer's shader imports lobes' package (`import lobes::ggx::…;`), the `wesl`
+/// crate (0.4) compiles it with its own resolver and mangler, and wgpu runs the result.
+#[test]
+fn a_wesl_consumer_matches_the_f64_albedo() {
+    use wesl::syntax::PathOrigin;
+    let shader = String::from("import lobes::ggx::{ggx_sample_vndf, ggx_eval};\nimport lobes::rng::rng_uniforms;\n")
+        + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", "ggx_sample_vndf(").replace("EVAL(", "ggx_eval(");
+    let root = wesl::ModulePath::new(PathOrigin::Absolute, vec!["renderer".into()]);
+    let mut local = wesl::VirtualResolver::new();
+    local.add_module(root.clone(), shader.into());
+    let mut packages = wesl::PkgResolver::new();
+    packages.add_package(&embed::WESL_PACKAGE);
+    let mut router = wesl::Router::new();
+    router.mount_resolver(wesl::ModulePath::new(PathOrigin::Absolute, vec![]), local);
+    router.mount_fallback_resolver(packages);
+    let compiled = wesl::Wesl::new("").set_custom_resolver(router).compile(&root).unwrap_or_else(|e| panic!("{e}")).to_string();
+    assert!(compiled.contains("fn saturate(") && compiled.contains("const PI"), "the renderer's names stay its own:\n{compiled}");
+    assert_albedo("WESL (wesl 0.4)", consumer_albedo(&gpu(), &compiled), run_albedo());
+}
+
+/// naga_oil (0.23, on naga 30): the renderer's shader imports lobes' naga_oil modules
+/// (`#import lobes::ggx::…`) beside its own names and composes and validates. (wgpu here has no
+/// `naga-ir` feature to run naga_oil's module; its code is the WESL consumer's, which runs.)
+#[test]
+fn a_naga_oil_consumer_composes_and_validates() {
+    use naga_oil::compose::{Composer, NagaModuleDescriptor};
+    let shader = String::from("#import lobes::ggx::{ggx_sample_vndf, ggx_eval}\n#import lobes::rng::rng_uniforms\n")
+        + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", "ggx_sample_vndf(").replace("EVAL(", "ggx_eval(");
+    let mut composer = Composer::default();
+    embed::add_naga_oil_modules(&mut composer, &[Module::Rng, Module::Ggx]).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    let module = composer
+        .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "renderer.wgsl", ..Default::default() })
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default()).validate(&module).unwrap();
+    assert!(module.entry_points.iter().any(|e| e.name == "albedo"));
+}

@@ -1,7 +1,8 @@
 //! The feature sets the crate promises, by their dependency trees: `check` (the library
 //! without the command line, what a renderer's `cargo test` uses with `lobes::check`) pulls in
-//! none of the command line's crates, and no features at all (`lobes::embed` alone) only the
-//! GPU crates. `.ci/run` compiles both (`cargo check --no-default-features [--features check]`).
+//! none of the command line's crates; no features at all (`lobes::embed` alone) none of the GPU
+//! crates; each of the embed's features (naga, naga-oil, wgpu, wesl) only its own. `.ci/run`
+//! compiles them (`cargo check --no-default-features [--features F]`).
 
 use std::process::Command;
 
@@ -30,17 +31,40 @@ fn the_library_needs_no_command_line_crates() {
     }
 }
 
+/// The counts docs/embedding.md quotes for each feature set, which these bounds hold (a tree
+/// may shrink as dependencies drop crates; growing past a bound needs the docs changed).
 #[test]
-fn the_embed_alone_needs_only_the_gpu_crates() {
+fn the_embed_alone_needs_no_gpu_crates() {
     let tree = tree(&[]);
-    let direct = ["wgpu", "naga", "naga_oil", "bytemuck", "thiserror", "pollster"];
-    for wanted in direct {
+    for wanted in ["lobes", "bytemuck", "thiserror"] {
         assert!(tree.iter().any(|c| c == wanted), "{wanted} is missing:\n{tree:?}");
     }
-    for beyond in ["clap", "image", "plotters", "serde_json", "statrs", "rayon", "glam", "toml", "schemars", "tempfile", "comfy-table", "ab_glyph"] {
+    for beyond in ["wgpu", "naga", "naga_oil", "regex", "pollster", "wesl", "clap", "image", "statrs", "glam"] {
         assert!(!tree.iter().any(|c| c == beyond), "{beyond} is in the embed's tree:\n{tree:?}");
     }
-    // wgpu and naga_oil's own dependencies are the rest; 128 crates were in the library's tree
-    // before the embed had a feature set of its own
-    assert!(tree.len() < 90, "{} crates: {tree:?}", tree.len());
+    // 9 on 2026-12-01: lobes, bytemuck and thiserror with their derive macros' syn stack
+    assert!(tree.len() <= 9, "{} crates: {tree:?}", tree.len());
+}
+
+#[test]
+fn each_embed_feature_adds_only_its_own_crates() {
+    // (features, crates it must hold, crates it must not hold, the most crates: docs/embedding.md)
+    let sets: [(&str, &[&str], &[&str], usize); 4] = [
+        ("naga", &["naga"], &["wgpu", "naga_oil", "regex", "wesl"], 30),
+        ("naga-oil", &["naga_oil", "naga"], &["wgpu", "wesl"], 42),
+        ("wgpu", &["wgpu"], &["naga_oil", "regex", "wesl", "pollster"], 55),
+        ("wesl", &["wesl"], &["wgpu", "naga", "naga_oil"], 46),
+    ];
+    for (features, with, without, most) in sets {
+        let tree = tree(&["--features", features]);
+        for c in with {
+            assert!(tree.iter().any(|t| t == c), "--features {features} lacks {c}:\n{tree:?}");
+        }
+        for c in without {
+            assert!(!tree.iter().any(|t| t == c), "--features {features} pulls {c}:\n{tree:?}");
+        }
+        assert!(tree.len() <= most, "--features {features}: {} crates, docs/embedding.md says {most}: {tree:?}", tree.len());
+    }
+    assert!(tree(&["--features", "check"]).len() <= 124);
+    assert!(tree(&["--features", "cli"]).len() <= 173);
 }

@@ -77,7 +77,8 @@ pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
         crate::atomic::write_atomic(&path, contents.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-    eprintln!("wrote {} files to {}: {}", files.len(), dir.display(), names.join(", "));
+    let plural = if files.len() == 1 { "" } else { "s" };
+    eprintln!("wrote {} file{plural} to {}: {}", files.len(), dir.display(), names.join(", "));
     Ok(())
 }
 
