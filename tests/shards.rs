@@ -196,7 +196,9 @@ fn a_merged_case_that_fails_the_albedo_check_fails() {
     let mut shard = ShardFile::read(&path).unwrap();
     let sums = shard.weighted.as_mut().unwrap();
     sums.bins.iter_mut().for_each(|b| *b *= 2);
-    std::fs::write(&path, serde_json::to_string(&shard).unwrap()).unwrap();
+    // an edit on purpose: sealed with the checksum of the edited sums (an unsealed edit is
+    // refused, tests/fault_injection.rs)
+    std::fs::write(&path, serde_json::to_string(&shard.sealed()).unwrap()).unwrap();
 
     let merged = lobes(&dir, &["merge", "parts", "--out", "merged", "--json"]);
     assert_eq!(merged.status.code(), Some(1), "{}", stderr(&merged));

@@ -6,10 +6,20 @@
 
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Whether a signal arrived since [`watch`].
 static REQUESTED: AtomicBool = AtomicBool::new(false);
+
+/// What to do before a second signal ends the process ([`before_exit`]).
+static BEFORE_EXIT: Mutex<Option<Box<dyn FnOnce() + Send>>> = Mutex::new(None);
+
+/// Sets what a second signal does before it ends the process (`lobes run` writes its summary
+/// files: every exit the process survives leaves them).
+pub fn before_exit(f: impl FnOnce() + Send + 'static) {
+    *BEFORE_EXIT.lock().unwrap_or_else(|p| p.into_inner()) = Some(Box::new(f));
+}
 
 /// Starts watching for SIGINT and SIGTERM, on a thread of its own (where printing is safe).
 pub fn watch() -> anyhow::Result<()> {
@@ -18,6 +28,9 @@ pub fn watch() -> anyhow::Result<()> {
         for _ in signals.forever() {
             if REQUESTED.swap(true, Ordering::SeqCst) {
                 eprintln!("lobes: interrupted again: stopping now; the case in flight has no histogram.json");
+                if let Some(f) = BEFORE_EXIT.lock().unwrap_or_else(|p| p.into_inner()).take() {
+                    f();
+                }
                 std::process::exit(super::EXIT_INTERRUPTED.into());
             }
             eprintln!("lobes: interrupted: stopping after the case in flight (interrupt again to stop now)");

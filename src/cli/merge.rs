@@ -2,7 +2,9 @@
 //! I/N`, [`crate::run::shard`]) and judges the sums as `lobes run` judges a case
 //! ([`crate::run::merge`], [`crate::run::judge`]), with the same outputs and table.
 
-use super::{ChecksFailed, FileArgs, OutputArgs, emit, emit_json, parse_level, prepare_out};
+use super::{ChecksFailed, FileArgs, OutputArgs, emit, emit_json, parse_level};
+use crate::report::folder::Access;
+use crate::scene::Entry;
 use crate::report::output::{self, CaseSummary, RunSummary};
 use crate::run::{Expected, judge};
 use crate::run::merge::{merge, read_shards};
@@ -31,34 +33,58 @@ pub struct MergeArgs {
 
 /// `lobes merge DIR... --out DIR`.
 pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
-    let shards = read_shards(&args.dirs)?;
-    let merged = merge(&shards)?;
+    // as `lobes run`: an existing --out is locked first, and bad shards replace its summary
+    let existing = args.files.claim_existing(&args.out)?;
+    let (shards, merged) = match read_shards(&args.dirs).and_then(|shards| merge(&shards).map(|m| (shards, m))) {
+        Ok(found) => found,
+        Err(e) => {
+            let e = anyhow::Error::from(e);
+            if let Some(folder) = &existing {
+                super::run::record_error(folder, args.significance, &e);
+            }
+            return Err(e);
+        }
+    };
     let (adapter, backend) = (&merged.adapter, &merged.backend);
-    if merged.mixed_adapters() {
-        eprintln!(
-            "lobes: warning: the shards come from more than one adapter ({adapter}); their counts add exactly, \
-             but the sum is not bit-identical to a run on any one of them"
-        );
+    for mixture in &merged.mixtures {
+        eprintln!("lobes: warning: {mixture}; their counts add exactly, but the sum is not bit-identical to a run on any one of them");
     }
     let n = merged.scene.cases.len();
     let level = sidak(args.significance, n);
-    prepare_out(&args.out)?;
-    crate::report::summary::remove(&args.out)?;
+    let folder = match existing {
+        Some(folder) => folder,
+        None => args.files.claim(&args.out, Access::Owner)?,
+    };
+    let stale = folder.clean(&merged.scene.cases.iter().map(|c| c.name.as_str()).collect::<Vec<_>>())?;
     let mut rows = Vec::new();
-    let mut summary = RunSummary { shard_files: Some(shards.len()), ..RunSummary::new(adapter.clone(), backend.clone(), args.significance, level) };
+    let mut summary = RunSummary { shard_files: Some(shards.len()), stale, ..RunSummary::new(adapter.clone(), backend.clone(), args.significance, level) };
+    // as `lobes run`: a case whose outputs cannot be written is an error, the others still run
     for (case, sampled, parts) in merged.iter() {
-        let result = judge(case, sampled.clone(), Expected::of(case), level)?;
-        output::write_case(&args.out, &result, adapter, backend, args.files.style())?;
-        rows.push(output::table_row(&result));
-        summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
+        let judged = judge(case, sampled.clone(), Expected::of(case), level).and_then(|result| {
+            output::write_case(&args.out, &result, adapter, backend, args.files.style())
+                .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", args.out.join(&case.name).display()))
+                .map(|()| result)
+        });
+        match judged {
+            Ok(result) => {
+                rows.push(output::table_row(&result));
+                summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
+            }
+            Err(e) => {
+                eprintln!("lobes: error: case '{}': {e:#}; no histogram.json was written for it", case.name);
+                let dash = || "-".to_string();
+                rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
+                summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::error(&Entry::Lobe(case), format!("{e:#}")) });
+            }
+        }
     }
     let heading = [
         format!("adapter: {adapter}"),
         format!("merged {} shard files of scene {} ({})", shards.len(), merged.scene_name, merged.scene_fnv1a64),
         format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance),
     ];
-    crate::report::summary::write(&args.out, &summary, &heading)?;
-    let failed = summary.failed;
+    let written = crate::report::summary::write(&args.out, &summary, &heading);
+    let (failed, errors) = (summary.failed, summary.errors);
     if args.output.json {
         emit_json(&summary)?;
     } else {
@@ -69,6 +95,10 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         }
         text += &format!("\noutputs in {} (index.html, summary.json, junit.xml)\n", args.out.display());
         emit(&text)?;
+    }
+    written?;
+    if errors > 0 {
+        anyhow::bail!("{errors} of {n} cases could not be written (see the errors above)");
     }
     if failed > 0 {
         return Err(ChecksFailed(format!("{failed} of {n} cases failed the χ² test or the albedo checks")).into());

@@ -28,6 +28,8 @@ pub mod tutorial;
 pub mod wgsl;
 
 use crate::reference::{LobeKind, Method};
+use crate::engine::gpu::GpuError;
+use crate::report::folder::{Access, FolderError, OutFolder};
 use crate::run::shard::ShardError;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use glam::DVec3;
@@ -158,14 +160,15 @@ pub struct ChecksFailed(pub String);
 pub struct Interrupted(pub String);
 
 /// The process exit code for an error, by what is anywhere in its chain: an [`Interrupted`]
-/// gives [`EXIT_INTERRUPTED`]; a [`UsageError`], a clap error or bad shards ([`ShardError`])
+/// gives [`EXIT_INTERRUPTED`]; a [`UsageError`], a clap error, bad shards ([`ShardError`]), an
+/// output folder lobes cannot use ([`FolderError`]) or a `WGPU_BACKEND` that names no backend
 /// [`EXIT_USAGE`]; a [`ChecksFailed`] [`EXIT_CHECKS_FAILED`]; anything else (the tool could not
 /// do the work) [`EXIT_TOOL_FAILURE`].
 pub fn exit_code(err: &anyhow::Error) -> u8 {
     let any = |f: &dyn Fn(&(dyn std::error::Error + 'static)) -> bool| err.chain().any(f);
     if any(&|e| e.is::<Interrupted>()) {
         EXIT_INTERRUPTED
-    } else if any(&|e| e.is::<UsageError>() || e.is::<clap::Error>() || e.is::<ShardError>()) {
+    } else if any(&|e| e.is::<UsageError>() || e.is::<clap::Error>() || e.is::<ShardError>() || e.is::<FolderError>() || e.downcast_ref::<GpuError>().is_some_and(GpuError::is_bad_input)) {
         EXIT_USAGE
     } else if any(&|e| e.is::<ChecksFailed>()) {
         EXIT_CHECKS_FAILED
@@ -198,15 +201,29 @@ pub struct OutputArgs {
     pub json: bool,
 }
 
-/// How `lobes run` and `lobes merge` write their JSON files.
+/// How `lobes run` and `lobes merge` write their output folder.
 #[derive(Debug, Clone, Args)]
 pub struct FileArgs {
     /// Indent histogram.json and timing.json for reading (default: compact, one line).
     #[arg(long)]
     pub pretty: bool,
+    /// Where another lobes is writing --out, wait until it has finished (without it: exit 2,
+    /// naming that process). One run owns an output folder at a time.
+    #[arg(long)]
+    pub wait: bool,
 }
 
 impl FileArgs {
+    /// Creates and locks the output folder `out` ([`OutFolder::claim`]).
+    pub fn claim(&self, out: &Path, access: Access) -> Result<OutFolder, FolderError> {
+        OutFolder::claim(out, access, self.wait)
+    }
+
+    /// Locks `out` if it is already a folder ([`OutFolder::claim_existing`]).
+    pub fn claim_existing(&self, out: &Path) -> Result<Option<OutFolder>, FolderError> {
+        OutFolder::claim_existing(out, Access::Owner, self.wait)
+    }
+
     pub fn style(&self) -> crate::report::output::JsonStyle {
         if self.pretty { crate::report::output::JsonStyle::Pretty } else { crate::report::output::JsonStyle::Compact }
     }

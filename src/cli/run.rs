@@ -2,7 +2,7 @@
 //! the f64 reference, with per-case outputs and a table; with `--shard I/N`, one shard of every
 //! case, written as raw results for `lobes merge`.
 
-use super::{ChecksFailed, FileArgs, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, prepare_out, usage};
+use super::{ChecksFailed, FileArgs, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, usage};
 use crate::report::output::{self, CaseSummary, JsonStyle, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
@@ -12,7 +12,9 @@ use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
+use crate::report::folder::{Access, OutFolder};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 #[derive(Debug, Clone, Args)]
@@ -106,22 +108,11 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Removes the `histogram.json` an earlier run left in the case's folder.
-fn remove_stale(out: &Path, name: &str) -> anyhow::Result<()> {
-    let stale = out.join(name).join("histogram.json");
-    match std::fs::remove_file(&stale) {
-        Ok(()) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => anyhow::bail!("cannot remove the earlier {}: {e}", stale.display()),
-    }
-}
-
-/// Runs one case and writes its outputs. A `histogram.json` left by an earlier run is removed
-/// first, so a case that fails here leaves no complete-looking `histogram.json` behind. The
-/// expected counts (f64 quadrature on the CPU) are computed on another thread while the GPU
+/// Runs one case and writes its outputs (an earlier run's were removed before the first case,
+/// [`OutFolder::clean`], so a case that fails here leaves no complete-looking `histogram.json`
+/// behind). The expected counts (f64 quadrature on the CPU) are computed on another thread while the GPU
 /// samples.
 fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, style: JsonStyle, progress: &mut dyn FnMut(u64)) -> anyhow::Result<CaseResult> {
-    remove_stale(out, &case.name)?;
     let (sampled, expected) = std::thread::scope(|s| {
         let quadrature = s.spawn(|| Expected::of(case));
         let sampled = run_case(backend, case, 0..case.samples, progress);
@@ -136,7 +127,6 @@ fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, sty
 
 /// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
 fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path, style: JsonStyle) -> anyhow::Result<([String; 9], CaseSummary)> {
-    remove_stale(out, &case.name)?;
     let result = run_user(backend, case, level)?;
     output::write_user_case(out, &result, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
@@ -189,10 +179,8 @@ impl PlainProgress {
     }
 }
 
-pub fn run(args: &RunArgs) -> anyhow::Result<()> {
-    if let Some(shard) = args.shard {
-        return run_shard(args, shard);
-    }
+/// The scene to run and the backend to run it on, or why the run cannot start.
+fn start(args: &RunArgs) -> anyhow::Result<(Scene, Backend)> {
     let overrides = Overrides { samples: args.samples, seed: args.seed };
     let scene = read_scene(args.scene.as_ref(), overrides)?.1.select(&args.cases).map_err(usage)?;
     if args.cpu
@@ -200,14 +188,70 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     {
         return Err(usage(format!("{at}: case '{name}' is a WGSL sampler, which runs on a GPU adapter only; run without --cpu")));
     }
-    prepare_out(&args.out)?;
-    crate::report::summary::remove(&args.out)?;
-    let mut backend = Backend::open(args.cpu)?;
+    let backend = Backend::open(args.cpu)?;
     check_fits(&backend, &scene)?;
-    interrupt::watch()?;
+    Ok((scene, backend))
+}
+
+/// A run that stops before its cases (bad input, no adapter) into an output folder that
+/// already exists: the earlier run's outputs are removed and the summary files say why no case
+/// ran (status `error`), so that CI reads this run's failure, never the earlier run's pass.
+pub(super) fn record_error(folder: &OutFolder, significance: f64, err: &anyhow::Error) {
+    let written = folder.clean(&[]).and_then(|stale| {
+        let summary = RunSummary { stale, ..RunSummary::of_error(significance, format!("{err:#}")) };
+        crate::report::summary::write(folder.path(), &summary, &[])
+    });
+    if let Err(e) = written {
+        eprintln!("lobes: error: {e:#}");
+    }
+}
+
+pub fn run(args: &RunArgs) -> anyhow::Result<()> {
+    if let Some(shard) = args.shard {
+        return run_shard(args, shard);
+    }
+    // An --out that exists is locked first: where another lobes holds it, nothing is touched
+    let existing = args.files.claim_existing(&args.out)?;
+    let (scene, mut backend) = match start(args) {
+        Ok(started) => started,
+        Err(e) => {
+            if let Some(folder) = &existing {
+                record_error(folder, args.significance, &e);
+            }
+            return Err(e);
+        }
+    };
+    let folder = match existing {
+        Some(folder) => folder,
+        None => args.files.claim(&args.out, Access::Owner)?,
+    };
+    let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
+    let stale = folder.clean(&names)?;
+    if !stale.is_empty() {
+        eprintln!(
+            "lobes: note: removed the outputs of {} cases of an earlier run in {} that this run does not have ({})",
+            stale.len(),
+            args.out.display(),
+            stale.join(", ")
+        );
+    }
     let n = scene.len();
     let level = sidak(args.significance, n);
-    let mut summary = RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level);
+    let heading = [format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
+    let summary = Arc::new(Mutex::new(RunSummary { stale, ..RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level) }));
+    interrupt::watch()?;
+    // a second signal ends the process at once: it writes the summary first, the case in
+    // flight and the rest as not run
+    let (all, out, head, shared) = (names.iter().map(|s| s.to_string()).collect::<Vec<_>>(), args.out.clone(), heading.to_vec(), summary.clone());
+    interrupt::before_exit(move || {
+        let mut s = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        s.status = RunStatus::Interrupted;
+        s.not_run = all.iter().filter(|n| !s.cases.iter().any(|c| &c.case == *n)).cloned().collect();
+        if let Err(e) = crate::report::summary::write(&out, &s, &head) {
+            eprintln!("lobes: error: {e:#}");
+        }
+    });
+    let record = |f: &mut dyn FnMut(&mut RunSummary)| f(&mut summary.lock().unwrap_or_else(|p| p.into_inner()));
     let mut rows = Vec::new();
     let (mut wall_rows, mut user_rows) = (false, false);
     let plain = PlainProgress::new(n);
@@ -217,8 +261,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     // still run; a stop asked for by SIGINT/SIGTERM ends the run after the case in flight.
     for (i, (entry, at)) in scene.entries().enumerate() {
         if interrupt::requested() {
-            summary.status = RunStatus::Interrupted;
-            summary.not_run.push(entry.name().to_string());
+            record(&mut |s| {
+                s.status = RunStatus::Interrupted;
+                s.not_run.push(entry.name().to_string());
+            });
             continue;
         }
         let t = Instant::now();
@@ -246,7 +292,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             Ok((row, case_summary)) => {
                 let verdict = if case_summary.passed { "pass" } else { "FAIL" };
                 rows.push(row);
-                summary.push(case_summary);
+                record(&mut |s| s.push(case_summary.clone()));
                 verdict
             }
             Err(e) => {
@@ -259,13 +305,13 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 }
                 let dash = || "-".to_string();
                 rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
-                summary.push(CaseSummary::error(&entry, format!("{e:#}")));
+                record(&mut |s| s.push(CaseSummary::error(&entry, format!("{e:#}"))));
                 "ERROR"
             }
         };
         plain.finished(i, entry.name(), verdict, t.elapsed().as_secs_f64());
     }
-    let heading = [format!("adapter: {}", summary.adapter), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
+    let summary = summary.lock().unwrap_or_else(|p| p.into_inner()).clone();
     let written = crate::report::summary::write(&args.out, &summary, &heading);
     if args.output.json {
         emit_json(&summary)?;
@@ -314,7 +360,8 @@ fn run_shard(args: &RunArgs, shard: Shard) -> anyhow::Result<()> {
     }
     let mut backend = Backend::open(args.cpu)?;
     let adapter = backend.adapter();
-    prepare_out(&args.out)?;
+    // shared with other shard runs into the same folder; held until the process ends
+    let _folder = args.files.claim(&args.out, Access::Shard)?;
     let origin = ShardOrigin { scene: &source, cases: scene.cases.len(), shard, adapter: &adapter, backend: backend.name() };
     let mut cases = Vec::new();
     for (case_index, case) in scene.cases.iter().enumerate() {

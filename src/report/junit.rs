@@ -3,7 +3,7 @@
 //! (χ², albedo, a user's checks), an `<error>` where the tool could not run it, or `<skipped>`
 //! where an interrupted run never started it. Written by `quick-junit`, which escapes the XML.
 
-use super::output::{RunStatus, RunSummary};
+use super::output::RunSummary;
 use quick_junit::{NonSuccessKind, Property, Report, TestCase, TestCaseStatus, TestSuite};
 use std::time::Duration;
 
@@ -17,7 +17,7 @@ pub fn to_xml(summary: &RunSummary) -> anyhow::Result<String> {
         Property::new("lobes_version", summary.lobes_version.as_str()),
         Property::new("adapter", summary.adapter.as_str()),
         Property::new("backend", summary.backend.as_str()),
-        Property::new("status", if summary.status == RunStatus::Complete { "complete" } else { "interrupted" }),
+        Property::new("status", summary.status.name()),
         Property::new("significance", summary.significance.to_string()),
         Property::new("per_case_significance", summary.per_case_significance.to_string()),
     ]);
@@ -46,6 +46,12 @@ pub fn to_xml(summary: &RunSummary) -> anyhow::Result<String> {
         test.set_classname(SUITE);
         suite.add_test_case(test);
     }
+    if let Some(error) = &summary.error {
+        // a run that ran nothing is one test that could not run, not an empty (passing) suite
+        let mut test = TestCase::new(SUITE, non_success(NonSuccessKind::Error, error));
+        test.set_classname(SUITE);
+        suite.add_test_case(test);
+    }
     let mut report = Report::new(SUITE);
     report.add_test_suite(suite);
     Ok(report.to_string()?)
@@ -60,7 +66,7 @@ fn non_success(kind: NonSuccessKind, message: &str) -> TestCaseStatus {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::output::{CaseMeasured, CaseSummary};
+    use crate::report::output::{CaseMeasured, CaseSummary, RunStatus};
 
     fn case(name: &str, passed: bool, failure: Option<&str>, error: Option<&str>) -> CaseSummary {
         CaseSummary {

@@ -16,6 +16,7 @@ pub mod compare;
 pub mod heatmap;
 #[cfg(feature = "cli")]
 pub mod junit;
+pub mod folder;
 pub mod html;
 pub mod label;
 pub mod marginals;

@@ -37,8 +37,9 @@ pub const HISTOGRAM_VERSION: u32 = 2;
 /// The version of the layout of `timing.json`.
 pub const TIMING_VERSION: u32 = 1;
 /// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
-/// `--json`) and of `lobes run --shard` (2: the run's status, lobes' version, why a case failed).
-pub const SUMMARY_VERSION: u32 = 2;
+/// `--json`) and of `lobes run --shard` (2: the run's status, lobes' version, why a case failed;
+/// 3: the status `error` with its `error`, and `stale`).
+pub const SUMMARY_VERSION: u32 = 3;
 
 /// `histogram.json`: a case's measured and expected histograms and its verdicts.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -384,12 +385,19 @@ pub struct RunSummary {
     pub shard_files: Option<usize>,
     /// Cases that ran and failed a check.
     pub failed: usize,
-    /// Cases that could not run (always 0 for `lobes merge`, which stops at the first error).
+    /// Cases that could not run (for `lobes merge`: whose outputs could not be written).
     pub errors: usize,
     /// The cases that finished (passed, failed or could not run), in scene order.
     pub cases: Vec<CaseSummary>,
     /// The scene's cases that never started because the run was interrupted.
     pub not_run: Vec<String>,
+    /// Case folders an earlier run left in the output folder that are not cases of this run:
+    /// their outputs were removed ([`super::folder::OutFolder::clean`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stale: Vec<String>,
+    /// Why the run ran no case (status `error`): the message lobes printed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
 /// How a run ended.
@@ -398,8 +406,25 @@ pub struct RunSummary {
 pub enum RunStatus {
     /// Every case of the scene ran (or could not run, with its error).
     Complete,
-    /// Stopped by SIGINT or SIGTERM after the case in flight; `not_run` lists the rest.
+    /// Stopped by SIGINT or SIGTERM after the case in flight (or, at a second signal, during
+    /// it); `not_run` lists the rest.
     Interrupted,
+    /// No case ran: bad input (exit 2, such as a scene that does not parse) or the tool could
+    /// not start (exit 3, such as no adapter); `error` says why. Written only into an output
+    /// folder that already existed, replacing an earlier run's summary, so that CI never reads
+    /// an earlier pass as this run's.
+    Error,
+}
+
+impl RunStatus {
+    /// Its name in `summary.json` and `junit.xml`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunStatus::Complete => "complete",
+            RunStatus::Interrupted => "interrupted",
+            RunStatus::Error => "error",
+        }
+    }
 }
 
 impl RunSummary {
@@ -418,7 +443,14 @@ impl RunSummary {
             errors: 0,
             cases: Vec::new(),
             not_run: Vec::new(),
+            stale: Vec::new(),
+            error: None,
         }
+    }
+
+    /// The summary of a run that ran no case because of `error` (status `error`).
+    pub fn of_error(significance: f64, error: String) -> Self {
+        RunSummary { status: RunStatus::Error, error: Some(error), ..RunSummary::new("none".into(), "none".into(), significance, significance) }
     }
 
     /// Adds a finished case, counting it as failed or as an error.

@@ -97,21 +97,57 @@ pub struct Merged {
     /// The adapters and backends that drew the shards, each once, joined by ` + `.
     pub adapter: String,
     pub backend: String,
+    /// What differs between the shards' origins, one line each: more than one backend, more
+    /// than one adapter, each value with its number of files and one of them.
+    pub mixtures: Vec<String>,
     /// Per case of the scene, in order: the added results and the number of shards.
     pub cases: Vec<(Sampled, usize)>,
 }
 
 impl Merged {
-    /// Whether the shards come from more than one adapter or backend: their counts add
-    /// exactly, but the sum is not bit-identical to a run on any one of them.
-    pub fn mixed_adapters(&self) -> bool {
-        self.adapter.contains(" + ") || self.backend.contains(" + ")
-    }
-
     /// The cases with their added results.
     pub fn iter(&self) -> impl Iterator<Item = (&Case, &Sampled, usize)> {
         self.scene.cases.iter().zip(&self.cases).map(|(c, (s, n))| (c, s, *n))
     }
+}
+
+/// Where the shards differ in `what` (`backend`, `adapter`): the values, each with its number of
+/// files and the first of them; None where they agree.
+fn mixture(what: &str, shards: &[ShardOnDisk], value: impl Fn(&ShardFile) -> &str) -> Option<String> {
+    let mut by: BTreeMap<&str, (usize, &Path)> = BTreeMap::new();
+    for s in shards {
+        by.entry(value(&s.file)).or_insert((0, &s.path)).0 += 1;
+    }
+    (by.len() > 1).then(|| {
+        let each: Vec<String> = by.iter().map(|(v, (n, p))| format!("'{v}' in {n} file{} (such as {})", if *n == 1 { "" } else { "s" }, p.display())).collect();
+        format!("the shards come from more than one {what}: {}", each.join(", "))
+    })
+}
+
+/// Adds `part` to `total` cell by cell; None where a sum would exceed 2⁶⁴ − 1.
+fn checked_add(total: &mut [u64], part: &[u64]) -> Option<()> {
+    for (t, p) in total.iter_mut().zip(part) {
+        *t = t.checked_add(*p)?;
+    }
+    Some(())
+}
+
+/// Whether adding `b` to `a` keeps every count and sum within 64 bits ([`Sampled::add`] adds
+/// them unchecked).
+fn adds_within_64_bits(a: &Sampled, b: &Sampled) -> bool {
+    let mut counts = a.counts.bins.clone();
+    let mut invalid = a.counts.invalid;
+    let fits = checked_add(&mut counts, &b.counts.bins).and(checked_add(&mut invalid, &b.counts.invalid));
+    let weighted = match (&a.weighted, &b.weighted) {
+        (Some(x), Some(y)) => {
+            let (x, y) = (&x.sums, &y.sums);
+            let scalars = [x.squares_bins, x.squares_all, x.overflow, x.squares_lower];
+            let other = [y.squares_bins, y.squares_all, y.overflow, y.squares_lower];
+            checked_add(&mut x.bins.clone(), &y.bins).and(checked_add(&mut x.invalid.clone(), &y.invalid)).and(checked_add(&mut scalars.clone(), &other))
+        }
+        _ => Some(()),
+    };
+    fits.and(weighted).is_some()
 }
 
 fn joined(values: impl Iterator<Item = String>) -> String {
@@ -179,7 +215,15 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
         let (head, rest) = parts.split_first().expect("a tiling of 0 .. samples ≥ 1");
         let mut sum = head.file.sampled();
         for p in rest {
-            sum.add(&p.file.sampled());
+            let part = p.file.sampled();
+            if !adds_within_64_bits(&sum, &part) {
+                return Err(ShardError(format!(
+                    "case '{}': adding {} makes a count or sum exceed 2^64 − 1 (a damaged or edited file); run its shard again",
+                    case.name,
+                    p.path.display()
+                )));
+            }
+            sum.add(&part);
         }
         cases.push((sum, parts.len()));
     }
@@ -188,6 +232,7 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
         scene_fnv1a64: fnv1a64(&first.file.scene),
         adapter: joined(shards.iter().map(|s| s.file.adapter.clone())),
         backend: joined(shards.iter().map(|s| s.file.backend.clone())),
+        mixtures: [mixture("backend", shards, |f| &f.backend), mixture("adapter", shards, |f| &f.adapter)].into_iter().flatten().collect(),
         scene,
         cases,
     })
@@ -200,6 +245,30 @@ mod tests {
 
     fn fake(first: u64, end: u64) -> ShardOnDisk {
         ShardOnDisk { path: PathBuf::from(format!("s{first}.json")), file: example(first, end) }
+    }
+
+    /// Issue 24 item 14: a shard whose backend differs names the backends and files, not "more
+    /// than one adapter" and one adapter.
+    #[test]
+    fn a_mixture_names_what_differs_and_where() {
+        let a = fake(0, 5);
+        let mut b = fake(5, 10);
+        b.path = PathBuf::from("p/b.json");
+        assert_eq!(mixture("backend", &[a.clone(), b.clone()], |f| &f.backend), None);
+        b.file.backend = "cpu".into();
+        b.file.adapter = "cpu (f64 reference, 2 threads)".into();
+        let m = mixture("backend", &[a.clone(), b.clone()], |f| &f.backend).unwrap();
+        assert_eq!(m, "the shards come from more than one backend: 'cpu' in 1 file (such as p/b.json), 'gpu' in 1 file (such as s0.json)");
+        assert!(mixture("adapter", &[a, b], |f| &f.adapter).unwrap().contains("'a' in 1 file"));
+    }
+
+    #[test]
+    fn sums_beyond_64_bits_are_found() {
+        let (a, b) = (fake(0, 5).file.sampled(), fake(5, 10).file.sampled());
+        assert!(adds_within_64_bits(&a, &b));
+        let mut big = b.clone();
+        big.counts.bins[0] = u64::MAX;
+        assert!(!adds_within_64_bits(&a, &big));
     }
 
     #[test]

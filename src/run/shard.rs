@@ -10,6 +10,13 @@
 //! sample 0), the weighted sums of a weighted case, and the scene's full text, so that
 //! `lobes merge` needs nothing else. Floats are written so that they read back bit-exactly
 //! (serde_json's `float_roundtrip`).
+//!
+//! A shard file is read only by the lobes that wrote it (the same `lobes_version`: another
+//! version may draw or count differently), and carries a checksum of its results
+//! (`counts_fnv1a64`, [`ShardFile::checksum`]): its counts are totalled with checked additions
+//! and must add up to its range, and an edit that keeps the total (a count moved from one bin to
+//! another) changes the checksum. Both are refused as bad input. (The checksum finds edits and
+//! damage, not an attacker: anyone can recompute it.)
 
 use super::record::{ByReason, CaseDescription, Timing, WeightedTiming};
 use super::Sampled;
@@ -27,8 +34,10 @@ use std::path::{Path, PathBuf};
 /// The format tag of a shard file.
 pub const SHARD_FORMAT: &str = "lobes-shard";
 /// The version of the shard file layout (1: the layout before `format_version`, with the
-/// exact bits of the per-sample check in a side field).
-pub const SHARD_VERSION: u32 = 2;
+/// exact bits of the per-sample check in a side field; 3: `counts_fnv1a64`).
+pub const SHARD_VERSION: u32 = 3;
+/// The lobes that writes (and alone reads) shard files.
+pub const LOBES_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Bad shards: a file that is not a readable shard of this lobes, or shards that do not add up
 /// to one scene. Bad input: the CLI exits with its usage code.
@@ -178,6 +187,18 @@ pub struct ShardFile {
     pub scene_name: String,
     pub scene_fnv1a64: String,
     pub scene: String,
+    /// The FNV-1a hash of the results that merge adds up ([`ShardFile::checksum`]).
+    pub counts_fnv1a64: String,
+}
+
+/// The results a shard's checksum covers, in the order hashed.
+#[derive(Serialize)]
+struct Results<'a> {
+    first: u64,
+    end: u64,
+    counts: &'a [u64],
+    invalid: &'a ByReason<u64>,
+    weighted: &'a Option<WeightedSums>,
 }
 
 /// The minimum read first, to tell a file of another kind or version from a damaged one.
@@ -186,6 +207,7 @@ struct Header {
     format: Option<String>,
     format_version: Option<u64>,
     version: Option<u64>,
+    lobes_version: Option<String>,
 }
 
 impl ShardFile {
@@ -218,7 +240,22 @@ impl ShardFile {
             scene_name: scene.name.clone(),
             scene_fnv1a64: fnv1a64(&scene.text),
             scene: scene.text.clone(),
+            counts_fnv1a64: String::new(),
         }
+        .sealed()
+    }
+
+    /// The FNV-1a hash of the results merge adds up: the range, the counts, the invalid counts
+    /// and the weighted sums (as their JSON, which reads back exactly).
+    pub fn checksum(&self) -> String {
+        let results = Results { first: self.first, end: self.end, counts: &self.counts, invalid: &self.invalid, weighted: &self.weighted };
+        fnv1a64(&serde_json::to_string(&results).expect("numbers serialise"))
+    }
+
+    /// The file with its checksum set (after results are changed on purpose, as tests do).
+    pub fn sealed(mut self) -> ShardFile {
+        self.counts_fnv1a64 = self.checksum();
+        self
     }
 
     /// Parses and checks a shard file's text; `path` names it in errors.
@@ -235,18 +272,37 @@ impl ShardFile {
                 "shard format version {v} is not supported (this lobes reads version {SHARD_VERSION}); run the shard again with this lobes"
             )));
         }
+        if let Some(v) = header.lobes_version.as_deref().filter(|v| *v != LOBES_VERSION) {
+            return Err(bad(format!(
+                "written by lobes {v}, and this is lobes {LOBES_VERSION}: another version may draw or count samples differently; \
+                 run the shard again with this lobes"
+            )));
+        }
         let s: ShardFile = serde_json::from_str(text).map_err(|e| bad(format!("not a valid shard file: {e}")))?;
         if s.first > s.end || s.end > s.samples {
             return Err(bad(format!("sample range {}..{} is not within 0..{}", s.first, s.end, s.samples)));
         }
-        let total = s.counts.iter().sum::<u64>() + <[u64; Invalid::COUNT]>::from(s.invalid).iter().sum::<u64>();
-        if total != s.end - s.first {
+        let cells = s.counts.iter().chain(<[u64; Invalid::COUNT]>::from(s.invalid).iter()).copied().collect::<Vec<u64>>();
+        let total = cells.iter().try_fold(0u64, |t, &c| t.checked_add(c));
+        if total != Some(s.end - s.first) {
+            let total = total.map_or("more than 2^64 − 1".to_string(), |t| t.to_string());
             return Err(bad(format!(
-                "counts add up to {total} but the range {}..{} has {} samples (a damaged file?)",
+                "counts add up to {total} but the range {}..{} has {} samples (a damaged or edited file)",
                 s.first,
                 s.end,
                 s.end - s.first
             )));
+        }
+        let checksum = s.checksum();
+        if s.counts_fnv1a64 != checksum {
+            return Err(bad(format!(
+                "the results do not match their checksum (counts_fnv1a64 {} in the file, {checksum} of its counts, invalid counts \
+                 and weighted sums): the file was edited or damaged; run the shard again",
+                s.counts_fnv1a64
+            )));
+        }
+        if let Some(why) = backend_mismatch(&s.backend, &s.adapter) {
+            return Err(bad(why));
         }
         if let Some(w) = &s.weighted {
             if w.bins.len() != s.counts.len() || w.max_error.len() != s.counts.len() {
@@ -284,6 +340,20 @@ impl ShardFile {
     }
 }
 
+/// Why a shard's `backend` cannot be what drew it: not one lobes writes, or not the kind of its
+/// `adapter` (the CPU engine's adapter is `cpu (f64 reference, …)`, [`super::Backend::adapter`]).
+fn backend_mismatch(backend: &str, adapter: &str) -> Option<String> {
+    let cpu_adapter = adapter.starts_with("cpu (");
+    match backend {
+        "gpu" | "cpu" if (backend == "cpu") == cpu_adapter => None,
+        "gpu" | "cpu" => Some(format!(
+            "backend is '{backend}' but the adapter '{adapter}' is {}: the file was edited or damaged; run the shard again",
+            if cpu_adapter { "lobes' CPU engine" } else { "a GPU adapter" }
+        )),
+        other => Some(format!("backend '{other}' is not one lobes writes (gpu or cpu): the file was edited or damaged; run the shard again")),
+    }
+}
+
 /// A shard file read from disk: where from, and what it holds.
 #[derive(Debug, Clone)]
 pub struct ShardOnDisk {
@@ -301,7 +371,7 @@ pub(crate) mod tests {
         ShardFile {
             format: SHARD_FORMAT.into(),
             format_version: SHARD_VERSION,
-            lobes_version: "0".into(),
+            lobes_version: LOBES_VERSION.into(),
             case: "c".into(),
             case_index: 0,
             cases: 1,
@@ -323,7 +393,9 @@ pub(crate) mod tests {
             scene_name: "s".into(),
             scene_fnv1a64: fnv1a64(""),
             scene: "".into(),
+            counts_fnv1a64: String::new(),
         }
+        .sealed()
     }
 
     /// Every f64 a shard carries reads back bit for bit (serde_json's `float_roundtrip`; without
@@ -355,6 +427,7 @@ pub(crate) mod tests {
             let mut s = example(0, 10);
             s.timing = Timing { gpu_seconds: Some(pair[0]), histogram_wall_seconds: pair[1] };
             s.per_sample_check = Some(AngleCheck { compared: 4096, validity_mismatches: 0, max_angle_rad: pair[1], mean_angle_rad: pair[0] });
+            let s = s.sealed();
             let text = serde_json::to_string(&s).unwrap();
             let back = ShardFile::parse(Path::new("x.json"), &text).unwrap();
             let a = back.per_sample_check.as_ref().unwrap();
@@ -372,17 +445,49 @@ pub(crate) mod tests {
         let mut old = good.clone();
         old.as_object_mut().unwrap().remove("format_version");
         old["version"] = 1.into();
-        assert!(err(old).contains("d/x.json: shard format version 1 is not supported (this lobes reads version 2)"));
+        assert!(err(old).contains("d/x.json: shard format version 1 is not supported (this lobes reads version 3)"));
         let mut other = good.clone();
         other["format"] = "lobes-histogram".into();
         assert!(err(other).contains("not a lobes shard file"));
         let mut damaged = good.clone();
         damaged["counts"] = serde_json::json!([9]);
         assert!(err(damaged).contains("counts add up to 9 but the range 0..10 has 10 samples"));
+        let mut newer = good.clone();
+        newer["lobes_version"] = "9.9.9".into();
+        let e = err(newer);
+        assert!(e.contains("d/x.json: written by lobes 9.9.9, and this is lobes ") && e.contains("run the shard again with this lobes"), "{e}");
+        let mut quantum = good.clone();
+        quantum["backend"] = "quantum".into();
+        assert!(err(quantum).contains("backend 'quantum' is not one lobes writes (gpu or cpu)"));
+        let mut cpu = good.clone();
+        cpu["backend"] = "cpu".into();
+        assert!(err(cpu).contains("backend is 'cpu' but the adapter 'a' is a GPU adapter"));
         let mut missing = good;
         missing.as_object_mut().unwrap().remove("seed");
         assert!(err(missing).contains("missing field `seed`"));
         assert!(ShardFile::parse(Path::new("x"), "{").unwrap_err().to_string().contains("invalid JSON"));
+    }
+
+    /// Issue 24 item 9: a bin set to 2⁶⁴ − 1 with a bin that wraps the total back to the range
+    /// was accepted (the unchecked sum wrapped); a count moved between bins kept the total.
+    #[test]
+    fn counts_that_wrap_or_move_are_refused() {
+        let mut two = example(0, 10);
+        two.counts = vec![4, 6];
+        two.description.cols = 2;
+        let good = serde_json::to_value(two.sealed()).unwrap();
+        assert!(ShardFile::parse(Path::new("x.json"), &good.to_string()).is_ok());
+        let err = |v: &serde_json::Value| ShardFile::parse(Path::new("x.json"), &v.to_string()).unwrap_err().to_string();
+        let mut wraps = good.clone();
+        // (2^64 − 1) + 11 wraps to 10, the range's length
+        wraps["counts"] = serde_json::json!([u64::MAX, 11]);
+        assert!(err(&wraps).contains("counts add up to more than 2^64 − 1"), "{}", err(&wraps));
+        let mut moved = good.clone();
+        moved["counts"] = serde_json::json!([5, 5]);
+        assert!(err(&moved).contains("do not match their checksum"), "{}", err(&moved));
+        let mut resealed: ShardFile = serde_json::from_value(moved).unwrap();
+        resealed = resealed.sealed();
+        assert!(ShardFile::parse(Path::new("x.json"), &serde_json::to_string(&resealed).unwrap()).is_ok(), "a sealed edit passes");
     }
 
     #[test]

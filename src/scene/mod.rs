@@ -568,6 +568,9 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
         .into_iter()
         .map(|point| {
             let name = format!("{name}{}", point.suffix);
+            if let Some(why) = crate::report::folder::reserved(&name) {
+                return Err(ctx.err(name_span.clone(), format!("case name '{name}' is reserved: {why} (each case writes OUT/<case>/); rename the case")));
+            }
             if name.len() > MAX_NAME_LEN {
                 return Err(ctx.err(
                     name_span.clone(),

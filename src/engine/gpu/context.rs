@@ -14,6 +14,12 @@ pub enum GpuError {
          `apt-get install mesa-vulkan-drivers libvulkan1` (lavapipe), or a vendor driver"
     )]
     NoAdapter(String),
+    /// `WGPU_BACKEND` set to names wgpu does not know (it would then try no backend at all).
+    #[error("WGPU_BACKEND='{value}' is not a list of wgpu backends (unknown: {unknown}); set it to a comma-separated list of vulkan, metal, dx12, gl (or unset it: lobes then tries Vulkan, Metal and DX12)")]
+    UnknownBackend { value: String, unknown: String },
+    /// No adapter of the backends `WGPU_BACKEND` asks for.
+    #[error("no GPU adapter of WGPU_BACKEND='{value}' found ({reason}); unset WGPU_BACKEND to try the default backends (Vulkan, Metal, DX12), or install a driver for the one it names")]
+    NoAdapterOfBackend { value: String, reason: String },
     #[error("WGPU_ADAPTER_NAME='{wanted}' matches no adapter; the adapters here are: {found}. Set it to part of one of these names (case does not matter), or unset it")]
     AdapterNotNamed { wanted: String, found: String },
     #[error("the adapter '{adapter}' refused a device: {source}")]
@@ -36,6 +42,28 @@ impl GpuError {
     /// elsewhere; every other error concerns one job only.
     pub fn is_device_lost(&self) -> bool {
         matches!(self, GpuError::Lost(_))
+    }
+
+    /// Whether the error is the user's setting, not the machine (the CLI exits with 2).
+    pub fn is_bad_input(&self) -> bool {
+        matches!(self, GpuError::UnknownBackend { .. })
+    }
+}
+
+/// The names wgpu's `Backends::from_comma_list` knows (wgpu-types 30, `backend.rs`).
+const BACKEND_NAMES: [&str; 11] = ["vulkan", "vk", "dx12", "d3d12", "metal", "mtl", "opengl", "gles", "gl", "webgpu", "noop"];
+
+/// `WGPU_BACKEND`, if set: an error where an item names no backend (wgpu itself only logs it,
+/// and with no known item at all tries no backend, which reads as "no adapter").
+fn backend_from_env() -> Result<Option<String>, GpuError> {
+    let Some(value) = std::env::var_os("WGPU_BACKEND") else { return Ok(None) };
+    let value = value.to_string_lossy().into_owned();
+    let unknown: Vec<String> =
+        value.to_lowercase().split(',').map(str::trim).filter(|b| !BACKEND_NAMES.contains(b)).map(|b| format!("'{b}'")).collect();
+    if unknown.is_empty() {
+        Ok(Some(value))
+    } else {
+        Err(GpuError::UnknownBackend { unknown: unknown.join(", "), value })
     }
 }
 
@@ -80,8 +108,9 @@ impl Gpu {
     /// As [`Gpu::new`], with the adapter's limits passed through `shrink` first: tests use it to
     /// impose small limits and prove that work is split to fit them.
     pub fn with_limits(shrink: impl FnOnce(wgpu::Limits) -> wgpu::Limits) -> Result<Self, GpuError> {
+        let backend = backend_from_env()?;
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        if std::env::var_os("WGPU_BACKEND").is_none() {
+        if backend.is_none() {
             desc.backends = wgpu::Backends::PRIMARY;
         }
         let instance = wgpu::Instance::new(desc);
@@ -91,7 +120,10 @@ impl Gpu {
         };
         let adapter = match std::env::var("WGPU_ADAPTER_NAME") {
             Ok(wanted) if !wanted.is_empty() => named_adapter(&instance, &wanted)?,
-            _ => pollster::block_on(instance.request_adapter(&options)).map_err(|e| GpuError::NoAdapter(e.to_string()))?,
+            _ => pollster::block_on(instance.request_adapter(&options)).map_err(|e| match backend {
+                Some(value) => GpuError::NoAdapterOfBackend { value, reason: e.to_string() },
+                None => GpuError::NoAdapter(e.to_string()),
+            })?,
         };
         let info = adapter.get_info();
         // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
