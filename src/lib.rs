@@ -63,6 +63,7 @@ pub mod engine {
         pub mod context;
         pub mod library;
         pub mod precision;
+        pub mod stack;
         pub use context::{Gpu, GpuError};
     }
 }
