@@ -139,8 +139,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         super::prepare_out(dir)?;
         remove_stale(dir)?;
     }
-    let gpu = Gpu::new()?;
+    // before the device opens: a signal while it does is seen at the first submission
     interrupt::watch("stopping the check now (interrupt again to end at once)")?;
+    let gpu = Gpu::new()?;
     let _stop = gpu.stop_when(interrupt::requested);
     if args.power {
         return power(&gpu, &sampler, &settings, args);
