@@ -25,7 +25,9 @@ fn main() -> ExitCode {
         }
         Err(e) => e.exit(),
     };
-    match cli.run() {
+    // on a thread with a large stack: wgpu parses a user's WGSL again, and writes it as SPIR-V,
+    // recursing once per level of an expression (lobes::engine::gpu::stack)
+    match lobes::engine::gpu::stack::with_big_stack(|| cli.run()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             let code = lobes::cli::exit_code(&err);

@@ -130,7 +130,13 @@ impl Composed {
     }
 
     /// Parses and validates the composed text with naga; errors point at the original files.
+    /// (On a thread with a large stack: a user's expression may nest deeper than an ordinary
+    /// stack holds, [`crate::engine::gpu::stack`].)
     pub fn validate(&self) -> Result<naga::Module, CheckError> {
+        crate::engine::gpu::stack::with_big_stack(|| self.parse_and_validate())
+    }
+
+    fn parse_and_validate(&self) -> Result<naga::Module, CheckError> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
             let labels: Vec<String> = e.labels().map(|(_, l)| l.to_string()).collect();
             CheckError::Wgsl(self.diagnostic(e.location(&self.text), e.message(), &labels))

@@ -158,7 +158,18 @@ pub struct Settings {
     /// An f64 reference pdf p(wi, d) on the CPU (the design's "CPU reference"): when given, the
     /// expected histogram integrates it instead of the WGSL pdf, in f64.
     pub reference: Option<Reference>,
+    /// The time the whole check may take ([`DEFAULT_TIMEOUT`]; at most [`MAX_TIMEOUT_SECONDS`]): the
+    /// GPU's work still unfinished then ends the check with [`GpuError::TimedOut`] (a sampler
+    /// that loops forever never returns), and the device is abandoned
+    /// ([`crate::engine::gpu::dispatch::Bounds`]).
+    pub timeout: std::time::Duration,
 }
+
+/// The time a check may take unless told otherwise: 10 minutes (the default 2²² samples take
+/// seconds on lavapipe; 2³² samples of a costly sampler on a laptop's GPU take minutes).
+pub const DEFAULT_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(600);
+/// The longest `timeout` allowed: 10⁶ s (11.6 days).
+pub const MAX_TIMEOUT_SECONDS: f64 = 1e6;
 
 /// An f64 pdf p(wi, d) written in Rust, integrated with the f64 quadrature instead of the WGSL pdf.
 ///
@@ -199,6 +210,7 @@ impl Default for Settings {
             significance: 0.01,
             probe_samples: 4096,
             reference: None,
+            timeout: DEFAULT_TIMEOUT,
         }
     }
 }
@@ -226,8 +238,12 @@ impl Settings {
         if !self.incident_phi.is_finite() {
             return bad("--incident-phi", format!("{} is not finite", self.incident_phi));
         }
-        if self.samples == 0 {
-            return bad("--samples", "must be at least 1".into());
+        if !(1..=crate::scene::MAX_SAMPLES).contains(&self.samples) {
+            return bad("--samples", format!("{} is not allowed; give a whole number from 1 to 2^40 ({})", self.samples, crate::scene::MAX_SAMPLES));
+        }
+        let t = self.timeout.as_secs_f64();
+        if !(t > 0.0 && t <= MAX_TIMEOUT_SECONDS) {
+            return bad("--timeout", format!("{t} s is not allowed; give seconds > 0, at most {MAX_TIMEOUT_SECONDS:e}"));
         }
         if let Some((r, c)) = self.bins
             && (r == 0 || c == 0 || r as u64 * c as u64 > 1 << 24)
@@ -256,6 +272,7 @@ pub const PDF_CONSISTENCY_LIMIT: f64 = 1e-3;
 pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
     let started = std::time::Instant::now();
     settings.validate()?;
+    let _deadline = gpu.deadline(settings.timeout);
     sampler.validate()?;
     let (rows, cols) = settings.grid(&sampler.domain);
     let composed = gpu::compose(sampler)?;

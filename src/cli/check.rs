@@ -1,11 +1,13 @@
 //! `lobes check`: judge a user's WGSL sampler (see [`crate::check`]).
 
-use super::{NumberList, OutputArgs, emit, emit_json, parse_azimuth, parse_number_list, parse_polar_180, usage};
+use super::{NumberList, OutputArgs, emit, emit_json, interrupt, parse_azimuth, parse_number_list, parse_polar_180, usage};
 use crate::report::table;
 use crate::check::{self, CheckError, Domain, Settings, UserSampler};
-use crate::engine::gpu::Gpu;
+use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
-use std::path::PathBuf;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// Where the user's sampler puts its points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -45,9 +47,13 @@ pub struct CheckArgs {
     /// Incident φ in degrees from +x.
     #[arg(long, value_name = "DEG", value_parser = parse_azimuth, allow_hyphen_values = true, default_value = "0")]
     pub incident_phi: f64,
-    /// Samples drawn for the histogram (and the weights).
-    #[arg(long, value_name = "N", default_value_t = 1 << 22)]
+    /// Samples drawn for the histogram (and the weights), 1 to 2^40.
+    #[arg(long, value_name = "N", default_value_t = 1 << 22, value_parser = clap::value_parser!(u64).range(1..=crate::scene::MAX_SAMPLES))]
     pub samples: u64,
+    /// Seconds the whole check may take (default 600): a sampler that is still running then (an
+    /// endless loop) fails the check with the pass it was in; raise it for a large --samples.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
+    pub timeout: Option<f64>,
     /// Histogram ROWS,COLS (default 64,128 on the sphere, 64,64 on the plane).
     #[arg(long, value_name = "ROWS,COLS", value_parser = parse_number_list)]
     pub bins: Option<NumberList>,
@@ -69,8 +75,15 @@ pub struct CheckArgs {
     pub output: OutputArgs,
 }
 
+/// A check's error as the command's: bad input (exit 2), a stop asked for (130), out of time
+/// (a failed check, 1), or the tool's failure (3).
 fn input(e: CheckError) -> anyhow::Error {
-    if e.is_input() { usage(e.to_string()) } else { e.into() }
+    match e {
+        CheckError::Gpu(GpuError::Stopped(_)) => super::Interrupted(e.to_string()).into(),
+        CheckError::Gpu(GpuError::TimedOut { .. }) => super::ChecksFailed(e.to_string()).into(),
+        e if e.is_input() => usage(e.to_string()),
+        e => e.into(),
+    }
 }
 
 impl CheckArgs {
@@ -104,8 +117,17 @@ impl CheckArgs {
             bins,
             seed: self.seed,
             significance: self.significance,
+            timeout: self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
             ..Settings::default()
         })
+    }
+}
+
+/// `--timeout`: seconds, a number > 0 and at most [`check::MAX_TIMEOUT_SECONDS`].
+fn parse_timeout(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t > 0.0 && t <= check::MAX_TIMEOUT_SECONDS => Ok(t),
+        _ => Err(format!("'{s}' is not a time limit; give seconds, a number > 0 and at most {:e}", check::MAX_TIMEOUT_SECONDS)),
     }
 }
 
@@ -115,12 +137,23 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     settings.validate().map_err(input)?;
     if let Some(dir) = &args.out {
         super::prepare_out(dir)?;
+        remove_stale(dir)?;
     }
+    // before the device opens: a signal while it does is seen at the first submission
+    interrupt::watch("stopping the check now (interrupt again to end at once)")?;
     let gpu = Gpu::new()?;
+    let _stop = gpu.stop_when(interrupt::requested);
     if args.power {
         return power(&gpu, &sampler, &settings, args);
     }
-    let report = check::check(&gpu, &sampler, &settings).map_err(input)?;
+    let started = Instant::now();
+    let report = match check::check(&gpu, &sampler, &settings) {
+        Ok(report) => report,
+        Err(CheckError::Gpu(e @ (GpuError::TimedOut { .. } | GpuError::Stopped(_)))) => {
+            return unfinished(&gpu, &sampler, &settings, args, &e, started.elapsed().as_secs_f64());
+        }
+        Err(e) => return Err(input(e)),
+    };
     if let Some(dir) = &args.out {
         crate::report::check::write(dir, &report, &sampler.composed().map_err(input)?)?;
     }
@@ -136,6 +169,80 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         return Err(super::ChecksFailed(format!("{} failed: {}", report.sampler, report.failed().join(", "))).into());
     }
     Ok(())
+}
+
+/// The outputs of an earlier check in `dir`, which this one replaces (so that none is left
+/// looking like this check's when it ends early).
+fn remove_stale(dir: &Path) -> anyhow::Result<()> {
+    for name in [crate::report::check::REPORT_JSON, crate::report::check::POWER_JSON] {
+        match std::fs::remove_file(dir.join(name)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => anyhow::bail!("cannot remove the earlier {}: {e}", dir.join(name).display()),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// Why a check ended without every verdict.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+enum Status {
+    /// SIGINT or SIGTERM: no verdict (exit 130).
+    Interrupted,
+    /// Out of time (`--timeout`): the check fails (exit 1).
+    TimedOut,
+}
+
+/// The report of a check that ended early, on stdout (one JSON object with --json); `--out`
+/// then holds no `report.json` (an earlier one is removed when the check starts).
+#[derive(Debug, Serialize)]
+struct Unfinished {
+    format_version: u32,
+    status: Status,
+    passed: bool,
+    sampler: String,
+    adapter: String,
+    samples: u64,
+    timeout_seconds: f64,
+    wall_seconds: f64,
+    /// What the GPU was doing, and what to do.
+    reason: String,
+}
+
+/// Reports a check that was interrupted (exit 130) or ran out of time (a failure, exit 1).
+/// The GPU may still be running the sampler: the device is abandoned, never waited for.
+fn unfinished(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs, e: &GpuError, seconds: f64) -> anyhow::Result<()> {
+    let (status, reason) = match e {
+        GpuError::TimedOut { .. } => (
+            Status::TimedOut,
+            format!("{e}; a sampler, pdf or eval that never returns (an endless loop) ends here; for a larger --samples raise --timeout"),
+        ),
+        _ => (Status::Interrupted, format!("{e}; no verdict")),
+    };
+    let report = Unfinished {
+        format_version: check::report::REPORT_VERSION,
+        status,
+        passed: false,
+        sampler: format!("{}/{} in {}", sampler.sample, sampler.pdf, sampler.sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")),
+        adapter: gpu.adapter_name(),
+        samples: settings.samples,
+        timeout_seconds: settings.timeout.as_secs_f64(),
+        wall_seconds: seconds,
+        reason,
+    };
+    if args.output.json {
+        emit_json(&report)?;
+    } else {
+        let name = if status == Status::TimedOut { "timeout" } else { "interrupted" };
+        let mut t = format!("{} on {} ({} samples)\n", report.sampler, report.adapter, report.samples);
+        t += &table::render(&["check", "result", "summary"], [vec![name, verdict(false), &report.reason]].into_iter());
+        t += if status == Status::TimedOut { "FAILED\n" } else { "interrupted\n" };
+        emit(&t)?;
+    }
+    match status {
+        Status::TimedOut => Err(super::ChecksFailed(format!("{} failed: {e}", report.sampler)).into()),
+        Status::Interrupted => Err(super::Interrupted(format!("lobes check interrupted after {seconds:.1} s: no verdict")).into()),
+    }
 }
 
 fn verdict(passed: bool) -> &'static str {

@@ -1,8 +1,11 @@
-//! SIGINT (Ctrl-C) and SIGTERM during `lobes run`: the first signal asks the run to stop after
-//! the case in flight (which then reports and writes what finished, [`super::Interrupted`]); a
-//! second one ends the process at once with [`super::EXIT_INTERRUPTED`]. Every file lobes writes
-//! is atomic ([`crate::report::atomic`]) and a case's `histogram.json` comes last, so a case cut
-//! short that way leaves a folder without `histogram.json`: recognisably incomplete.
+//! SIGINT (Ctrl-C) and SIGTERM during `lobes run` and `lobes check`: the first signal asks the
+//! command to stop (`run`: after the lobe case in flight; a user's sampler case, and `check`,
+//! at once: the GPU's waits see [`requested`] through
+//! [`crate::engine::gpu::Gpu::stop_when`]), and the command then reports and writes what
+//! finished ([`super::Interrupted`]); a second one ends the process at once with
+//! [`super::EXIT_INTERRUPTED`]. Every file lobes writes is atomic ([`crate::report::atomic`])
+//! and a case's `histogram.json` comes last, so a case cut short that way leaves a folder
+//! without `histogram.json`: recognisably incomplete.
 
 use signal_hook::consts::{SIGINT, SIGTERM};
 use signal_hook::iterator::Signals;
@@ -21,8 +24,9 @@ pub fn before_exit(f: impl FnOnce() + Send + 'static) {
     *BEFORE_EXIT.lock().unwrap_or_else(|p| p.into_inner()) = Some(Box::new(f));
 }
 
-/// Starts watching for SIGINT and SIGTERM, on a thread of its own (where printing is safe).
-pub fn watch() -> anyhow::Result<()> {
+/// Starts watching for SIGINT and SIGTERM, on a thread of its own (where printing is safe);
+/// `first` is what the first signal prints after "lobes: interrupted: ".
+pub fn watch(first: &'static str) -> anyhow::Result<()> {
     let mut signals = Signals::new([SIGINT, SIGTERM]).map_err(|e| anyhow::anyhow!("cannot watch for Ctrl-C: {e}"))?;
     std::thread::spawn(move || {
         for _ in signals.forever() {
@@ -33,7 +37,7 @@ pub fn watch() -> anyhow::Result<()> {
                 }
                 std::process::exit(super::EXIT_INTERRUPTED.into());
             }
-            eprintln!("lobes: interrupted: stopping after the case in flight (interrupt again to stop now)");
+            eprintln!("lobes: interrupted: {first}");
         }
     });
     Ok(())

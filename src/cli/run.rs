@@ -8,6 +8,7 @@ use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
 use crate::run::{Backend, CaseResult, Expected, device_lost, judge, run_case};
 use crate::scene::{Case, DEFAULT_SCENE, Entry, Overrides, Scene, UserCase};
+use crate::engine::gpu::GpuError;
 use crate::stats::chi2::sidak;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -239,7 +240,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     let level = sidak(args.significance, n);
     let heading = [format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
     let summary = Arc::new(Mutex::new(RunSummary { stale, ..RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level) }));
-    interrupt::watch()?;
+    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now")?;
     // a second signal ends the process at once: it writes the summary first, the case in
     // flight and the rest as not run
     let (all, out, head, shared) = (names.iter().map(|s| s.to_string()).collect::<Vec<_>>(), args.out.clone(), heading.to_vec(), summary.clone());
@@ -269,7 +270,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         }
         let t = Instant::now();
         let outcome = match (&lost, entry) {
-            (Some(where_lost), _) => Err(anyhow::anyhow!("not run: the GPU device was lost in case '{where_lost}'")),
+            (Some(why), _) => Err(anyhow::anyhow!("not run: {why}")),
             (None, Entry::Lobe(case)) => {
                 let bar = progress_bar(case.samples, &case.name);
                 let outcome = run_and_write(&mut backend, case, level, &args.out, args.files.style(), &mut plain.samples(i, &case.name, case.samples, &bar));
@@ -283,6 +284,11 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 user_rows = true;
                 let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
                 bar.enable_steady_tick(Duration::from_millis(200));
+                // a user's sampler may never return: a signal stops it at once
+                let _stop = match &backend {
+                    Backend::Gpu(engine) => Some(engine.gpu.stop_when(interrupt::requested)),
+                    Backend::Cpu => None,
+                };
                 let outcome = run_user_and_write(&backend, case, level, &args.out, args.files.style());
                 bar.finish_and_clear();
                 outcome
@@ -295,12 +301,27 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 record(&mut |s| s.push(case_summary.clone()));
                 verdict
             }
+            Err(e) if stopped(&e) => {
+                // the case in flight stopped by SIGINT/SIGTERM did not finish: it is not run
+                summary.status = RunStatus::Interrupted;
+                summary.not_run.push(entry.name().to_string());
+                continue;
+            }
+            Err(e) if timed_out(&e) => {
+                // a failure of the case, with its reason; the device still runs its work
+                eprintln!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name());
+                lost = Some(format!("the GPU device is still running case '{}', which ran out of time", entry.name()));
+                let dash = || "-".to_string();
+                rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "FAIL".into(), dash(), dash()]);
+                summary.push(CaseSummary { failure: Some(format!("{e:#}")), error: None, ..CaseSummary::error(&entry, String::new()) });
+                "FAIL"
+            }
             Err(e) => {
                 if lost.is_none() {
                     eprintln!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
                     if device_lost(&e) {
                         eprintln!("lobes: error: the GPU device is unusable; the remaining cases do not run");
-                        lost = Some(entry.name().to_string());
+                        lost = Some(format!("the GPU device was lost in case '{}'", entry.name()));
                     }
                 }
                 let dash = || "-".to_string();
@@ -345,6 +366,16 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         (e, 0) => anyhow::bail!("{e} of {n} cases could not run (see the errors above)"),
         (e, f) => anyhow::bail!("{e} of {n} cases could not run and {f} failed the χ² test or the albedo checks"),
     }
+}
+
+/// Whether `e` is a user's case stopped by SIGINT/SIGTERM ([`GpuError::Stopped`]).
+fn stopped(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| matches!(c.downcast_ref::<GpuError>(), Some(GpuError::Stopped(_))))
+}
+
+/// Whether `e` is a user's case out of time ([`GpuError::TimedOut`]): a failure of the case.
+fn timed_out(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| matches!(c.downcast_ref::<GpuError>(), Some(GpuError::TimedOut { .. })))
 }
 
 /// `lobes run SCENE --shard I/N --out DIR`: samples shard I of every case and writes

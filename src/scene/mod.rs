@@ -45,6 +45,7 @@ mod sweep;
 pub mod template;
 mod user;
 
+pub use sweep::MAX_CASES;
 pub use user::UserCase;
 
 use crate::engine::job::{DiscreteMethod, Job, Scatter};
@@ -151,6 +152,7 @@ struct RawCase {
     params: Option<Sweep>,
     domain: Option<Val>,
     bounds: Option<Val>,
+    timeout: Option<Val>,
 }
 
 impl RawCase {
@@ -426,7 +428,7 @@ impl Scene {
         for c in &raw.case {
             let here = line_column(text, c.span().start);
             let name_span = c.get_ref().name.as_ref().map_or(c.span(), |n| n.span());
-            for parsed in validate_table(&ctx, c, &defaults)? {
+            for parsed in validate_table(&ctx, c, &defaults, MAX_CASES - scene.order.len() as u64)? {
                 let name = match &parsed {
                     Parsed::Lobe(case) => &case.name,
                     Parsed::User(case) => &case.name,
@@ -541,8 +543,9 @@ struct Common {
     seed: u64,
 }
 
-/// The cases of one `[[case]]` table: one, or one per point of its sweeps.
-fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result<Vec<Parsed>, SceneError> {
+/// The cases of one `[[case]]` table: one, or one per point of its sweeps, of which the scene
+/// has room for `room` more ([`MAX_CASES`]; counted before the sweeps are expanded).
+fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, room: u64) -> Result<Vec<Parsed>, SceneError> {
     let c = spanned.get_ref();
     let name = check_name(ctx, spanned)?;
     let name_span = c.name.as_ref().map_or(spanned.span(), |n| n.span());
@@ -555,11 +558,26 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
             return Err(ctx.err(s.span(), format!("{} = [] sweeps over no values; give a value, or an array of values (one case each)", key.name)));
         }
     }
+    let (count, factors) = sweep::count(sweeps);
+    if count > room as u128 {
+        let above = match MAX_CASES - room {
+            0 => String::new(),
+            n => format!(", after the {n} cases of the tables above"),
+        };
+        return Err(ctx.err(
+            spanned.span(),
+            format!(
+                "case '{name}' sweeps to {count} cases ({}){above}; a scene makes at most {MAX_CASES} cases: sweep fewer values, or split the scene",
+                sweep::describe(&factors)
+            ),
+        ));
+    }
     let points = sweep::points(sweeps);
     let sampler = match &c.sampler {
         Some(raw) => Some(user::sampler(ctx, c, &points[0], raw)?),
         None => {
-            let user_keys = [("params", points[0].get("params")), ("domain", c.domain.as_ref()), ("bounds", c.bounds.as_ref())];
+            let user_keys =
+                [("params", points[0].get("params")), ("domain", c.domain.as_ref()), ("bounds", c.bounds.as_ref()), ("timeout", c.timeout.as_ref())];
             reject_keys(ctx, &user_keys, "only applies to a user sampler (sampler = { wgsl = [...], sample = ..., pdf = ... }); remove it")?;
             None
         }
@@ -589,7 +607,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults) -> Result
             };
             let common = Common { name, samples, seed };
             match &sampler {
-                Some(s) => user::case(ctx, d, &point, common, s).map(Parsed::User),
+                Some(s) => user::case(ctx, d, &point, common, s, c.timeout.as_ref()).map(Parsed::User),
                 None => validate_case(ctx, spanned, d, &point, common).map(Parsed::Lobe),
             }
         })

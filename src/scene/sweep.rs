@@ -160,6 +160,31 @@ fn label(v: &Value) -> String {
     }
 }
 
+/// The most cases a scene may make, its sweeps expanded (each case is listed, judged and written
+/// to a folder of its own: 10⁵ cases are already hours of work and megabytes of names).
+pub const MAX_CASES: u64 = 100_000;
+
+/// The number of cases `sweeps` make, their product counted before anything is expanded, and
+/// the swept keys that multiply with the number of values of each.
+pub(super) fn count(sweeps: [Option<&Sweep>; KEYS.len()]) -> (u128, Vec<(&'static str, usize)>) {
+    let factors: Vec<(&'static str, usize)> = KEYS
+        .iter()
+        .zip(sweeps)
+        .filter_map(|(key, sweep)| {
+            let values = sweep.and_then(|s| if key.list { s.lists() } else { s.scalars() })?;
+            Some((key.name, values.len()))
+        })
+        .collect();
+    // at most 17 factors, each under 2^32 (a TOML array's length): the product may pass u64
+    let product = factors.iter().try_fold(1u128, |p, &(_, n)| p.checked_mul(n as u128)).unwrap_or(u128::MAX);
+    (product, factors)
+}
+
+/// "alpha (100 values) × incident_theta (1000 values)", the factors of [`count`].
+pub(super) fn describe(factors: &[(&str, usize)]) -> String {
+    factors.iter().map(|(k, n)| format!("{k} ({n} values)")).collect::<Vec<_>>().join(" × ")
+}
+
 /// Every combination of the swept keys' values; `sweeps[i]` is the value of `KEYS[i]`.
 pub(super) fn points(sweeps: [Option<&Sweep>; KEYS.len()]) -> Vec<Point> {
     let mut points = vec![Point::default()];
@@ -242,6 +267,20 @@ mod tests {
         assert_eq!(grid[7].2, Some(Value::Integer(90)));
         assert_eq!(grid[7].3, Some(Value::Array(vec![Value::Float(0.1), Value::Float(0.2)])));
         assert!(expand("theta = []").is_empty());
+    }
+
+    /// The product is counted without expanding, also where it passes u64 (17 keys of 2^32).
+    #[test]
+    fn the_count_is_the_product_of_the_swept_keys() {
+        let t: T = toml::from_str("theta = [0, 1, 2]\nphi = [1, 2]\nparams = [[0.1], [0.2], [0.3], [0.4]]\nalpha = 0.5").unwrap();
+        let mut sweeps: [Option<&Sweep>; KEYS.len()] = Default::default();
+        for (name, sweep) in [("incident_theta", &t.theta), ("incident_phi", &t.phi), ("params", &t.params), ("alpha", &t.alpha)] {
+            sweeps[KEYS.iter().position(|k| k.name == name).unwrap()] = sweep.as_ref();
+        }
+        let (n, factors) = count(sweeps);
+        assert_eq!(n, 24);
+        assert_eq!(n as usize, points(sweeps).len());
+        assert_eq!(describe(&factors), "incident_theta (3 values) × incident_phi (2 values) × params (4 values)");
     }
 
     #[test]

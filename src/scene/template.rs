@@ -60,6 +60,7 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 # domain = "sphere"       # sphere | plane (then bounds = [x0, y0, x1, y1])
 # incident_theta = {user_theta:?}   # degrees, 0 ≤ θ ≤ 180 (a user sampler's default)
 # bins = [{srows}, {scols}]        # default [{srows}, {scols}] on the sphere, [{prows}, {pcols}] on the plane
+# timeout = {timeout}           # seconds all its checks may take (a sampler that loops forever fails here)
 "#,
         samples = DEFAULT_SAMPLES,
         max_samples = MAX_SAMPLES,
@@ -77,6 +78,7 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
         scols = sphere.1,
         prows = plane.0,
         pcols = plane.1,
+        timeout = user.timeout.as_secs(),
     )
 }
 

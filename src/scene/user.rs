@@ -6,7 +6,7 @@
 
 use super::sweep::Point;
 use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
-use crate::check::{Domain, MAX_PARAMS, Settings, UserSampler};
+use crate::check::{DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
 use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -103,7 +103,7 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
 }
 
 /// One case of a user's sampler at one point of its sweeps.
-pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>) -> Result<UserCase, SceneError> {
+pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, timeout: Option<&Val>) -> Result<UserCase, SceneError> {
     let defaults = Settings::default();
     let incident_theta = match point.get("incident_theta") {
         Some(t) => number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?,
@@ -119,8 +119,15 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
         (None, Some(g)) => Some(*g),
         (None, None) => None,
     };
+    let timeout = match timeout {
+        Some(t) => {
+            let allowed = format!("timeout is the seconds the case's checks may take, a number > 0 and at most {MAX_TIMEOUT_SECONDS:e} (default {})", DEFAULT_TIMEOUT.as_secs());
+            std::time::Duration::from_secs_f64(number(ctx, t, "timeout", |x| x > 0.0 && x <= MAX_TIMEOUT_SECONDS, &allowed)?)
+        }
+        None => defaults.timeout,
+    };
     let Common { name, samples, seed } = common;
-    let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, ..defaults };
+    let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, timeout, ..defaults };
     Ok(UserCase { name, sampler: sampler.clone(), settings })
 }
 

@@ -30,6 +30,16 @@ pub enum GpuError {
     Readback(String),
     #[error("the GPU device was lost or ran out of memory: {0}")]
     Lost(String),
+    /// A wait passed its deadline ([`super::dispatch::Bounds`]); the device still runs the
+    /// work and is abandoned.
+    #[error("no result within {seconds} s (the time limit): the GPU was still running {pass}")]
+    TimedOut { seconds: f64, pass: String },
+    /// A stop was asked for (SIGINT/SIGTERM) while the device ran this work.
+    #[error("stopped (SIGINT/SIGTERM) while the GPU was running {0}")]
+    Stopped(String),
+    /// The device was abandoned earlier (for this reason) and runs nothing more.
+    #[error("the GPU device still runs work given up earlier ({0}); nothing more runs on it")]
+    Abandoned(String),
     #[error("too large for this GPU adapter: {0}")]
     TooLarge(String),
     /// The engine's passes disagree with each other (the device still works).
@@ -41,7 +51,7 @@ impl GpuError {
     /// Whether the device is unusable after this error, so that further work should go
     /// elsewhere; every other error concerns one job only.
     pub fn is_device_lost(&self) -> bool {
-        matches!(self, GpuError::Lost(_))
+        matches!(self, GpuError::Lost(_) | GpuError::TimedOut { .. } | GpuError::Stopped(_) | GpuError::Abandoned(_))
     }
 
     /// Whether the error is the user's setting, not the machine (the CLI exits with 2).
@@ -82,6 +92,9 @@ pub struct Gpu {
     /// The first error the device reported outside a call that returns one (validation, out
     /// of memory, loss), until [`Gpu::check_errors`] takes it.
     errors: Arc<Mutex<Option<String>>>,
+    /// The deadline and the stop that bound waits on the device ([`super::dispatch::Bounds`]).
+    #[cfg(feature = "check")]
+    pub(super) bounds: super::dispatch::Bounds,
 }
 
 /// The first adapter whose name contains `wanted`, ignoring case (what `WGPU_ADAPTER_NAME` means
@@ -160,6 +173,8 @@ impl Gpu {
             #[cfg(feature = "check")]
             pipeline_cache,
             errors,
+            #[cfg(feature = "check")]
+            bounds: Default::default(),
         })
     }
 
@@ -193,6 +208,13 @@ impl Drop for Gpu {
     /// Saves the pipeline cache; a cache that cannot be written costs the next process time,
     /// not this one its results, so that is a note.
     fn drop(&mut self) {
+        // an abandoned device still runs work that may never end, and dropping the last handle
+        // of a device or queue waits for it: those handles are kept, and the cache is not saved
+        if self.abandoned().is_some() {
+            std::mem::forget(self.device.clone());
+            std::mem::forget(self.queue.clone());
+            return;
+        }
         if let Some(Err(e)) = self.pipeline_cache.as_ref().map(DiskCache::save) {
             eprintln!("lobes: note: pipeline cache not saved ({e}); set {}=off to stop using it", pipeline_cache::DISABLE_VAR);
         }

@@ -6,6 +6,47 @@ use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use super::params::Params;
 use crate::engine::job::SampleRange;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// How long a wait on the device sleeps before it looks at its [`Bounds`] again.
+const SLICE: Duration = Duration::from_millis(50);
+
+/// What bounds the device's work: a deadline ([`Gpu::deadline`]) and a stop asked for
+/// ([`Gpu::stop_when`], SIGINT/SIGTERM), seen before every submission and every 50 ms of every
+/// wait. A wait that gives up leaves its work running on the device (a shader may loop forever,
+/// and no API takes a submission back): the device is then abandoned, nothing more is submitted
+/// to it, and it is never dropped (dropping a device waits for its work), so that the process
+/// can still report and exit.
+#[derive(Default)]
+pub struct Bounds {
+    /// When the work in hand must end, and the time it was given.
+    deadline: Mutex<Option<(Instant, Duration)>>,
+    /// Whether a stop was asked for.
+    stop: Mutex<Option<fn() -> bool>>,
+    /// The label of the pass last submitted, for messages.
+    pass: Mutex<String>,
+    /// Why the device was abandoned, once it was.
+    abandoned: Mutex<Option<String>>,
+}
+
+/// Lifts a bound set by [`Gpu::deadline`] or [`Gpu::stop_when`] when dropped.
+#[must_use = "the bound lasts while this guard lives"]
+pub struct Bound<'g> {
+    gpu: &'g Gpu,
+    deadline: bool,
+}
+
+impl Drop for Bound<'_> {
+    fn drop(&mut self) {
+        let b = &self.gpu.bounds;
+        if self.deadline {
+            *b.deadline.lock().unwrap() = None;
+        } else {
+            *b.stop.lock().unwrap() = None;
+        }
+    }
+}
 
 /// One pipeline dispatched over `groups` workgroups.
 pub struct Step<'a> {
@@ -99,7 +140,8 @@ impl Gpu {
             encoder.resolve_query_set(set, 0..n, resolve, 0);
             encoder.copy_buffer_to_buffer(resolve, 0, read, 0, n as u64 * 8);
         }
-        self.queue.submit([encoder.finish()]);
+        let label = passes.iter().map(|p| p.label).collect::<Vec<_>>().join(", ");
+        self.submit(&label, [encoder.finish()])?;
         let ticks = match &queries {
             Some((_, _, read)) => {
                 let stamps: Vec<u64> = bytemuck::cast_slice(&self.read(read, n as u64 * 8)?).to_vec();
@@ -114,6 +156,50 @@ impl Gpu {
         Ok(self.has_timestamps().then(|| ticks as f64 * self.queue.get_timestamp_period() as f64 * 1e-9))
     }
 
+    /// Bounds the device's work by `timeout` from now, until the guard drops: a wait still
+    /// unfinished then fails with [`GpuError::TimedOut`] and abandons the device ([`Bounds`]).
+    pub fn deadline(&self, timeout: Duration) -> Bound<'_> {
+        *self.bounds.deadline.lock().unwrap() = Some((Instant::now() + timeout, timeout));
+        Bound { gpu: self, deadline: true }
+    }
+
+    /// Stops the device's work once `stop` says so (polled), until the guard drops: submitting
+    /// or waiting then fails with [`GpuError::Stopped`] (a wait abandons the device).
+    pub fn stop_when(&self, stop: fn() -> bool) -> Bound<'_> {
+        *self.bounds.stop.lock().unwrap() = Some(stop);
+        Bound { gpu: self, deadline: false }
+    }
+
+    /// Why the device was abandoned (a wait timed out or was stopped), if it was.
+    pub fn abandoned(&self) -> Option<String> {
+        self.bounds.abandoned.lock().unwrap().clone()
+    }
+
+    /// The bound that has been passed, if any: the device abandoned, a stop asked for, the
+    /// deadline gone by.
+    fn bound_passed(&self) -> Result<(), GpuError> {
+        let b = &self.bounds;
+        if let Some(why) = b.abandoned.lock().unwrap().clone() {
+            return Err(GpuError::Abandoned(why));
+        }
+        let pass = || b.pass.lock().unwrap().clone();
+        if b.stop.lock().unwrap().is_some_and(|stop| stop()) {
+            return Err(GpuError::Stopped(pass()));
+        }
+        match *b.deadline.lock().unwrap() {
+            Some((at, given)) if Instant::now() >= at => Err(GpuError::TimedOut { seconds: given.as_secs_f64(), pass: pass() }),
+            _ => Ok(()),
+        }
+    }
+
+    /// Submits `buffers` unless a bound has been passed; `pass` names the work in messages.
+    fn submit(&self, pass: &str, buffers: impl IntoIterator<Item = wgpu::CommandBuffer>) -> Result<(), GpuError> {
+        self.bound_passed()?;
+        *self.bounds.pass.lock().unwrap() = pass.to_string();
+        self.queue.submit(buffers);
+        Ok(())
+    }
+
     /// Zeroes `buffer` on the device.
     pub fn clear(&self, buffer: &wgpu::Buffer) {
         let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -121,9 +207,21 @@ impl Gpu {
         self.queue.submit([encoder.finish()]);
     }
 
+    /// Waits for the work submitted, in slices of [`SLICE`]: a bound passed in between gives
+    /// up the wait and abandons the device ([`Bounds`]).
     fn wait(&self) -> Result<(), GpuError> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Lost(e.to_string()))?;
-        Ok(())
+        loop {
+            match self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(SLICE) }) {
+                Ok(_) => return Ok(()),
+                Err(wgpu::PollError::Timeout) => {
+                    if let Err(e) = self.bound_passed() {
+                        self.bounds.abandoned.lock().unwrap().get_or_insert_with(|| e.to_string());
+                        return Err(e);
+                    }
+                }
+                Err(e) => return Err(GpuError::Lost(e.to_string())),
+            }
+        }
     }
 
     /// Copies the first `size` bytes of `src` to the host.
@@ -134,6 +232,7 @@ impl Gpu {
             let staging = self.buffer("readback", size, wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST);
             let mut encoder = self.device.create_command_encoder(&Default::default());
             encoder.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+            self.bound_passed()?;
             self.queue.submit([encoder.finish()]);
             staging
         };

@@ -288,6 +288,12 @@ pub fn plain(source: &str) -> String {
 /// a module of its own (a root builds only the imported items it uses): the check that every
 /// import resolves and every file is valid WGSL, errors at the file's line.
 fn validate(order: &[&File]) -> Result<(), GpuError> {
+    // a user's file (`lobes check`) may nest deeper than an ordinary stack holds
+    super::stack::with_big_stack(|| compose_each(order))
+}
+
+/// [`validate`]'s work, on its thread.
+fn compose_each(order: &[&File]) -> Result<(), GpuError> {
     let caps = naga::valid::Capabilities::default() | naga::valid::Capabilities::FLOAT64;
     let mut composer = Composer::default().with_capabilities(caps);
     // `what`: the file the error is in (it may be one that the file being built imports)
@@ -311,6 +317,11 @@ fn validate(order: &[&File]) -> Result<(), GpuError> {
 /// Parses and validates a composed module with naga, so that a broken composition is a clear
 /// error rather than a wgpu panic.
 pub fn validate_module(what: &str, source: &str) -> Result<naga::Module, GpuError> {
+    super::stack::with_big_stack(|| parse_and_validate(what, source))
+}
+
+/// [`validate_module`]'s work, on its thread.
+fn parse_and_validate(what: &str, source: &str) -> Result<naga::Module, GpuError> {
     let module = naga::front::wgsl::parse_str(source)
         .map_err(|e| GpuError::Shader { what: what.into(), message: e.emit_to_string(source) })?;
     // FLOAT64 for lobes::experiments::tradeoff's f64 kernels; wgpu still refuses f64 on a device without SHADER_F64.

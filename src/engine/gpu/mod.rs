@@ -10,6 +10,7 @@ pub mod library;
 pub mod params;
 pub mod pipeline_cache;
 pub mod precision;
+pub mod stack;
 pub mod weighted;
 
 pub use context::{Gpu, GpuError};
