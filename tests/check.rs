@@ -453,3 +453,23 @@ fn bad_flags_exit_2_naming_the_flag() {
         assert!(stderr.contains(flag), "{extra:?} should name {flag}: {stderr}");
     }
 }
+
+/// Issue 24 item 1: the GGX sampler with its guard inverted (`wi.z > 0.0` for `wi.z <= 0.0`)
+/// rejects every sample and its pdf is 0 everywhere, which agree: χ² = 0 on 0 dof and
+/// ∫pdf = 0 against a valid fraction of 0 read as a pass. A test that tested nothing fails,
+/// saying no sample was valid.
+#[test]
+fn a_sampler_that_rejects_every_sample_fails() {
+    let gpu = gpu();
+    let text = std::fs::read_to_string(files(&["ggx_vndf.wgsl"])[0].clone()).unwrap().replace("wi.z <= 0.0", "wi.z > 0.0");
+    let path = temp_wgsl("inverted_guard.wgsl", &text);
+    let s = UserSampler::from_files(&[path], "ggx_sample", "ggx_pdf", None, Domain::Sphere).unwrap();
+    let r = check(&gpu, &s, &Settings { params: vec![0.3, 0.3], samples: 262_144, ..Settings::default() }).unwrap();
+    show(&r);
+    assert!(!r.passed);
+    let chi2 = r.get("chi2").unwrap();
+    assert!(!chi2.passed && chi2.summary.starts_with("no sample was valid"), "{}", chi2.summary);
+    let f = r.figures::<lobes::check::report::Chi2Figures>().unwrap();
+    assert_eq!(f.chi2.untested, Some(lobes::stats::chi2::Untested::NoValidSample));
+    assert_eq!(r.invalid.iter().sum::<u64>(), 262_144);
+}

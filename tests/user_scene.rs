@@ -141,6 +141,28 @@ incident_theta = 30
     assert!(table.contains("FAIL (jacobian"), "{table}");
 }
 
+/// Issue 24 item 1 as a scene case: a sampler that rejects every sample (ggx_vndf.wgsl with its
+/// guard inverted, its pdf 0 everywhere) passed with χ² = 0 on 0 dof; it fails, saying no sample
+/// was valid, and the run exits 1.
+#[test]
+fn a_user_sampler_that_rejects_every_sample_fails_the_run() {
+    let dir = scratch("rejects-all");
+    let text = std::fs::read_to_string(root().join("examples/samplers/ggx_vndf.wgsl")).unwrap().replace("wi.z <= 0.0", "wi.z > 0.0");
+    std::fs::write(dir.join("inverted.wgsl"), text).unwrap();
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        "[[case]]\nname = \"inverted\"\nsampler = { wgsl = [\"inverted.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\nparams = [0.3, 0.3]\nsamples = 262144\n",
+    )
+    .unwrap();
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    let case = &summary(&out).cases[0];
+    assert!(!case.passed && case.failed_checks.as_ref().unwrap().iter().any(|c| c == "chi2"), "{case:?}");
+    let reason = case.failure.clone().unwrap();
+    assert!(reason.contains("no sample was valid"), "{reason}");
+}
+
 /// Writes a scene whose case uses ggx_vndf.wgsl through a path relative to the scene file.
 fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
     let scene = dir.join("bad.toml");

@@ -446,11 +446,10 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         ),
         figures: Figures::Normalization(norm),
     });
-    let observed: Vec<u64> = totals[..bins].iter().copied().chain([invalid.iter().sum()]).collect();
-    let exp: Vec<f64> = expected.iter().copied().chain([expected_invalid]).collect();
-    let chi2 = chi2::test(&observed, &exp, settings.significance);
+    let chi2 = chi2::judge((&totals[..bins], &expected), (&[invalid.iter().sum()], &[expected_invalid]), settings.significance);
     let summary = format!(
-        "χ² = {:.1} on {} dof, p = {:.3e} (significance {}); ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
+        "{}χ² = {:.1} on {} dof, p = {:.3e} (significance {}); ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
+        chi2.untested.map_or(String::new(), |u| format!("{}; ", u.describe())),
         chi2.statistic, chi2.dof, chi2.p_value, settings.significance, pdf_total, chi2.in_impossible_cells, integrals.max_error_sigma
     );
     let passed = chi2.passed;

@@ -607,10 +607,7 @@ fn failure(r: &CaseResult) -> Option<String> {
     let mut why = Vec::new();
     let c = &r.chi2;
     if !c.passed {
-        why.push(format!("χ² = {:.1} with {} dof, p = {:.3e} below the case's level {:.3e}", c.statistic, c.dof, c.p_value, c.significance));
-        if c.in_impossible_cells > 0 {
-            why.push(format!("{} samples in bins of zero probability", c.in_impossible_cells));
-        }
+        why.extend(crate::run::compare::chi2_failure(&r.counts, &r.expected, c));
     }
     if let Some(w) = r.weighted.as_ref().filter(|w| !w.check.passed) {
         let a = &w.check;

@@ -24,9 +24,11 @@ pub struct ExpectedCounts {
     pub quadrature: Option<Expected>,
 }
 
-/// N × (the pdf integrated over each bin), N × pmf for a discrete job.
+/// N × (the pdf integrated over each bin), N × pmf for a discrete job; the quadrature's
+/// tolerance is `q`'s at N ([`Quadrature::for_samples`]).
 pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCounts {
     let n = samples as f64;
+    let q = &q.for_samples(samples);
     match job {
         Job::Lobe { lobe, incident, grid, scatter: Scatter::Dielectric { eta } } => {
             let glass = RoughDielectric::new(*lobe, *eta).expect("a dielectric job is checked when made");
@@ -42,6 +44,38 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
             ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; Invalid::COUNT], quadrature: None }
         }
     }
+}
+
+/// The largest quadrature error of any bin allowed for a verdict, in units of its count's
+/// standard deviation at the run's N ([`Expected::max_error_sigma_at`]). The default tolerance is a
+/// hundredth of that σ per part (at N ≥ 10⁸, less below), and the bins of every documented
+/// configuration stay below 0.05 (docs/statistics.md).
+pub const MAX_QUADRATURE_SIGMA: f64 = 0.1;
+
+/// Whether the expected counts of a run of `samples` samples are accurate enough to judge by:
+/// `Err` with what is wrong where the quadrature has not converged, so that no verdict is drawn
+/// from them (`lobes run` and `lobes merge` report the case as an error, exit 3).
+///
+/// ```
+/// use lobes::{engine::job::{Job, Scatter}, reference::{Lobe, LobeKind, Method, reflect::spherical}};
+/// use lobes::{run::compare::{expected_counts, converged}, stats::{expected::Quadrature, histogram::SphereGrid}};
+/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.02, alpha_y: 0.02, alpha_angle: 0.0 };
+/// let job = Job::Lobe { lobe, incident: spherical(0.5, 0.0), grid: SphereGrid { rows: 16, cols: 32 }, scatter: Scatter::Reflect };
+/// assert!(converged(&expected_counts(&job, 1_000_000, &Quadrature::default()), 1_000_000).is_ok());
+/// // a single 5 × 5 rule per bin cannot resolve a lobe of α 0.02
+/// let coarse = Quadrature { max_depth: 0, max_initial_split: 1, ..Quadrature::default() };
+/// assert!(converged(&expected_counts(&job, 1_000_000, &coarse), 1_000_000).is_err());
+/// ```
+pub fn converged(expected: &ExpectedCounts, samples: u64) -> Result<(), String> {
+    let Some(q) = &expected.quadrature else { return Ok(()) };
+    let sigma = q.max_error_sigma_at(samples);
+    if sigma <= MAX_QUADRATURE_SIGMA {
+        return Ok(());
+    }
+    Err(format!(
+        "the f64 reference's quadrature did not converge: a bin's error estimate is {sigma:.3}σ of its count at {samples} samples (at most {MAX_QUADRATURE_SIGMA}σ gives a verdict; {} parts accepted at the depth limit), so no verdict is drawn",
+        q.unconverged_parts
+    ))
 }
 
 /// The narrowest feature of a rough dielectric's density and BSDF, for the quadrature's initial
@@ -71,10 +105,37 @@ fn dielectric_expected(glass: &RoughDielectric, wi: DVec3, grid: crate::stats::h
 
 /// Pearson's χ² over all cells, bins and invalid reasons alike: a sampler that puts mass below
 /// the horizon at the wrong rate fails like one that puts it in the wrong bin.
+/// ([`chi2::judge`]: no valid sample, or a single cell, is never a pass.)
 pub fn chi2_test(counts: &Counts, expected: &ExpectedCounts, significance: f64) -> Chi2 {
-    let observed: Vec<u64> = counts.bins.iter().chain(&counts.invalid).copied().collect();
-    let exp: Vec<f64> = expected.bins.iter().chain(&expected.invalid).copied().collect();
-    chi2::test(&observed, &exp, significance)
+    chi2::judge((&counts.bins, &expected.bins), (&counts.invalid, &expected.invalid), significance)
+}
+
+/// Why a failed χ² test failed, one phrase each: what left it untested ([`chi2::Untested`]), the
+/// statistic against the level, the samples in bins the reference gives no probability, and the
+/// invalid samples of a reason it expects none of, by name (they are no bin's).
+///
+/// ```
+/// use lobes::{engine::job::Counts, run::compare::{ExpectedCounts, chi2_failure, chi2_test}};
+/// let counts = Counts { bins: vec![500, 480], invalid: [0, 0, 20, 0, 0] };
+/// let expected = ExpectedCounts { bins: vec![500.0, 500.0], invalid: [0.0; 5], quadrature: None };
+/// let why = chi2_failure(&counts, &expected, &chi2_test(&counts, &expected, 0.01));
+/// assert_eq!(why[1], "20 samples rejected as non_finite_pdf, where the reference expects none");
+/// ```
+pub fn chi2_failure(counts: &Counts, expected: &ExpectedCounts, c: &Chi2) -> Vec<String> {
+    let mut why: Vec<String> = c.untested.map(|u| u.describe().to_string()).into_iter().collect();
+    if c.untested.is_none() || c.p_value < c.significance {
+        why.push(format!("χ² = {:.1} with {} dof, p = {:.3e} below the case's level {:.3e}", c.statistic, c.dof, c.p_value, c.significance));
+    }
+    let in_empty_bins: u64 = counts.bins.iter().zip(&expected.bins).filter(|(_, e)| **e <= 0.0).map(|(o, _)| o).sum();
+    if in_empty_bins > 0 {
+        why.push(format!("{in_empty_bins} samples in bins of zero probability"));
+    }
+    for ((reason, &o), &e) in Invalid::ALL.iter().zip(&counts.invalid).zip(&expected.invalid) {
+        if o > 0 && e <= 0.0 {
+            why.push(format!("{o} samples rejected as {}, where the reference expects none", reason.name()));
+        }
+    }
+    why
 }
 
 /// GPU directions against the f64 reference, sample by sample: `lobes run`'s per-sample check
@@ -181,9 +242,8 @@ pub fn albedo_check(
     // seen from the upper side (where the closed forms of Λ hold)
     let (reference_bins, furnace_wi) = match *scatter {
         Scatter::Reflect => {
-            let width = lobe.alpha_x.min(lobe.alpha_y).min(1.0);
             let f_cos = |w: DVec3| effects.eval(lobe, wi, w) * w.z;
-            (expected::probabilities(&f_cos, *grid, width, q).probabilities, wi)
+            (expected::peaked_probabilities(&f_cos, *grid, expected::lobe_peak(lobe, wi), q).probabilities, wi)
         }
         Scatter::Dielectric { eta } => {
             let glass = RoughDielectric::new(*lobe, eta).expect("a dielectric job is checked when made");

@@ -193,6 +193,7 @@ pub fn judge(case: &Case, sampled: Sampled, expected: Expected, significance: f6
         case.samples
     );
     let Expected { counts: expected, seconds: quadrature_seconds } = expected;
+    compare::converged(&expected, case.samples).map_err(anyhow::Error::msg)?;
     let chi2 = compare::chi2_test(&counts, &expected, significance);
     let weighted = match (&case.effects, weighted) {
         (None, _) => None,

@@ -55,6 +55,7 @@ use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
+use crate::stats::expected::MIN_ALPHA;
 use serde::Deserialize;
 use std::collections::HashMap;
 use suggest::did_you_mean;
@@ -690,7 +691,16 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         return Err(ctx.err(w.span(), "weights only apply to lobe = \"discrete\"; remove them"));
     }
     let rough = "roughness must be a finite number > 0";
-    let positive = |v: &Val, key| number(ctx, v, key, |x| x > 0.0, rough);
+    let positive = |v: &Val, key| {
+        let a = number(ctx, v, key, |x| x > 0.0, rough)?;
+        if a < MIN_ALPHA {
+            return Err(ctx.err(
+                v.span(),
+                format!("{key} = {a:e} is below the smallest roughness lobes judges, {MIN_ALPHA:e}: the f64 reference cannot resolve a narrower lobe, so its histogram could not be judged; give {key} ≥ {MIN_ALPHA:e}"),
+            ));
+        }
+        Ok(a)
+    };
     let (ax, ay) = match (point.get("alpha"), point.get("alpha_x"), point.get("alpha_y")) {
         (Some(a), None, None) => {
             let a = positive(a, "alpha")?;
@@ -911,6 +921,18 @@ mod tests {
         assert!(err.message.contains("longer than 100 characters") && err.line == 2, "{err}");
         let dup = "[[case]]\nname = \"g-theta0\"\nlobe = \"ward\"\nalpha = 0.2\n[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = [0]\n";
         assert!(Scene::parse("s.toml", dup).unwrap_err().message.contains("duplicate case name 'g-theta0'"));
+    }
+
+    /// Issue 24 item 2: α below what the f64 reference resolves (1e-12 passed on 0 dof) is
+    /// refused at its value, naming the smallest α supported.
+    #[test]
+    fn alpha_below_the_smallest_supported_is_refused() {
+        let parse = |keys: &str| Scene::parse("s.toml", &format!("[[case]]\nname = \"g\"\nlobe = \"ggx\"\nmethod = \"vndf\"\n{keys}\n"));
+        let err = parse("alpha = 1e-12").unwrap_err();
+        assert!(err.message.contains("below the smallest roughness lobes judges, 1e-4") && (err.line, err.column) == (5, 9), "{err}");
+        let err = parse("alpha_x = 0.3\nalpha_y = 5e-5").unwrap_err();
+        assert!(err.message.starts_with("alpha_y = 5e-5 is below") && err.line == 6, "{err}");
+        assert!(parse(&format!("alpha = {MIN_ALPHA}")).is_ok());
     }
 
     #[test]

@@ -20,6 +20,34 @@ pub struct Chi2 {
     /// Observed samples in cells whose expected count is exactly 0 (any rejects the sampler).
     #[serde(rename = "samples_in_zero_probability_cells")]
     pub in_impossible_cells: u64,
+    /// Why the test judged nothing, where it could not: such a test never passes, whatever its
+    /// p-value (absent where the test judged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub untested: Option<Untested>,
+}
+
+/// Why a χ² test judged nothing. Neither is a pass: a test that tested nothing says nothing of
+/// the sampler.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Untested {
+    /// No sample landed in a bin: every one was rejected, so no direction was compared.
+    NoValidSample,
+    /// The expected counts make a single cell after pooling: 0 degrees of freedom, where the
+    /// statistic is 0 whatever the samples did (one cell holds them all, the total is fixed).
+    OneCell,
+}
+
+impl Untested {
+    /// One line saying what happened, for the reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Untested::NoValidSample => "no sample was valid: every sample was rejected, so the histogram tested nothing",
+            Untested::OneCell => {
+                "the χ² test has 0 degrees of freedom: the expected counts make a single cell of count ≥ 5 after pooling, so it tested nothing (more samples, fewer bins or a wider lobe give it cells to compare)"
+            }
+        }
+    }
 }
 
 /// Šidák's correction: the per-test level that keeps the family-wise level `alpha` over `tests`
@@ -89,7 +117,30 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
     let statistic: f64 = cells.iter().map(|(o, e)| (o - e) * (o - e) / e).sum();
     let dof = cells.len().saturating_sub(1) as u64;
     let p = if impossible > 0 { 0.0 } else { p_value(statistic, dof) };
-    Chi2 { statistic, dof, p_value: p, significance, passed: p >= significance, in_impossible_cells: impossible }
+    let untested = (dof == 0).then_some(Untested::OneCell);
+    Chi2 { statistic, dof, p_value: p, significance, passed: p >= significance && untested.is_none(), in_impossible_cells: impossible, untested }
+}
+
+/// The test of a sampler's histogram, the one `lobes run`, `lobes merge` and `lobes check` judge
+/// by: Pearson's [`test`] over the bins and the invalid-sample cells together, where a histogram
+/// with no sample in any bin is [`Untested::NoValidSample`] (it never passes) and one whose
+/// cells pool into one is [`Untested::OneCell`].
+///
+/// ```
+/// use lobes::stats::chi2::{judge, Untested};
+/// // every sample rejected, and a pdf of 0 that expects just that: χ² = 0, yet no pass
+/// let t = judge((&[0, 0], &[0.0, 0.0]), (&[1000], &[1000.0]), 0.01);
+/// assert_eq!((t.statistic, t.passed, t.untested), (0.0, false, Some(Untested::NoValidSample)));
+/// ```
+pub fn judge(bins: (&[u64], &[f64]), invalid: (&[u64], &[f64]), significance: f64) -> Chi2 {
+    let observed: Vec<u64> = bins.0.iter().chain(invalid.0).copied().collect();
+    let expected: Vec<f64> = bins.1.iter().chain(invalid.1).copied().collect();
+    let mut t = test(&observed, &expected, significance);
+    if bins.0.iter().all(|&o| o == 0) {
+        t.untested = Some(Untested::NoValidSample);
+        t.passed = false;
+    }
+    t
 }
 
 #[cfg(test)]
@@ -161,9 +212,39 @@ mod tests {
         let t = test(&[2, 1, 6, 9], &[1.0, 1.0, 8.0, 9.0], 0.01);
         assert_eq!(t.dof, 1);
         assert!((t.statistic - 0.1).abs() < 1e-15, "{}", t.statistic);
-        // only small cells, never reaching 5: one cell, dof 0, p = 1
+        // only small cells, never reaching 5: one cell, dof 0, p = 1, and no pass
         let t = test(&[1, 2], &[1.0, 2.0], 0.01);
         assert_eq!((t.dof, t.statistic, t.p_value), (0, 0.0, 1.0));
+        assert_eq!((t.passed, t.untested), (false, Some(Untested::OneCell)));
+    }
+
+    /// Issue 24 item 2: GGX at α = 1e-12 seen by a quadrature that misses its peak, 10⁶
+    /// samples all in the mirror bin, against 5e-11 expected in the bins and 10⁶ below the
+    /// horizon. Pooled, every bin joins the below-horizon cell: one cell, χ² = 0 on 0 dof,
+    /// which read p = 1, pass. So did a single sample.
+    #[test]
+    fn zero_degrees_of_freedom_never_pass() {
+        let mut bins = vec![0u64; 64];
+        bins[40] = 1_000_000;
+        let expected = vec![5e-11 / 64.0; 64];
+        let t = judge((&bins, &expected), (&[0, 0], &[1e6 - 5e-11, 0.0]), 0.01);
+        assert_eq!((t.dof, t.passed, t.untested), (0, false, Some(Untested::OneCell)), "{t:?}");
+        let t = judge((&[1, 0, 0], &[0.5, 0.3, 0.2]), (&[0], &[0.0]), 0.01);
+        assert_eq!((t.dof, t.passed, t.untested), (0, false, Some(Untested::OneCell)), "{t:?}");
+        // two cells test something
+        let t = judge((&[500, 500], &[500.0, 500.0]), (&[0], &[0.0]), 0.01);
+        assert_eq!((t.dof, t.passed, t.untested), (1, true, None));
+    }
+
+    /// Issue 24 item 1: a sampler that rejects every sample, with a pdf of 0 that agrees.
+    #[test]
+    fn no_valid_sample_never_passes() {
+        // its reasons split over two cells of ≥ 5 (dof 1, χ² = 0): still no pass
+        let t = judge((&[0; 8], &[0.0; 8]), (&[600, 400], &[600.0, 400.0]), 0.01);
+        assert_eq!((t.dof, t.statistic, t.passed, t.untested), (1, 0.0, false, Some(Untested::NoValidSample)));
+        // where the pdf expected valid samples, the statistic rejects too
+        let t = judge((&[0; 4], &[250.0; 4]), (&[1000], &[0.0]), 0.01);
+        assert_eq!((t.passed, t.untested), (false, Some(Untested::NoValidSample)));
     }
 
     #[test]
