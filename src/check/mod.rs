@@ -551,11 +551,20 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     };
     let table: Vec<hard::HardRow> =
         thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
-    let failing: Vec<String> = table
-        .iter()
-        .filter(|r| !r.passed)
-        .map(|r| format!("θi {}° (first at u = {:?}: {})", r.incident_theta, r.first_failure.unwrap_or_default(), r.first_failure_got.as_deref().unwrap_or("")))
-        .collect();
+    let failing_rows: Vec<&hard::HardRow> = table.iter().filter(|r| !r.passed).collect();
+    let failing: Vec<String> = match failing_rows.first() {
+        None => Vec::new(),
+        Some(first) => {
+            let angles: Vec<String> = failing_rows.iter().map(|r| format!("{}°", r.incident_theta)).collect();
+            vec![format!(
+                "θi {}; the first at θi {}°, u = {:?}: {}",
+                angles.join(", "),
+                first.incident_theta,
+                first.first_failure.unwrap_or_default(),
+                first.first_failure_got.as_deref().unwrap_or("")
+            )]
+        }
+    };
     checks.push(Check {
         passed: failing.is_empty(),
         summary: if failing.is_empty() {
