@@ -224,6 +224,19 @@ fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     lobes_out[o + 6u] = vec4<f32>(lobes_user_pdf(wi, s.xyz), lobes_user_eval(wi, s.xyz), length(s.xyz), 0.0);
 }
 
+// (pdf(d), eval(d), 0, 0) at the points d = lobes_in[i].xyz, for the incident direction of the
+// uniforms: where pdf_values looks for the worst value (src/check/mod.rs).
+@compute @workgroup_size(64)
+fn lobes_pdf_at(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let d = lobes_in[i].xyz;
+    let wi = lobes_check.wi.xyz;
+    lobes_out[i] = vec4<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d), 0.0, 0.0);
+}
+
 // Estimator weights of samples base + (gid · samples_per_thread + k): per invocation
 // (Σ w, Σ w², the largest |w − w_pdf| / w_pdf, number of samples with eval > 0), where
 // w = eval(d) / (the reported pdf) is the weight a renderer computes from the sampler alone and
@@ -265,13 +278,19 @@ fn lobes_finite3(d: vec3<f32>) -> bool {
     return all(b != vec3<u32>(0x7f800000u));
 }
 
-// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1. Bins as lobes bins
+// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1 (a rejection,
+// pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`). Bins as lobes bins
 // directions (src/stats/histogram.rs): rows uniform in cos θ over [−1, 1], columns in φ over
 // [−π, π), φ = π wrapping to column 0; on the plane, rows in y and columns in x over the bounds.
 fn lobes_cell(s: vec4<f32>) -> u32 {
     let bins = lobes_check.rows * lobes_check.cols;
     if (!lobes_finite3(s.xyz)) {
         return bins + LOBES_NON_FINITE_POINT - 1u;
+    }
+    // pdf exactly 0 at a finite point, (0, 0, 0) or any other: the rejection the contract allows,
+    // whatever the point (as the hard cases read it), not a point outside the domain
+    if (s.w == 0.0) {
+        return bins + LOBES_ZERO_PDF - 1u;
     }
     var row = 0u;
     var col = 0u;

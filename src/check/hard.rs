@@ -12,14 +12,15 @@ pub const U_VALUES: [f32; 5] = [0.0, 1.0 / 16_777_216.0, 0.5, 1.0 - 1.0 / 16_777
 /// (for samplers of transmission or phase functions; a reflection-only sampler rejects those).
 pub const INCIDENT_THETA: [f64; 7] = [0.0, 45.0, 89.9, 89.999, 90.001, 135.0, 180.0];
 
-/// Every u of the table, in order.
-pub fn uniforms() -> Vec<[f32; 4]> {
-    let v = U_VALUES;
-    let mut out = Vec::with_capacity(625);
-    for a in v {
-        for b in v {
-            for c in v {
-                for d in v {
+/// Every u of the table with components among `values` ([`U_VALUES`], or those of
+/// `Conventions::hard_u_values`), in order.
+pub fn uniforms(values: &[f32]) -> Vec<[f32; 4]> {
+    let v = values;
+    let mut out = Vec::with_capacity(v.len().pow(4));
+    for &a in v {
+        for &b in v {
+            for &c in v {
+                for &d in v {
                     out.push([a, b, c, d]);
                 }
             }
@@ -45,7 +46,29 @@ pub struct HardRow {
     pub bad_pdf_function: u32,
     /// The u of the first failing sample.
     pub first_failure: Option<[f32; 4]>,
+    /// What that sample got, e.g. "d = (0, 0, NaN), |d| = NaN, pdf = 0.1592, pdf(d) = 0.1592"
+    /// (as text: NaN and ∞ have no JSON number).
+    pub first_failure_got: Option<String>,
     pub passed: bool,
+}
+
+/// A number as the messages print it: 4 significant digits, NaN, ∞.
+pub fn show(x: f32) -> String {
+    if x.is_nan() {
+        "NaN".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "∞".into() } else { "−∞".into() }
+    } else if x == 0.0 || (1e-3..1e4).contains(&x.abs()) {
+        format!("{}", (x as f64 * 1e4).round() / 1e4)
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// What a probed sample got: its point, length, reported pdf and pdf(d).
+fn got(p: &[[f32; 4]; 7]) -> String {
+    let d = p[0];
+    format!("d = ({}, {}, {}), |d| = {}, pdf = {}, pdf(d) = {}", show(d[0]), show(d[1]), show(d[2]), show(p[6][2]), show(d[3]), show(p[6][0]))
 }
 
 /// Classifies the probed samples of one row (`probe[0]` = (d, reported pdf), `probe[6]` =
@@ -60,6 +83,7 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
         bad_point: 0,
         bad_pdf_function: 0,
         first_failure: None,
+        first_failure_got: None,
         passed: true,
     };
     for (p, u) in probes.iter().zip(u) {
@@ -88,6 +112,7 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
         };
         if failed && r.first_failure.is_none() {
             r.first_failure = Some(*u);
+            r.first_failure_got = Some(got(p));
         }
     }
     r.passed = r.first_failure.is_none();

@@ -36,14 +36,19 @@
 
 mod builtin;
 pub mod compose;
+pub mod conventions;
 mod gpu;
 pub mod hard;
 pub mod jacobian;
+mod pdf_values;
 pub mod power;
 pub mod quadrature;
 pub mod report;
 
 pub use compose::Source;
+pub use conventions::{Conventions, Frame, Incident, Measure};
+/// glam, whose `DVec3` [`Reference`] takes: a renderer's tests need no glam of their own.
+pub use glam;
 pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
@@ -97,6 +102,8 @@ pub struct UserSampler {
     pub pdf: String,
     pub eval: Option<String>,
     pub domain: Domain,
+    /// How the sampler is written: its frame, measure and declared domain ([`Conventions`]).
+    pub conventions: Conventions,
 }
 
 /// The user's parameters: at most this many numbers (`params: array<vec4<f32>, 4>`).
@@ -106,8 +113,31 @@ impl UserSampler {
     /// Reads the files (in order) and checks the functions against the contract.
     pub fn from_files(paths: &[PathBuf], sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
         let sources = paths.iter().map(|p| Source::read(p)).collect::<Result<Vec<_>, _>>()?;
-        let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain };
+        Self::from_sources(sources, sample, pdf, eval, domain)
+    }
+
+    /// As [`UserSampler::from_files`], from texts already read (a renderer's `include_str!`),
+    /// in lobes' conventions ([`UserSampler::with_conventions`] declares others).
+    ///
+    /// ```
+    /// use lobes::check::{Conventions, Domain, Source, UserSampler};
+    /// let text = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { return vec4<f32>(0.0, 0.0, 1.0, 1.0); }\n\
+    ///             fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 1.0; }";
+    /// let s = UserSampler::from_sources(vec![Source { name: "s.wgsl".into(), text: text.into() }], "s", "p", None, Domain::Sphere)?
+    ///     .with_conventions(Conventions { u_open: true, ..Conventions::default() })?;
+    /// assert!(s.conventions.u_open);
+    /// # Ok::<(), lobes::check::CheckError>(())
+    /// ```
+    pub fn from_sources(sources: Vec<Source>, sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
+        let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain, conventions: Conventions::default() };
         s.validate()?;
+        Ok(s)
+    }
+
+    /// The same sampler declared in `conventions` (`--incident upper`, `--reflection-only`, …).
+    pub fn with_conventions(self, conventions: Conventions) -> Result<Self, CheckError> {
+        let s = Self { conventions, ..self };
+        s.conventions.validate(matches!(s.domain, Domain::Plane { .. }))?;
         Ok(s)
     }
 
@@ -119,6 +149,7 @@ impl UserSampler {
         {
             return Err(CheckError::Input(format!("--bounds: {x0},{y0},{x1},{y1} is not a box: need X0 < X1 and Y0 < Y1, all finite")));
         }
+        self.conventions.validate(matches!(self.domain, Domain::Plane { .. }))?;
         let mut functions = vec![(self.sample.as_str(), compose::SAMPLE), (self.pdf.as_str(), compose::PDF)];
         if let Some(e) = &self.eval {
             functions.push((e.as_str(), compose::EVAL));
@@ -174,8 +205,10 @@ pub const MAX_TIMEOUT_SECONDS: f64 = 1e6;
 /// An f64 pdf p(wi, d) written in Rust, integrated with the f64 quadrature instead of the WGSL pdf.
 ///
 /// ```
-/// let uniform = lobes::check::Reference::new(|_wi, _d| 1.0 / (4.0 * std::f64::consts::PI));
-/// assert!(((uniform.0)(glam::DVec3::Z, glam::DVec3::X) - 0.0795775).abs() < 1e-7);
+/// // glam is re-exported: a renderer's tests need no glam dependency of their own
+/// use lobes::check::glam::DVec3;
+/// let uniform = lobes::check::Reference::new(|_wi: DVec3, _d: DVec3| 1.0 / (4.0 * std::f64::consts::PI));
+/// assert!(((uniform.0)(DVec3::Z, DVec3::X) - 0.0795775).abs() < 1e-7);
 /// ```
 #[derive(Clone)]
 pub struct Reference(pub std::sync::Arc<dyn Fn(glam::DVec3, glam::DVec3) -> f64 + Send + Sync>);
@@ -257,7 +290,8 @@ impl Settings {
     }
 }
 
-/// The incident direction at θ, φ in degrees.
+/// The incident direction at θ, φ in degrees (lobes' frame; the same numbers in a y-up frame,
+/// `conventions::Frame`).
 fn incident(theta: f64, phi: f64) -> [f32; 3] {
     let w = crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians());
     [w.x as f32, w.y as f32, w.z as f32]
@@ -274,6 +308,9 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     settings.validate()?;
     let _deadline = gpu.deadline(settings.timeout);
     sampler.validate()?;
+    if !matches!(sampler.domain, Domain::Plane { .. }) {
+        sampler.conventions.check_incident(settings.incident_theta)?;
+    }
     let (rows, cols) = settings.grid(&sampler.domain);
     let composed = gpu::compose(sampler)?;
     let passes = gpu::Passes::new(gpu, &composed)?;
@@ -371,9 +408,16 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
 
     // The Jacobian.
     let jac = jacobian::judge(&probes, &probe_u, plane);
+    // the length of d at the worst probe: a map onto non-unit vectors has the wrong |J| on the
+    // sphere, and the cause is then the length, not the density
+    let worst_length = probes.iter().zip(&probe_u).find(|(_, u)| **u == jac.worst_u).map(|(p, _)| p[6][2]);
+    let not_unit = match worst_length {
+        Some(l) if !plane && !jac.passed && !((l as f64 - 1.0).abs() <= 1e-3) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
+        _ => String::new(),
+    };
     let summary = if jac.applicable {
         format!(
-            "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%){}",
+            "pdf · |J| has median {:.4} and worst {:.4}; {:.2}% of {} samples off by more than {:.0}% (limit {:.0}%){}{not_unit}",
             jac.median_ratio.unwrap_or(f64::NAN),
             jac.worst_ratio,
             100.0 * jac.share_off,
@@ -412,14 +456,23 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     };
     let n = settings.samples as f64;
     let pdf_total: f64 = integrals.probabilities.iter().sum();
+    // where the pdf is bad: its worst point on a fine grid (the WGSL pdf's, as the hard cases)
+    let worst = if integrals.bad_parts > 0 { pdf_values::worst(&passes, &params, &sampler.domain, &sampler.conventions)? } else { None };
+    let worst_text = worst.as_ref().map(|w| w.describe(&sampler.pdf, plane));
     checks.push(Check {
         passed: integrals.bad_parts == 0,
         summary: if integrals.bad_parts == 0 {
             format!("{}(d) finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf, integrals.parts)
         } else {
-            format!("{}(d) returned NaN, ∞ or a negative value in {} of {} quadrature parts", sampler.pdf, integrals.bad_parts, integrals.parts)
+            format!(
+                "{}(d) returned NaN, ∞ or a negative value in {} of {} quadrature parts; {}",
+                sampler.pdf,
+                integrals.bad_parts,
+                integrals.parts,
+                worst_text.clone().unwrap_or_else(|| "no such value on a fine grid of the domain: it lies between the grid's points".into())
+            )
         },
-        figures: Figures::PdfValues(PdfValuesFigures { bad_parts: integrals.bad_parts, parts: integrals.parts }),
+        figures: Figures::PdfValues(PdfValuesFigures { bad_parts: integrals.bad_parts, parts: integrals.parts, worst: worst_text }),
     });
     let expected: Vec<f64> = integrals.probabilities.iter().map(|p| n * p).collect();
     let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
@@ -448,9 +501,17 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     });
     let chi2 = chi2::judge((&totals[..bins], &expected), (&[invalid.iter().sum()], &[expected_invalid]), settings.significance);
     let summary = format!(
-        "{}χ² = {:.1} on {} dof, p = {:.3e} (significance {}); ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
+        "{}χ² = {:.1} on {} dof, p = {:.3e} (significance {}){}{}; ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
         chi2.untested.map_or(String::new(), |u| format!("{}; ", u.describe())),
-        chi2.statistic, chi2.dof, chi2.p_value, settings.significance, pdf_total, chi2.in_impossible_cells, integrals.max_error_sigma
+        chi2.statistic,
+        chi2.dof,
+        chi2.p_value,
+        settings.significance,
+        report::invalid_dominates(&invalid, expected_invalid, chi2.statistic).map_or(String::new(), |m| format!("; {m}")),
+        report::borderline(chi2.p_value, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}")),
+        pdf_total,
+        chi2.in_impossible_cells,
+        integrals.max_error_sigma
     );
     let passed = chi2.passed;
     let figures = Chi2Figures { chi2, pdf_integral: pdf_total, invalid, expected_invalid, quadrature: integrals.clone() };
@@ -486,14 +547,17 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         let af = AlbedoFigures { mean_weight: mean, std_error: se, quadrature: quad, quadrature_error: quad_err, z, p_value: p, significance: settings.significance };
         checks.push(Check {
             passed: p >= settings.significance,
-            summary: format!("mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6}: z = {z:.2}, p = {p:.3e}"),
+            summary: format!(
+                "mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6}: z = {z:.2}, p = {p:.3e}{}",
+                report::borderline(p, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}"))
+            ),
             figures: Figures::Albedo(af),
         });
     }
 
     // Hard cases.
-    let us = hard::uniforms();
-    let thetas: Vec<f64> = if plane { vec![settings.incident_theta] } else { hard::INCIDENT_THETA.to_vec() };
+    let us = hard::uniforms(&sampler.conventions.hard_u_values());
+    let thetas: Vec<f64> = if plane { vec![settings.incident_theta] } else { sampler.conventions.hard_thetas() };
     let items: Vec<([f32; 4], [f32; 3])> =
         thetas.iter().flat_map(|&t| us.iter().map(move |u| (*u, incident(t, settings.incident_phi)))).collect();
     let probes = passes.probe(&params, &items)?;
@@ -503,11 +567,25 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     };
     let table: Vec<hard::HardRow> =
         thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
-    let failing: Vec<String> = table.iter().filter(|r| !r.passed).map(|r| format!("θi {}° (first at u = {:?})", r.incident_theta, r.first_failure.unwrap_or_default())).collect();
+    let failing_rows: Vec<&hard::HardRow> = table.iter().filter(|r| !r.passed).collect();
+    let failing: Vec<String> = match failing_rows.first() {
+        None => Vec::new(),
+        Some(first) => {
+            let angles: Vec<String> = failing_rows.iter().map(|r| format!("{}°", r.incident_theta)).collect();
+            vec![format!(
+                "θi {}; the first at θi {}°, u = {:?}: {}",
+                angles.join(", "),
+                first.incident_theta,
+                first.first_failure.unwrap_or_default(),
+                first.first_failure_got.as_deref().unwrap_or("")
+            )]
+        }
+    };
     checks.push(Check {
         passed: failing.is_empty(),
         summary: if failing.is_empty() {
-            format!("{} inputs at u ∈ {{0, 2⁻²⁴, ½, 1 − 2⁻²⁴, 1}}⁴ × {} incident angles: every sample valid or rejected with pdf 0", items.len(), thetas.len())
+            let ones = if sampler.conventions.u_open { "" } else { ", 1" };
+            format!("{} inputs at u ∈ {{0, 2⁻²⁴, ½, 1 − 2⁻²⁴{ones}}}⁴ × {} incident angles: every sample valid or rejected with pdf 0", items.len(), thetas.len())
         } else {
             format!("NaN, ∞, a negative pdf or a bad point at {}", failing.join(", "))
         },
@@ -533,9 +611,10 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     })
 }
 
-/// "my_sample/my_pdf in file.wgsl".
+/// "my_sample/my_pdf in file.wgsl", and the conventions declared: "… (--reflection-only)".
 fn describe(s: &UserSampler) -> String {
     let files: Vec<&str> = s.sources.iter().map(|f| f.name.as_str()).collect();
-    format!("{}/{} in {}", s.sample, s.pdf, files.join(", "))
+    let conventions = if s.conventions.is_default() { String::new() } else { format!(" ({})", s.conventions.flags()) };
+    format!("{}/{} in {}{conventions}", s.sample, s.pdf, files.join(", "))
 }
 

@@ -74,6 +74,9 @@ pub struct PdfValuesFigures {
     /// Quadrature parts whose integral of the pdf came out NaN, ∞ or negative.
     pub bad_parts: u64,
     pub parts: u64,
+    /// With bad parts: the worst value on a fine grid of the domain and where, e.g.
+    /// "p(d) = NaN at d = (0.1, 0.2, 0.97) (θ 14.1°, φ 63.4°)" (text: NaN has no JSON number).
+    pub worst: Option<String>,
 }
 
 /// ∫pdf over the domain against the valid fraction of the samples.
@@ -97,6 +100,44 @@ pub struct Chi2Figures {
     pub invalid: [u64; 4],
     pub expected_invalid: f64,
     pub quadrature: Integrals,
+}
+
+impl Chi2Figures {
+    /// Whether the χ² test passed (the check's verdict; `"passed"` in its JSON figures).
+    pub fn passed(&self) -> bool {
+        self.chi2.passed
+    }
+}
+
+/// A count with its thousands apart, as the messages print it: 34 739.
+pub fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// When the invalid cell holds most of the χ² statistic (or any count where none was expected):
+/// "34 739 invalid samples where 33 were expected (zero_pdf 34 000, outside_domain 739)".
+pub fn invalid_dominates(invalid: &[u64; 4], expected: f64, statistic: f64) -> Option<String> {
+    let observed: u64 = invalid.iter().sum();
+    let o = observed as f64;
+    let share = if expected > 0.0 { (o - expected).powi(2) / expected } else if observed > 0 { f64::INFINITY } else { 0.0 };
+    if observed == 0 || !(share > 0.5 * statistic) || o <= expected {
+        return None;
+    }
+    let reasons: Vec<String> = REASONS.iter().zip(invalid).filter(|(_, n)| **n > 0).map(|(r, n)| format!("{r} {}", grouped(*n))).collect();
+    Some(format!("{} invalid samples where {} were expected ({})", grouped(observed), grouped(expected.round() as u64), reasons.join(", ")))
+}
+
+/// For a p-value between the significance and 10 × it: the hint that one seed decides little.
+pub fn borderline(p: f64, significance: f64, seed: u64) -> Option<String> {
+    (p >= significance && p < 10.0 * significance).then(|| format!("borderline (p within 10× the significance): run again with another seed, e.g. --seed {}", seed + 1))
 }
 
 /// eval/pdf from the sampler against eval/pdf(d).
@@ -204,5 +245,37 @@ impl Report {
         let failed: Vec<String> = self.checks.iter().filter(|c| !c.passed).map(|c| format!("  {}: {}", c.name(), c.summary)).collect();
         let out = outputs.map(|p| format!("\noutputs: {}", p.display())).unwrap_or_default();
         panic!("lobes check: {} failed {} of {} checks:\n{}{out}", self.sampler, failed.len(), self.checks.len(), failed.join("\n"));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_are_grouped_by_thousands() {
+        assert_eq!(grouped(0), "0");
+        assert_eq!(grouped(999), "999");
+        assert_eq!(grouped(34_739), "34 739");
+        assert_eq!(grouped(1_234_567), "1 234 567");
+    }
+
+    /// The invalid cell is named when it holds most of χ², not when the bins do.
+    #[test]
+    fn a_dominating_invalid_cell_is_named() {
+        let m = invalid_dominates(&[0, 739, 0, 34_000], 33.0, 3.7e7).unwrap();
+        assert_eq!(m, "34 739 invalid samples where 33 were expected (outside_domain 739, zero_pdf 34 000)");
+        // (34 739 − 33)² / 33 ≈ 3.65e7: less than half of a statistic of 1e8
+        assert!(invalid_dominates(&[0, 739, 0, 34_000], 33.0, 1e8).is_none());
+        assert!(invalid_dominates(&[0, 0, 0, 10], 0.0, 5.0).is_some());
+        assert!(invalid_dominates(&[0, 0, 0, 0], 3.0, 5.0).is_none());
+        // fewer than expected: the pdf allows more rejections than happen; not "invalid samples"
+        assert!(invalid_dominates(&[0, 0, 0, 10], 1000.0, 1000.0).is_none());
+    }
+
+    #[test]
+    fn borderline_p_values_suggest_another_seed() {
+        assert!(borderline(0.05, 0.01, 1).unwrap().contains("--seed 2"));
+        assert!(borderline(0.005, 0.01, 1).is_none() && borderline(0.1, 0.01, 1).is_none());
     }
 }

@@ -2,7 +2,7 @@
 
 use super::{NumberList, OutputArgs, emit, emit_json, interrupt, parse_azimuth, parse_number_list, parse_polar_180, usage};
 use crate::report::table;
-use crate::check::{self, CheckError, Domain, Settings, UserSampler};
+use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Settings, UserSampler};
 use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -47,6 +47,25 @@ pub struct CheckArgs {
     /// Incident φ in degrees from +x.
     #[arg(long, value_name = "DEG", value_parser = parse_azimuth, allow_hyphen_values = true, default_value = "0")]
     pub incident_phi: f64,
+    /// Where the sampler's incident light may come from: sphere, or upper (above the surface
+    /// only: the hard cases and --incident-theta stay below 90°).
+    #[arg(long, value_name = "sphere|upper", default_value = "sphere")]
+    pub incident: Incident,
+    /// The sampler only reflects: --incident upper, and any d with d·n ≤ 0 is a rejection
+    /// whatever pdf it reports (its pdf and eval taken as 0 there).
+    #[arg(long)]
+    pub reflection_only: bool,
+    /// The sampler's uniforms are in [0, 1): the hard cases never feed exactly 1.
+    #[arg(long)]
+    pub u_open: bool,
+    /// The measure of the pdf (and eval): solid-angle, or projected (per |cos θ| dσ; eval is then
+    /// f without the cosine).
+    #[arg(long, value_name = "solid-angle|projected", default_value = "solid-angle")]
+    pub measure: Measure,
+    /// The sampler's tangent frame: z-up, or y-up (normal +y; --incident-theta from +y, φ from +x
+    /// towards +z).
+    #[arg(long, value_name = "z-up|y-up", default_value = "z-up")]
+    pub frame: Frame,
     /// Samples drawn for the histogram (and the weights), 1 to 2^40.
     #[arg(long, value_name = "N", default_value_t = 1 << 22, value_parser = clap::value_parser!(u64).range(1..=crate::scene::MAX_SAMPLES))]
     pub samples: u64,
@@ -97,7 +116,8 @@ impl CheckArgs {
                 _ => return Err(usage(format!("--bounds: expected 4 numbers X0,Y0,X1,Y1, got {}", b.0.len()))),
             },
         };
-        UserSampler::from_files(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain).map_err(input)
+        let conventions = Conventions { incident: self.incident, reflection_only: self.reflection_only, u_open: self.u_open, measure: self.measure, frame: self.frame };
+        UserSampler::from_files(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain).and_then(|s| s.with_conventions(conventions)).map_err(input)
     }
 
     fn settings(&self) -> anyhow::Result<Settings> {
@@ -135,6 +155,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let sampler = args.sampler()?;
     let settings = args.settings()?;
     settings.validate().map_err(input)?;
+    if sampler.domain == Domain::Sphere {
+        sampler.conventions.check_incident(settings.incident_theta).map_err(input)?;
+    }
     if let Some(dir) = &args.out {
         super::prepare_out(dir)?;
         remove_stale(dir)?;

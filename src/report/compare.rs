@@ -78,12 +78,13 @@ pub fn residual(measured: f64, expected: f64) -> f64 {
     }
 }
 
-/// The rows `first..end` of a row-major grid that hold a sample or at least half an expected
-/// count, with every row in between (all rows when none does).
+/// The rows `first..end` of a row-major grid that hold a sample, at least half an expected
+/// count or a negative expected count (a pdf below 0 is drawn, never cropped), with every row in
+/// between (all rows when none does).
 pub fn drawn_rows(measured: &[f64], expected: &[f64], rows: usize, cols: usize) -> Range<usize> {
     let occupied = |r: usize| {
         let cells = r * cols..(r + 1) * cols;
-        measured[cells.clone()].iter().any(|&c| c > 0.0) || expected[cells].iter().sum::<f64>() >= 0.5
+        measured[cells.clone()].iter().any(|&c| c > 0.0) || expected[cells.clone()].iter().sum::<f64>() >= 0.5 || expected[cells].iter().any(|&e| e < 0.0)
     };
     match ((0..rows).find(|&r| occupied(r)), (0..rows).rfind(|&r| occupied(r))) {
         (Some(first), Some(last)) => first..last + 1,
@@ -177,9 +178,22 @@ fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::R
     let clipped = if residuals.iter().any(|r| r.abs() > RESIDUAL_LIMIT) { format!(", colours clipped at ±{RESIDUAL_LIMIT}") } else { String::new() };
     let grey = if residuals.iter().any(|r| r.is_nan()) { "; grey: samples where nothing is expected" } else { "" };
     let pooled = format!("; 0 where under {MIN_EXPECTED} are expected (pooled by χ²)");
+    // a pdf below 0 somewhere: the expected map on a diverging scale, its negative bins blue,
+    // instead of drawn as 0 on the counts' scale
+    let negative = expected.iter().filter(|&&e| e < 0.0).count();
+    let (expected_title, expected_scale, expected_mapping) = if negative == 0 {
+        ("expected counts, N × ∫pdf (same colour scale)".to_string(), Scale::Sequential, counts)
+    } else {
+        let lim = expected.iter().map(|e| e.abs()).fold(0.0, f64::max).max(1.0);
+        (
+            format!("expected counts, N × ∫pdf: {negative} bins below 0 (blue), where the pdf is negative; a linear scale, not the measured one"),
+            Scale::Diverging,
+            Mapping::Symmetric { lim },
+        )
+    };
     let maps = [
         (MEASURED_PNG, title(c, &measured_title), &measured, Scale::Sequential, counts),
-        (EXPECTED_PNG, title(c, "expected counts, N × ∫pdf (same colour scale)"), &expected, Scale::Sequential, counts),
+        (EXPECTED_PNG, title(c, &expected_title), &expected, expected_scale, expected_mapping),
         (
             RESIDUAL_PNG,
             title(c, &format!("(measured − expected)/√expected{pooled}{clipped}{grey}")),
@@ -253,6 +267,9 @@ mod tests {
         // samples alone keep a row
         let stray = grid(|r, c| if r == 0 && c == 0 { 1.0 } else { 0.0 });
         assert_eq!(drawn_rows(&stray, &zero, 4, 8), 0..1);
+        // and so does a negative expected count (a pdf below 0), though the row's sum is < 0.5
+        let below = grid(|r, c| if r == 0 && c == 0 { -3.0 } else if r == 3 { 10.0 } else { 0.0 });
+        assert_eq!(drawn_rows(&zero, &below, 4, 8), 0..4);
     }
 
     #[test]

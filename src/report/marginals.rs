@@ -6,6 +6,11 @@
 //! band `e ± 2σ` with `σ = √e`, the Poisson approximation of one bin's multinomial spread
 //! (`Var = N p (1 − p) ≤ N p`). A correct sampler keeps about 95% of its bars' tops inside the
 //! band; bars outside it are drawn red, so the bins that drive χ² stand out.
+//!
+//! Where a panel's counts span more than three decades (a narrow lobe's tails, the rows near
+//! the horizon) its count axis is logarithmic ("samples per bin (log)"), so the small bins stay
+//! readable; a negative expected count (a pdf below 0) keeps the axis linear and extends it below
+//! 0, where the tick is drawn.
 
 use super::text::{PLOTTERS_FONT as FONT, register_plotters_font};
 use image::RgbImage;
@@ -97,6 +102,11 @@ where
     let band = |i: usize| 2.0 * p.expected[i].max(0.0).sqrt();
     let top = (0..bins).map(|i| p.measured[i].max(p.expected[i] + band(i))).fold(0.0, f64::max);
     let top = if top > 0.0 { top * 1.05 } else { 1.0 };
+    let lowest = (0..bins).map(|i| p.expected[i]).fold(0.0, f64::min);
+    let log = log_axis(&p.measured[..bins], &p.expected[..bins]);
+    // the count axis: log₁₀ of the count from half a count up, or the count itself
+    let y = |v: f64| if log { v.max(LOG_FLOOR).log10() } else { v };
+    let (y0, y1) = if log { (LOG_FLOOR.log10(), top.log10()) } else { (1.05 * lowest, top) };
     let (x0, x1) = match (p.edges.first(), p.edges.last()) {
         (Some(&a), Some(&b)) if b > a => (a, b),
         _ => (0.0, 1.0),
@@ -107,13 +117,13 @@ where
         .margin_right(20)
         .x_label_area_size(44)
         .y_label_area_size(64)
-        .build_cartesian_2d(x0..x1, 0.0..top)?;
+        .build_cartesian_2d(x0..x1, y0..y1)?;
     chart
         .configure_mesh()
         .max_light_lines(0)
         .x_desc(p.x_label)
-        .y_desc("samples per bin")
-        .y_label_formatter(&|v| super::label::compact(*v))
+        .y_desc(if log { "samples per bin (log)" } else { "samples per bin" })
+        .y_label_formatter(&|v| super::label::compact(if log { 10f64.powf(*v) } else { *v }))
         // a tick computed as a sum of steps lands near 0 as ±1e-16: shown as 0
         .x_label_formatter(&|v| super::label::compact(if v.abs() < 1e-9 * (x1 - x0) { 0.0 } else { *v }))
         .label_style((FONT, TEXT_PX - 2.0))
@@ -124,19 +134,33 @@ where
     chart.draw_series((0..bins).map(|i| {
         let (a, b) = edge(i);
         let e = p.expected[i];
-        Rectangle::new([(a, (e - band(i)).max(0.0)), (b, e + band(i))], BAND.filled())
+        Rectangle::new([(a, y((e - band(i)).max(0.0))), (b, y(e + band(i)))], BAND.filled())
     }))?;
     chart.draw_series((0..bins).map(|i| {
         let (a, b) = edge(i);
         let inset = 0.15 * (b - a);
         let colour = if outside_band(p.measured[i], p.expected[i]) { BAR_OUT } else { BAR };
-        Rectangle::new([(a + inset, 0.0), (b - inset, p.measured[i])], colour.mix(0.85).filled())
+        Rectangle::new([(a + inset, y(0.0)), (b - inset, y(p.measured[i]))], colour.mix(0.85).filled())
     }))?;
     chart.draw_series((0..bins).map(|i| {
         let (a, b) = edge(i);
-        PathElement::new([(a, p.expected[i]), (b, p.expected[i])], BLACK.stroke_width(2))
+        PathElement::new([(a, y(p.expected[i])), (b, y(p.expected[i]))], BLACK.stroke_width(2))
     }))?;
     Ok(())
+}
+
+/// The bottom of a logarithmic count axis: half a count (an empty bin's bar has no height).
+const LOG_FLOOR: f64 = 0.5;
+
+/// Whether a panel's count axis is logarithmic: its positive counts span more than three
+/// decades, and no expected count is negative.
+pub fn log_axis(measured: &[f64], expected: &[f64]) -> bool {
+    if expected.iter().any(|&e| e < 0.0) {
+        return false;
+    }
+    let positive = measured.iter().chain(expected).copied().filter(|&v| v >= LOG_FLOOR);
+    let (lo, hi) = positive.fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    hi > 1000.0 * lo
 }
 
 #[cfg(test)]
@@ -150,6 +174,13 @@ mod tests {
         assert!(outside_band(121.0, 100.0) && outside_band(79.0, 100.0));
         // nothing expected: any sample is outside
         assert!(outside_band(1.0, 0.0) && !outside_band(0.0, 0.0));
+    }
+
+    #[test]
+    fn small_counts_get_a_log_axis() {
+        assert!(!log_axis(&[100.0, 400.0, 0.0], &[100.0, 400.0, 0.0]));
+        assert!(log_axis(&[1e6, 3.0, 0.0], &[1e6, 2.5, 0.1]));
+        assert!(!log_axis(&[1e6, 3.0], &[1e6, -2.0]), "a negative expectation keeps the axis linear");
     }
 
     #[test]

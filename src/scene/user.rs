@@ -6,7 +6,7 @@
 
 use super::sweep::Point;
 use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
-use crate::check::{DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
+use crate::check::{Conventions, DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
 use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;
@@ -20,6 +20,12 @@ pub(super) struct RawSampler {
     sample: Option<Val>,
     pdf: Option<Val>,
     eval: Option<Val>,
+    // the sampler's conventions (crate::check::conventions), as `lobes check`'s flags
+    incident: Option<Val>,
+    reflection_only: Option<Val>,
+    u_open: Option<Val>,
+    measure: Option<Val>,
+    frame: Option<Val>,
 }
 
 /// One validated case of a user's sampler: the sampler (shared by the cases of a sweep) and the
@@ -67,8 +73,38 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
     let base = Path::new(ctx.file).parent().unwrap_or(Path::new(""));
     let paths: Vec<_> = files.iter().map(|f| base.join(f)).collect();
     let domain = domain(ctx, c)?;
-    UserSampler::from_files(&paths, &sample, &pdf, eval.as_deref(), domain).map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
-    .map(Arc::new)
+    let conventions = conventions(ctx, r)?;
+    UserSampler::from_files(&paths, &sample, &pdf, eval.as_deref(), domain)
+        .and_then(|s| s.with_conventions(conventions))
+        .map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
+        .map(Arc::new)
+}
+
+/// `incident = "upper"`, `reflection_only = true`, `u_open = true`, `measure = "projected"`,
+/// `frame = "y-up"`: the flags of `lobes check` as keys of `sampler`.
+fn conventions(ctx: &Ctx, r: &RawSampler) -> Result<Conventions, SceneError> {
+    fn named<T: std::str::FromStr<Err = String>>(ctx: &Ctx, v: &Option<Val>, key: &str, names: &[&str]) -> Result<Option<T>, SceneError> {
+        let allowed = format!("sampler.{key} is one of {}", names.join(", "));
+        v.as_ref()
+            .map(|v| string(ctx, v, &format!("sampler.{key}"), &allowed)?.parse::<T>().map_err(|e| ctx.err(v.span(), format!("sampler.{key}: {e}"))))
+            .transpose()
+    }
+    let flag = |v: &Option<Val>, key: &str| -> Result<bool, SceneError> {
+        match v.as_ref().map(|v| (v, v.get_ref())) {
+            None => Ok(false),
+            Some((_, Value::Boolean(b))) => Ok(*b),
+            Some((v, other)) => Err(ctx.err(v.span(), format!("sampler.{key} must be true or false, got {}", kind_of(other)))),
+        }
+    };
+    let d = Conventions::default();
+    use crate::check::{Frame, Incident, Measure};
+    Ok(Conventions {
+        incident: named(ctx, &r.incident, "incident", Incident::NAMES)?.unwrap_or(d.incident),
+        reflection_only: flag(&r.reflection_only, "reflection_only")?,
+        u_open: flag(&r.u_open, "u_open")?,
+        measure: named(ctx, &r.measure, "measure", Measure::NAMES)?.unwrap_or(d.measure),
+        frame: named(ctx, &r.frame, "frame", Frame::NAMES)?.unwrap_or(d.frame),
+    })
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no
@@ -106,7 +142,14 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
 pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, timeout: Option<&Val>) -> Result<UserCase, SceneError> {
     let defaults = Settings::default();
     let incident_theta = match point.get("incident_theta") {
-        Some(t) => number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?,
+        Some(t) => {
+            let theta = number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?;
+            // a sweep stays where the sampler is declared for (incident = "upper": below 90°)
+            if sampler.domain == Domain::Sphere {
+                sampler.conventions.check_incident(theta).map_err(|e| ctx.err(t.span(), format!("incident_theta: {e}")))?;
+            }
+            theta
+        }
         None => defaults.incident_theta,
     };
     let incident_phi = incident_phi(ctx, point)?;

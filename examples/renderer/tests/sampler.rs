@@ -13,9 +13,7 @@ fn gpu() -> Gpu {
 fn sampler(extra: &[(&str, &str)], sample: &str, pdf: &str, eval: Option<&str>) -> UserSampler {
     let mut sources = vec![Source { name: "shaders/diffuse.wgsl".into(), text: renderer_example::diffuse_wgsl().into() }];
     sources.extend(extra.iter().map(|(name, text)| Source { name: (*name).into(), text: (*text).into() }));
-    let s = UserSampler { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain: Domain::Sphere };
-    s.validate().unwrap_or_else(|e| panic!("{e}"));
-    s
+    UserSampler::from_sources(sources, sample, pdf, eval, Domain::Sphere).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn print(label: &str, report: &Report) {

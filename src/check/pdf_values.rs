@@ -1,0 +1,100 @@
+//! Where the pdf is NaN, ∞ or negative: when `pdf_values` finds bad quadrature parts, the pdf is
+//! evaluated on a fine grid of the domain (the centres of 256 × 512 cells in (cos θ, φ) on the
+//! sphere, 256 × 256 of the box on the plane) and the worst point named: NaN first, then ±∞,
+//! then the most negative value.
+
+use super::conventions::Conventions;
+use super::gpu::{Params, Passes};
+use super::hard::show;
+use super::{CheckError, Domain};
+
+/// The grid's rows and columns on the sphere (on the plane: rows × rows).
+const ROWS: u32 = 256;
+const COLS: u32 = 512;
+
+/// The worst value found and where, in the user's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Worst {
+    /// The point (in the user's frame on the sphere) and its θ, φ in degrees (the same numbers in
+    /// either frame).
+    pub d: [f64; 3],
+    pub angles: (f64, f64),
+    pub value: f32,
+}
+
+impl Worst {
+    /// "pdf(d) = NaN at d = (0.1, 0.2, 0.97) (θ 14.1°, φ 63.4°)" (θ, φ on the sphere only).
+    pub fn describe(&self, pdf: &str, plane: bool) -> String {
+        let [x, y, z] = self.d.map(|v| show(v as f32));
+        let angles = if plane {
+            String::new()
+        } else {
+            let (t, p) = self.angles;
+            format!(" (θ {t:.1}°, φ {p:.1}°)")
+        };
+        format!("{pdf}(d) = {} at d = ({x}, {y}, {z}){angles}", show(self.value))
+    }
+}
+
+fn angles(d: [f64; 3]) -> (f64, f64) {
+    (d[2].clamp(-1.0, 1.0).acos().to_degrees(), d[1].atan2(d[0]).to_degrees())
+}
+
+/// How bad a value is: NaN 3, ±∞ 2, negative 1 (then by how negative), else none.
+fn badness(v: f32) -> Option<(u8, f32)> {
+    if v.is_nan() {
+        Some((3, 0.0))
+    } else if v.is_infinite() {
+        Some((2, 0.0))
+    } else if v < 0.0 {
+        Some((1, -v))
+    } else {
+        None
+    }
+}
+
+/// The worst point of the grid, if any is bad.
+pub(super) fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conventions) -> Result<Option<Worst>, CheckError> {
+    let points: Vec<[f32; 4]> = match *domain {
+        Domain::Sphere => (0..ROWS * COLS)
+            .map(|k| {
+                let z = -1.0 + 2.0 * ((k / COLS) as f64 + 0.5) / ROWS as f64;
+                let phi = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * ((k % COLS) as f64 + 0.5) / COLS as f64;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                [(r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32, 0.0]
+            })
+            .collect(),
+        Domain::Plane { bounds: [x0, y0, x1, y1] } => (0..ROWS * ROWS)
+            .map(|k| {
+                let x = x0 + (x1 - x0) * ((k % ROWS) as f64 + 0.5) / ROWS as f64;
+                let y = y0 + (y1 - y0) * ((k / ROWS) as f64 + 0.5) / ROWS as f64;
+                [x as f32, y as f32, 0.0, 0.0]
+            })
+            .collect(),
+    };
+    let values = passes.pdf_at(params, &points)?;
+    let worst = points
+        .iter()
+        .zip(&values)
+        .filter_map(|(d, v)| badness(v[0]).map(|b| (b, d, v[0])))
+        .max_by(|a, b| a.0.0.cmp(&b.0.0).then(a.0.1.total_cmp(&b.0.1)));
+    Ok(worst.map(|(_, d, value)| {
+        let d = [d[0] as f64, d[1] as f64, d[2] as f64];
+        Worst { d: if matches!(domain, Domain::Plane { .. }) { d } else { conventions.to_user(d) }, angles: angles(d), value }
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nan_is_worse_than_infinity_is_worse_than_negative() {
+        assert!(badness(f32::NAN) > badness(f32::INFINITY));
+        assert!(badness(f32::NEG_INFINITY) > badness(-1e30));
+        assert!(badness(-2.0) > badness(-1.0));
+        assert_eq!(badness(0.0), None);
+        let w = Worst { d: [0.0, 0.0, -1.0], angles: angles([0.0, 0.0, -1.0]), value: -1.0 };
+        assert_eq!(w.describe("p", false), "p(d) = -1 at d = (0, 0, -1) (θ 180.0°, φ 0.0°)");
+    }
+}
