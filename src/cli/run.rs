@@ -303,8 +303,10 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             }
             Err(e) if stopped(&e) => {
                 // the case in flight stopped by SIGINT/SIGTERM did not finish: it is not run
-                summary.status = RunStatus::Interrupted;
-                summary.not_run.push(entry.name().to_string());
+                record(&mut |s| {
+                    s.status = RunStatus::Interrupted;
+                    s.not_run.push(entry.name().to_string());
+                });
                 continue;
             }
             Err(e) if timed_out(&e) => {
@@ -313,7 +315,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
                 lost = Some(format!("the GPU device is still running case '{}', which ran out of time", entry.name()));
                 let dash = || "-".to_string();
                 rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "FAIL".into(), dash(), dash()]);
-                summary.push(CaseSummary { failure: Some(format!("{e:#}")), error: None, ..CaseSummary::error(&entry, String::new()) });
+                record(&mut |s| s.push(CaseSummary { failure: Some(format!("{e:#}")), error: None, ..CaseSummary::error(&entry, String::new()) }));
                 "FAIL"
             }
             Err(e) => {
