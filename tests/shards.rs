@@ -215,3 +215,20 @@ fn a_merged_case_that_fails_the_albedo_check_fails() {
     let table = lobes(&dir, &["merge", "parts", "--out", "merged"]);
     assert!(String::from_utf8_lossy(&table.stdout).lines().any(|l| l.starts_with("w ") && l.contains("FAIL")));
 }
+
+/// Issue 24 item 14: honest shards from the GPU and from the CPU engine merge, with a warning
+/// that names both backends and a file of each (it said "more than one adapter" and named one).
+#[test]
+fn shards_of_two_backends_are_named_in_the_warning() {
+    require_gpu();
+    let dir = scratch("two-backends");
+    let scene = "[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nincident_theta = 30.0\nsamples = 40_000\nbins = [8, 16]\n";
+    std::fs::write(dir.join("scene.toml"), scene).unwrap();
+    assert!(lobes(&dir, &["run", "scene.toml", "--shard", "0/2", "--out", "gpu"]).status.success());
+    assert!(lobes(&dir, &["run", "scene.toml", "--cpu", "--shard", "1/2", "--out", "cpu"]).status.success());
+    let merged = lobes(&dir, &["merge", "gpu", "cpu", "--out", "m"]);
+    assert!(merged.status.code() != Some(2), "{}", stderr(&merged));
+    let e = stderr(&merged);
+    assert!(e.contains("lobes: warning: the shards come from more than one backend: 'cpu' in 1 file (such as cpu/g/shard-1-of-2.json), 'gpu' in 1 file (such as gpu/g/shard-0-of-2.json)"), "{e}");
+    assert!(e.contains("more than one adapter: 'cpu (f64 reference"), "{e}");
+}
