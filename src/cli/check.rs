@@ -258,7 +258,8 @@ fn unfinished(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &Chec
     } else {
         let name = if status == Status::TimedOut { "timeout" } else { "interrupted" };
         let mut t = format!("{} on {} ({} samples)\n", report.sampler, report.adapter, report.samples);
-        t += &table::render(&["check", "result", "summary"], [vec![name, verdict(false), &report.reason]].into_iter());
+        let result = if status == Status::TimedOut { verdict(false) } else { "-" };
+        t += &table::render(&["check", "result", "summary"], [vec![name, result, &report.reason]]);
         t += if status == Status::TimedOut { "FAILED\n" } else { "interrupted\n" };
         emit(&t)?;
     }
