@@ -332,38 +332,11 @@ fn parse_and_validate(what: &str, source: &str) -> Result<naga::Module, GpuError
     Ok(module)
 }
 
-/// The names a file declares at module scope (`fn`, `const`, `override`, `struct`, `alias`,
-/// `var`): the lines that start, after their attributes, with one of those keywords at column 0
-/// (as every file here writes its module-scope declarations).
-fn declared(source: &str) -> Vec<&str> {
-    fn ident(s: &str) -> Option<&str> {
-        let s = s.trim_start();
-        let end = s.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(s.len());
-        (end > 0).then(|| &s[..end])
-    }
-    fn skip_attributes(mut s: &str) -> &str {
-        while let Some(after) = s.strip_prefix('@') {
-            let end = after.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(after.len());
-            s = &after[end..];
-            if let Some(args) = s.strip_prefix('(') {
-                s = args.find(')').map_or("", |i| &args[i + 1..]);
-            }
-            s = s.trim_start();
-        }
-        s
-    }
-    let mut out = Vec::new();
-    for line in source.lines().filter(|l| !l.starts_with(char::is_whitespace)) {
-        let rest = skip_attributes(line);
-        for keyword in ["fn ", "const ", "override ", "struct ", "alias "] {
-            out.extend(rest.strip_prefix(keyword).and_then(ident));
-        }
-        if let Some(var) = rest.strip_prefix("var") {
-            out.extend(ident(var.find('>').map_or(var, |i| &var[i + 1..])));
-        }
-    }
-    out
-}
+// The text rules of lobes::embed and build.rs (`declared`): one file, compiled into each.
+#[path = "../../embed/text.rs"]
+#[allow(dead_code)]
+mod text;
+use text::declared;
 
 /// The `#import` lines a generated file needs: for each module in the import closure of `from`,
 /// the names it declares that `code` uses.
