@@ -329,36 +329,38 @@ mod tests {
         judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true)
     }
 
-    /// d = (u.x, 10⁻³ u.y) with f32-like rounding noise σ = 10⁻⁷ in d.y (+σ on the side of
-    /// larger u.y, −σ on the other, the worst case for a central difference): at step 2⁻¹² the
-    /// difference reads |J| 40 % high, the steps of 2⁻⁷ … 2⁻⁵ agree to 0.7 %, and the ratio
-    /// there is 1 within the allowance; a pdf of half the density is off.
+    /// The probe u of the two tests below.
+    const U: [f32; 4] = [0.3, 0.6, 0.0, 0.0];
+
+    /// d = (u.x, slope · u.y) on the plane with a rounding error σ in d.y: +σ on the side of
+    /// larger u.y than U's, −σ on the other (the worst case for a central difference); the
+    /// reported pdf is the exact density 1/slope.
+    fn noisy(slope: f64, sigma: f64) -> impl Fn([f32; 4]) -> [f32; 4] {
+        move |v: [f32; 4]| {
+            let noise = sigma * (v[1] as f64 - U[1] as f64).signum() * (v[1] != U[1]) as u8 as f64;
+            [v[0], (slope * v[1] as f64 + noise) as f32, 0.0, (1.0 / slope) as f32]
+        }
+    }
+
+    /// Slope 10⁻³ with σ = 10⁻⁷ (f32's rounding at a narrow lobe): at step 2⁻¹² the difference
+    /// reads |J| 40 % high, the steps of 2⁻⁷ … 2⁻⁵ agree to 0.7 %, and the ratio there is 1
+    /// within the allowance; a pdf of half the density is off.
     #[test]
     fn a_map_resolved_only_by_large_steps_is_judged_at_them() {
-        let u = [0.3, 0.6, 0.0, 0.0];
-        let map = |v: [f32; 4]| {
-            let noise = 1e-7 * (v[1] as f64 - u[1] as f64).signum() * (v[1] != u[1]) as u8 as f64;
-            [v[0], (1e-3 * v[1] as f64 + noise) as f32, 0.0, 1e3]
-        };
-        let (p, at) = probed(map, u, 1e3);
-        let c = judge_all(p, u, at);
+        let (p, at) = probed(noisy(1e-3, 1e-7), U, 1e3);
+        let c = judge_all(p, U, at);
         assert!(c.passed && c.compared == MIN_COMPARED && (c.median_ratio.unwrap() - 1.0).abs() < 2e-2 && c.largest_step >= 1.0 / 64.0, "{c:?}");
-        let (p, at) = probed(map, u, 500.0);
-        let c = judge_all(p, u, at);
+        let (p, at) = probed(noisy(1e-3, 1e-7), U, 500.0);
+        let c = judge_all(p, U, at);
         assert!(!c.passed && (c.worst_ratio - 0.5).abs() < 2e-2, "{c:?}");
     }
 
-    /// The same map with noise 10⁻⁵: no two steps agree to 1 %, and the probe is skipped as
+    /// Slope 10⁻² with σ = 10⁻⁵: no three steps agree to 1 %, and the probe is skipped as
     /// unresolved, not judged.
     #[test]
     fn an_unresolved_map_is_skipped_and_counted() {
-        let u = [0.3, 0.6, 0.0, 0.0];
-        let map = |v: [f32; 4]| {
-            let noise = 1e-5 * (v[1] as f64 - u[1] as f64).signum() * (v[1] != u[1]) as u8 as f64;
-            [v[0], (1e-2 * v[1] as f64 + noise) as f32, 0.0, 100.0]
-        };
-        let (p, at) = probed(map, u, 100.0);
-        let c = judge_all(p, u, at);
+        let (p, at) = probed(noisy(1e-2, 1e-5), U, 100.0);
+        let c = judge_all(p, U, at);
         assert!(c.compared == 0 && c.skipped_unresolved == MIN_COMPARED && !c.applicable && c.passed, "{c:?}");
     }
 
