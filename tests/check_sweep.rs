@@ -158,3 +158,39 @@ fn broken_samplers_still_fail_by_their_check() {
     eprintln!("broken samplers: {} runs, {caught} caught by their check", cases.len());
     assert!(missed.is_empty(), "{missed:#?}");
 }
+
+/// A GGX visible-normal sampler whose pdf takes D in the form α² / (π ((α² − 1) m.z² + 1)²),
+/// as many renderers write it (an ulp of m.z becomes ≈ 4/α² ulps of D), and reports that very
+/// pdf function at its d: at α 0.0079, θi 45° the two f32 evaluations differ by more than 10⁻³
+/// (measured 3.7·10⁻³ on lavapipe), within the pdf's f32 conditioning, and `pdf_consistency`
+/// passes; the same sampler reporting 1.02 × its pdf fails it.
+#[test]
+fn an_ill_conditioned_pdf_is_judged_against_its_f32_conditioning() {
+    let mz = |factor: &str| {
+        format!(
+            "fn mz_d(mz: f32, a: f32) -> f32 {{\n let t = (a * a - 1.0) * mz * mz + 1.0;\n return a * a / (GGX_PI * t * t);\n}}\n\
+             fn mz_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n let a = params[0].x;\n let m = wi + d;\n\
+             if (wi.z <= 0.0 || dot(m, m) == 0.0) {{ return 0.0; }}\n let h = normalize(m);\n\
+             if (dot(wi, h) <= 0.0 || h.z <= 0.0) {{ return 0.0; }}\n return ggx_g1(wi, vec2<f32>(a)) * mz_d(h.z, a) / (4.0 * wi.z);\n}}\n\
+             fn mz_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+             if (wi.z <= 0.0) {{ return vec4<f32>(0.0, 0.0, 1.0, 0.0); }}\n let a = params[0].x;\n\
+             let h = ggx_visible_normal(wi, vec2<f32>(a), u.xy);\n let d = 2.0 * dot(wi, h) * h - wi;\n\
+             return vec4<f32>(d, {factor} * mz_pdf(wi, d, params));\n}}\n"
+        )
+    };
+    let gpu = gpu();
+    let settings = Settings { params: vec![0.0079], incident_theta: 45.0, samples: 1 << 20, ..Settings::default() };
+    let judged = |factor: &str| {
+        let mut sources = vec![lobes::check::Source::read(&files(&["ggx_vndf.wgsl"])[0]).unwrap()];
+        sources.push(lobes::check::Source { name: "mz.wgsl".into(), text: mz(factor) });
+        let s = UserSampler { sources, sample: "mz_sample".into(), pdf: "mz_pdf".into(), eval: None, domain: Domain::Sphere };
+        s.validate().unwrap_or_else(|e| panic!("{e}"));
+        run(&gpu, format!("m.z-form GGX × {factor}"), &s, settings.clone()).report
+    };
+    let r = judged("1.0");
+    let c = r.figures::<lobes::check::report::ConsistencyFigures>().unwrap();
+    assert!(r.get("pdf_consistency").unwrap().passed && c.max_relative_difference > 1e-3 && c.widened > 0, "{c:?}");
+    assert!(r.passed, "{:?}", r.failed());
+    let r = judged("1.02");
+    assert!(!r.get("pdf_consistency").unwrap().passed, "{}", r.get("pdf_consistency").unwrap().summary);
+}
