@@ -237,10 +237,38 @@ fn lobes_pdf_at(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     lobes_out[i] = vec4<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d), 0.0, 0.0);
 }
 
-// Estimator weights of samples base + (gid · samples_per_thread + k): per invocation
-// (Σ w, Σ w², the largest |w − w_pdf| / w_pdf, number of samples with eval > 0), where
-// w = eval(d) / (the reported pdf) is the weight a renderer computes from the sampler alone and
-// w_pdf = eval(d) / pdf(d) the one from the pdf function. Invalid samples weigh 0.
+// Limits of the weights pass, the host's constants: LOBES_WEIGHT_LIMIT is
+// crate::stats::weighted::WEIGHT_ERROR_LIMIT and LOBES_CONDITIONING_ULPS is
+// check::CONDITIONING_ULPS (src/check/gpu.rs holds them equal in a test).
+const LOBES_WEIGHT_LIMIT: f32 = 1e-3;
+const LOBES_CONDITIONING_ULPS: f32 = 4.0;
+
+// The f32 conditioning of the pdf at d: the largest relative change of pdf(d) when one
+// component of d moves by 2⁻²³ |d|∞ (about an ulp of a unit vector's largest component), with
+// pdf = pdf(d) > 0. A narrow lobe amplifies it: GGX's D(m) at α turns an ulp of m.z into ≈ 4/α²
+// ulps of D, so a correct sampler and its pdf, the same f32 formula evaluated twice, may differ
+// by that much (docs/testing-your-own-sampler.md, "f32 conditioning").
+fn lobes_conditioning_at(wi: vec3<f32>, d: vec3<f32>, pdf: f32) -> f32 {
+    let delta = 1.1920929e-7 * max(max(abs(d.x), abs(d.y)), abs(d.z));
+    var k = 0.0;
+    for (var c = 0u; c < 6u; c++) {
+        var e = vec3<f32>(0.0);
+        e[c / 2u] = select(-delta, delta, (c & 1u) == 0u);
+        let q = lobes_user_pdf(wi, d + e);
+        // a pdf that is NaN or ∞ next to d: d is not resolved (the pdf_values check judges it)
+        k = max(k, select(1e30, abs(q - pdf) / pdf, lobes_positive(q) || q == 0.0));
+    }
+    return k;
+}
+
+// Estimator weights of samples base + (gid · samples_per_thread + k): per invocation two vec4s,
+//   (Σ w, Σ w², the largest |w − w_pdf| / w_pdf, number of samples with eval > 0)
+//   (Σ |w − w_pdf| over the samples within their allowance, the largest |w − w_pdf| / w_pdf
+//    over its allowance, 0, 0)
+// where w = eval(d) / (the reported pdf) is the weight a renderer computes from the sampler alone
+// and w_pdf = eval(d) / pdf(d) the one from the pdf function. The allowance is LOBES_WEIGHT_LIMIT
+// plus LOBES_CONDITIONING_ULPS times the pdf's f32 conditioning at d (computed only where the
+// error exceeds the limit). Invalid samples weigh 0.
 @compute @workgroup_size(64)
 fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let t = gid.x + gid.y * nwg.x * 64u;
@@ -250,6 +278,7 @@ fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
     }
     let wi = lobes_check.wi.xyz;
     var acc = vec4<f32>(0.0);
+    var err = vec4<f32>(0.0);
     for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
         let local = first + k;
         if (local < lobes_check.count) {
@@ -259,12 +288,51 @@ fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
             if (e > 0.0 && lobes_positive(s.w) && lobes_positive(pdf)) {
                 let w = e / s.w;
                 let w_pdf = e / pdf;
+                let rel = abs(w - w_pdf) / w_pdf;
                 acc += vec4<f32>(w, w * w, 0.0, 1.0);
-                acc.z = max(acc.z, abs(w - w_pdf) / w_pdf);
+                acc.z = max(acc.z, rel);
+                var judged = rel / LOBES_WEIGHT_LIMIT;
+                if (judged > 1.0) {
+                    judged = rel / (LOBES_WEIGHT_LIMIT + LOBES_CONDITIONING_ULPS * lobes_conditioning_at(wi, s.xyz, pdf));
+                }
+                // only an error within its allowance is f32's; a larger one is the sampler's
+                err.x += select(0.0, abs(w - w_pdf), judged <= 1.0);
+                err.y = max(err.y, judged);
             }
         }
     }
-    lobes_out[t] = acc;
+    lobes_out[2u * t] = acc;
+    lobes_out[2u * t + 1u] = err;
+}
+
+// The sample map at the host's own uniforms (the Jacobian's steps, src/check/jacobian.rs):
+// item i of lobes_in is u, and lobes_out[i] = sample(wi, u) at the incident lobes_check.wi.
+@compute @workgroup_size(64)
+fn lobes_map(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    lobes_out[i] = lobes_user_sample(lobes_check.wi.xyz, lobes_in[i]);
+}
+
+// The pdf's f32 conditioning at the host's points: item i of lobes_in is d, and lobes_out[i] =
+// (pdf(d), its conditioning lobes_conditioning_at, 0, 0) at the incident lobes_check.wi; the
+// conditioning is 0 where pdf(d) is not finite and > 0.
+@compute @workgroup_size(64)
+fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let wi = lobes_check.wi.xyz;
+    let d = lobes_in[i].xyz;
+    let pdf = lobes_user_pdf(wi, d);
+    var k = 0.0;
+    if (lobes_positive(pdf)) {
+        k = lobes_conditioning_at(wi, d, pdf);
+    }
+    lobes_out[i] = vec4<f32>(pdf, k, 0.0, 0.0);
 }
 
 // Reason codes of invalid samples (src/check/mod.rs: REASONS), counted after the bins.

@@ -192,14 +192,39 @@ impl<'g> Passes<'g> {
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
-    /// Per-invocation weight sums of samples `first .. first + count`: (Σw, Σw², max weight
-    /// error, samples with eval > 0).
-    pub fn weights(&self, params: &Params, first: u64, count: u32) -> Result<Vec<[f32; 4]>, CheckError> {
+    /// Per-invocation weight sums of samples `first .. first + count` (user_passes.wgsl,
+    /// `lobes_weights`): (Σw, Σw², max weight error, samples with eval > 0) and (Σ|w − w_pdf|,
+    /// max weight error over its allowance, 0, 0).
+    pub fn weights(&self, params: &Params, first: u64, count: u32) -> Result<Vec<[[f32; 4]; 2]>, CheckError> {
         let spt = 64u32;
         let p = Params { base: split(first), count, samples_per_thread: spt, ..*params };
         let n = count.div_ceil(spt);
-        let bytes = self.run("lobes_weights", &p, &[], n, n as u64 * 16, false)?;
-        Ok(bytemuck::cast_slice(&bytes).to_vec())
+        let bytes = self.run("lobes_weights", &p, &[], n, n as u64 * 32, false)?;
+        let flat: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
+    }
+
+    /// `entry` over `items` in calls of at most 2^20, one vec4 out per item.
+    fn per_item(&self, entry: &str, params: &Params, items: &[[f32; 4]]) -> Result<Vec<[f32; 4]>, CheckError> {
+        let mut out = Vec::with_capacity(items.len());
+        for chunk in items.chunks(1 << 20) {
+            let p = Params { count: chunk.len() as u32, ..*params };
+            let bytes = self.run(entry, &p, chunk, chunk.len() as u32, chunk.len() as u64 * 16, false)?;
+            out.extend_from_slice(bytemuck::cast_slice(&bytes));
+        }
+        Ok(out)
+    }
+
+    /// sample(wi, u) at each u, at the incident direction of `params` (the Jacobian's steps).
+    pub fn map(&self, params: &Params, us: &[[f32; 4]]) -> Result<Vec<[f32; 4]>, CheckError> {
+        self.per_item("lobes_map", params, us)
+    }
+
+    /// (pdf(d), the pdf's f32 conditioning at d) at each point d, at the incident direction of
+    /// `params` (user_passes.wgsl, `lobes_conditioning_at`).
+    pub fn conditioning(&self, params: &Params, points: &[[f32; 3]]) -> Result<Vec<[f32; 2]>, CheckError> {
+        let items: Vec<[f32; 4]> = points.iter().map(|d| [d[0], d[1], d[2], 0.0]).collect();
+        Ok(self.per_item("lobes_conditioning", params, &items)?.into_iter().map(|v| [v[0], v[1]]).collect())
     }
 }
 
@@ -246,6 +271,18 @@ mod tests {
         };
         let source = compose(&s).unwrap().text;
         crate::engine::gpu::layout::check_struct(&source, "LobesCheckParams", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
+    }
+
+    /// The weights pass's limits are the host's constants.
+    #[test]
+    fn weights_pass_constants_are_the_hosts() {
+        let source = include_str!("../../shaders/check/user_passes.wgsl");
+        let value = |name: &str| -> f64 {
+            let line = source.lines().find(|l| l.starts_with(&format!("const {name}: f32 = "))).unwrap_or_else(|| panic!("{name}"));
+            line.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap()
+        };
+        assert_eq!(value("LOBES_WEIGHT_LIMIT") as f32, crate::stats::weighted::WEIGHT_ERROR_LIMIT);
+        assert_eq!(value("LOBES_CONDITIONING_ULPS"), super::super::CONDITIONING_ULPS);
     }
 
     fn sampler(text: &str) -> UserSampler {

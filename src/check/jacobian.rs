@@ -4,8 +4,15 @@
 //! p(d) = 1 / |J(u)|, with |J| = |∂d/∂u₁ × ∂d/∂u₂| on the sphere (the area of the image of a unit
 //! square of u, per unit solid angle) and |det ∂(x, y)/∂(u₁, u₂)| on the plane (pbrt-v4 §2.4.1,
 //! "transforming between distributions"). The derivatives are central differences of the GPU's
-//! map with step ε; a sample is skipped where the map is not smooth at that scale (the second
-//! difference exceeds a tenth of the first: a fold, a seam or a branch between lobes).
+//! map, in f64 on the host, at steps ε · 2ᵏ ([`STEPS`]): at each step where the map is smooth
+//! (the second difference under a tenth of the first: no fold, seam or branch between lobes
+//! within it), and at the three consecutive steps that agree best, the first two extrapolated
+//! (Richardson) with the larger of their differences as the error. A narrow lobe needs the large steps (over 2ε its d moves
+//! by little more than f32 rounding), a curved map the small ones. A sample is skipped where no
+//! step is smooth (`skipped_not_smooth`) or where no two steps agree on |J| to [`UNRESOLVED`]
+//! (`skipped_unresolved`: d resolved to a few ulps, an f32 staircase), and judged against
+//! [`TOLERANCE`] plus what f32 leaves unknown there: twice the error of |J|, and a multiple of
+//! the pdf's f32 conditioning at d (`super::CONDITIONING_ULPS`).
 //! This catches a missing Jacobian factor (the reflection's 1/(4|ωr·h|), a cos θ) even where a
 //! coarse histogram cannot.
 //!
@@ -29,12 +36,27 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Finite-difference step in u (2⁻¹²: its central-difference truncation error, ε²/6 of the
-/// third derivative, and the f32 rounding of d over 2ε, about 10⁻⁴, both stay well under the
-/// tolerance for maps of moderate curvature).
+/// The smallest finite-difference step in u (2⁻¹²), and the probe's margin from the edges of
+/// [0, 1] is 2ε.
 pub const EPS: f32 = 1.0 / 4096.0;
-/// A sample is off when |p · |J| / share − 1| exceeds this (for an event: 1 − p · |J| / share).
+/// Steps of the central differences: ε · 2ᵏ for k < STEPS (2⁻¹² … 2⁻⁵). A small step is exact
+/// for a curved map but reads the f32 rounding of d (≈ 6·10⁻⁸) over a change of d that a narrow
+/// lobe makes tiny: GGX at α = 0.0064 moves d by ≈ 6·10⁻⁶ over 2ε, so central differences at
+/// 2⁻¹² alone are off by percents. A large step averages the rounding out but meets the map's
+/// curvature. Each derivative is taken at the three consecutive steps that agree best,
+/// combined by Richardson extrapolation (4 D(h) − D(2h)) / 3, with the larger of |D(h) − D(2h)|
+/// and |D(2h) − D(4h)| as its error (three steps: two may agree by chance on a staircase).
+pub const STEPS: usize = 8;
+/// Uniforms probed around each probe sample: for u.x then u.y, for each step, u + h and u − h.
+pub const AROUND: usize = 4 * STEPS;
+/// A sample is off when |p · |J| / share − 1| exceeds this plus its allowance (for an event:
+/// 1 − p · |J| / share): twice the relative error of |J| that the steps leave (Richardson's
+/// value amplifies rounding noise up to 2.3 times the steps' difference), and `ulps` (the
+/// check's [`super::CONDITIONING_ULPS`]) times the pdf's f32 conditioning at d.
 pub const TOLERANCE: f64 = 1e-2;
+/// A probe whose steps leave |J| uncertain by more than this is skipped (`skipped_unresolved`):
+/// no three steps agree, d moves by only a few f32 ulps over them (an f32 staircase).
+pub const UNRESOLVED: f64 = 1e-2;
 /// The check fails when more than this share of the compared samples is off.
 pub const MAX_SHARE_OFF: f64 = 1e-2;
 /// Fewer compared samples than this and the check does not apply.
@@ -47,8 +69,12 @@ pub struct JacobianCheck {
     pub compared: u64,
     /// Samples where d moves continuously with u.z or u.w, or where both choose an event.
     pub skipped_selection: u64,
-    /// Samples where the map is not smooth at the step's scale.
+    /// Samples where the map is not smooth at any step's scale.
     pub skipped_not_smooth: u64,
+    /// Samples where no two steps agree on |J| to [`UNRESOLVED`]: the map is resolved only to a
+    /// few f32 ulps of d there (a staircase, such as sin θ = √(1 − cos²θ) near a pole).
+    #[serde(default)]
+    pub skipped_unresolved: u64,
     /// Samples with an invalid point or pdf at or around them.
     pub skipped_invalid: u64,
     /// Compared samples where the sampler chose an event with u.z or u.w (share < 1), judged by
@@ -56,15 +82,23 @@ pub struct JacobianCheck {
     pub compared_events: u64,
     /// Those of them above 1 + TOLERANCE: not off (another event may land on the same d).
     pub above_events: u64,
-    /// Compared samples with |p · |J| / share − 1| > TOLERANCE (for an event: below 1 − TOLERANCE).
+    /// Compared samples with |p · |J| / share − 1| over TOLERANCE plus their allowance (for an
+    /// event: below 1 − TOLERANCE − allowance).
     pub off: u64,
     pub share_off: f64,
     /// Median and worst p · |J| / share over the compared samples (1 for a correct pdf; no median
-    /// without compared samples; an event's ratio above 1 is not the worst).
+    /// without compared samples; an event's ratio above 1 is not the worst). The worst is the
+    /// sample whose deviation is largest against its TOLERANCE + allowance.
     pub median_ratio: Option<f64>,
     pub worst_ratio: f64,
     /// The u of the worst sample.
     pub worst_u: [f32; 4],
+    /// TOLERANCE + the allowance at the worst sample.
+    #[serde(default)]
+    pub worst_limit: f64,
+    /// The largest step any compared sample's derivatives were taken at.
+    #[serde(default)]
+    pub largest_step: f64,
     pub tolerance: f64,
     /// Whether enough samples could be compared for a verdict.
     pub applicable: bool,
@@ -77,6 +111,9 @@ fn v3(v: [f32; 4]) -> [f64; 3] {
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
 fn norm(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
@@ -84,48 +121,124 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-/// |J| of the map at a probed sample with the share of its event, or why it cannot be compared.
+/// Step k: ε · 2ᵏ.
+fn step(k: usize) -> f32 {
+    EPS * (1u32 << k) as f32
+}
+
+/// The uniforms around `u` that the Jacobian needs (`AROUND` of them, in the order the module
+/// doc says): a step that would leave [0, 1] gives u itself, which [`judge`] knows not to use.
+pub fn around(u: [f32; 4]) -> [[f32; 4]; AROUND] {
+    let mut out = [u; AROUND];
+    for axis in 0..2 {
+        for k in 0..STEPS {
+            let (plus, minus) = (u[axis] + step(k), u[axis] - step(k));
+            if plus <= 1.0 && minus >= 0.0 {
+                out[(axis * STEPS + k) * 2][axis] = plus;
+                out[(axis * STEPS + k) * 2 + 1][axis] = minus;
+            }
+        }
+    }
+    out
+}
+
+/// ∂d/∂u along one axis: Richardson's value and its error estimate (absolute), at step `h`.
+struct Derivative {
+    value: [f64; 3],
+    error: f64,
+    h: f64,
+}
+
+/// The derivative of the map along `axis` at `u` from the samples `at` of [`around`]`(u)`
+/// (this axis's 2 · STEPS), or `None` where no two consecutive steps are smooth.
+fn derivative(u: [f32; 4], axis: usize, d0: [f64; 3], at: &[[f32; 4]], plane: bool) -> Option<Derivative> {
+    let point = |v: [f32; 4]| {
+        let mut p = v3(v);
+        if plane {
+            p[2] = 0.0;
+        }
+        p
+    };
+    let d0 = if plane { [d0[0], d0[1], 0.0] } else { d0 };
+    // the central difference at each usable step: both points valid, and smooth there (the second
+    // difference under a tenth of the first: no fold, seam or branch between lobes within it)
+    let steps = around(u);
+    let steps = &steps[axis * 2 * STEPS..(axis + 1) * 2 * STEPS];
+    let diffs: Vec<Option<[f64; 3]>> = (0..STEPS)
+        .map(|k| {
+            let (p, m) = (at[2 * k], at[2 * k + 1]);
+            let span = steps[2 * k][axis] as f64 - steps[2 * k + 1][axis] as f64;
+            let valid = |v: [f32; 4]| v.iter().all(|x| x.is_finite()) && v[3] > 0.0;
+            if span <= 0.0 || !valid(p) || !valid(m) {
+                return None;
+            }
+            let (p, m) = (point(p), point(m));
+            let first = sub(p, m);
+            let second = norm([p[0] - 2.0 * d0[0] + m[0], p[1] - 2.0 * d0[1] + m[1], p[2] - 2.0 * d0[2] + m[2]]);
+            (norm(first) > 0.0 && second <= 0.1 * norm(first)).then(|| scale(first, 1.0 / span))
+        })
+        .collect();
+    // three consecutive steps must agree: two alone may agree by chance on a staircase whose
+    // treads are as long as the steps
+    (0..STEPS - 2)
+        .filter_map(|k| {
+            let (a, b, c) = (diffs[k]?, diffs[k + 1]?, diffs[k + 2]?);
+            let value = scale(sub(scale(a, 4.0), b), 1.0 / 3.0);
+            Some(Derivative { value, error: norm(sub(a, b)).max(norm(sub(b, c))), h: step(k + 1) as f64 })
+        })
+        .min_by(|x, y| (x.error / norm(x.value)).total_cmp(&(y.error / norm(y.value))))
+}
+
+/// |J| of the map at a probed sample with the share of its event and its relative error, or why
+/// it cannot be compared.
 enum Local {
-    Jacobian { j: f64, share: f64 },
+    Jacobian { j: f64, share: f64, error: f64, h: f64 },
     Selection,
     NotSmooth,
+    Unresolved,
     Invalid,
 }
 
-fn local(probe: &[[f32; 4]; 7], plane: bool) -> Local {
+fn local(probe: &[[f32; 4]; 7], u: [f32; 4], at: &[[f32; 4]; AROUND], plane: bool) -> Local {
     let finite = probe[..6].iter().all(|v| v.iter().all(|x| x.is_finite()));
     if !finite || probe[0][3] <= 0.0 || !(probe[6][0] > 0.0 && probe[6][0].is_finite()) {
         return Local::Invalid;
     }
-    let d0 = v3(probe[0]);
-    let mut d = [v3(probe[1]), v3(probe[2]), v3(probe[3]), v3(probe[4])];
-    if plane {
-        for p in &mut d {
-            p[2] = 0.0;
-        }
+    // the neighbours at the smallest step, as the probe pass drew them
+    if probe[1..5].iter().any(|v| v[3] <= 0.0) {
+        return Local::Invalid;
     }
     // shares of u.z and u.w: 1 unused, < 0 d moves with it (user_passes.wgsl: lobes_share)
     let (sz, sw) = (probe[5][0] as f64, probe[5][1] as f64);
     if sz < 0.0 || sw < 0.0 || (sz < 1.0 && sw < 1.0) {
         return Local::Selection;
     }
-    let h = 2.0 * EPS as f64;
-    let (dx, dy) = (sub(d[0], d[1]), sub(d[2], d[3]));
-    let second = |p: [f64; 3], m: [f64; 3]| norm([p[0] - 2.0 * d0[0] + m[0], p[1] - 2.0 * d0[1] + m[1], p[2] - 2.0 * d0[2] + m[2]]);
-    if second(d[0], d[1]) > 0.1 * norm(dx) || second(d[2], d[3]) > 0.1 * norm(dy) || norm(dx) == 0.0 || norm(dy) == 0.0 {
+    let d0 = v3(probe[0]);
+    let (Some(a), Some(b)) = (derivative(u, 0, d0, &at[..2 * STEPS], plane), derivative(u, 1, d0, &at[2 * STEPS..], plane)) else {
+        return Local::NotSmooth;
+    };
+    let area = if plane { (a.value[0] * b.value[1] - a.value[1] * b.value[0]).abs() } else { norm(cross(a.value, b.value)) };
+    if area == 0.0 {
         return Local::NotSmooth;
     }
-    let area = if plane { (dx[0] * dy[1] - dx[1] * dy[0]).abs() } else { norm(cross(dx, dy)) };
-    Local::Jacobian { j: area / (h * h), share: sz.min(sw) }
+    // |δ(a × b)| ≤ |δa| |b| + |a| |δb|
+    let error = (a.error * norm(b.value) + norm(a.value) * b.error) / area;
+    if error > UNRESOLVED {
+        return Local::Unresolved;
+    }
+    Local::Jacobian { j: area, share: sz.min(sw), error, h: a.h.max(b.h) }
 }
 
-/// Compares the pdf function at each probed sample with 1 / |J|; `u` are the probed uniforms.
-pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], plane: bool) -> JacobianCheck {
+/// Compares the pdf function at each probed sample with share / |J|: `u` are the probed
+/// uniforms, `at` the map at [`around`] each of them, `conditioning` the pdf's f32 conditioning
+/// at each probe's d (0 where unknown) and `ulps` its multiple allowed.
+pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]], conditioning: &[f64], ulps: f64, plane: bool) -> JacobianCheck {
     let mut c = JacobianCheck {
         probed: probes.len() as u64,
         compared: 0,
         skipped_selection: 0,
         skipped_not_smooth: 0,
+        skipped_unresolved: 0,
         skipped_invalid: 0,
         compared_events: 0,
         above_events: 0,
@@ -134,29 +247,37 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], plane: bool) -> JacobianC
         median_ratio: None,
         worst_ratio: 1.0,
         worst_u: [0.0; 4],
+        worst_limit: TOLERANCE,
+        largest_step: 0.0,
         tolerance: TOLERANCE,
         applicable: false,
         passed: true,
     };
     let mut ratios = Vec::new();
-    for (p, u) in probes.iter().zip(u) {
-        match local(p, plane) {
+    let mut worst = 0.0;
+    for (((p, u), at), kappa) in probes.iter().zip(u).zip(at).zip(conditioning) {
+        match local(p, *u, at, plane) {
             Local::Invalid => c.skipped_invalid += 1,
             Local::Selection => c.skipped_selection += 1,
             Local::NotSmooth => c.skipped_not_smooth += 1,
-            Local::Jacobian { j, share } => {
+            Local::Unresolved => c.skipped_unresolved += 1,
+            Local::Jacobian { j, share, error, h } => {
                 let ratio = p[6][0] as f64 * j / share;
                 ratios.push(ratio);
+                c.largest_step = c.largest_step.max(h);
+                let limit = TOLERANCE + 2.0 * error + ulps * kappa;
                 let event = share < 1.0;
                 let deviation = if event { (1.0 - ratio).max(0.0) } else { (ratio - 1.0).abs() };
                 c.compared_events += event as u64;
-                c.above_events += (event && ratio > 1.0 + TOLERANCE) as u64;
-                if deviation > TOLERANCE {
+                c.above_events += (event && ratio > 1.0 + limit) as u64;
+                if deviation > limit {
                     c.off += 1;
                 }
-                if deviation > (c.worst_ratio - 1.0).abs() {
+                if deviation / limit > worst {
+                    worst = deviation / limit;
                     c.worst_ratio = ratio;
                     c.worst_u = *u;
+                    c.worst_limit = limit;
                 }
             }
         }
@@ -185,7 +306,62 @@ mod tests {
 
     fn judged(pdf: f32, shares: [f32; 2]) -> JacobianCheck {
         let n = MIN_COMPARED as usize;
-        judge(&vec![probe(pdf, shares); n], &vec![[0.3, 0.6, 0.0, 0.0]; n], true)
+        let u = [0.3, 0.6, 0.0, 0.0];
+        let at = around(u).map(|v| [v[0], v[1], 0.0, pdf]);
+        judge(&vec![probe(pdf, shares); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true)
+    }
+
+    /// The probe of `map` at `u` with pdf `pdf` (shares 1), and the map around it.
+    fn probed(map: impl Fn([f32; 4]) -> [f32; 4], u: [f32; 4], pdf: f32) -> ([[f32; 4]; 7], [[f32; 4]; AROUND]) {
+        let mut p = [map(u); 7];
+        for (i, (axis, s)) in [(0, EPS), (0, -EPS), (1, EPS), (1, -EPS)].into_iter().enumerate() {
+            let mut v = u;
+            v[axis] += s;
+            p[i + 1] = map(v);
+        }
+        p[5] = [1.0, 1.0, 0.0, 0.0];
+        p[6] = [pdf, 0.0, 0.0, 0.0];
+        (p, around(u).map(map))
+    }
+
+    fn judge_all(p: [[f32; 4]; 7], u: [f32; 4], at: [[f32; 4]; AROUND]) -> JacobianCheck {
+        let n = MIN_COMPARED as usize;
+        judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true)
+    }
+
+    /// The probe u of the two tests below.
+    const U: [f32; 4] = [0.3, 0.6, 0.0, 0.0];
+
+    /// d = (u.x, slope · u.y) on the plane with a rounding error σ in d.y: +σ on the side of
+    /// larger u.y than U's, −σ on the other (the worst case for a central difference); the
+    /// reported pdf is the exact density 1/slope.
+    fn noisy(slope: f64, sigma: f64) -> impl Fn([f32; 4]) -> [f32; 4] {
+        move |v: [f32; 4]| {
+            let noise = sigma * (v[1] as f64 - U[1] as f64).signum() * (v[1] != U[1]) as u8 as f64;
+            [v[0], (slope * v[1] as f64 + noise) as f32, 0.0, (1.0 / slope) as f32]
+        }
+    }
+
+    /// Slope 10⁻³ with σ = 10⁻⁷ (f32's rounding at a narrow lobe): at step 2⁻¹² the difference
+    /// reads |J| 40 % high, the steps of 2⁻⁷ … 2⁻⁵ agree to 0.7 %, and the ratio there is 1
+    /// within the allowance; a pdf of half the density is off.
+    #[test]
+    fn a_map_resolved_only_by_large_steps_is_judged_at_them() {
+        let (p, at) = probed(noisy(1e-3, 1e-7), U, 1e3);
+        let c = judge_all(p, U, at);
+        assert!(c.passed && c.compared == MIN_COMPARED && (c.median_ratio.unwrap() - 1.0).abs() < 2e-2 && c.largest_step >= 1.0 / 64.0, "{c:?}");
+        let (p, at) = probed(noisy(1e-3, 1e-7), U, 500.0);
+        let c = judge_all(p, U, at);
+        assert!(!c.passed && (c.worst_ratio - 0.5).abs() < 2e-2, "{c:?}");
+    }
+
+    /// Slope 10⁻² with σ = 10⁻⁵: no three steps agree to 1 %, and the probe is skipped as
+    /// unresolved, not judged.
+    #[test]
+    fn an_unresolved_map_is_skipped_and_counted() {
+        let (p, at) = probed(noisy(1e-2, 1e-5), U, 100.0);
+        let c = judge_all(p, U, at);
+        assert!(c.compared == 0 && c.skipped_unresolved == MIN_COMPARED && !c.applicable && c.passed, "{c:?}");
     }
 
     /// |J| = 1: a pdf of 1 matches, 2 does not.

@@ -64,8 +64,20 @@ pub struct ConsistencyFigures {
     pub max_relative_difference: f64,
     /// Samples where pdf(d) is NaN or ∞ while the sampler reports a valid pdf (each fails).
     pub pdf_function_not_finite: u64,
+    /// The u of the worst sample: the first whose pdf(d) is not finite, else the one whose
+    /// difference is largest against its limit.
     pub worst_u: [f32; 4],
+    /// The limit where the pdf is well conditioned ([`super::PDF_CONSISTENCY_LIMIT`]).
     pub limit: f64,
+    /// The worst sample's limit: `limit` + [`super::CONDITIONING_ULPS`] × the pdf's f32
+    /// conditioning at its d.
+    #[serde(default)]
+    pub worst_limit: f64,
+    /// Samples beyond `limit` but within their widened limit, and beyond it (each fails).
+    #[serde(default)]
+    pub widened: u64,
+    #[serde(default)]
+    pub over_limit: u64,
 }
 
 /// The pdf function's values at the quadrature's nodes.
@@ -145,6 +157,10 @@ pub fn borderline(p: f64, significance: f64, seed: u64) -> Option<String> {
 pub struct WeightFigures {
     pub max_weight_error: f64,
     pub limit: f64,
+    /// The largest weight error over its allowance: `limit` + [`super::CONDITIONING_ULPS`] ×
+    /// the pdf's f32 conditioning at the sample's d (the check passes at ≤ 1).
+    #[serde(default)]
+    pub max_over_allowance: f64,
 }
 
 /// The mean weight against the quadrature of eval.
@@ -153,7 +169,16 @@ pub struct AlbedoFigures {
     pub mean_weight: f64,
     pub std_error: f64,
     pub quadrature: f64,
+    /// The resolution of the quadrature of eval (relative as that of ∫pdf).
     pub quadrature_error: f64,
+    /// The mean of |w − eval/pdf(d)| (0 for a sample beyond the weights' allowance: that error
+    /// is the sampler's) plus the f32 rounding of the mean: the f32 error of the weights.
+    #[serde(default)]
+    pub weight_error: f64,
+    /// |mean − ∫eval| not counted against the sampler: 2 × quadrature_error + weight_error; z
+    /// is the rest over the standard error (0 within the allowance).
+    #[serde(default)]
+    pub allowance: f64,
     pub z: f64,
     pub p_value: f64,
     pub significance: f64,
