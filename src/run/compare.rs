@@ -59,12 +59,14 @@ pub const MAX_QUADRATURE_SIGMA: f64 = 0.1;
 /// ```
 /// use lobes::{engine::job::{Job, Scatter}, reference::{Lobe, LobeKind, Method, reflect::spherical}};
 /// use lobes::{run::compare::{expected_counts, converged}, stats::{expected::Quadrature, histogram::SphereGrid}};
-/// let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 0.02, alpha_y: 0.02, alpha_angle: 0.0 };
+/// let lobe = Lobe { kind: LobeKind::Ward, method: Method::Ndf, alpha_x: 0.05, alpha_y: 0.05, alpha_angle: 0.0 };
 /// let job = Job::Lobe { lobe, incident: spherical(0.5, 0.0), grid: SphereGrid { rows: 16, cols: 32 }, scatter: Scatter::Reflect };
 /// assert!(converged(&expected_counts(&job, 1_000_000, &Quadrature::default()), 1_000_000).is_ok());
-/// // a single 5 × 5 rule per bin cannot resolve a lobe of α 0.02
+/// // one 5 × 5 rule and its quarters per bin cannot resolve a lobe of α 0.05 in bins of 0.2 rad
 /// let coarse = Quadrature { max_depth: 0, max_initial_split: 1, ..Quadrature::default() };
-/// assert!(converged(&expected_counts(&job, 1_000_000, &coarse), 1_000_000).is_err());
+/// // at 10¹² samples, where a count's σ is 10⁻⁶ of it
+/// let n = 1_000_000_000_000;
+/// assert!(converged(&expected_counts(&job, n, &coarse), n).is_err());
 /// ```
 pub fn converged(expected: &ExpectedCounts, samples: u64) -> Result<(), String> {
     let Some(q) = &expected.quadrature else { return Ok(()) };
