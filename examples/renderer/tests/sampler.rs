@@ -13,7 +13,7 @@ fn gpu() -> Gpu {
 fn sampler(extra: &[(&str, &str)], sample: &str, pdf: &str, eval: Option<&str>) -> UserSampler {
     let mut sources = vec![Source { name: "shaders/diffuse.wgsl".into(), text: renderer_example::diffuse_wgsl().into() }];
     sources.extend(extra.iter().map(|(name, text)| Source { name: (*name).into(), text: (*text).into() }));
-    let s = UserSampler { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain: Domain::Sphere };
+    let s = UserSampler { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain: Domain::Sphere, composition: Default::default() };
     s.validate().unwrap_or_else(|e| panic!("{e}"));
     s
 }
