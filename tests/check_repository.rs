@@ -122,6 +122,8 @@ fn oil_args(extra: &[&str]) -> Vec<String> {
         "rand",
         "--samples",
         "1048576",
+        "--seed",
+        "2",
         "--json",
     ]
     .iter()

@@ -459,6 +459,11 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
         let text = e.emit_to_string(composer);
         // codespan's "┌─ file:line:col" first, as compilers write it
         let at = text.lines().find_map(|l| l.trim_start().strip_prefix("┌─ ")).map(str::trim).unwrap_or("");
+        // naga_oil parses a module when a root needs it: the file says which module erred
+        let module = modules
+            .iter()
+            .find(|m| at.rsplitn(3, ':').nth(2) == Some(m.source.name.as_str()))
+            .map_or(module.to_string(), |m| m.path.clone());
         CheckError::Wgsl(format!("{at}: error in module {module}: {}\n{text}", e.inner))
     };
     for &i in &order {
@@ -477,7 +482,7 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
     }
     let module = composer
         .make_naga_module(NagaModuleDescriptor { source: &sources[0].text, file_path: &sources[0].name, shader_type: ShaderType::Wgsl, shader_defs: defs, additional_imports: &[] })
-        .map_err(|e| oil_error(e, &composer, "(the sampler's file)"))?;
+        .map_err(|e| oil_error(e, &composer, &format!("{} (the sampler's file)", root_name(&sources[0]))))?;
     let suffixes: Vec<(String, String)> = order.iter().map(|&i| (modules[i].path.clone(), Composer::decorated_name(Some(&modules[i].path), ""))).collect();
     let mut origins = Vec::new();
     for name in super::compose::global_names(&module) {
@@ -486,6 +491,11 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
         }
     }
     Ok((write_wgsl(&module, naga::valid::Capabilities::all())?, origins))
+}
+
+/// The sampler file's own import path, or its file name.
+fn root_name(s: &Source) -> String {
+    naga_oil::compose::get_preprocessor_data(&s.text).0.unwrap_or_else(|| s.name.clone())
 }
 
 /// A validated module written back as WGSL, with the names as the module holds them: naga's
