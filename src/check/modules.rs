@@ -432,12 +432,10 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
                 let close = crate::scene::suggest::closest(import, names.iter().copied())
                     .or_else(|| parent.and_then(|p| crate::scene::suggest::closest(p, names.iter().copied())));
                 return Err(CheckError::Input(format!(
-                    "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {}`{}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {}=FILE",
+                    "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
                     show_roots(roots),
-                    parent.unwrap_or(import),
                     close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
                     if names.is_empty() { "none".to_string() } else { names.join(", ") },
-                    parent.unwrap_or(import),
                 )));
             };
             if order.contains(&i) {
@@ -491,6 +489,24 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
         }
     }
     Ok((write_wgsl(&module, naga::valid::Capabilities::all())?, origins))
+}
+
+/// `text` without terminal colour codes (`ESC [ … m`), which wesl's diagnostics hold.
+fn strip_ansi(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c == '\u{1b}' {
+            for c in chars.by_ref() {
+                if c.is_ascii_alphabetic() {
+                    break;
+                }
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// The sampler file's own import path, or its file name.
@@ -657,7 +673,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(String
     };
     let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
     compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
-    let result = compiler.compile(&root_path).map_err(|e| CheckError::Wgsl(format!("{}: {e}", sources[0].name)))?;
+    let result = compiler.compile(&root_path).map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
     let mut origins = Vec::new();
     use wesl::syntax::GlobalDeclaration as G;
     for decl in &result.syntax.global_declarations {
