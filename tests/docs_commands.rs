@@ -6,8 +6,9 @@
 //! tests") describes the block kinds to authors.
 //!
 //! Block kinds, by the fence's info string:
-//! - `sh`: each line runs with bash in a temporary folder holding copies of `scenes/` and
-//!   `examples/`, `lobes` first on PATH and `cargo run --release -- ARGS` run as `lobes ARGS`;
+//! - `sh`: each line runs with bash in a temporary folder holding copies of `scenes/`,
+//!   `examples/` and `tests/fixtures/repository/` (the renderer trees of
+//!   docs/testing-your-own-sampler.md), `lobes` first on PATH and `cargo run --release -- ARGS` run as `lobes ARGS`;
 //!   one folder per page, lines in order. Exit 0, or the code of a trailing `# exit N`. Not run:
 //!   `bash .ci/install &&` (apt; the rest of the line runs), `cargo test`, `cargo clippy`,
 //!   `duplicates` (the suite and the tools), `cargo run --example NAME` (its code runs in
@@ -249,6 +250,7 @@ fn every_documented_command_runs() {
         let work = tmp.path().join(page.replace('/', "_"));
         copy_tree(&Path::new(ROOT).join("scenes"), &work.join("scenes"));
         copy_tree(&Path::new(ROOT).join("examples"), &work.join("examples"));
+        copy_tree(&Path::new(ROOT).join("tests/fixtures/repository"), &work.join("tests/fixtures/repository"));
         for line in lines {
             let at = format!("{page}:{}", line.number);
             let text = line.text.as_str();

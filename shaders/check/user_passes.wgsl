@@ -1,7 +1,7 @@
 #define_import_path lobes::check
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::check_params::lobes_check
-#import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval}
+#import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
 
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
 // functions through three wrappers of `lobes::user`, the module that the composing host
@@ -9,7 +9,8 @@
 //   fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32>   // (d, pdf the sampler reports)
 //   fn lobes_user_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32
 //   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
-// and `const LOBES_DOMAIN_PLANE: bool`. Every name here starts with `lobes_` so that it cannot
+// and `const LOBES_DOMAIN_PLANE: bool`, and fn lobes_user_draws() -> u32, the draws the last
+// sample took from the queue of the user's --rand functions. Every name here starts with `lobes_` so that it cannot
 // collide with the user's own.
 
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
@@ -235,6 +236,24 @@ fn lobes_pdf_at(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let d = lobes_in[i].xyz;
     let wi = lobes_check.wi.xyz;
     lobes_out[i] = vec4<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d), 0.0, 0.0);
+}
+
+// The user's --rand draws at item i of lobes_in = (u, wi) (src/check/gpu.rs: rand_order): per
+// item 2 vec4s,
+//   0: (draws one sample took, its reported pdf, 0, 0)
+//   1: lobes_share along u.x, u.y, u.z, u.w (−1 where d moves with it: a smooth coordinate)
+@compute @workgroup_size(64)
+fn lobes_draws(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let u = lobes_in[2u * i];
+    let wi = lobes_in[2u * i + 1u].xyz;
+    let s = lobes_user_sample(wi, u);
+    let n = lobes_user_draws();
+    lobes_out[2u * i] = vec4<f32>(f32(n), s.w, 0.0, 0.0);
+    lobes_out[2u * i + 1u] = vec4<f32>(lobes_share(wi, u, 0u, s.xyz), lobes_share(wi, u, 1u, s.xyz), lobes_share(wi, u, 2u, s.xyz), lobes_share(wi, u, 3u, s.xyz));
 }
 
 // Limits of the weights pass, the host's constants: LOBES_WEIGHT_LIMIT is

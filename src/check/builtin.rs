@@ -42,7 +42,7 @@ impl UserSampler {
             Source { name: format!("lobes' {} (shaders/lib)", spec.wgsl.eval_module), text: library },
             Source { name: format!("the {} wrapper (src/check/builtin.rs)", spec.name()), text: wrapper },
         ];
-        let s = Self { sources, sample: SAMPLE.into(), pdf: PDF.into(), eval: None, domain: Domain::Sphere, conventions: Default::default() };
+        let s = Self { sources, sample: SAMPLE.into(), pdf: PDF.into(), eval: None, domain: Domain::Sphere, conventions: Default::default(), composition: Default::default() };
         s.validate().unwrap_or_else(|e| panic!("lobes' {} sampler does not meet the contract: {e}", spec.name()));
         s
     }

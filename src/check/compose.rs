@@ -133,16 +133,21 @@ impl Composed {
     /// (On a thread with a large stack: a user's expression may nest deeper than an ordinary
     /// stack holds, [`crate::engine::gpu::stack`].)
     pub fn validate(&self) -> Result<naga::Module, CheckError> {
-        crate::engine::gpu::stack::with_big_stack(|| self.parse_and_validate())
+        Ok(self.validate_with(naga::valid::Capabilities::default())?.0)
     }
 
-    fn parse_and_validate(&self) -> Result<naga::Module, CheckError> {
+    /// [`Self::validate`] with the given capabilities, and naga's information on the module
+    /// (the types of its expressions).
+    pub fn validate_with(&self, caps: naga::valid::Capabilities) -> Result<(naga::Module, naga::valid::ModuleInfo), CheckError> {
+        crate::engine::gpu::stack::with_big_stack(|| self.parse_and_validate(caps))
+    }
+
+    fn parse_and_validate(&self, caps: naga::valid::Capabilities) -> Result<(naga::Module, naga::valid::ModuleInfo), CheckError> {
         let module = naga::front::wgsl::parse_str(&self.text).map_err(|e| {
             let labels: Vec<String> = e.labels().map(|(_, l)| l.to_string()).collect();
             CheckError::Wgsl(self.diagnostic(e.location(&self.text), e.message(), &labels))
         })?;
-        let caps = naga::valid::Capabilities::default();
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| {
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| {
             let labels: Vec<String> = e.spans().map(|(_, l)| l.clone()).collect();
             let mut message = e.as_inner().to_string();
             let mut source: Option<&dyn std::error::Error> = std::error::Error::source(e.as_inner());
@@ -152,11 +157,13 @@ impl Composed {
             }
             CheckError::Wgsl(self.diagnostic(e.location(&self.text), &message, &labels))
         })?;
-        Ok(module)
+        Ok((module, info))
     }
 }
 
 /// The user's files alone, validated, with each named function checked against its signature.
+/// (Any capability is allowed here: what the passes cannot run is the final composition's to
+/// refuse, once a composed tree is cut to what the sampler reaches.)
 pub(super) fn check_user(sources: &[Source], functions: &[(&str, Signature)]) -> Result<naga::Module, CheckError> {
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
@@ -165,7 +172,7 @@ pub(super) fn check_user(sources: &[Source], functions: &[(&str, Signature)]) ->
     for s in sources {
         composed.push(&s.name, &s.text);
     }
-    let module = composed.validate()?;
+    let module = composed.validate_with(naga::valid::Capabilities::all())?.0;
     let files = sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
     for &(name, sig) in functions {
         let expected = sig.text.replace("NAME", name);
@@ -203,9 +210,21 @@ fn describe(module: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
             return t.wgsl().to_string();
         }
     }
+    describe_inner(inner)
+}
+
+/// A scalar or vector type as WGSL writes it; else naga's debug form.
+pub(super) fn describe_inner(inner: &TypeInner) -> String {
+    let scalar = |s: &naga::Scalar| match s.kind {
+        ScalarKind::Float => format!("f{}", s.width * 8),
+        ScalarKind::Sint => format!("i{}", s.width * 8),
+        ScalarKind::Uint => format!("u{}", s.width * 8),
+        ScalarKind::Bool => "bool".to_string(),
+        k => format!("{k:?}").to_lowercase(),
+    };
     match inner {
-        TypeInner::Scalar(s) => format!("{:?}{}", s.kind, s.width * 8).to_lowercase(),
-        TypeInner::Vector { size, scalar } => format!("vec{}<{:?}{}>", *size as u8, scalar.kind, scalar.width * 8).to_lowercase(),
+        TypeInner::Scalar(s) => scalar(s),
+        TypeInner::Vector { size, scalar: s } => format!("vec{}<{}>", *size as u8, scalar(s)),
         other => format!("{other:?}"),
     }
 }

@@ -1,7 +1,8 @@
 //! The GPU passes over a user's sampler (`shaders/check/user_passes.wgsl`): histogram, weights,
 //! quadrature of rectangles and the probe of the sample map.
 
-use super::compose::Composed;
+use super::compose::{Composed, Source};
+use super::modules::{Draw, UserCode, compose_user};
 use super::{CheckError, Domain, UserSampler};
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::{Gpu, GpuError};
@@ -41,23 +42,144 @@ pub(super) struct Passes<'g> {
     pipelines: std::cell::RefCell<std::collections::HashMap<String, wgpu::ComputePipeline>>,
 }
 
-/// The generated wrappers that call the user's functions (`lobes_contract_*`), and the layer of
-/// the sampler's conventions over them that defines the names the passes use (`lobes_user_*`,
-/// [`super::conventions`]).
-fn glue(sampler: &UserSampler) -> String {
-    let eval = match &sampler.eval {
-        Some(name) => format!("{name}(wi, d, lobes_check.user)"),
-        None => "0.0".to_string(),
+/// Whether `s` names a function (with the contract's signature) rather than being a call
+/// expression over lobes' names.
+pub(super) fn is_name(s: &str) -> bool {
+    let mut c = s.trim().chars();
+    c.next().is_some_and(|f| f.is_ascii_alphabetic() || f == '_') && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// What the sample call returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Returned {
+    /// A function of the contract: (d, pdf).
+    Contract,
+    /// An expression's vec3 (d, or h) and vec4 ((d, pdf), or (h, pdf of h)).
+    Vec3,
+    Vec4,
+}
+
+/// The path of the generated glue in messages: errors in a call expression point here.
+pub(super) const GLUE: &str = "<lobes check glue>";
+
+/// lobes' names for call expressions: `wi`, `u`, `d`, `params`, `p0` … `p15` and `rng`, a
+/// `ptr<function, u32>` to a state seeded from the uniforms (or from d in the pdf).
+fn names(seed: &str) -> String {
+    let mut out = format!("    var lobes_state = {seed};\n    let rng = &lobes_state;\n");
+    for row in 0..4 {
+        let lets: Vec<String> = (0..4).map(|k| format!("let p{} = params[{row}].{};", 4 * row + k, ["x", "y", "z", "w"][k])).collect();
+        out += &format!("    {}\n", lets.join(" "));
+    }
+    out
+}
+
+/// The type probe of a sample expression: a function whose `lobes_r` has the expression's type.
+pub(super) fn type_probe(sample: &str) -> String {
+    format!(
+        "// the type of --sample\nfn lobes_type_probe(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) {{\n{}    let lobes_r = {sample};\n}}\n",
+        names("0u")
+    )
+}
+
+/// The generated functions that call the user's code as --sample, --pdf and --eval say, under the
+/// contract's signatures with `params` an argument (`lobes_glue_sample/pdf/eval`), the queue of
+/// --rand (`lobes_rand_take`, in the order `order` of u's components) and the seeding of `rng`.
+pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], reach: bool) -> String {
+    let half = sampler.composition.sample_returns == super::SampleReturns::HalfVector;
+    let sample = match returned {
+        Returned::Contract => format!("    return {}(wi, u, params);\n", sampler.sample),
+        r => {
+            let mut s = format!("{}    // --sample\n    let lobes_r = {};\n", names("lobes_rng_seed(u)"), sampler.sample);
+            s += if half {
+                "    let lobes_h = lobes_r.xyz;\n    let lobes_d = 2.0 * dot(wi, lobes_h) * lobes_h - wi;\n"
+            } else {
+                "    let lobes_d = lobes_r.xyz;\n"
+            };
+            s += match (r, half) {
+                // the pdf of h over that of d: the reflection's Jacobian |dω_h/dω_d| = 1 / (4 |wi·h|)
+                // (Walter et al. 2007, eq. 14)
+                (Returned::Vec4, true) => "    return vec4<f32>(lobes_d, lobes_r.w / (4.0 * abs(dot(wi, lobes_h))));\n",
+                (Returned::Vec4, false) => "    return vec4<f32>(lobes_d, lobes_r.w);\n",
+                _ => "    return vec4<f32>(lobes_d, lobes_glue_pdf(wi, lobes_d, params));\n",
+            };
+            s
+        }
+    };
+    let density = |flag: &str, call: Option<&str>| match call {
+        None => "    return 0.0;\n".to_string(),
+        Some(n) if is_name(n) => format!("    return {n}(wi, d, params);\n"),
+        Some(e) => format!("{}    // {flag}\n    return {e};\n", names("lobes_rng_seed(vec4<f32>(d, 0.0))")),
+    };
+    let reach = if reach {
+        "// (what the glue reaches is what the composed module keeps)\n\
+         @compute @workgroup_size(1)\n\
+         fn lobes_reach() {\n\
+         \x20   let wi = vec3<f32>(0.0, 0.0, 1.0);\n\
+         \x20   _ = lobes_glue_sample(wi, vec4<f32>(0.5), array<vec4<f32>, 4>());\n\
+         \x20   _ = lobes_glue_pdf(wi, wi, array<vec4<f32>, 4>());\n\
+         \x20   _ = lobes_glue_eval(wi, wi, array<vec4<f32>, 4>());\n\
+         \x20   _ = lobes_rand_take(0u);\n\
+         }\n"
+    } else {
+        ""
     };
     format!(
-        "// Generated by lobes check: the user's functions under the names lobes' passes call.\n\
+        "// Generated by lobes check: the user's functions called as --sample, --pdf and --eval say.\n\
+         var<private> lobes_rand_u: vec4<f32>;\n\
+         var<private> lobes_rand_next: u32;\n\
+         const LOBES_RAND_ORDER = array<u32, 4>({o0}u, {o1}u, {o2}u, {o3}u);\n\
+         // The next n uniforms of the queue u[LOBES_RAND_ORDER[0]], u[LOBES_RAND_ORDER[1]], …: the\n\
+         // bodies of the user's --rand functions. Past the fourth it gives 0, and the host refuses a\n\
+         // sampler that draws more (lobes_user_draws).\n\
+         fn lobes_rand_take(n: u32) -> vec4<f32> {{\n\
+         \x20   var r = vec4<f32>(0.0);\n\
+         \x20   for (var k = 0u; k < n; k++) {{\n\
+         \x20       let i = lobes_rand_next + k;\n\
+         \x20       if (i < 4u) {{\n\
+         \x20           r[k] = lobes_rand_u[LOBES_RAND_ORDER[i]];\n\
+         \x20       }}\n\
+         \x20   }}\n\
+         \x20   lobes_rand_next += n;\n\
+         \x20   return r;\n\
+         }}\n\
+         // PCG hash (Jarzynski & Olano 2020, \"Hash Functions for GPU Rendering\"), and the state of\n\
+         // `rng` from the bits of the uniforms: the same u gives the same draws.\n\
+         fn lobes_pcg(v: u32) -> u32 {{\n\
+         \x20   let s = v * 747796405u + 2891336453u;\n\
+         \x20   let w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n\
+         \x20   return (w >> 22u) ^ w;\n\
+         }}\n\
+         fn lobes_rng_seed(u: vec4<f32>) -> u32 {{\n\
+         \x20   let b = bitcast<vec4<u32>>(u);\n\
+         \x20   return lobes_pcg(b.x ^ lobes_pcg(b.y ^ lobes_pcg(b.z ^ lobes_pcg(b.w))));\n\
+         }}\n\
+         fn lobes_glue_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         \x20   lobes_rand_u = u;\n\
+         \x20   lobes_rand_next = 0u;\n\
+         {sample}}}\n\
+         fn lobes_glue_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{pdf}}}\n\
+         fn lobes_glue_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{eval}}}\n\
+         {reach}",
+        o0 = order[0],
+        o1 = order[1],
+        o2 = order[2],
+        o3 = order[3],
+        pdf = density("--pdf", Some(&sampler.pdf)),
+        eval = density("--eval", sampler.eval.as_deref()),
+    )
+}
+
+/// The wrappers under the names lobes' passes call, with `params` from the uniforms.
+fn contract_glue(sampler: &UserSampler) -> String {
+    format!(
+        "// Generated by lobes check: the glue under the names lobes' passes call.\n\
          const LOBES_DOMAIN_PLANE: bool = {plane};\n\
-         fn lobes_contract_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32> {{ return {sample}(wi, u, lobes_check.user); }}\n\
-         fn lobes_contract_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32 {{ return {pdf}(wi, d, lobes_check.user); }}\n\
-         fn lobes_contract_eval(wi: vec3<f32>, d: vec3<f32>) -> f32 {{ return {eval}; }}\n{conventions}",
+         fn lobes_contract_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32> {{ return lobes_glue_sample(wi, u, lobes_check.user); }}\n\
+         fn lobes_contract_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32 {{ return lobes_glue_pdf(wi, d, lobes_check.user); }}\n\
+         fn lobes_contract_eval(wi: vec3<f32>, d: vec3<f32>) -> f32 {{ return lobes_glue_eval(wi, d, lobes_check.user); }}\n\
+         // the draws the last lobes_user_sample took from the --rand queue\n\
+         fn lobes_user_draws() -> u32 {{ return lobes_rand_next; }}\n{conventions}",
         plane = matches!(sampler.domain, Domain::Plane { .. }),
-        sample = sampler.sample,
-        pdf = sampler.pdf,
         conventions = sampler.conventions.wgsl(),
     )
 }
@@ -65,7 +187,129 @@ fn glue(sampler: &UserSampler) -> String {
 /// The path of the generated module `lobes::user` in messages.
 const USER_MODULE: &str = "<lobes check glue>";
 
-/// The user's files, the glue and lobes' passes as one module, validated by naga (errors at the
+/// What the sample expression returns (the contract's function: `Contract`), from naga's types
+/// of the expression in a probe function.
+pub(super) fn returned(code: &UserCode, sampler: &UserSampler) -> Result<Returned, CheckError> {
+    if is_name(&sampler.sample) {
+        return Ok(Returned::Contract);
+    }
+    let mut c = Composed::default();
+    for p in &code.parts {
+        c.push(&p.name, &p.text);
+    }
+    c.push(GLUE, &type_probe(&sampler.sample));
+    let (module, info) = c.validate_with(naga::valid::Capabilities::all())?;
+    let (h, f) = module.functions.iter().find(|(_, f)| f.name.as_deref() == Some("lobes_type_probe")).ok_or_else(|| CheckError::Internal("no type probe".into()))?;
+    let (e, _) = f.named_expressions.iter().find(|(_, n)| n.as_str() == "lobes_r").ok_or_else(|| CheckError::Internal("no lobes_r".into()))?;
+    let inner = info[h][*e].ty.inner_with(&module.types);
+    match inner {
+        naga::TypeInner::Vector { size: naga::VectorSize::Tri, scalar } if *scalar == naga::Scalar::F32 => Ok(Returned::Vec3),
+        naga::TypeInner::Vector { size: naga::VectorSize::Quad, scalar } if *scalar == naga::Scalar::F32 => Ok(Returned::Vec4),
+        other => Err(CheckError::Input(format!(
+            "--sample '{}' returns {}; a sample expression returns vec3<f32> (d) or vec4<f32> (d, pdf)",
+            sampler.sample,
+            super::compose::describe_inner(other)
+        ))),
+    }
+}
+
+/// The replacement body of a --rand function returning `inner`: the next 1 to 4 uniforms.
+fn rand_body(name: &str, module: &naga::Module, f: &naga::Function) -> Result<String, CheckError> {
+    let ty = f.result.as_ref().map(|r| &module.types[r.ty].inner);
+    let n = match ty {
+        Some(naga::TypeInner::Scalar(s)) if *s == naga::Scalar::F32 => 1,
+        Some(naga::TypeInner::Vector { size, scalar }) if *scalar == naga::Scalar::F32 => *size as u32,
+        other => {
+            return Err(CheckError::Input(format!(
+                "--rand {name}: returns {}; lobes hands out uniforms in [0, 1] as f32, vec2<f32>, vec3<f32> or vec4<f32>",
+                other.map_or("nothing".to_string(), super::compose::describe_inner)
+            )));
+        }
+    };
+    let swizzle = ["", ".x", ".xy", ".xyz", ""][n as usize];
+    Ok(format!("{{ return lobes_rand_take({n}u){swizzle}; }}"))
+}
+
+/// The parts with the bodies of the --rand functions replaced by lobes' queue (lines kept). A
+/// function that `required` and is absent is an error naming the functions there.
+fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bool) -> Result<Vec<Source>, CheckError> {
+    if rand.is_empty() {
+        return Ok(parts.to_vec());
+    }
+    let mut c = Composed::default();
+    for p in parts {
+        c.push(&p.name, &p.text);
+    }
+    let module = naga::front::wgsl::parse_str(&c.text).map_err(|e| CheckError::Internal(format!("the composed WGSL does not parse: {}", e.message())))?;
+    let mut bodies = Vec::new();
+    for name in rand {
+        let found = code.functions_named(&module, name);
+        if found.is_empty() && required {
+            let known: Vec<String> = module
+                .functions
+                .iter()
+                .filter_map(|(_, f)| f.name.as_deref())
+                .filter(|n| !n.starts_with("lobes_"))
+                .map(|n| code.origins.iter().find(|o| o.0 == n).map_or(n.to_string(), |o| format!("{}::{}", o.1, o.2)))
+                .collect();
+            return Err(CheckError::Input(format!(
+                "--rand {name}: no function `{name}` in {}{} (functions there: {})",
+                code.files.join(", "),
+                crate::scene::suggest::did_you_mean(name, known.iter().map(String::as_str)),
+                known.join(", ")
+            )));
+        }
+        for h in found {
+            bodies.push((h, rand_body(name, &module, &module.functions[h])?));
+        }
+    }
+    let text = super::modules::replace_bodies(&c.text, &module, &bodies)?;
+    // the lines are kept: each part takes back as many as it had
+    let mut lines = text.lines();
+    Ok(parts
+        .iter()
+        .map(|p| {
+            let n = p.text.lines().count();
+            let mut t: String = lines.by_ref().take(n).map(|l| format!("{l}\n")).collect();
+            if n == 0 {
+                t.clear();
+            }
+            Source { name: p.name.clone(), text: t }
+        })
+        .collect())
+}
+
+/// The user's code with the glue: plain files as they are (their --rand bodies replaced) and the
+/// glue after them; a composed tree with the glue, compacted to what the glue reaches, written
+/// back as WGSL.
+pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Source>, CheckError> {
+    let code = compose_user(&sampler.sources, &sampler.composition)?;
+    let returned = returned(&code, sampler)?;
+    let rand = &sampler.composition.rand;
+    if code.dialect == super::modules::Dialect::Wgsl {
+        let mut parts = replace_rand(&code.parts, &code, rand, true)?;
+        parts.push(Source { name: GLUE.into(), text: glue(sampler, returned, order, false) });
+        return Ok(parts);
+    }
+    // that each --rand function exists before compaction (after it, only the reached ones do)
+    replace_rand(&code.parts, &code, rand, true)?;
+    let mut c = Composed::default();
+    c.push(&code.parts[0].name, &code.parts[0].text);
+    c.push(GLUE, &glue(sampler, returned, order, true));
+    let (mut module, _) = c.validate_with(naga::valid::Capabilities::all())?;
+    naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
+    module.entry_points.clear();
+    let text = super::modules::write_wgsl(&module, naga::valid::Capabilities::all())?;
+    let parts = vec![Source { name: code.parts[0].name.clone(), text }];
+    // naga's writer writes a run of underscores as one (`package_utils__1rand_f` → `package_utils_1rand_f`)
+    let mut written = code.clone();
+    for o in &mut written.origins {
+        o.0 = o.0.split('_').filter(|w| !w.is_empty()).collect::<Vec<_>>().join("_");
+    }
+    replace_rand(&parts, &written, rand, false)
+}
+
+/// The user's code, the glue and lobes' passes as one module, validated by naga (errors at the
 /// user's file:line:column).
 ///
 /// lobes' passes (`shaders/check/user_passes.wgsl`, `lobes::check`) are a naga_oil module like
@@ -75,8 +319,15 @@ const USER_MODULE: &str = "<lobes check glue>";
 /// naga_oil refuses some valid WGSL (a struct member whose name ends in a digit), so an error
 /// naga_oil finds in `lobes::user` itself is left to naga.
 pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
-    let glue = glue(sampler);
-    let user: String = sampler.sources.iter().map(|s| format!("{}\n", s.text)).collect();
+    let order = Draw::components(sampler.composition.rand_order.as_deref().unwrap_or(&[]));
+    compose_ordered(sampler, order)
+}
+
+/// [`compose`] with the --rand queue in the order `order` of u's components.
+pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<Composed, CheckError> {
+    let parts = prepare(sampler, order)?;
+    let glue = contract_glue(sampler);
+    let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
     let module = format!("#define_import_path lobes::user\n#import lobes::check_params::lobes_check\n{user}{glue}");
     let chosen = [File::generated(USER_MODULE, module)];
     match library::validate_files(&["lobes::check"], &chosen) {
@@ -86,7 +337,7 @@ pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
     let mut c = Composed::default();
     for (path, text) in library::pieces(&["lobes::check"], &chosen)? {
         if path == USER_MODULE {
-            for s in &sampler.sources {
+            for s in &parts {
                 c.push(&s.name, &s.text);
             }
             c.push(USER_MODULE, &glue);
@@ -184,6 +435,16 @@ impl<'g> Passes<'g> {
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
+    /// The --rand draws at each (u, wi): 2 vec4s per item, (draws, reported pdf, 0, 0) and the
+    /// share along u.x, u.y, u.z, u.w (user_passes.wgsl: lobes_draws).
+    pub fn draws(&self, params: &Params, items: &[([f32; 4], [f32; 3])]) -> Result<Vec<[[f32; 4]; 2]>, CheckError> {
+        let input: Vec<[f32; 4]> = items.iter().flat_map(|(u, w)| [*u, [w[0], w[1], w[2], 0.0]]).collect();
+        let p = Params { count: items.len() as u32, ..*params };
+        let bytes = self.run("lobes_draws", &p, &input, items.len() as u32, items.len() as u64 * 2 * 16, false)?;
+        let flat: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
+    }
+
     /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons.
     pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize) -> Result<Vec<u32>, CheckError> {
         let spt = 64u32;
@@ -228,6 +489,57 @@ impl<'g> Passes<'g> {
     }
 }
 
+/// The order of the --rand queue (the component of u each draw takes) and a note for the
+/// report: `--rand-order` as given, else what lobes' probe finds at 256 uniforms, with the queue
+/// in call order: a draw along which the sample stays put over a run of its values (a share in
+/// [0, 1), as the Jacobian check measures events on u.z and u.w) chooses an event and goes to
+/// u.z, then u.w; the others move the direction and go to u.x, then u.y. More than four draws in
+/// one sample is an error naming the count.
+pub(super) fn rand_order(passes: &Passes, params: &Params, sampler: &UserSampler, seed: u64) -> Result<([u32; 4], String), CheckError> {
+    let wi = [params.wi[0], params.wi[1], params.wi[2]];
+    let margin = 2.0 * super::jacobian::EPS as f64;
+    let items: Vec<([f32; 4], [f32; 3])> = (0..256u64)
+        .map(|i| (crate::reference::rng::uniforms(seed ^ 0x5851_f42d_4c95_7f2d, i).map(|x| (margin + (1.0 - 2.0 * margin) * x) as f32), wi))
+        .collect();
+    let out = passes.draws(params, &items)?;
+    let most = out.iter().map(|o| o[0][0] as u32).max().unwrap_or(0);
+    let names = sampler.composition.rand.join(", ");
+    if most > 4 {
+        return Err(CheckError::Input(format!(
+            "--rand {names}: one sample drew {most} random numbers; lobes hands out four (u.x, u.y, u.z, u.w). A sampler checked with --rand draws at most four per sample"
+        )));
+    }
+    if most == 0 {
+        return Err(CheckError::Input(format!(
+            "--rand {names}: no sample called {} (256 probed); name the functions the sampler draws its random numbers from",
+            if sampler.composition.rand.len() == 1 { "it" } else { "them" }
+        )));
+    }
+    if let Some(order) = &sampler.composition.rand_order {
+        let c = Draw::components(order);
+        return Ok((c, format!("; random draws {} (--rand-order)", Draw::list(&c, most as usize))));
+    }
+    let mut kinds = Vec::new();
+    for k in 0..most as usize {
+        let valid = out.iter().filter(|o| o[0][1] > 0.0 && o[0][1].is_finite());
+        let (smooth, event) = valid.fold((0, 0), |(s, e), o| match o[1][k] {
+            x if x < 0.0 => (s + 1, e),
+            x if x < 1.0 => (s, e + 1),
+            _ => (s, e),
+        });
+        kinds.push(event > smooth);
+    }
+    let events = kinds.iter().filter(|&&e| e).count();
+    if events == 0 || events > 2 || kinds.len() - events > 2 {
+        let c = Draw::components(&[]);
+        return Ok((c, format!("; random draws {} in call order", Draw::list(&c, most as usize))));
+    }
+    let mut smooth = [Draw::X, Draw::Y].into_iter();
+    let order: Vec<Draw> = kinds.iter().map(|&e| if e { Draw::Event } else { smooth.next().expect("at most two") }).collect();
+    let c = Draw::components(&order);
+    Ok((c, format!("; random draws {} (found by lobes' probe)", Draw::list(&c, most as usize))))
+}
+
 /// A 64-bit value as the (lo, hi) pair the kernels take.
 pub(super) fn split(v: u64) -> [u32; 2] {
     [v as u32, (v >> 32) as u32]
@@ -268,6 +580,7 @@ mod tests {
             eval: None,
             domain: Domain::Sphere,
             conventions: Default::default(),
+            composition: Default::default(),
         };
         let source = compose(&s).unwrap().text;
         crate::engine::gpu::layout::check_struct(&source, "LobesCheckParams", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
@@ -287,7 +600,7 @@ mod tests {
 
     fn sampler(text: &str) -> UserSampler {
         let sources = vec![super::super::Source { name: "t.wgsl".into(), text: text.into() }];
-        UserSampler { sources, sample: "s".into(), pdf: "p".into(), eval: None, domain: Domain::Sphere, conventions: Default::default() }
+        UserSampler { sources, sample: "s".into(), pdf: "p".into(), eval: None, domain: Domain::Sphere, conventions: Default::default(), composition: Default::default() }
     }
 
     /// The user's lines keep their file's numbers in the composition, and valid WGSL that

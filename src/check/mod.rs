@@ -39,6 +39,7 @@ pub mod compose;
 pub mod conventions;
 mod gpu;
 pub mod hard;
+pub mod modules;
 pub mod jacobian;
 mod pdf_values;
 pub mod power;
@@ -49,6 +50,7 @@ pub use compose::Source;
 pub use conventions::{Conventions, Frame, Incident, Measure};
 /// glam, whose `DVec3` [`Reference`] takes: a renderer's tests need no glam of their own.
 pub use glam;
+pub use modules::{Composition, Dialect, Draw, SampleReturns};
 pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
@@ -94,7 +96,12 @@ pub enum Domain {
     Plane { bounds: [f64; 4] },
 }
 
-/// A user's sampler: WGSL files and the names of its functions.
+/// A user's sampler: WGSL files and how to call its functions.
+///
+/// `sample`, `pdf` and `eval` are each a function name with the contract's signature, or a WGSL
+/// call expression over lobes' names `wi`, `u` (sample), `d` (pdf, eval), `params`, `p0` … `p15`
+/// and `rng` (a `ptr<function, u32>` seeded per sample); `composition` says where imported
+/// modules are found and which functions are the user's RNG ([`Composition`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct UserSampler {
     pub sources: Vec<Source>,
@@ -104,6 +111,8 @@ pub struct UserSampler {
     pub domain: Domain,
     /// How the sampler is written: its frame, measure and declared domain ([`Conventions`]).
     pub conventions: Conventions,
+    /// How its files are composed and its functions called ([`Composition`]).
+    pub composition: Composition,
 }
 
 /// The user's parameters: at most this many numbers (`params: array<vec4<f32>, 4>`).
@@ -112,8 +121,33 @@ pub const MAX_PARAMS: usize = 16;
 impl UserSampler {
     /// Reads the files (in order) and checks the functions against the contract.
     pub fn from_files(paths: &[PathBuf], sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
+        Self::from_repository(paths, sample, pdf, eval, domain, Composition::default())
+    }
+
+    /// [`Self::from_files`] for files as they are in a renderer's repository: imports found
+    /// under the shader roots, call expressions, the renderer's own RNG.
+    ///
+    /// ```no_run
+    /// use lobes::check::{check, Composition, Domain, Settings, UserSampler};
+    /// let composition = Composition::default()
+    ///     .shader_root("shaders")
+    ///     .stub("package::bindings", "tests/no_bindings.wesl")
+    ///     .rand("rand_f");
+    /// let sampler = UserSampler::from_repository(
+    ///     &["shaders/sampling.wesl".into()],
+    ///     "sample_ggx_vndf(wi, p0, rng)",
+    ///     "ggx_vndf_pdf(wi, d, p0)",
+    ///     None,
+    ///     Domain::Sphere,
+    ///     composition,
+    /// )?;
+    /// let gpu = lobes::engine::gpu::Gpu::new()?;
+    /// check(&gpu, &sampler, &Settings { params: vec![0.3], ..Settings::default() })?.assert_passed();
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn from_repository(paths: &[PathBuf], sample: &str, pdf: &str, eval: Option<&str>, domain: Domain, composition: Composition) -> Result<Self, CheckError> {
         let sources = paths.iter().map(|p| Source::read(p)).collect::<Result<Vec<_>, _>>()?;
-        Self::from_sources(sources, sample, pdf, eval, domain)
+        Self::build(sources, sample, pdf, eval, domain, composition)
     }
 
     /// As [`UserSampler::from_files`], from texts already read (a renderer's `include_str!`),
@@ -129,7 +163,11 @@ impl UserSampler {
     /// # Ok::<(), lobes::check::CheckError>(())
     /// ```
     pub fn from_sources(sources: Vec<Source>, sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
-        let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain, conventions: Conventions::default() };
+        Self::build(sources, sample, pdf, eval, domain, Composition::default())
+    }
+
+    fn build(sources: Vec<Source>, sample: &str, pdf: &str, eval: Option<&str>, domain: Domain, composition: Composition) -> Result<Self, CheckError> {
+        let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain, conventions: Conventions::default(), composition };
         s.validate()?;
         Ok(s)
     }
@@ -150,17 +188,26 @@ impl UserSampler {
             return Err(CheckError::Input(format!("--bounds: {x0},{y0},{x1},{y1} is not a box: need X0 < X1 and Y0 < Y1, all finite")));
         }
         self.conventions.validate(matches!(self.domain, Domain::Plane { .. }))?;
+        if self.composition.sample_returns == SampleReturns::HalfVector && matches!(self.domain, Domain::Plane { .. }) {
+            return Err(CheckError::Input("--sample-returns half-vector: a half vector reflects wi into a direction; it does not apply to --domain plane".into()));
+        }
+        let code = modules::compose_user(&self.sources, &self.composition)?;
+        // a name is a function of the contract's signature; an expression is judged in the glue
         let mut functions = vec![(self.sample.as_str(), compose::SAMPLE), (self.pdf.as_str(), compose::PDF)];
         if let Some(e) = &self.eval {
             functions.push((e.as_str(), compose::EVAL));
         }
-        let module = compose::check_user(&self.sources, &functions)?;
-        if let Some(name) = compose::global_names(&module).into_iter().find(|n| gpu::reserved(n)) {
+        functions.retain(|(n, _)| gpu::is_name(n));
+        let module = compose::check_user(&code.parts, &functions)?;
+        let imported = |n: &String| code.origins.iter().any(|o| &o.0 == n);
+        if let Some(name) = compose::global_names(&module).into_iter().find(|n| gpu::reserved(n) && !imported(n)) {
             return Err(CheckError::Input(format!(
                 "{}: the name `{name}` is lobes' own (its RNG or a `lobes_` name); rename it in your file",
                 self.sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
             )));
         }
+        // the glue's own errors (a call expression's, a --rand function's) now, not at the GPU
+        gpu::prepare(self, Draw::components(self.composition.rand_order.as_deref().unwrap_or(&[])))?;
         Ok(())
     }
 
@@ -322,8 +369,6 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         sampler.conventions.check_incident(settings.incident_theta)?;
     }
     let (rows, cols) = settings.grid(&sampler.domain);
-    let composed = gpu::compose(sampler)?;
-    let passes = gpu::Passes::new(gpu, &composed)?;
     let mut user = [[0f32; 4]; 4];
     for (i, p) in settings.params.iter().enumerate() {
         user[i / 4][i % 4] = *p as f32;
@@ -348,6 +393,16 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         _pad_b: 0,
         _pad_c: 0,
     };
+    let mut passes = gpu::Passes::new(gpu, &gpu::compose(sampler)?)?;
+    // the user's --rand draws: at most four, and (without --rand-order) in the order lobes' probe finds
+    let mut draws = String::new();
+    if !sampler.composition.rand.is_empty() {
+        let (order, note) = gpu::rand_order(&passes, &params, sampler, settings.seed)?;
+        if sampler.composition.rand_order.is_none() && order != Draw::components(&[]) {
+            passes = gpu::Passes::new(gpu, &gpu::compose_ordered(sampler, order)?)?;
+        }
+        draws = note;
+    }
     let plane = matches!(sampler.domain, Domain::Plane { .. });
     let mut checks = Vec::new();
 
@@ -673,7 +728,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         format_version: REPORT_VERSION,
         passed,
         checks,
-        sampler: describe(sampler),
+        sampler: describe(sampler) + &draws,
         domain: sampler.domain,
         samples: settings.samples,
         rows,

@@ -368,7 +368,7 @@ impl<'g> WgslIntegrand<'g> {
             name: "the quadrature's unused sampler (src/check/quadrature.rs)".into(),
             text: format!("fn {UNSAMPLED}(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{ return vec4<f32>(0.0); }}\n"),
         });
-        let sampler = UserSampler { sources, sample: UNSAMPLED.into(), pdf: function.into(), eval: None, domain: Domain::Sphere, conventions: Default::default() };
+        let sampler = UserSampler { sources, sample: UNSAMPLED.into(), pdf: function.into(), eval: None, domain: Domain::Sphere, conventions: Default::default(), composition: Default::default() };
         sampler.validate()?;
         Ok(Self { passes: Passes::new(gpu, &gpu::compose(&sampler)?)? })
     }

@@ -18,21 +18,57 @@ pub enum DomainChoice {
     Plane,
 }
 
+/// What a sample expression returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReturnsChoice {
+    /// The direction d (vec3), or (d, pdf) (vec4).
+    Direction,
+    /// A half vector h (vec3), or (h, pdf of h) (vec4).
+    HalfVector,
+}
+
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// The WGSL files that define the sampler, in order.
     #[arg(required = true, value_name = "FILE.wgsl")]
     pub files: Vec<PathBuf>,
-    /// The sampling function: fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>.
-    #[arg(long, value_name = "NAME")]
+    /// The sampling function: fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>,
+    /// or a WGSL call expression over wi, u, params, p0 … p15 and rng returning vec4 (d, pdf) or
+    /// vec3 (d), e.g. 'sample_ggx_vndf(wi, p0, rng)'.
+    #[arg(long, value_name = "NAME|EXPR")]
     pub sample: String,
-    /// The density: fn(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32.
-    #[arg(long, value_name = "NAME")]
+    /// The density: fn(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32, or a call
+    /// expression over wi, d, params, p0 … p15 and rng, e.g. 'ggx_vndf_pdf(wi, d, p0)'.
+    #[arg(long, value_name = "NAME|EXPR")]
     pub pdf: String,
-    /// Optional f·|cos| (or the phase function), same signature as --pdf: adds the weight and
+    /// Optional f·|cos| (or the phase function), same forms as --pdf: adds the weight and
     /// albedo checks.
-    #[arg(long, value_name = "NAME")]
+    #[arg(long, value_name = "NAME|EXPR")]
     pub eval: Option<String>,
+    /// Where imported modules are found (repeatable): naga_oil's #import paths or WESL's
+    /// package root. Default: the first file's folder.
+    #[arg(long = "shader-root", value_name = "DIR")]
+    pub shader_root: Vec<PathBuf>,
+    /// A shader def (repeatable): naga_oil's #ifdef/#if (VALUE true, false or an integer), WESL's
+    /// @if features (true or false). No value: true.
+    #[arg(long, value_name = "NAME[=VALUE]")]
+    pub define: Vec<String>,
+    /// A stand-in for a module the test does not need (repeatable): bind groups, scene bindings,
+    /// ray queries. MODULE as the imports name it (a::b, package::a::b).
+    #[arg(long, value_name = "MODULE=FILE")]
+    pub stub: Vec<String>,
+    /// The sampler's random function (repeatable): its body becomes lobes' queue of u.x, u.y, u.z,
+    /// u.w in call order (vec2/3/4 results take 2/3/4); at most four draws per sample.
+    #[arg(long, value_name = "NAME")]
+    pub rand: Vec<String>,
+    /// Which --rand draw is which, in call order: x, y (smooth coordinates) and event (a draw
+    /// that chooses a lobe), e.g. event,x,y. Default: found by lobes' probe.
+    #[arg(long, value_name = "ORDER")]
+    pub rand_order: Option<String>,
+    /// What the sample expression returns: the direction d, or a half vector h that lobes
+    /// reflects wi about (dividing a returned pdf of h by 4 |wi·h|).
+    #[arg(long, value_enum, default_value = "direction")]
+    pub sample_returns: ReturnsChoice,
     #[arg(long, value_enum, default_value = "sphere")]
     pub domain: DomainChoice,
     /// The plane's box, X0,Y0,X1,Y1 (with --domain plane).
@@ -117,7 +153,21 @@ impl CheckArgs {
             },
         };
         let conventions = Conventions { incident: self.incident, reflection_only: self.reflection_only, u_open: self.u_open, measure: self.measure, frame: self.frame };
-        UserSampler::from_files(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain).and_then(|s| s.with_conventions(conventions)).map_err(input)
+        let composition = check::Composition::from_flags(
+            &self.shader_root,
+            &self.define,
+            &self.stub,
+            &self.rand,
+            self.rand_order.as_deref(),
+            match self.sample_returns {
+                ReturnsChoice::Direction => check::SampleReturns::Direction,
+                ReturnsChoice::HalfVector => check::SampleReturns::HalfVector,
+            },
+        )
+        .map_err(usage)?;
+        UserSampler::from_repository(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain, composition)
+            .and_then(|s| s.with_conventions(conventions))
+            .map_err(input)
     }
 
     fn settings(&self) -> anyhow::Result<Settings> {

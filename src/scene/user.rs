@@ -26,6 +26,12 @@ pub(super) struct RawSampler {
     u_open: Option<Val>,
     measure: Option<Val>,
     frame: Option<Val>,
+    rand: Option<Val>,
+    rand_order: Option<Val>,
+    shader_root: Option<Val>,
+    define: Option<Val>,
+    stub: Option<Val>,
+    sample_returns: Option<Val>,
 }
 
 /// One validated case of a user's sampler: the sampler (shared by the cases of a sweep) and the
@@ -37,7 +43,7 @@ pub struct UserCase {
     pub settings: Settings,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name\", pdf = \"fn name\", eval = \"fn name\" } (eval optional; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\", frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -74,7 +80,8 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
     let paths: Vec<_> = files.iter().map(|f| base.join(f)).collect();
     let domain = domain(ctx, c)?;
     let conventions = conventions(ctx, r)?;
-    UserSampler::from_files(&paths, &sample, &pdf, eval.as_deref(), domain)
+    let composition = composition(ctx, r, base)?;
+    UserSampler::from_repository(&paths, &sample, &pdf, eval.as_deref(), domain, composition)
         .and_then(|s| s.with_conventions(conventions))
         .map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
         .map(Arc::new)
@@ -105,6 +112,72 @@ fn conventions(ctx: &Ctx, r: &RawSampler) -> Result<Conventions, SceneError> {
         measure: named(ctx, &r.measure, "measure", Measure::NAMES)?.unwrap_or(d.measure),
         frame: named(ctx, &r.frame, "frame", Frame::NAMES)?.unwrap_or(d.frame),
     })
+}
+
+/// A list of strings (`rand`, `shader_root`).
+fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneError> {
+    match v.get_ref() {
+        Value::Array(items) => items
+            .iter()
+            .map(|i| match i {
+                Value::String(s) => Ok(s.as_str()),
+                other => Err(ctx.err(v.span(), format!("sampler.{key} must hold strings, got {}; {SAMPLER_ALLOWED}", kind_of(other)))),
+            })
+            .collect(),
+        other => Err(ctx.err(v.span(), format!("sampler.{key} must be an array of strings, got {}; {SAMPLER_ALLOWED}", kind_of(other)))),
+    }
+}
+
+/// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
+/// stub, sample_returns (the flags of `lobes check`), paths relative to the scene file.
+fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
+    use crate::check::{Composition, Draw, SampleReturns};
+    let mut c = Composition::default();
+    if let Some(v) = &r.rand {
+        c.rand = strings(ctx, v, "rand")?.into_iter().map(String::from).collect();
+    }
+    if let Some(v) = &r.rand_order {
+        let o = string(ctx, v, "sampler.rand_order", "write rand_order = \"event,x,y\"")?;
+        c.rand_order = Some(Draw::parse_list(o).map_err(|e| ctx.err(v.span(), format!("sampler.rand_order: {e}")))?);
+        if c.rand.is_empty() {
+            return Err(ctx.err(v.span(), "sampler.rand_order: only with rand = [...] (the order of the draws of the functions rand names)"));
+        }
+    }
+    if let Some(v) = &r.shader_root {
+        c.shader_roots = strings(ctx, v, "shader_root")?.into_iter().map(|d| base.join(d)).collect();
+    }
+    let table = |v: &Val, key: &str| match v.get_ref() {
+        Value::Table(t) => Ok(t.clone()),
+        other => Err(ctx.err(v.span(), format!("sampler.{key} must be a table, got {}; {SAMPLER_ALLOWED}", kind_of(other)))),
+    };
+    if let Some(v) = &r.define {
+        for (name, value) in table(v, "define")? {
+            let value = match value {
+                Value::Boolean(true) => None,
+                Value::Boolean(false) => Some("false".to_string()),
+                Value::Integer(i) => Some(i.to_string()),
+                Value::String(s) => Some(s),
+                other => return Err(ctx.err(v.span(), format!("sampler.define.{name} must be true, false or an integer, got {}", kind_of(&other)))),
+            };
+            c.defines.push((name, value));
+        }
+    }
+    if let Some(v) = &r.stub {
+        for (module, file) in table(v, "stub")? {
+            let Value::String(f) = file else {
+                return Err(ctx.err(v.span(), format!("sampler.stub.\"{module}\" must be a file name (a string); {SAMPLER_ALLOWED}")));
+            };
+            c.stubs.push((module, base.join(f)));
+        }
+    }
+    if let Some(v) = &r.sample_returns {
+        c.sample_returns = match string(ctx, v, "sampler.sample_returns", "use \"direction\" or \"half-vector\"")? {
+            "direction" => SampleReturns::Direction,
+            "half-vector" => SampleReturns::HalfVector,
+            other => return Err(ctx.err(v.span(), format!("sampler.sample_returns '{other}' is unknown; use \"direction\" or \"half-vector\""))),
+        };
+    }
+    Ok(c)
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no

@@ -1,0 +1,780 @@
+//! A user's sampler as it is in its repository: the modules its file imports, found under the
+//! shader roots and composed the way the renderer composes them, into WGSL that lobes' glue
+//! (`gpu::glue`) calls.
+//!
+//! Three dialects, told apart by the files' own text ([`dialect`]):
+//! - plain WGSL: the files, in order, as they are (their lines keep their numbers in the
+//!   composition, `compose::Composed`);
+//! - naga_oil (Bevy ≤ 0.19 and many wgpu projects): `#define_import_path`, `#import a::b::{c}`,
+//!   `#import a::b as x`, `#ifdef`/`#if` shader defs. naga_oil's `Composer` composes the tree;
+//! - WESL (Bevy 0.20): `import package::a::b;`, `super::`, `@if` features, by the `wesl` crate
+//!   (0.4, feature "wesl"), with lobes' resolver over the shader roots ([`Roots`]).
+//!
+//! A composed tree becomes one WGSL text: the naga module of the tree and the glue, compacted to
+//! what the glue's calls reach (so a module's bind groups, ray queries or other entry points need
+//! not suit lobes' passes), written back by naga's WGSL writer. Errors in the user's modules are
+//! the composer's, at the module's file:line:column; an import that no root holds names the
+//! module, the roots searched and the closest module names.
+
+use super::CheckError;
+use super::compose::Source;
+use std::path::{Path, PathBuf};
+
+/// How lobes finds and calls a sampler beyond the contract's three functions (issue 23 §1–2).
+///
+/// ```
+/// use lobes::check::{Composition, Draw, SampleReturns};
+/// let c = Composition::default()
+///     .shader_root("shaders")
+///     .define("MULTISCATTER", None)
+///     .stub("renderer::bindings", "tests/stub_bindings.wgsl")
+///     .rand("rand_f")
+///     .rand_order(&[Draw::Event, Draw::X, Draw::Y]);
+/// assert_eq!(c.shader_roots.len(), 1);
+/// assert_eq!(c.sample_returns, SampleReturns::Direction);
+/// assert_eq!(lobes::check::Draw::parse_list("event,x,y").unwrap(), vec![Draw::Event, Draw::X, Draw::Y]);
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Composition {
+    /// Where modules are found (`--shader-root`, repeatable); none: the first file's folder.
+    pub shader_roots: Vec<PathBuf>,
+    /// Shader defs (`--define NAME[=VALUE]`): naga_oil's `#ifdef`/`#if`, WESL's `@if` features.
+    pub defines: Vec<(String, Option<String>)>,
+    /// Stand-ins for modules the test does not need (`--stub MODULE=FILE`): bind groups, scene
+    /// bindings, ray queries.
+    pub stubs: Vec<(String, PathBuf)>,
+    /// The user's random functions (`--rand NAME`): their bodies are replaced by lobes' queue of
+    /// u.x, u.y, u.z, u.w in call order.
+    pub rand: Vec<String>,
+    /// Which draw takes which uniform (`--rand-order`); `None`: found by lobes' probe.
+    pub rand_order: Option<Vec<Draw>>,
+    /// What the sample expression returns (`--sample-returns`).
+    pub sample_returns: SampleReturns,
+}
+
+impl Composition {
+    pub fn shader_root(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.shader_roots.push(dir.into());
+        self
+    }
+    pub fn define(mut self, name: &str, value: Option<&str>) -> Self {
+        self.defines.push((name.into(), value.map(Into::into)));
+        self
+    }
+    pub fn stub(mut self, module: &str, file: impl Into<PathBuf>) -> Self {
+        self.stubs.push((module.into(), file.into()));
+        self
+    }
+    pub fn rand(mut self, name: &str) -> Self {
+        self.rand.push(name.into());
+        self
+    }
+    pub fn rand_order(mut self, order: &[Draw]) -> Self {
+        self.rand_order = Some(order.to_vec());
+        self
+    }
+    pub fn sample_returns(mut self, r: SampleReturns) -> Self {
+        self.sample_returns = r;
+        self
+    }
+    /// The command line's flags: `--define NAME[=VALUE]`, `--stub MODULE=FILE`, `--rand-order
+    /// event,x,y`; a bad one is an error naming the flag.
+    pub fn from_flags(
+        shader_roots: &[PathBuf],
+        defines: &[String],
+        stubs: &[String],
+        rand: &[String],
+        rand_order: Option<&str>,
+        sample_returns: SampleReturns,
+    ) -> Result<Self, String> {
+        let defines = defines
+            .iter()
+            .map(|d| match d.split_once('=') {
+                Some((n, v)) => Ok((n.trim().to_string(), Some(v.trim().to_string()))),
+                None => Ok((d.trim().to_string(), None)),
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        if let Some((n, _)) = defines.iter().find(|(n, _)| !super::gpu::is_name(n)) {
+            return Err(format!("--define '{n}': a shader def is a name (letters, digits, _), as in --define UNIFORM_HEMISPHERE or --define SAMPLES=4"));
+        }
+        let stubs = stubs
+            .iter()
+            .map(|s| match s.split_once('=') {
+                Some((m, f)) if !m.trim().is_empty() && !f.trim().is_empty() => Ok((m.trim().to_string(), PathBuf::from(f.trim()))),
+                _ => Err(format!("--stub '{s}': give MODULE=FILE, e.g. --stub package::bindings=tests/no_bindings.wesl")),
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let rand_order = rand_order.map(|o| Draw::parse_list(o).map_err(|e| format!("--rand-order: {e}"))).transpose()?;
+        if rand_order.is_some() && rand.is_empty() {
+            return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
+        }
+        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, rand: rand.to_vec(), rand_order, sample_returns })
+    }
+
+    /// Whether anything beyond the contract's plain files is asked for.
+    pub fn is_plain(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// What a sample expression's result means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SampleReturns {
+    /// The sampled direction d (vec3) or (d, pdf) (vec4).
+    #[default]
+    Direction,
+    /// A half vector h (vec3) or (h, pdf of h) (vec4): lobes reflects wi about h, d = 2 (wi·h) h − wi,
+    /// and divides the pdf of h by the reflection's Jacobian 4 |wi·h| (Walter et al. 2007, eq. 14).
+    HalfVector,
+}
+
+/// What one random draw of the user's sampler decides (`--rand-order`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Draw {
+    /// The first coordinate that moves the direction smoothly: u.x.
+    X,
+    /// The second: u.y.
+    Y,
+    /// A draw that chooses an event (a lobe of a mixture): u.z, the next one u.w. lobes' Jacobian
+    /// check differentiates in u.x and u.y and measures events' shares along u.z and u.w.
+    Event,
+}
+
+impl Draw {
+    /// `event,x,y`: at most one x, one y and two events.
+    pub fn parse_list(s: &str) -> Result<Vec<Draw>, String> {
+        let allowed = "a comma-separated list of x, y and event (at most one x, one y, two events), e.g. event,x,y";
+        let draws = s
+            .split(',')
+            .map(|w| match w.trim() {
+                "x" => Ok(Draw::X),
+                "y" => Ok(Draw::Y),
+                "event" => Ok(Draw::Event),
+                other => Err(format!("'{other}' is not a draw; give {allowed}")),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let count = |d| draws.iter().filter(|&&x| x == d).count();
+        if count(Draw::X) > 1 || count(Draw::Y) > 1 || count(Draw::Event) > 2 {
+            return Err(format!("'{s}' gives u.x, u.y or u.z/u.w twice; give {allowed}"));
+        }
+        Ok(draws)
+    }
+
+    /// The component of u each draw takes, in call order; draws past the list take the
+    /// components left, in the order x, y, z, w.
+    pub fn components(order: &[Draw]) -> [u32; 4] {
+        let mut out = Vec::new();
+        let mut events = [2u32, 3].into_iter();
+        for d in order {
+            out.push(match d {
+                Draw::X => 0,
+                Draw::Y => 1,
+                Draw::Event => events.next().expect("at most two events (parse_list)"),
+            });
+        }
+        for c in 0..4 {
+            if !out.contains(&c) {
+                out.push(c);
+            }
+        }
+        [out[0], out[1], out[2], out[3]]
+    }
+
+    /// The order as written: `event,x,y`.
+    pub fn list(components: &[u32; 4], draws: usize) -> String {
+        let names: Vec<&str> = components.iter().take(draws).map(|c| match c {
+            0 => "x",
+            1 => "y",
+            _ => "event",
+        }).collect();
+        names.join(",")
+    }
+}
+
+/// The way the files compose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dialect {
+    /// Plain WGSL files, concatenated in order.
+    Wgsl,
+    /// naga_oil's `#import` / `#define_import_path` / shader defs.
+    NagaOil,
+    /// WESL's `import package::…;`.
+    Wesl,
+}
+
+impl Dialect {
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::Wgsl => "WGSL",
+            Dialect::NagaOil => "naga_oil",
+            Dialect::Wesl => "WESL",
+        }
+    }
+}
+
+/// The dialect of the files, from their text: a naga_oil directive at the start of a line, a WESL
+/// `import …;` statement (or a `.wesl` file), else plain WGSL.
+pub fn dialect(sources: &[Source]) -> Dialect {
+    let directive = |l: &str| {
+        let l = l.trim_start();
+        ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if ", "#else", "#endif"].iter().any(|d| l.starts_with(d))
+    };
+    let wesl_import = |l: &str| {
+        let l = l.trim_start();
+        l.starts_with("import ") && (l.contains("::") || l.trim_end().ends_with(';'))
+    };
+    if sources.iter().any(|s| s.text.lines().any(directive)) {
+        Dialect::NagaOil
+    } else if sources.iter().any(|s| s.name.ends_with(".wesl") || s.text.lines().any(wesl_import)) {
+        Dialect::Wesl
+    } else {
+        Dialect::Wgsl
+    }
+}
+
+/// The user's code before lobes' glue: the parts of its text, and where names from other modules
+/// came from.
+#[derive(Debug, Clone)]
+pub(super) struct UserCode {
+    pub dialect: Dialect,
+    /// The files as they are (plain WGSL), or one part: the composed tree.
+    pub parts: Vec<Source>,
+    /// (name in the text, module path, name in that module) of the items of imported modules.
+    pub origins: Vec<(String, String, String)>,
+    /// The files the tree was read from (for messages).
+    pub files: Vec<String>,
+}
+
+impl UserCode {
+    /// The functions named `name` (plain, or `module::path::name`) in `module`.
+    pub fn functions_named(&self, module: &naga::Module, name: &str) -> Vec<naga::Handle<naga::Function>> {
+        module
+            .functions
+            .iter()
+            .filter(|(_, f)| {
+                let Some(n) = f.name.as_deref() else { return false };
+                n == name
+                    || self.origins.iter().any(|(m, path, item)| m == n && (item == name || format!("{path}::{item}") == name))
+            })
+            .map(|(h, _)| h)
+            .collect()
+    }
+}
+
+/// The roots modules are looked up under: the given ones, else the first file's folder.
+fn roots(sources: &[Source], c: &Composition) -> Vec<PathBuf> {
+    if !c.shader_roots.is_empty() {
+        return c.shader_roots.clone();
+    }
+    let first = Path::new(&sources[0].name);
+    vec![first.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).to_path_buf()]
+}
+
+fn show_roots(roots: &[PathBuf]) -> String {
+    roots.iter().map(|r| r.display().to_string()).collect::<Vec<_>>().join(", ")
+}
+
+/// Every file with one of `exts` under `dir` (hidden folders and `target` skipped), at most
+/// 20 000.
+fn scan(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if out.len() >= 20_000 {
+            return;
+        }
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if p.is_dir() {
+            if !name.starts_with('.') && name != "target" {
+                scan(&p, exts, out);
+            }
+        } else if exts.iter().any(|e| p.extension().and_then(|x| x.to_str()) == Some(e)) {
+            out.push(p);
+        }
+    }
+}
+
+/// The stubs' files, read.
+fn stubs(c: &Composition) -> Result<Vec<(String, Source)>, CheckError> {
+    c.stubs.iter().map(|(m, f)| Source::read(f).map(|s| (m.clone(), s))).collect()
+}
+
+/// The 1-based line and column of byte `at` of `text`.
+fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rfind('\n').map_or(before.len(), |n| before.len() - n - 1) + 1;
+    (line, col)
+}
+
+/// The user's files composed as their dialect composes them.
+pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
+    if sources.is_empty() {
+        return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
+    }
+    let files = sources.iter().map(|s| s.name.clone()).collect();
+    let mut d = dialect(sources);
+    if d == Dialect::Wgsl && !c.defines.is_empty() {
+        // shader defs of plain files are naga_oil's (#ifdef); with none in the files they are unused
+        d = Dialect::NagaOil;
+    }
+    match d {
+        Dialect::Wgsl => {
+            if let Some((m, _)) = c.stubs.first() {
+                return Err(CheckError::Input(format!("--stub {m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
+            }
+            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files })
+        }
+        Dialect::NagaOil => naga_oil_tree(sources, c).map(|(text, origins)| UserCode {
+            dialect: d,
+            parts: vec![Source { name: format!("<{} with its modules, composed by naga_oil>", sources[0].name), text }],
+            origins,
+            files,
+        }),
+        Dialect::Wesl => wesl_tree(sources, c).map(|(text, origins)| UserCode {
+            dialect: d,
+            parts: vec![Source { name: format!("<{} with its modules, composed by wesl>", sources[0].name), text }],
+            origins,
+            files,
+        }),
+    }
+}
+
+/// `--define` values as naga_oil's shader defs: no value or `true`/`false` a bool, else an
+/// integer (`7`, `-1`; `7u` unsigned).
+fn shader_defs(c: &Composition) -> Result<std::collections::HashMap<String, naga_oil::compose::ShaderDefValue>, CheckError> {
+    use naga_oil::compose::ShaderDefValue as V;
+    c.defines
+        .iter()
+        .map(|(n, v)| {
+            let value = match v.as_deref() {
+                None | Some("true") => V::Bool(true),
+                Some("false") => V::Bool(false),
+                Some(s) => match (s.strip_suffix('u').map(str::parse::<u32>), s.parse::<i32>()) {
+                    (Some(Ok(u)), _) => V::UInt(u),
+                    (_, Ok(i)) => V::Int(i),
+                    _ => return Err(CheckError::Input(format!("--define {n}={s}: the value must be true, false or an integer (7, -1, 7u)"))),
+                },
+            };
+            Ok((n.clone(), value))
+        })
+        .collect()
+}
+
+/// A naga_oil module: its import path, file and text.
+struct OilModule {
+    path: String,
+    source: Source,
+    /// The file's `#import`s (module paths; an imported item's module is its prefix).
+    imports: Vec<String>,
+}
+
+fn oil_module(source: Source, as_name: Option<&str>) -> Option<OilModule> {
+    let (name, imports, _) = naga_oil::compose::get_preprocessor_data(&source.text);
+    let path = as_name.map(String::from).or(name)?;
+    Some(OilModule { path, imports: imports.into_iter().map(|i| i.import).collect(), source })
+}
+
+/// The tree of `sources[0]` composed by naga_oil, as WGSL text (the root's names as written, the
+/// imported ones decorated), and each decorated name's origin.
+fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+    use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
+    let roots = roots(sources, c);
+    let defs = shader_defs(c)?;
+    // the modules: stubs first, then the files given, then every .wgsl under the roots
+    let mut modules: Vec<OilModule> = Vec::new();
+    let mut stubbed = Vec::new();
+    for (m, s) in stubs(c)? {
+        stubbed.push(m.clone());
+        modules.push(oil_module(s, Some(&m)).expect("a stub has a name"));
+    }
+    for s in &sources[1..] {
+        match oil_module(s.clone(), None) {
+            Some(m) => modules.push(m),
+            None => {
+                return Err(CheckError::Input(format!(
+                    "{}: no #define_import_path: with naga_oil imports, give the sampler's file first and its modules by --shader-root (or as files with their #define_import_path)",
+                    s.name
+                )));
+            }
+        }
+    }
+    let mut found = Vec::new();
+    for r in &roots {
+        if !r.is_dir() {
+            return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
+        }
+        scan(r, &["wgsl"], &mut found);
+    }
+    let root_path = std::fs::canonicalize(&sources[0].name).ok();
+    for f in found {
+        if std::fs::canonicalize(&f).ok() == root_path {
+            continue;
+        }
+        let Ok(text) = std::fs::read_to_string(&f) else { continue };
+        if let Some(m) = oil_module(Source { name: f.display().to_string(), text }, None)
+            && !modules.iter().any(|x| x.path == m.path)
+        {
+            modules.push(m);
+        }
+    }
+    let root = oil_module(sources[0].clone(), Some("")).expect("named");
+    // the modules the root needs, each after those it imports
+    let mut order: Vec<usize> = Vec::new();
+    fn visit(from: &OilModule, modules: &[OilModule], roots: &[PathBuf], order: &mut Vec<usize>, stack: &mut Vec<String>) -> Result<(), CheckError> {
+        for import in &from.imports {
+            let parent = import.rsplit_once("::").map(|(p, _)| p);
+            let Some(i) = modules.iter().position(|m| &m.path == import).or_else(|| modules.iter().position(|m| Some(m.path.as_str()) == parent)) else {
+                let at = from.source.text.find(import.as_str()).map(|b| line_col(&from.source.text, b));
+                let at = at.map_or(from.source.name.clone(), |(l, c)| format!("{}:{l}:{c}", from.source.name));
+                let names: Vec<&str> = modules.iter().map(|m| m.path.as_str()).collect();
+                let close = crate::scene::suggest::closest(import, names.iter().copied())
+                    .or_else(|| parent.and_then(|p| crate::scene::suggest::closest(p, names.iter().copied())));
+                return Err(CheckError::Input(format!(
+                    "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
+                    show_roots(roots),
+                    close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
+                    if names.is_empty() { "none".to_string() } else { names.join(", ") },
+                )));
+            };
+            if order.contains(&i) {
+                continue;
+            }
+            if stack.contains(&modules[i].path) {
+                return Err(CheckError::Input(format!("{}: imports form a cycle: {} -> {}", modules[i].source.name, stack.join(" -> "), modules[i].path)));
+            }
+            stack.push(modules[i].path.clone());
+            visit(&modules[i], modules, roots, order, stack)?;
+            stack.pop();
+            order.push(i);
+        }
+        Ok(())
+    }
+    visit(&root, &modules, &roots, &mut order, &mut Vec::new())?;
+    let mut composer = Composer::default().with_capabilities(naga::valid::Capabilities::all());
+    let oil_error = |e: naga_oil::compose::ComposerError, composer: &Composer, module: &str| {
+        let text = e.emit_to_string(composer);
+        // codespan's "┌─ file:line:col" first, as compilers write it
+        let at = text.lines().find_map(|l| l.trim_start().strip_prefix("┌─ ")).map(str::trim).unwrap_or("");
+        // naga_oil parses a module when a root needs it: the file says which module erred
+        let module = modules
+            .iter()
+            .find(|m| at.rsplitn(3, ':').nth(2) == Some(m.source.name.as_str()))
+            .map_or(module.to_string(), |m| m.path.clone());
+        CheckError::Wgsl(format!("{at}: error in module {module}: {}\n{text}", e.inner))
+    };
+    for &i in &order {
+        let m = &modules[i];
+        let added = composer
+            .add_composable_module(ComposableModuleDescriptor {
+                source: &m.source.text,
+                file_path: &m.source.name,
+                language: ShaderLanguage::Wgsl,
+                as_name: stubbed.contains(&m.path).then(|| m.path.clone()),
+                shader_defs: defs.clone(),
+                ..Default::default()
+            })
+            .map(|_| ());
+        added.map_err(|e| oil_error(e, &composer, &m.path))?;
+    }
+    let module = composer
+        .make_naga_module(NagaModuleDescriptor { source: &sources[0].text, file_path: &sources[0].name, shader_type: ShaderType::Wgsl, shader_defs: defs, additional_imports: &[] })
+        .map_err(|e| oil_error(e, &composer, &format!("{} (the sampler's file)", root_name(&sources[0]))))?;
+    let suffixes: Vec<(String, String)> = order.iter().map(|&i| (modules[i].path.clone(), Composer::decorated_name(Some(&modules[i].path), ""))).collect();
+    let mut origins = Vec::new();
+    for name in super::compose::global_names(&module) {
+        if let Some((path, suffix)) = suffixes.iter().find(|(_, s)| name.ends_with(s.as_str())) {
+            origins.push((name.clone(), path.clone(), name[..name.len() - suffix.len()].to_string()));
+        }
+    }
+    Ok((write_wgsl(&module, naga::valid::Capabilities::all())?, origins))
+}
+
+/// `text` without terminal colour codes (`ESC [ … m`), which wesl's diagnostics hold.
+fn strip_ansi(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        if c == '\u{1b}' {
+            for c in chars.by_ref() {
+                if c.is_ascii_alphabetic() {
+                    break;
+                }
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// The sampler file's own import path, or its file name.
+fn root_name(s: &Source) -> String {
+    naga_oil::compose::get_preprocessor_data(&s.text).0.unwrap_or_else(|| s.name.clone())
+}
+
+/// A validated module written back as WGSL, with the names as the module holds them: naga's
+/// writer appends `_` to a name that ends in a digit (`v0` → `v0_`), which is undone here.
+pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities) -> Result<String, CheckError> {
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        .validate(module)
+        .map_err(|e| CheckError::Internal(format!("the composed module does not validate: {}", e.as_inner())))?;
+    let text = naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty())
+        .map_err(|e| CheckError::Internal(format!("naga's WGSL writer failed: {e}")))?;
+    Ok(undo_digit_suffix(&text))
+}
+
+/// `name0_` → `name0` for every identifier that ends in a digit and one underscore.
+fn undo_digit_suffix(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let b = text.as_bytes();
+    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut i = 0;
+    while i < b.len() {
+        if ident(b[i]) && (i == 0 || !ident(b[i - 1])) {
+            let start = i;
+            while i < b.len() && ident(b[i]) {
+                i += 1;
+            }
+            let word = &text[start..i];
+            let w = word.as_bytes();
+            if w.len() >= 3 && !w[0].is_ascii_digit() && w[w.len() - 1] == b'_' && w[w.len() - 2].is_ascii_digit() {
+                out.push_str(&word[..word.len() - 1]);
+            } else {
+                out.push_str(word);
+            }
+        } else {
+            out.push(text[i..].chars().next().expect("in range"));
+            i += text[i..].chars().next().expect("in range").len_utf8();
+        }
+    }
+    out
+}
+
+#[cfg(not(feature = "wesl"))]
+fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+    Err(CheckError::Input(format!("{}: WESL imports need lobes built with the feature \"wesl\" (the CLI has it)", sources[0].name)))
+}
+
+/// lobes' WESL resolver: `package::a::b` is `a/b.wesl` (or `.wgsl`) under the first shader root
+/// that has it, a stub where one is given.
+#[cfg(feature = "wesl")]
+struct Roots {
+    roots: Vec<PathBuf>,
+    stubs: Vec<(String, Source)>,
+    /// Module paths (`package::a::b`) of the files under the roots, for "closest" names.
+    known: Vec<String>,
+}
+
+#[cfg(feature = "wesl")]
+impl Roots {
+    fn file(&self, path: &wesl::ModulePath) -> Option<PathBuf> {
+        self.roots.iter().find_map(|r| {
+            let mut p = r.clone();
+            p.extend(&path.components);
+            ["wesl", "wgsl"].iter().map(|e| p.with_extension(e)).find(|f| f.is_file())
+        })
+    }
+    fn stub(&self, path: &wesl::ModulePath) -> Option<&Source> {
+        let shown = path.to_string();
+        self.stubs.iter().find(|(m, _)| *m == shown || format!("package::{m}") == shown).map(|(_, s)| s)
+    }
+}
+
+#[cfg(feature = "wesl")]
+impl wesl::Resolver for Roots {
+    fn resolve_source<'a>(&'a self, path: &wesl::ModulePath) -> Result<std::borrow::Cow<'a, str>, wesl::ResolveError> {
+        if let Some(s) = self.stub(path) {
+            return Ok(s.text.as_str().into());
+        }
+        let not_found = |why: String| wesl::ResolveError::ModuleNotFound(path.clone(), why);
+        let Some(f) = self.file(path) else {
+            let shown = path.to_string();
+            let close = crate::scene::suggest::closest(&shown, self.known.iter().map(String::as_str));
+            return Err(not_found(format!(
+                "unresolved import: no file {}.wesl or .wgsl under the shader roots ({}){}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {shown}=FILE",
+                path.components.join("/"),
+                show_roots(&self.roots),
+                close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
+                if self.known.is_empty() { "none".to_string() } else { self.known.join(", ") },
+            )));
+        };
+        std::fs::read_to_string(&f).map(Into::into).map_err(|e| not_found(format!("{}: {e}", f.display())))
+    }
+    fn display_name(&self, path: &wesl::ModulePath) -> Option<String> {
+        match self.stub(path) {
+            Some(s) => Some(s.name.clone()),
+            None => self.file(path).map(|f| f.display().to_string()),
+        }
+    }
+}
+
+/// The tree of `sources[0]` composed by the wesl crate: WGSL text (the root's names as written,
+/// imported ones mangled) and each mangled name's origin.
+#[cfg(feature = "wesl")]
+fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+    use wesl::SourceMap;
+    if let Some(s) = sources.get(1) {
+        return Err(CheckError::Input(format!(
+            "{}: with WESL imports give only the sampler's file; the modules it imports are found under --shader-root",
+            s.name
+        )));
+    }
+    let roots = roots(sources, c);
+    for r in &roots {
+        if !r.is_dir() {
+            return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
+        }
+    }
+    // the root's module path: its file under the first root that holds it
+    let file = std::fs::canonicalize(&sources[0].name).map_err(|e| CheckError::Input(format!("{}: {e}", sources[0].name)))?;
+    let (base, rel) = roots
+        .iter()
+        .find_map(|r| {
+            let r = std::fs::canonicalize(r).ok()?;
+            file.strip_prefix(&r).ok().map(|rel| (r.clone(), rel.with_extension("")))
+        })
+        .ok_or_else(|| CheckError::Input(format!("{}: not under any shader root ({}); WESL's `package::` paths start at a root", sources[0].name, show_roots(&roots))))?;
+    let mut known = Vec::new();
+    for r in &roots {
+        let mut files = Vec::new();
+        scan(r, &["wesl", "wgsl"], &mut files);
+        for f in files {
+            if let Ok(rel) = f.strip_prefix(r) {
+                let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
+                known.push(format!("package::{}", comps.join("::")));
+            }
+        }
+    }
+    let components: Vec<String> = rel.iter().map(|c| c.to_string_lossy().into_owned()).collect();
+    let root_path = wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components };
+    let _ = base;
+    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known };
+    let mut features = wesl::Features::default();
+    for (n, v) in &c.defines {
+        let on = match v.as_deref() {
+            None | Some("true") => true,
+            Some("false") => false,
+            Some(other) => return Err(CheckError::Input(format!("--define {n}={other}: WESL's @if features are true or false"))),
+        };
+        features.flags.insert(n.clone(), on.into());
+    }
+    let options = wesl::CompileOptions {
+        imports: true,
+        condcomp: true,
+        strip: true,
+        lazy: true,
+        keep_root: true,
+        mangle_root: false,
+        validate: false,
+        features,
+        ..Default::default()
+    };
+    let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
+    compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
+    let result = compiler.compile(&root_path).map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
+    let mut origins = Vec::new();
+    use wesl::syntax::GlobalDeclaration as G;
+    for decl in &result.syntax.global_declarations {
+        let id = match decl.node() {
+            G::Declaration(d) => Some(&d.ident),
+            G::TypeAlias(d) => Some(&d.ident),
+            G::Struct(d) => Some(&d.ident),
+            G::Function(d) => Some(&d.ident),
+            _ => None,
+        };
+        if let Some(id) = id {
+            let name = id.name().to_string();
+            if let Some((path, item)) = result.sourcemap.as_ref().and_then(|m| m.get_decl(&name)) {
+                origins.push((name.clone(), path.to_string(), item.to_string()));
+            }
+        }
+    }
+    Ok((result.to_string(), origins))
+}
+
+/// Replaces the body of each function in `functions` (handles of `module`, parsed from `text`)
+/// with `body(function)`, keeping the text's line count (the body's newlines stay), so that
+/// every later line keeps its number.
+pub(super) fn replace_bodies(text: &str, module: &naga::Module, functions: &[(naga::Handle<naga::Function>, String)]) -> Result<String, CheckError> {
+    let mut spans: Vec<(usize, usize, &str)> = Vec::new();
+    for (h, body) in functions {
+        let span = module.functions.get_span(*h).to_range().ok_or_else(|| CheckError::Internal("a function without a span".into()))?;
+        let decl = &text[span.clone()];
+        // the body: the first `{` after the argument list's `)`
+        let open_args = decl.find('(').ok_or_else(|| CheckError::Internal("a function without arguments".into()))?;
+        let mut depth = 0i32;
+        let mut close_args = None;
+        for (i, ch) in decl[open_args..].char_indices() {
+            match ch {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        close_args = Some(open_args + i);
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let close_args = close_args.ok_or_else(|| CheckError::Internal("unbalanced parentheses".into()))?;
+        let open = close_args + decl[close_args..].find('{').ok_or_else(|| CheckError::Internal("a function without a body".into()))?;
+        let end = decl.rfind('}').ok_or_else(|| CheckError::Internal("a function without a body".into()))?;
+        spans.push((span.start + open, span.start + end + 1, body.as_str()));
+    }
+    spans.sort();
+    let mut out = String::with_capacity(text.len());
+    let mut at = 0;
+    for (start, end, body) in spans {
+        out.push_str(&text[at..start]);
+        out.push_str(body);
+        out.push_str(&"\n".repeat(text[start..end].matches('\n').count()));
+        at = end;
+    }
+    out.push_str(&text[at..]);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draw_orders() {
+        assert_eq!(Draw::components(&[]), [0, 1, 2, 3]);
+        assert_eq!(Draw::components(&[Draw::Event, Draw::X, Draw::Y]), [2, 0, 1, 3]);
+        assert_eq!(Draw::components(&[Draw::X, Draw::Event, Draw::Event, Draw::Y]), [0, 2, 3, 1]);
+        assert_eq!(Draw::list(&[2, 0, 1, 3], 3), "event,x,y");
+        assert!(Draw::parse_list("x,x").is_err());
+        assert!(Draw::parse_list("z").unwrap_err().contains("'z' is not a draw"));
+    }
+
+    #[test]
+    fn digit_suffixes_are_undone() {
+        assert_eq!(undo_digit_suffix("fn f0_(a: f32) -> f32 { let x_1 = a; return v2_ + b_; }"), "fn f0(a: f32) -> f32 { let x_1 = a; return v2 + b_; }");
+    }
+
+    #[test]
+    fn bodies_are_replaced_keeping_lines() {
+        let text = "fn a() -> f32 {\n  return 1.0;\n}\nfn r(s: ptr<function, u32>) -> f32 {\n  *s = *s + 1u;\n  return f32(*s);\n}\nfn b() -> f32 { return r_(); }\n";
+        let text = text.replace("r_()", "2.0");
+        let module = naga::front::wgsl::parse_str(&text).unwrap();
+        let (h, _) = module.functions.iter().find(|(_, f)| f.name.as_deref() == Some("r")).unwrap();
+        let out = replace_bodies(&text, &module, &[(h, "{ return 0.5; }".into())]).unwrap();
+        assert_eq!(out.lines().count(), text.lines().count());
+        assert!(out.contains("fn r(s: ptr<function, u32>) -> f32 { return 0.5; }"), "{out}");
+        assert_eq!(out.lines().nth(7), Some("fn b() -> f32 { return 2.0; }"));
+        naga::front::wgsl::parse_str(&out).unwrap();
+    }
+
+    #[test]
+    fn dialects() {
+        let s = |name: &str, text: &str| vec![Source { name: name.into(), text: text.into() }];
+        assert_eq!(dialect(&s("a.wgsl", "fn f() {}")), Dialect::Wgsl);
+        assert_eq!(dialect(&s("a.wgsl", "#import a::b::{c}\nfn f() {}")), Dialect::NagaOil);
+        assert_eq!(dialect(&s("a.wgsl", "import package::maths::pi;\nfn f() {}")), Dialect::Wesl);
+        assert_eq!(dialect(&s("a.wesl", "fn f() {}")), Dialect::Wesl);
+    }
+}
