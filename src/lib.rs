@@ -36,6 +36,10 @@
 #[cfg(feature = "check")]
 pub mod atomic;
 #[cfg(feature = "check")]
+pub mod folder_names;
+#[cfg(feature = "check")]
+pub mod suggest;
+#[cfg(feature = "check")]
 pub mod check;
 #[cfg(feature = "cli")]
 pub mod cli;

@@ -255,7 +255,7 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bo
             return Err(CheckError::Input(format!(
                 "--rand {name}: no function `{name}` in {}{} (functions there: {})",
                 code.files.join(", "),
-                crate::scene::suggest::did_you_mean(name, known.iter().map(String::as_str)),
+                crate::suggest::did_you_mean(name, known.iter().map(String::as_str)),
                 known.join(", ")
             )));
         }

@@ -318,8 +318,8 @@ impl Settings {
         if !self.incident_phi.is_finite() {
             return bad("--incident-phi", format!("{} is not finite", self.incident_phi));
         }
-        if !(1..=crate::scene::MAX_SAMPLES).contains(&self.samples) {
-            return bad("--samples", format!("{} is not allowed; give a whole number from 1 to 2^40 ({})", self.samples, crate::scene::MAX_SAMPLES));
+        if !(1..=crate::engine::job::MAX_SAMPLES).contains(&self.samples) {
+            return bad("--samples", format!("{} is not allowed; give a whole number from 1 to 2^40 ({})", self.samples, crate::engine::job::MAX_SAMPLES));
         }
         let t = self.timeout.as_secs_f64();
         if !(t > 0.0 && t <= MAX_TIMEOUT_SECONDS) {

@@ -429,8 +429,8 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
                 let at = from.source.text.find(import.as_str()).map(|b| line_col(&from.source.text, b));
                 let at = at.map_or(from.source.name.clone(), |(l, c)| format!("{}:{l}:{c}", from.source.name));
                 let names: Vec<&str> = modules.iter().map(|m| m.path.as_str()).collect();
-                let close = crate::scene::suggest::closest(import, names.iter().copied())
-                    .or_else(|| parent.and_then(|p| crate::scene::suggest::closest(p, names.iter().copied())));
+                let close = crate::suggest::closest(import, names.iter().copied())
+                    .or_else(|| parent.and_then(|p| crate::suggest::closest(p, names.iter().copied())));
                 return Err(CheckError::Input(format!(
                     "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
                     show_roots(roots),
@@ -591,7 +591,7 @@ impl wesl::Resolver for Roots {
         let not_found = |why: String| wesl::ResolveError::ModuleNotFound(path.clone(), why);
         let Some(f) = self.file(path) else {
             let shown = path.to_string();
-            let close = crate::scene::suggest::closest(&shown, self.known.iter().map(String::as_str));
+            let close = crate::suggest::closest(&shown, self.known.iter().map(String::as_str));
             return Err(not_found(format!(
                 "unresolved import: no file {}.wesl or .wgsl under the shader roots ({}){}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {shown}=FILE",
                 path.components.join("/"),

@@ -1,6 +1,9 @@
 //! What a histogram run samples, and what it returns. Shared by the GPU engine ([`crate::engine::gpu`])
 //! and the CPU reference engine ([`crate::engine::cpu`]).
 
+/// The largest sample count a case or a check may ask for (2^40; counts are exact far beyond it).
+pub const MAX_SAMPLES: u64 = 1 << 40;
+
 use crate::reference::discrete::{AliasTable, Distribution};
 use crate::reference::dielectric::{Event, RoughDielectric};
 use crate::reference::{Invalid, Lobe};

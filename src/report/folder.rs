@@ -19,15 +19,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{Read, Seek, Write};
 use std::path::{Path, PathBuf};
 
-/// The lock file at the top of the folder (kept after the run: removing it would race).
-pub const LOCK_FILE: &str = ".lobes.lock";
-/// The run's summary for CI (JUnit XML).
-pub const JUNIT_XML: &str = "junit.xml";
-/// The run's summary, written last.
-pub const SUMMARY_JSON: &str = "summary.json";
-
-/// The files a run writes at the top of its folder, which no case may be named.
-pub const TOP_LEVEL_FILES: [&str; 4] = [JUNIT_XML, super::html::INDEX_HTML, SUMMARY_JSON, LOCK_FILE];
+pub use crate::folder_names::{JUNIT_XML, LOCK_FILE, SUMMARY_JSON, TOP_LEVEL_FILES, reserved};
 
 /// The files of a case folder that `lobes run` and `lobes merge` write: only these are removed
 /// when the folder is cleaned (a user's own files there, and shard files, are kept). The first
@@ -45,20 +37,6 @@ pub const CASE_FILES: [&str; 10] = [
     "albedo.png",
 ];
 
-/// Why a case name is reserved, if it is: it names a file the run writes at the top of the
-/// output folder (ignoring case: some file systems do), or a temporary file.
-///
-/// ```
-/// assert!(lobes::report::folder::reserved("Summary.JSON").is_some());
-/// assert!(lobes::report::folder::reserved("ggx-vndf").is_none());
-/// ```
-pub fn reserved(name: &str) -> Option<String> {
-    let lower = name.to_lowercase();
-    if let Some(file) = TOP_LEVEL_FILES.iter().find(|f| **f == lower) {
-        return Some(format!("OUT/{file} is a file the run writes itself"));
-    }
-    crate::atomic::is_temporary(&lower).then(|| "names like .lobes-*.tmp are lobes' temporary files, removed by the next run".to_string())
-}
 
 /// A folder lobes cannot use: not a folder, cannot be created, or in use by another lobes.
 /// Bad input: the CLI exits with its usage code, and writes nothing into the folder.

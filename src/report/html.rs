@@ -17,7 +17,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// The file name in the output folder.
-pub const INDEX_HTML: &str = "index.html";
+pub use crate::folder_names::INDEX_HTML;
 
 /// The pictures a case folder may hold, in the order shown, with what each shows.
 const PICTURES: [(&str, &str); 6] = [

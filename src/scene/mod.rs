@@ -40,7 +40,8 @@
 //! fuzzes it).
 
 mod select;
-pub mod suggest;
+/// "Did you mean" ([`crate::suggest`], here too for the scene's messages).
+pub use crate::suggest;
 mod sweep;
 pub mod template;
 mod user;
@@ -68,8 +69,7 @@ pub const DEFAULT_SCENE: &str = include_str!("../../scenes/all-lobes.toml");
 /// The tutorial's examples as a scene.
 pub const TUTORIAL_SCENE: &str = include_str!("../../scenes/tutorial.toml");
 
-/// The largest sample count a case may ask for (2^40; counts are exact far beyond it).
-pub const MAX_SAMPLES: u64 = 1 << 40;
+pub use crate::engine::job::MAX_SAMPLES;
 /// The most bins (rows × cols, or discrete items) a case may have: 2^24. The GPU engine splits
 /// larger histograms into tiles that fit the adapter; this cap bounds the f64 quadrature, the
 /// heat maps and `histogram.json`.
@@ -587,7 +587,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, room: u64
         .into_iter()
         .map(|point| {
             let name = format!("{name}{}", point.suffix);
-            if let Some(why) = crate::report::folder::reserved(&name) {
+            if let Some(why) = crate::folder_names::reserved(&name) {
                 return Err(ctx.err(name_span.clone(), format!("case name '{name}' is reserved: {why} (each case writes OUT/<case>/); rename the case")));
             }
             if name.len() > MAX_NAME_LEN {

@@ -55,7 +55,12 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 # [[case]]
 # name = "my-ggx"
 # sampler = {{ wgsl = ["my_ggx.wgsl"], sample = "my_sample", pdf = "my_pdf", eval = "my_eval" }}
-#                         # files relative to the scene; eval is optional
+#                         # files relative to the scene; eval is optional; sample, pdf and eval
+#                         # are function names or WGSL calls over wi, u, d, params, p0…p15, rng
+# (more keys of sampler, as the flags of lobes check; docs/testing-your-own-sampler.md):
+#   shader_root = ["shaders"], define = {{ NAME = true }}, stub = {{ "package::bindings" = "stub.wesl" }}
+#   rand = ["rand_f"], rand_order = "event,x,y", sample_returns = "half-vector"
+#   incident = "upper", reflection_only = true, u_open = true, measure = "projected", frame = "y-up"
 # params = [0.3, 0.3]     # up to {max_params} numbers, params[i / 4][i % 4] in WGSL; default none
 # domain = "sphere"       # sphere | plane (then bounds = [x0, y0, x1, y1])
 # incident_theta = {user_theta:?}   # degrees, 0 ≤ θ ≤ 180 (a user sampler's default)

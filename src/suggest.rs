@@ -8,7 +8,7 @@ const MIN_SIMILARITY: f64 = 0.8;
 /// The candidate most like `word`, if any is like it at all.
 ///
 /// ```
-/// use lobes::scene::suggest::closest;
+/// use lobes::suggest::closest;
 /// assert_eq!(closest("alpah", ["alpha", "alpha_x", "lobe"]), Some("alpha"));
 /// assert_eq!(closest("GGX", ["ward", "ggx"]), Some("ggx"));
 /// assert_eq!(closest("phong", ["ward", "beckmann", "ggx"]), None);
