@@ -183,8 +183,7 @@ fn an_ill_conditioned_pdf_is_judged_against_its_f32_conditioning() {
     let judged = |factor: &str| {
         let mut sources = vec![lobes::check::Source::read(&files(&["ggx_vndf.wgsl"])[0]).unwrap()];
         sources.push(lobes::check::Source { name: "mz.wgsl".into(), text: mz(factor) });
-        let s = UserSampler { sources, sample: "mz_sample".into(), pdf: "mz_pdf".into(), eval: None, domain: Domain::Sphere };
-        s.validate().unwrap_or_else(|e| panic!("{e}"));
+        let s = UserSampler::from_sources(sources, "mz_sample", "mz_pdf", None, Domain::Sphere).unwrap_or_else(|e| panic!("{e}"));
         run(&gpu, format!("m.z-form GGX × {factor}"), &s, settings.clone()).report
     };
     let r = judged("1.0");
