@@ -492,6 +492,7 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(St
 }
 
 /// `text` without terminal colour codes (`ESC [ … m`), which wesl's diagnostics hold.
+#[cfg(feature = "wesl")]
 fn strip_ansi(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut chars = text.chars();
