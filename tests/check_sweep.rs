@@ -134,7 +134,8 @@ fn correct_samplers_pass_over_their_documented_range() {
 #[test]
 fn broken_samplers_still_fail_by_their_check() {
     let gpu = gpu();
-    let cases: Vec<(&str, UserSampler, Vec<f64>, f64, &[&str])> = vec![
+    type Case<'a> = (&'a str, UserSampler, Vec<f64>, f64, &'a [&'a str]);
+    let cases: Vec<Case> = vec![
         ("broken_no_jacobian", sampler(&["ggx_vndf.wgsl", "broken_no_jacobian.wgsl"], "broken_sample_no_jacobian", "broken_pdf_no_jacobian", None), vec![0.3, 0.3], 30.0, &["jacobian", "chi2"]),
         ("broken_no_jacobian", sampler(&["ggx_vndf.wgsl", "broken_no_jacobian.wgsl"], "broken_sample_no_jacobian", "broken_pdf_no_jacobian", None), vec![0.0064, 0.0064], 45.0, &["jacobian", "chi2"]),
         ("broken_mitsuba_g1", sampler(&["beckmann_vndf.wgsl", "broken_mitsuba_g1.wgsl"], "mitsuba_sample", "mitsuba_pdf", None), vec![0.8, 0.8], 85.0, &["normalization"]),

@@ -91,7 +91,7 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
         let in_domain = d[..3].iter().all(|x| x.is_finite())
             && match bounds {
                 Some([x0, y0, x1, y1]) => (x0..=x1).contains(&(d[0] as f64)) && (y0..=y1).contains(&(d[1] as f64)),
-                None => (p[6][2] as f64 - 1.0).abs() <= 1e-3,
+                None => is_unit(p[6][2]),
             };
         let fn_pdf = p[6][0];
         let failed = if !pdf.is_finite() || pdf < 0.0 {
@@ -117,4 +117,9 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
     }
     r.passed = r.first_failure.is_none();
     r
+}
+
+/// Whether a direction's length |d| is 1 to the hard cases' tolerance, 10⁻³ (NaN is not).
+pub(super) fn is_unit(length: f32) -> bool {
+    (length as f64 - 1.0).abs() <= 1e-3
 }

@@ -512,7 +512,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     // sphere, and the cause is then the length, not the density
     let worst_length = probes.iter().zip(&probe_u).find(|(_, u)| **u == jac.worst_u).map(|(p, _)| p[6][2]);
     let not_unit = match worst_length {
-        Some(l) if !plane && !jac.passed && !((l as f64 - 1.0).abs() <= 1e-3) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
+        Some(l) if !plane && !jac.passed && !hard::is_unit(l) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
         _ => String::new(),
     };
     let summary = if jac.applicable {

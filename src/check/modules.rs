@@ -232,6 +232,10 @@ pub fn dialect(sources: &[Source]) -> Dialect {
     }
 }
 
+/// An item of an imported module: (its name in the composed text, the module path, its name in
+/// that module).
+pub(super) type Origin = (String, String, String);
+
 /// The user's code before lobes' glue: the parts of its text, and where names from other modules
 /// came from.
 #[derive(Debug, Clone)]
@@ -239,8 +243,8 @@ pub(super) struct UserCode {
     pub dialect: Dialect,
     /// The files as they are (plain WGSL), or one part: the composed tree.
     pub parts: Vec<Source>,
-    /// (name in the text, module path, name in that module) of the items of imported modules.
-    pub origins: Vec<(String, String, String)>,
+    /// Where the items of imported modules came from.
+    pub origins: Vec<Origin>,
     /// The files the tree was read from (for messages).
     pub files: Vec<String>,
 }
@@ -378,7 +382,7 @@ fn oil_module(source: Source, as_name: Option<&str>) -> Option<OilModule> {
 
 /// The tree of `sources[0]` composed by naga_oil, as WGSL text (the root's names as written, the
 /// imported ones decorated), and each decorated name's origin.
-fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
     use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
     let roots = roots(sources, c);
     let defs = shader_defs(c)?;
@@ -554,7 +558,7 @@ fn undo_digit_suffix(text: &str) -> String {
 }
 
 #[cfg(not(feature = "wesl"))]
-fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
     Err(CheckError::Input(format!("{}: WESL imports need lobes built with the feature \"wesl\" (the CLI has it)", sources[0].name)))
 }
 
@@ -614,7 +618,7 @@ impl wesl::Resolver for Roots {
 /// The tree of `sources[0]` composed by the wesl crate: WGSL text (the root's names as written,
 /// imported ones mangled) and each mangled name's origin.
 #[cfg(feature = "wesl")]
-fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<(String, String, String)>), CheckError> {
+fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
     use wesl::SourceMap;
     if let Some(s) = sources.get(1) {
         return Err(CheckError::Input(format!(

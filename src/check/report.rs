@@ -126,7 +126,7 @@ pub fn grouped(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::new();
     for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
             out.push(' ');
         }
         out.push(c);
@@ -140,7 +140,8 @@ pub fn invalid_dominates(invalid: &[u64; 4], expected: f64, statistic: f64) -> O
     let observed: u64 = invalid.iter().sum();
     let o = observed as f64;
     let share = if expected > 0.0 { (o - expected).powi(2) / expected } else if observed > 0 { f64::INFINITY } else { 0.0 };
-    if observed == 0 || !(share > 0.5 * statistic) || o <= expected {
+    // (a NaN share or statistic says nothing dominates)
+    if observed == 0 || share.partial_cmp(&(0.5 * statistic)) != Some(std::cmp::Ordering::Greater) || o <= expected {
         return None;
     }
     let reasons: Vec<String> = REASONS.iter().zip(invalid).filter(|(_, n)| **n > 0).map(|(r, n)| format!("{r} {}", grouped(*n))).collect();

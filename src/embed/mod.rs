@@ -65,7 +65,7 @@ mod discrete;
 mod namespace;
 // the text rules; besides `with_bindings` they are build.rs's (and the unit tests')
 #[allow(dead_code)]
-mod text;
+pub(crate) mod text;
 
 #[cfg(feature = "wgpu")]
 pub use discrete::DiscreteBuffers;
@@ -444,7 +444,7 @@ pub fn discrete_table_wgsl(name: &str, bindings: DiscreteBindings) -> String {
     let prefix = format!("{PREFIX}_{name}");
     let defined = Module::Discrete.short_names();
     namespace::rename(&bindings.apply(discrete_short()), |t| {
-        defined.iter().any(|d| *d == t).then(|| prefixed(&prefix, t.strip_prefix("discrete_").or_else(|| t.strip_prefix("DISCRETE_")).unwrap_or(t)))
+        defined.contains(&t).then(|| prefixed(&prefix, t.strip_prefix("discrete_").or_else(|| t.strip_prefix("DISCRETE_")).unwrap_or(t)))
     })
 }
 
@@ -560,6 +560,7 @@ fn needed_by_import(m: Module, modules: &[Module]) -> bool {
 /// composer.make_naga_module(NagaModuleDescriptor { source: shader, file_path: "mine.wgsl", ..Default::default() }).unwrap();
 /// ```
 #[cfg(feature = "naga-oil")]
+#[allow(clippy::result_large_err)] // naga_oil's own error, as its Composer returns it
 pub fn add_naga_oil_modules(composer: &mut naga_oil::compose::Composer, modules: &[Module]) -> Result<(), naga_oil::compose::ComposerError> {
     for m in naga_oil_modules(modules) {
         if !composer.contains_module(&m.import_path) {

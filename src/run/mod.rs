@@ -144,12 +144,12 @@ pub fn run_case(backend: &mut Backend, case: &Case, range: Range<u64>, progress:
     };
     let total = sampled.counts.total();
     anyhow::ensure!(total == n, "case '{}': {total} samples counted for {n} requested", case.name);
-    if let (Backend::Gpu(engine), Job::Lobe { .. }) = (&mut *backend, &case.job) {
-        if first == 0 {
-            let k = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
-            let dirs = engine.directions(&case.job, SampleRange::whole(case.seed, k as u64))?;
-            sampled.angle = Some(compare::angle_check(&case.job, case.seed, 0, &dirs));
-        }
+    if let (Backend::Gpu(engine), Job::Lobe { .. }) = (&mut *backend, &case.job)
+        && first == 0
+    {
+        let k = ANGLE_CHECK_SAMPLES.min(case.samples.min(u32::MAX as u64) as u32);
+        let dirs = engine.directions(&case.job, SampleRange::whole(case.seed, k as u64))?;
+        sampled.angle = Some(compare::angle_check(&case.job, case.seed, 0, &dirs));
     }
     if let Some(effects) = &case.effects {
         sampled.weighted = Some(match backend {

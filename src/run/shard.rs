@@ -304,10 +304,10 @@ impl ShardFile {
         if let Some(why) = backend_mismatch(&s.backend, &s.adapter) {
             return Err(bad(why));
         }
-        if let Some(w) = &s.weighted {
-            if w.bins.len() != s.counts.len() || w.max_error.len() != s.counts.len() {
-                return Err(bad(format!("field 'weighted' has {} bins where 'counts' has {}", w.bins.len(), s.counts.len())));
-            }
+        if let Some(w) = &s.weighted
+            && (w.bins.len() != s.counts.len() || w.max_error.len() != s.counts.len())
+        {
+            return Err(bad(format!("field 'weighted' has {} bins where 'counts' has {}", w.bins.len(), s.counts.len())));
         }
         Ok(s)
     }

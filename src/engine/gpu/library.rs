@@ -332,11 +332,8 @@ fn parse_and_validate(what: &str, source: &str) -> Result<naga::Module, GpuError
     Ok(module)
 }
 
-// The text rules of lobes::embed and build.rs (`declared`): one file, compiled into each.
-#[path = "../../embed/text.rs"]
-#[allow(dead_code)]
-mod text;
-use text::declared;
+// The text rules of lobes::embed and build.rs (`declared`).
+use crate::embed::text::declared;
 
 /// The `#import` lines a generated file needs: for each module in the import closure of `from`,
 /// the names it declares that `code` uses.
