@@ -65,7 +65,7 @@ mod discrete;
 mod namespace;
 // the text rules; besides `with_bindings` they are build.rs's (and the unit tests')
 #[allow(dead_code)]
-pub(crate) mod text;
+mod text;
 
 #[cfg(feature = "wgpu")]
 pub use discrete::DiscreteBuffers;

@@ -332,8 +332,12 @@ fn parse_and_validate(what: &str, source: &str) -> Result<naga::Module, GpuError
     Ok(module)
 }
 
-// The text rules of lobes::embed and build.rs (`declared`).
-use crate::embed::text::declared;
+// The text rules of lobes::embed and build.rs (`declared`): one file, compiled into each (a
+// `use crate::embed::text` would make the engine and the embed import each other).
+#[path = "../../embed/text.rs"]
+#[allow(dead_code, clippy::duplicate_mod)]
+mod text;
+use text::declared;
 
 /// The `#import` lines a generated file needs: for each module in the import closure of `from`,
 /// the names it declares that `code` uses.
