@@ -2,7 +2,7 @@
 //! histograms whose albedo is judged against f64 quadrature and the weak white furnace, and the
 //! per-bin weight check. Each check is shown to reject a deliberately broken weight.
 
-use lobes::engine::gpu::GpuEngine;
+use lobes::engine::gpu::{Counting, GpuEngine};
 use lobes::engine::gpu::effects::{self, Composed, Specialisation};
 use lobes::engine::job::{Job, SampleRange, Scatter};
 use lobes::reference::effects::Effects;
@@ -36,7 +36,7 @@ fn functions(source: &str) -> Vec<String> {
 
 fn scene_modules(toml: &str) -> Vec<Composed> {
     let scene = Scene::parse("test.toml", toml).unwrap();
-    scene.cases.iter().map(|c| effects::case_module(&c.job, c.effects.as_ref(), 4096, c.job.bins() as u32)).collect()
+    scene.cases.iter().map(|c| effects::case_module(&c.job, c.effects.as_ref(), Counting::Workgroup, c.job.bins() as u32)).collect()
 }
 
 #[test]
@@ -60,7 +60,7 @@ fn modules_hold_only_the_code_their_effects_need() {
 
     // the uber-kernel holds everything, and no override constants
     let e = Effects { fresnel: Fresnel::Dielectric { eta: 1.5 }, masking: Masking::G1 };
-    let uber = effects::compose_effects(&job(LobeKind::Ggx, Method::Ndf, 0.3, 0.3, 10.0), &e, 4096, Specialisation::Uber);
+    let uber = effects::compose_effects(&job(LobeKind::Ggx, Method::Ndf, 0.3, 0.3, 10.0), &e, Counting::Workgroup, Specialisation::Uber);
     let names = functions(&uber.source);
     for f in ["ward_sample", "beckmann_sample_vndf", "ggx_sample_bounded", "fresnel_conductor", "masking_separable"] {
         assert!(names.iter().any(|n| n == f), "uber-kernel lacks {f}");

@@ -18,7 +18,8 @@ struct LobesCheckParams {
     // the histogram's grid
     rows: u32,
     cols: u32,
-    _pad_a: u32,
+    // per-invocation slabs of the histogram (0: global atomics)
+    slabs: u32,
     _pad_b: u32,
     _pad_c: u32,
 }

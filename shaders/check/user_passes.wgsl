@@ -16,6 +16,8 @@
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
+// lobes_check.slabs slabs of rows * cols + 4 cells, one per invocation of lobes_histogram_slabs
+@group(0) @binding(4) var<storage, read_write> lobes_slabs: array<u32>;
 
 // x > 0 and finite, read from the bits (not relying on NaN comparing false, which fast-math
 // lowerings may not keep).
@@ -416,7 +418,9 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
 }
 
 // Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
-// keeps each dispatch under 2^32 samples and adds into 64-bit totals).
+// keeps each dispatch under 2^32 samples and adds into 64-bit totals), one storage atomic per
+// sample: on GPUs. On CPU adapters lobes_histogram_slabs and lobes_reduce_slabs instead
+// (src/engine/gpu/counting.rs chooses).
 @compute @workgroup_size(64)
 fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let first = (gid.x + gid.y * nwg.x * 64u) * lobes_check.samples_per_thread;
@@ -428,4 +432,40 @@ fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
             atomicAdd(&lobes_counts[lobes_cell(s)], 1u);
         }
     }
+}
+
+// The histogram in per-invocation slabs (CPU adapters: llvmpipe serialises the lanes' atomics on
+// shared counters; src/engine/gpu/counting.rs): invocation g of lobes_check.slabs counts samples
+// base + g, base + g + slabs, ... of the dispatch into its own slab with plain adds, which no other
+// invocation touches; lobes_reduce_slabs then adds the slabs into lobes_counts. A slab entry counts
+// some of one dispatch's samples (under 2^32), so none wraps.
+@compute @workgroup_size(8)
+fn lobes_histogram_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = gid.x + gid.y * nwg.x * 8u;
+    let slabs = lobes_check.slabs;
+    if (g >= slabs) {
+        return;
+    }
+    let first = g * (lobes_check.rows * lobes_check.cols + 4u);
+    let wi = lobes_check.wi.xyz;
+    for (var local = g; local < lobes_check.count; local += slabs) {
+        let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+        let w = first + lobes_cell(s);
+        lobes_slabs[w] = lobes_slabs[w] + 1u;
+    }
+}
+
+// lobes_counts[cell] = the sum of the slabs' counts of `cell`, one invocation per cell.
+@compute @workgroup_size(64)
+fn lobes_reduce_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let cell = gid.x + gid.y * nwg.x * 64u;
+    let cells = lobes_check.rows * lobes_check.cols + 4u;
+    if (cell >= cells) {
+        return;
+    }
+    var c = 0u;
+    for (var s = 0u; s < lobes_check.slabs; s++) {
+        c += lobes_slabs[s * cells + cell];
+    }
+    atomicStore(&lobes_counts[cell], c);
 }

@@ -1,8 +1,8 @@
 #define_import_path lobes::kernel
-#import lobes::job::{BINS, CELLS, SAMPLES_PER_THREAD, TILE_BINS, WG_SIZE}
+#import lobes::job::{BINS, CELLS, COUNT_WG, SAMPLES_PER_THREAD, SLABS, TILE_BINS, WG_SIZE}
 #import lobes::bindings::{params, counts, totals}
 #import lobes::rng::add64
-#import lobes::counting::{count_bin, flush_bins}
+#import lobes::counting::{count_bin, flush_bins, start_counting, take_count}
 #import lobes::draw::draw
 
 // The sampling-and-histogram kernels of every job. `lobes::job` is the job's generated module
@@ -10,10 +10,12 @@
 // `draw(index)` (shaders/passes/lobe_draw.wgsl or discrete_draw.wgsl) returns the bin of sample
 // `index` or BINS + reason - 1.
 //
-// Counting is exact: per workgroup, bins are packed two to a u32 word of workgroup atomics
-// (16 bits each; a workgroup draws WG_SIZE * SAMPLES_PER_THREAD <= 65535 samples), flushed into
-// per-chunk u32 global counters (a chunk holds < 2^32 samples), which `fold` adds into 64-bit
-// totals (lo, hi pairs with carry) after every chunk.
+// Counting is exact: the counting module (lobes::counting, src/engine/gpu/counting.rs) counts a
+// chunk's samples in workgroup atomics (a u32 per bin, or two 16-bit counters a word: a workgroup
+// draws WG_SIZE * SAMPLES_PER_THREAD <= 65535 samples) flushed into per-chunk u32 global
+// counters, in those counters directly, or in per-invocation slabs on CPU adapters; a chunk holds
+// at most 2^31 samples, and `fold` adds each chunk's counts into 64-bit totals (lo, hi pairs with
+// carry).
 
 // Where an invocation of a sampling pass is (sample_histogram, and weighted_histogram in
 // shaders/passes/weighted.wgsl).
@@ -41,7 +43,29 @@ fn samples_of(at: Invocation, count: u32) -> u32 {
     return min(SAMPLES_PER_THREAD, (count - first + WG_SIZE - 1u) / WG_SIZE);
 }
 
-@compute @workgroup_size(WG_SIZE)
+// The samples invocation `at` counts of a dispatch of `count`: first + k * stride for k < n, as
+// (first, stride, n). With atomics (SLABS 0) the blocks of sample_of; with slabs invocation g of
+// the SLABS (workgroups of COUNT_WG) takes g, g + SLABS, g + 2 SLABS, ... whatever the count, so
+// every slab is busy; invocations of a grid's last row past SLABS take none.
+fn counted_samples(at: Invocation, count: u32) -> vec3<u32> {
+    if (SLABS == 0u) {
+        return vec3<u32>(sample_of(at, 0u), WG_SIZE, samples_of(at, count));
+    }
+    // (SLABS is not 0 here, but naga refuses a division by the constant 0 even where dead)
+    let slabs = max(SLABS, 1u);
+    let g = invocation_of(at);
+    if (g >= slabs || g >= count) {
+        return vec3<u32>(0u, 1u, 0u);
+    }
+    return vec3<u32>(g, slabs, (count - g + slabs - 1u) / slabs);
+}
+
+// The index of invocation `at` within the counting dispatch.
+fn invocation_of(at: Invocation) -> u32 {
+    return (at.wg.x + at.wg.y * at.nwg.x) * COUNT_WG + at.lid;
+}
+
+@compute @workgroup_size(COUNT_WG)
 fn sample_histogram(at: Invocation) {
     // Per-reason counts in registers, updated without branches (a dynamically indexed
     // private array costs a scatter per SIMD lane on CPU drivers): reasons 1-4 in a vec4, the
@@ -49,10 +73,10 @@ fn sample_histogram(at: Invocation) {
     var invalid = vec4<u32>(0u);
     var invalid_5 = 0u;
     let base = params.base;
-    let first = sample_of(at, 0u);
-    let n = samples_of(at, params.count);
-    for (var k = 0u; k < n; k++) {
-        let cell = draw(add64(base, first + k * WG_SIZE));
+    let span = counted_samples(at, params.count);
+    start_counting(invocation_of(at));
+    for (var k = 0u; k < span.z; k++) {
+        let cell = draw(add64(base, span.x + k * span.y));
         if (cell < BINS) {
             // a pass counts the bins tile_first .. tile_first + TILE_BINS; untiled (TILE_BINS =
             // BINS, tile_first 0) all of them, with no test the compiler cannot remove
@@ -80,14 +104,15 @@ fn sample_histogram(at: Invocation) {
     }
 }
 
-// totals[i] += counts[i] with carry into the high word; counts[i] = 0.
+// totals[i] += the chunk's count of cell i (take_count: counts[i], and the slabs where the
+// counting module has them) with carry into the high word; the chunk's counters are left 0.
 @compute @workgroup_size(WG_SIZE)
 fn fold(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * WG_SIZE;
     if (i >= CELLS) {
         return;
     }
-    let c = atomicExchange(&counts[i], 0u);
+    let c = take_count(i);
     let t = totals[i];
     let lo = t.x + c;
     totals[i] = vec2<u32>(lo, t.y + select(0u, 1u, lo < t.x));

@@ -5,7 +5,8 @@ use super::compose::{Composed, Source};
 use super::modules::{Draw, UserCode, compose_user};
 use super::{CheckError, Domain, UserSampler};
 use crate::engine::gpu::library::{self, File};
-use crate::engine::gpu::{Gpu, GpuError};
+use crate::engine::gpu::counting::SLAB_WORKGROUP;
+use crate::engine::gpu::{Counting, Gpu, GpuError, Strategy};
 use crate::engine::gpu::dispatch::{Pass, Step};
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -27,7 +28,8 @@ pub(super) struct Params {
     pub samples_per_thread: u32,
     pub rows: u32,
     pub cols: u32,
-    pub _pad_a: u32,
+    /// Per-invocation slabs of the histogram pass (set by [`Passes::histogram`]).
+    pub slabs: u32,
     pub _pad_b: u32,
     pub _pad_c: u32,
 }
@@ -376,7 +378,7 @@ impl<'g> Passes<'g> {
     /// `out_bytes` of the buffer it writes (binding 2, or binding 3 for the histogram's counters).
     fn run(&self, entry: &str, params: &Params, input: &[[f32; 4]], invocations: u32, out_bytes: u64, counts: bool) -> Result<Vec<u8>, CheckError> {
         let gpu = self.gpu;
-        let pipeline = self.pipelines.borrow_mut().entry(entry.to_string()).or_insert_with(|| gpu.pipeline(&self.module, None, entry, &[])).clone();
+        let pipeline = self.pipeline(entry);
         let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check params"),
             contents: bytemuck::bytes_of(params),
@@ -445,12 +447,48 @@ impl<'g> Passes<'g> {
         Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons.
-    pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize) -> Result<Vec<u32>, CheckError> {
-        let spt = 64u32;
-        let p = Params { base: split(first), count, samples_per_thread: spt, ..*params };
-        let bytes = self.run("lobes_histogram", &p, &[], count.div_ceil(spt), cells as u64 * 4, true)?;
-        Ok(bytemuck::cast_slice(&bytes).to_vec())
+    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons;
+    /// in per-invocation slabs on a CPU adapter, else in storage atomics
+    /// ([`Counting::choose`]; `force` asks for one, as tests do).
+    pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize, force: Option<Strategy>) -> Result<Vec<u32>, CheckError> {
+        let gpu = self.gpu;
+        let p = Params { base: split(first), count, ..*params };
+        let slabs = match Counting::choose(gpu.info.device_type, &gpu.limits, cells as u32, force) {
+            Counting::Slabs { slabs } => slabs,
+            _ => {
+                let spt = 64u32;
+                let p = Params { samples_per_thread: spt, slabs: 0, ..p };
+                let bytes = self.run("lobes_histogram", &p, &[], count.div_ceil(spt), cells as u64 * 4, true)?;
+                return Ok(bytemuck::cast_slice(&bytes).to_vec());
+            }
+        };
+        let p = Params { slabs, ..p };
+        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("check params"),
+            contents: bytemuck::bytes_of(&p),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bytes = cells as u64 * 4;
+        let counts = gpu.buffer("check counts", bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let slab_buffer = gpu.buffer("check slabs", slabs as u64 * bytes, wgpu::BufferUsages::STORAGE);
+        let (sample, reduce) = (self.pipeline("lobes_histogram_slabs"), self.pipeline("lobes_reduce_slabs"));
+        let bind = |pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]| {
+            let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check slabs"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
+        };
+        let (sample_bind, reduce_bind) = (bind(&sample, &[(0, &uniform), (4, &slab_buffer)]), bind(&reduce, &[(0, &uniform), (3, &counts), (4, &slab_buffer)]));
+        let passes = [
+            Pass { label: "lobes_histogram_slabs", bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &sample, groups: (slabs / SLAB_WORKGROUP) as u64 }] },
+            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (cells as u32).div_ceil(WG) as u64 }] },
+        ];
+        let seconds = gpu.dispatch(&passes)?;
+        self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));
+        Ok(bytemuck::cast_slice(&gpu.read(&counts, bytes)?).to_vec())
+    }
+
+    /// The pipeline of `entry`, made at its first use.
+    fn pipeline(&self, entry: &str) -> wgpu::ComputePipeline {
+        self.pipelines.borrow_mut().entry(entry.to_string()).or_insert_with(|| self.gpu.pipeline(&self.module, None, entry, &[])).clone()
     }
 
     /// Per-invocation weight sums of samples `first .. first + count` (user_passes.wgsl,
@@ -564,7 +602,7 @@ mod tests {
             ("samples_per_thread", offset_of!(Params, samples_per_thread)),
             ("rows", offset_of!(Params, rows)),
             ("cols", offset_of!(Params, cols)),
-            ("_pad_a", offset_of!(Params, _pad_a)),
+            ("slabs", offset_of!(Params, slabs)),
             ("_pad_b", offset_of!(Params, _pad_b)),
             ("_pad_c", offset_of!(Params, _pad_c)),
         ];
@@ -616,5 +654,34 @@ mod tests {
         for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn rng_uniforms(", "fn lobes_user_sample("] {
             assert!(c.text.contains(entry), "{entry}");
         }
+    }
+
+    /// The histogram pass counts alike in per-invocation slabs (CPU adapters) and in storage
+    /// atomics (GPUs), bit for bit, on whatever adapter wgpu finds (lavapipe in CI): a sampler
+    /// that spreads over the sphere's bins and sends known shares of u to each invalid reason.
+    #[test]
+    fn histogram_slabs_count_as_atomics() {
+        let text = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
+                        let z = 2.0 * u.x - 1.0; let r = sqrt(max(1.0 - z * z, 0.0)); let phi = 6.2831853 * u.y;\n\
+                        let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
+                        if (u.z < 0.01) { return vec4<f32>(2.0 * d, 1.0); }\n\
+                        if (u.z < 0.02) { return vec4<f32>(d, 0.0); }\n\
+                        return vec4<f32>(d, 0.25 / 3.14159265); }\n\
+                    fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 0.25 / 3.14159265; }\n";
+        let gpu = Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
+        let passes = Passes::new(&gpu, &compose(&sampler(text)).unwrap()).unwrap();
+        let (rows, cols) = (32, 64);
+        let params = Params { wi: [0.0, 0.0, 1.0, 0.0], seed: [7, 0], rows, cols, ..Zeroable::zeroed() };
+        let cells = (rows * cols + 4) as usize;
+        for (first, count) in [(0u64, 1_000_003u32), (5_000_000_000, 77)] {
+            let atomics = passes.histogram(&params, first, count, cells, Some(Strategy::Atomics)).unwrap();
+            let slabs = passes.histogram(&params, first, count, cells, Some(Strategy::Slabs)).unwrap();
+            assert_eq!(atomics.iter().map(|&c| c as u64).sum::<u64>(), count as u64);
+            assert!(atomics == slabs, "slabs and atomics counted samples {first}.. differently");
+        }
+        // about 1 % each outside the domain and with pdf 0 (10 000 ± 100)
+        let counts = passes.histogram(&params, 0, 1_000_003, cells, Some(Strategy::Slabs)).unwrap();
+        let (outside, zero) = (counts[cells - 4 + 1], counts[cells - 4 + 3]);
+        assert!((9_500..10_500).contains(&outside) && (9_500..10_500).contains(&zero), "{outside} {zero}");
     }
 }

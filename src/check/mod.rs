@@ -389,7 +389,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         samples_per_thread: 1,
         rows,
         cols,
-        _pad_a: 0,
+        slabs: 0,
         _pad_b: 0,
         _pad_c: 0,
     };
@@ -413,7 +413,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let mut first = 0;
     while first < settings.samples {
         let n = chunk.min(settings.samples - first) as u32;
-        for (t, c) in totals.iter_mut().zip(passes.histogram(&params, first, n, bins + 4)?) {
+        for (t, c) in totals.iter_mut().zip(passes.histogram(&params, first, n, bins + 4, None)?) {
             *t += c as u64;
         }
         first += n as u64;

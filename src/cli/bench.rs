@@ -3,7 +3,7 @@
 
 use super::{OutputArgs, emit, emit_json};
 use crate::engine::cpu;
-use crate::engine::gpu::GpuEngine;
+use crate::engine::gpu::{Counting, GpuEngine, Strategy};
 use crate::engine::job::{Job, SampleRange, Scatter};
 use crate::reference::{Lobe, SAMPLERS, reflect};
 use crate::report::table;
@@ -38,6 +38,17 @@ pub struct BenchArgs {
     /// the uber-kernel with every lobe and effect switched at run time, alternating in one run.
     #[arg(long, value_name = "SCENE")]
     pub effects: Option<std::path::PathBuf>,
+    /// Instead of the lobe table: the two ways of counting on this adapter. For each sampler,
+    /// the counting pass with workgroup atomics and with per-invocation slabs (lobes counts in
+    /// slabs on CPU adapters, in atomics on GPUs), alternating in one run, their medians and
+    /// ratio; the counts of the two must be equal bit for bit (else an error).
+    #[arg(long, conflicts_with = "effects")]
+    pub counting: bool,
+    /// Instead of the lobe table: where start-up goes. Opening the adapter and device, composing
+    /// and validating the first sampler's module, its first histogram of 1024 samples (pipelines
+    /// made and the driver's compilation at first use) and the same again (a dispatch alone).
+    #[arg(long, conflicts_with_all = ["effects", "counting"])]
+    pub startup: bool,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -165,15 +176,164 @@ geometric mean of the ratios: {geo:.2}
     emit(&text)
 }
 
+/// Workgroup atomics against per-invocation slabs on one sampler.
+#[derive(Debug, Clone, Serialize)]
+pub struct CountingResult {
+    pub lobe: String,
+    pub method: String,
+    pub samples: u64,
+    /// What each strategy came to on this adapter ([`Counting::name`]).
+    pub atomics: String,
+    pub slabs: String,
+    /// Medians over the runs, GPU timestamps where available, else wall time.
+    pub atomics_seconds: f64,
+    pub slabs_seconds: f64,
+    pub atomics_samples_per_second: f64,
+    pub slabs_samples_per_second: f64,
+    /// atomics / slabs, the median of the per-run ratios: above 1, slabs are faster.
+    pub ratio: f64,
+    pub timing: String,
+}
+
+fn run_counting(args: &BenchArgs) -> anyhow::Result<()> {
+    let runs = args.runs.max(1);
+    let jobs = chosen(bench_jobs(args.alpha), &args.samplers)?;
+    let mut engine = GpuEngine::open()?;
+    let adapter = engine.gpu.adapter_name();
+    let device_type = format!("{:?}", engine.gpu.info.device_type);
+    let mut results = Vec::new();
+    for job in &jobs {
+        let mut time = |strategy, seed: u64, n: u64| -> anyhow::Result<(f64, bool, Counting, crate::engine::job::Counts)> {
+            engine.force_counting = Some(strategy);
+            let g = engine.histogram(job, SampleRange::whole(seed, n), &mut |_| {})?;
+            Ok((g.gpu_seconds.unwrap_or(g.wall_seconds), g.gpu_seconds.is_some(), g.counting, g.counts))
+        };
+        time(Strategy::Atomics, 0, 1 << 16)?; // compile and warm up both
+        time(Strategy::Slabs, 0, 1 << 16)?;
+        let (mut atomics, mut slabs, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut names, mut timed) = ((String::new(), String::new()), true);
+        for r in 0..runs as u64 {
+            let (a, ta, ca, counts_a) = time(Strategy::Atomics, r, args.samples)?;
+            let (s, ts, cs, counts_s) = time(Strategy::Slabs, r, args.samples)?;
+            anyhow::ensure!(counts_a == counts_s, "{}: seed {r}: counting with {} and with {} gave different counts", crate::engine::gpu::compose::describe(job), ca.name(), cs.name());
+            atomics.push(a);
+            slabs.push(s);
+            ratios.push(a / s);
+            names = (ca.name().to_string(), cs.name().to_string());
+            timed &= ta && ts;
+        }
+        let Job::Lobe { lobe, .. } = job else { unreachable!("bench jobs are lobes") };
+        let (a, s) = (median(atomics), median(slabs));
+        results.push(CountingResult {
+            lobe: lobe.kind.name().into(),
+            method: lobe.method.name().into(),
+            samples: args.samples,
+            atomics: names.0,
+            slabs: names.1,
+            atomics_seconds: a,
+            slabs_seconds: s,
+            atomics_samples_per_second: args.samples as f64 / a,
+            slabs_samples_per_second: args.samples as f64 / s,
+            ratio: median(ratios),
+            timing: if timed { "gpu timestamps" } else { "wall" }.into(),
+        });
+    }
+    engine.force_counting = None;
+    let default = engine.counting(64 * 128).name();
+    if args.output.json {
+        return emit_json(&serde_json::json!({"adapter": adapter, "device_type": device_type, "default_counting": default, "runs": runs, "counting": results}));
+    }
+    let mut text = format!(
+        "adapter: {adapter} (device type {device_type}; counts in {default} by default)\n\
+         counting pass, median of {runs} runs, 64 x 128 bins, alpha {}, 45 deg incidence; ratio = atomics time / slabs time (median of per-run ratios); counts equal bit for bit\n\n",
+        args.alpha
+    );
+    text += &table::render(
+        &["lobe", "method", "samples", "atomics", "atomics samples/s", "slabs", "slabs samples/s", "ratio"],
+        results.iter().map(|r| {
+            vec![
+                r.lobe.clone(),
+                r.method.clone(),
+                r.samples.to_string(),
+                r.atomics.clone(),
+                format!("{:.3e}", r.atomics_samples_per_second),
+                r.slabs.clone(),
+                format!("{:.3e}", r.slabs_samples_per_second),
+                format!("{:.2}", r.ratio),
+            ]
+        }),
+    );
+    emit(&text)
+}
+
+/// Where start-up goes, in seconds of wall time.
+#[derive(Debug, Clone, Serialize)]
+pub struct StartupResult {
+    /// Instance, adapter, device (and the pipeline cache file read, where there is one).
+    pub open_seconds: f64,
+    /// The first sampler's module composed and validated by naga.
+    pub compose_seconds: f64,
+    /// Its first histogram of 1024 samples: the module and pipelines made, the driver's
+    /// compilation at first use, one dispatch and the readback.
+    pub first_histogram_seconds: f64,
+    /// The same again: one dispatch and the readback.
+    pub second_histogram_seconds: f64,
+    /// Whether a pipeline cache was in use ([`crate::engine::gpu::pipeline_cache`]).
+    pub pipeline_cache: bool,
+}
+
+fn run_startup(args: &BenchArgs) -> anyhow::Result<()> {
+    let job = chosen(bench_jobs(args.alpha), &args.samplers)?.into_iter().next().expect("a sampler");
+    let t = Instant::now();
+    let mut engine = GpuEngine::open()?;
+    let open_seconds = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    crate::engine::gpu::compose::validate("startup", &engine.source(&job, None))?;
+    let compose_seconds = t.elapsed().as_secs_f64();
+    let mut histogram = || -> anyhow::Result<f64> {
+        let t = Instant::now();
+        engine.histogram(&job, SampleRange::whole(0, 1024), &mut |_| {})?;
+        Ok(t.elapsed().as_secs_f64())
+    };
+    let first_histogram_seconds = histogram()?;
+    let second_histogram_seconds = histogram()?;
+    let r = StartupResult { open_seconds, compose_seconds, first_histogram_seconds, second_histogram_seconds, pipeline_cache: engine.gpu.pipeline_cache.is_some() };
+    let adapter = engine.gpu.adapter_name();
+    drop(engine); // saves the pipeline cache, as a run does
+    if args.output.json {
+        return emit_json(&serde_json::json!({"adapter": adapter, "startup": r}));
+    }
+    let mut text = format!("adapter: {adapter}; pipeline cache {}\n\n", if r.pipeline_cache { "on" } else { "off" });
+    text += &table::render(
+        &["stage", "seconds"],
+        [
+            ("open the adapter and device", r.open_seconds),
+            ("compose and validate the module", r.compose_seconds),
+            ("first histogram, 1024 samples (pipelines, compilation)", r.first_histogram_seconds),
+            ("second histogram, 1024 samples", r.second_histogram_seconds),
+        ]
+        .into_iter()
+        .map(|(s, v)| vec![s.to_string(), format!("{v:.4}")]),
+    );
+    emit(&text)
+}
+
 pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if let Some(scene) = &args.effects {
         return run_effects(args, scene);
+    }
+    if args.counting {
+        return run_counting(args);
+    }
+    if args.startup {
+        return run_startup(args);
     }
     let runs = args.runs.max(1);
     let jobs = chosen(bench_jobs(args.alpha), &args.samplers)?;
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();
     let mut results = Vec::new();
+    let mut counting = "";
     for job in jobs {
         engine.histogram(&job, SampleRange::whole(0, 1 << 16), &mut |_| {})?; // compile and warm up
         let mut times = Vec::new();
@@ -184,6 +344,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             times.push(g.gpu_seconds.unwrap_or(g.wall_seconds));
         }
         results.push(result(&job, "gpu", args.samples, median(times), timing, args.alpha));
+        counting = engine.counting(job.bins() as u32).name();
         if !args.gpu_only {
             let times = (0..runs)
                 .map(|r| {
@@ -197,9 +358,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         }
     }
     if args.output.json {
-        return emit_json(&serde_json::json!({"adapter": adapter, "runs": runs, "results": results}));
+        return emit_json(&serde_json::json!({"adapter": adapter, "counting": counting, "runs": runs, "results": results}));
     }
-    let mut text = format!("adapter: {adapter}\nmedian of {runs} runs, 64 x 128 bins, alpha {}, 45 deg incidence\n\n", args.alpha);
+    let mut text = format!("adapter: {adapter}; counting in {counting}\nmedian of {runs} runs, 64 x 128 bins, alpha {}, 45 deg incidence\n\n", args.alpha);
     text += &table::render(
         &["lobe", "method", "backend", "samples", "seconds", "samples/s"],
         results.iter().map(|r| {

@@ -2,7 +2,7 @@
 //! case, once per distinct module, with the override constants its pipelines are made with.
 
 use super::{OutputArgs, emit, emit_json, usage};
-use crate::engine::gpu::GpuEngine;
+use crate::engine::gpu::{Counting, GpuEngine};
 use crate::engine::gpu::effects::{self, Composed};
 use crate::scene::Entry;
 use clap::Args;
@@ -26,18 +26,25 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
         let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
         return Err(usage(format!("--case {name}: no such case in {}; its cases are: {}", scene.file, names.join(", "))));
     }
-    // The module depends on the adapter's limits (workgroup storage, storage binding size):
+    // The module depends on the adapter's device type and limits (its counting, the workgroup
+    // storage, the storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
     let engine = GpuEngine::open().map_err(|e| eprintln!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits")).ok();
     let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
     for entry in entries {
         let m = match entry {
             Entry::Lobe(case) => {
-                let (words, tile) = match &engine {
-                    Some(e) => (e.gpu.limits.max_compute_workgroup_storage_size / 4, e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins)),
-                    None => (wgpu::Limits::default().max_compute_workgroup_storage_size / 4, case.job.bins() as u64),
+                let (counting, tile) = match &engine {
+                    Some(e) => {
+                        let tile = e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins) as u32;
+                        (e.counting(tile), tile)
+                    }
+                    None => {
+                        let tile = case.job.bins() as u32;
+                        (Counting::atomics(wgpu::Limits::default().max_compute_workgroup_storage_size / 4, tile), tile)
+                    }
                 };
-                effects::case_module(&case.job, case.effects.as_ref(), words, tile as u32)
+                effects::case_module(&case.job, case.effects.as_ref(), counting, tile)
             }
             // a user's sampler: its files, the glue and `lobes check`'s passes (one module for
             // every incident angle and params, which are uniforms)

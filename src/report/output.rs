@@ -32,8 +32,9 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The version of the layout of `histogram.json` (2: the times moved to `timing.json`).
-pub const HISTOGRAM_VERSION: u32 = 2;
+/// The version of the layout of `histogram.json` (2: the times moved to `timing.json`; 3:
+/// `counting` in place of `workgroup_counting`).
+pub const HISTOGRAM_VERSION: u32 = 3;
 /// The version of the layout of `timing.json`.
 pub const TIMING_VERSION: u32 = 1;
 /// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
@@ -71,8 +72,11 @@ pub struct HistogramFile {
     pub per_sample_check: Option<AngleCheck>,
     /// The expected histogram's quadrature (lobe cases).
     pub quadrature: Option<QuadratureRecord>,
-    /// Whether bins were counted in workgroup memory (GPU only).
-    pub workgroup_counting: Option<bool>,
+    /// How the GPU counted the bins: `workgroup` (a u32 workgroup atomic per bin),
+    /// `workgroup-packed` (two 16-bit ones a word), `global` (a storage atomic per sample) or
+    /// `slabs` (per-invocation slabs, on CPU adapters); null on the CPU engine, and where merged
+    /// shards counted differently.
+    pub counting: Option<String>,
     /// The weighted histogram of a case with effects.
     pub weighted: Option<WeightedRecord>,
     /// The checks of a user's WGSL sampler (`lobes check`); absent for lobes' own samplers.
@@ -201,7 +205,7 @@ impl HistogramFile {
                 max_error_sigma_at_1e8: q.max_error_sigma,
                 below_horizon_probability: q.below_horizon,
             }),
-            workgroup_counting: r.workgroup_counting,
+            counting: r.counting.clone(),
             weighted: r.weighted.as_ref().map(|w| WeightedRecord::new(r, w, cols)),
             user_sampler: None,
         }
@@ -234,7 +238,7 @@ impl HistogramFile {
             chi2: r.chi2.clone(),
             per_sample_check: None,
             quadrature: None,
-            workgroup_counting: None,
+            counting: None,
             weighted: None,
             user_sampler: Some(UserSamplerRecord {
                 passed: report.passed,

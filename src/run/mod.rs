@@ -65,7 +65,9 @@ pub struct CaseResult {
     pub histogram_seconds: f64,
     pub quadrature_seconds: f64,
     pub angle: Option<AngleCheck>,
-    pub workgroup_counting: Option<bool>,
+    /// How the GPU counted ([`crate::engine::gpu::Counting::name`]); None on the CPU engine or
+    /// where merged shards counted differently.
+    pub counting: Option<String>,
     /// The weighted histogram and its verdict, for a case with effects.
     pub weighted: Option<WeightedResult>,
 }
@@ -93,7 +95,7 @@ pub struct Sampled {
     pub counts: Counts,
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
-    pub workgroup_counting: Option<bool>,
+    pub counting: Option<String>,
     /// The per-sample check: only for a range that starts at sample 0, on the GPU.
     pub angle: Option<AngleCheck>,
     /// The weighted pass of a case with effects.
@@ -102,14 +104,14 @@ pub struct Sampled {
 
 impl Sampled {
     /// Adds the results of another range of the same case (shards add exactly): counts and
-    /// sums add, times add (GPU time only where both have it), workgroup counting is kept
+    /// sums add, times add (GPU time only where both have it), the counting is kept
     /// where both agree, and the per-sample check is whichever range has one.
     pub fn add(&mut self, other: &Sampled) {
         self.counts.add(&other.counts);
         self.gpu_seconds = self.gpu_seconds.zip(other.gpu_seconds).map(|(a, b)| a + b);
         self.wall_seconds += other.wall_seconds;
-        if self.workgroup_counting != other.workgroup_counting {
-            self.workgroup_counting = None;
+        if self.counting != other.counting {
+            self.counting = None;
         }
         if self.angle.is_none() {
             self.angle.clone_from(&other.angle);
@@ -132,14 +134,14 @@ pub fn run_case(backend: &mut Backend, case: &Case, range: Range<u64>, progress:
     let mut sampled = match backend {
         Backend::Gpu(engine) => {
             let r = engine.histogram(&case.job, samples, progress)?;
-            let workgroup_counting = Some(r.workgroup_counting);
-            Sampled { counts: r.counts, gpu_seconds: r.gpu_seconds, wall_seconds: r.wall_seconds, workgroup_counting, angle: None, weighted: None }
+            let counting = Some(r.counting.name().to_string());
+            Sampled { counts: r.counts, gpu_seconds: r.gpu_seconds, wall_seconds: r.wall_seconds, counting, angle: None, weighted: None }
         }
         Backend::Cpu => {
             let t = Instant::now();
             let counts = cpu::histogram(&case.job, samples);
             progress(n);
-            Sampled { counts, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64(), workgroup_counting: None, angle: None, weighted: None }
+            Sampled { counts, gpu_seconds: None, wall_seconds: t.elapsed().as_secs_f64(), counting: None, angle: None, weighted: None }
         }
     };
     let total = sampled.counts.total();
@@ -184,7 +186,7 @@ impl Expected {
 /// its [`Expected`] counts: the χ² test at per-case `significance`, and the albedo checks of
 /// a weighted case.
 pub fn judge(case: &Case, sampled: Sampled, expected: Expected, significance: f64) -> anyhow::Result<CaseResult> {
-    let Sampled { counts, gpu_seconds, wall_seconds, workgroup_counting, angle, weighted } = sampled;
+    let Sampled { counts, gpu_seconds, wall_seconds, counting, angle, weighted } = sampled;
     anyhow::ensure!(
         counts.total() == case.samples,
         "case '{}': {} samples counted for {} requested",
@@ -212,7 +214,7 @@ pub fn judge(case: &Case, sampled: Sampled, expected: Expected, significance: f6
         histogram_seconds: wall_seconds,
         quadrature_seconds,
         angle,
-        workgroup_counting,
+        counting,
         weighted,
     })
 }

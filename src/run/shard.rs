@@ -34,8 +34,9 @@ use std::path::{Path, PathBuf};
 /// The format tag of a shard file.
 pub const SHARD_FORMAT: &str = "lobes-shard";
 /// The version of the shard file layout (1: the layout before `format_version`, with the
-/// exact bits of the per-sample check in a side field; 3: `counts_fnv1a64`).
-pub const SHARD_VERSION: u32 = 3;
+/// exact bits of the per-sample check in a side field; 3: `counts_fnv1a64`; 4: `counting` in
+/// place of `workgroup_counting`).
+pub const SHARD_VERSION: u32 = 4;
 /// The lobes that writes (and alone reads) shard files.
 pub const LOBES_VERSION: &str = env!("CARGO_PKG_VERSION");
 
@@ -176,8 +177,9 @@ pub struct ShardFile {
     /// `gpu` or `cpu`.
     pub backend: String,
     pub timing: Timing,
-    /// Whether bins were counted in workgroup memory (GPU only).
-    pub workgroup_counting: Option<bool>,
+    /// How the GPU counted the bins (`workgroup`, `workgroup-packed`, `global` or `slabs`:
+    /// [`crate::engine::gpu::Counting`]); null on the CPU engine.
+    pub counting: Option<String>,
     /// GPU directions of the first samples against f64 (only in the shard that starts at 0).
     pub per_sample_check: Option<AngleCheck>,
     /// The weighted sums of a case with effects, and the time of their pass.
@@ -233,7 +235,7 @@ impl ShardFile {
             adapter: origin.adapter.into(),
             backend: origin.backend.into(),
             timing: Timing { gpu_seconds: sampled.gpu_seconds, histogram_wall_seconds: sampled.wall_seconds },
-            workgroup_counting: sampled.workgroup_counting,
+            counting: sampled.counting.clone(),
             per_sample_check: sampled.angle.clone(),
             weighted: sampled.weighted.as_ref().map(|w| w.sums.clone()),
             weighted_timing: sampled.weighted.as_ref().map(|w| WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds }),
@@ -329,7 +331,7 @@ impl ShardFile {
             counts: Counts { bins: self.counts.clone(), invalid: self.invalid.into() },
             gpu_seconds: self.timing.gpu_seconds,
             wall_seconds: self.timing.histogram_wall_seconds,
-            workgroup_counting: self.workgroup_counting,
+            counting: self.counting.clone(),
             angle: self.per_sample_check.clone(),
             weighted: self.weighted.as_ref().map(|sums| WeightedRun {
                 sums: sums.clone(),
@@ -386,7 +388,7 @@ pub(crate) mod tests {
             adapter: "a".into(),
             backend: "gpu".into(),
             timing: Timing { gpu_seconds: None, histogram_wall_seconds: 0.0 },
-            workgroup_counting: None,
+            counting: None,
             per_sample_check: None,
             weighted: None,
             weighted_timing: None,

@@ -30,6 +30,7 @@
 //! case live in `lobes::job` beside the call sites that read them.
 
 use super::context::GpuError;
+use super::counting::Counting;
 use super::layout;
 use super::library::{self, File};
 use super::precision::{self, Precision};
@@ -156,15 +157,15 @@ fn in_lobe_frame(args: &str) -> (String, String) {
     (params.join(", "), prologue)
 }
 
-/// The composed WGSL of `job`, counting all its bins.
+/// The composed WGSL of `job`, counting all its bins with atomics as on a GPU with
+/// `workgroup_words` words of workgroup storage ([`Counting::atomics`]).
 pub fn compose(job: &Job, workgroup_words: u32) -> String {
     compose_tile(job, workgroup_words, job.bins() as u32)
 }
 
 /// The composed WGSL of `job` counting `tile_bins` bins from `params.tile_first` on (a
-/// histogram too large for one storage buffer is counted tile by tile, one pass each), in
-/// workgroup memory when `ceil(tile_bins / 2)` words fit in `workgroup_words`, else in global
-/// memory.
+/// histogram too large for one storage buffer is counted tile by tile, one pass each), with the
+/// atomics `workgroup_words` words of workgroup storage allow ([`Counting::atomics`]).
 pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
     compose_precision(job, workgroup_words, tile_bins, Precision::F32Accurate)
 }
@@ -172,16 +173,21 @@ pub fn compose_tile(job: &Job, workgroup_words: u32, tile_bins: u32) -> String {
 /// As [`compose_tile`], in the arithmetic of `precision` (`lobes tradeoff`; see
 /// [`super::precision`]).
 pub fn compose_precision(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> String {
-    kernel(job, workgroup_words, tile_bins, precision).source()
+    compose_counting(job, Counting::atomics(workgroup_words, tile_bins), tile_bins, precision)
+}
+
+/// The composed WGSL of `job` counting `tile_bins` bins as `counting` says, in `precision`.
+pub fn compose_counting(job: &Job, counting: Counting, tile_bins: u32, precision: Precision) -> String {
+    kernel(job, counting, tile_bins, precision).source()
 }
 
 /// The counting kernel of `job`: `lobes::kernel` and, for a lobe, `lobes::lobe_kernel`, drawing
 /// with the job's sampler or discrete method.
-pub(crate) fn kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> Kernel {
+pub(crate) fn kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Precision) -> Kernel {
     match job {
-        Job::Lobe { lobe, .. } => lobe_kernel(job, workgroup_words, tile_bins, precision, &[sampler::find(lobe.kind, lobe.method)]),
+        Job::Lobe { lobe, .. } => lobe_kernel(job, counting, tile_bins, precision, &[sampler::find(lobe.kind, lobe.method)]),
         Job::Discrete { method, .. } => {
-            let mut k = counting_kernel(job, workgroup_words, tile_bins, precision);
+            let mut k = counting_kernel(job, counting, tile_bins, precision);
             k.chosen.push(library::DISCRETE_DRAW);
             let call = match method {
                 DiscreteMethod::Cdf if job.bins() > crate::reference::discrete::BLOCK => "discrete_sample_cdf_blocks(u.xy, n, last_positive)",
@@ -197,8 +203,8 @@ pub(crate) fn kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision:
 
 /// The counting kernel of a lobe `job` drawing with `samplers`: the job's own, or all of them
 /// switched at run time (the uber-kernel).
-pub(crate) fn lobe_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision, samplers: &[&SamplerSpec]) -> Kernel {
-    let mut k = counting_kernel(job, workgroup_words, tile_bins, precision);
+pub(crate) fn lobe_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Precision, samplers: &[&SamplerSpec]) -> Kernel {
+    let mut k = counting_kernel(job, counting, tile_bins, precision);
     k.roots.push("lobes::lobe_kernel");
     for spec in samplers {
         k.job.uses(spec.wgsl.module);
@@ -257,27 +263,34 @@ pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_node
     Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job }
 }
 
-/// `lobes::kernel` with the job's constants, the math of `precision` and the counting that
-/// `workgroup_words` words of workgroup memory allow: a u32 counter per bin where `tile_bins`
-/// fit, else two 16-bit counters a word where `ceil(tile_bins / 2)` fit, else global counters
-/// (`shaders/passes/counting_workgroup.wgsl`, `counting_global.wgsl`); the draw is the caller's.
-fn counting_kernel(job: &Job, workgroup_words: u32, tile_bins: u32, precision: Precision) -> Kernel {
+/// `lobes::kernel` with the job's constants, the math of `precision` and `counting`'s module
+/// (`shaders/passes/counting_workgroup.wgsl`, `counting_global.wgsl`, `counting_slabs.wgsl`);
+/// the draw is the caller's.
+fn counting_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Precision) -> Kernel {
     let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
         Job::Discrete { .. } => (1, bins),
     };
-    let bins_per_word = if tile_bins <= workgroup_words { 1 } else { 2 };
+    let bins_per_word = if counting == Counting::WorkgroupPacked { 2 } else { 1 };
+    // the workgroup array of counting_workgroup.wgsl, which only that module declares
     let wg_words = tile_bins.div_ceil(bins_per_word);
     let mut chosen = library::precision_files(precision);
-    if wg_words > workgroup_words {
-        chosen.push(library::COUNTING_GLOBAL);
+    match counting {
+        Counting::Workgroup | Counting::WorkgroupPacked => {}
+        Counting::Global => chosen.push(library::COUNTING_GLOBAL),
+        Counting::Slabs { .. } => chosen.push(library::COUNTING_SLABS),
     }
+    let slabs = match counting {
+        Counting::Slabs { slabs } => slabs,
+        _ => 0,
+    };
+    let count_wg = counting.workgroup_size();
     let mut job_module = JobModule::new(describe(job));
     job_module.push(&format!(
         "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
          const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n\
-         const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\n{}",
+         const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\nconst COUNT_WG: u32 = {count_wg}u;\nconst SLABS: u32 = {slabs}u;\n{}",
         layout::consts_wgsl()
     ));
     Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module }
@@ -317,6 +330,11 @@ mod tests {
                     // a histogram larger than workgroup memory counts in global memory
                     assert_eq!(src.contains("var<workgroup> wg_bins"), words == 4096);
                 }
+                // per-invocation slabs (CPU adapters): no workgroup memory, workgroups of 8
+                let src = compose_counting(&lobe_job(kind, method), Counting::Slabs { slabs: 512 }, 128, precision);
+                validate("kernel", &src).unwrap_or_else(|e| panic!("{kind:?} {method:?} {precision:?} slabs: {e}"));
+                assert!(src.contains("var<storage, read_write> slabs: array<u32>;") && !src.contains("var<workgroup>"));
+                assert!(src.contains("const SLABS: u32 = 512u;") && src.contains("const COUNT_WG: u32 = 8u;"));
             }
             validate("quadrature", &quadrature_kernel(spec, 8, 16, 5).source()).unwrap();
         }
@@ -324,6 +342,8 @@ mod tests {
         for method in [DiscreteMethod::Cdf, DiscreteMethod::Alias] {
             let src = compose(&Job::Discrete { dist: dist.clone(), method }, 4096);
             validate("discrete", &src).unwrap_or_else(|e| panic!("{method:?}: {e}"));
+            let slabs = compose_counting(&Job::Discrete { dist: dist.clone(), method }, Counting::Slabs { slabs: 128 }, 4, Precision::F32Accurate);
+            validate("discrete", &slabs).unwrap_or_else(|e| panic!("{method:?} slabs: {e}"));
             assert!(!src.contains("fn lobe_sample_at"), "a discrete kernel holds no lobe code");
         }
     }
@@ -344,7 +364,7 @@ mod tests {
         let kernel_wgsl = library::source("lobes::kernel").unwrap();
         let line = kernel_wgsl.lines().position(|l| l.trim() == "flush_bins(at.lid);").expect("kernel.wgsl flushes its bins") + 1;
         let broken = kernel_wgsl.replace("flush_bins(at.lid);", "flush_bins(no_such_value);");
-        let mut k = kernel(&lobe_job(LobeKind::Ward, Method::Ndf), 4096, 128, Precision::F32Accurate);
+        let mut k = kernel(&lobe_job(LobeKind::Ward, Method::Ndf), Counting::Workgroup, 128, Precision::F32Accurate);
         k.chosen.push(File::generated("shaders/passes/kernel.wgsl", broken));
         let message = k.compose().unwrap_err().to_string();
         assert!(message.contains(&format!("shaders/passes/kernel.wgsl:{line}:")), "{message}");

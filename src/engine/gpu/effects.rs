@@ -19,6 +19,7 @@
 
 use super::compose::{self, Kernel, call_site};
 use super::library;
+use super::counting::Counting;
 use super::precision::Precision;
 use crate::engine::job::{Job, Scatter};
 use crate::reference::effects::Effects;
@@ -127,7 +128,7 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rota
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
 /// that one module serves both passes of the case) and `shaders/passes/weighted.wgsl` with the
 /// effect files it needs.
-pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: Specialisation) -> Composed {
+pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Specialisation) -> Composed {
     let Job::Lobe { lobe, scatter, .. } = job else { panic!("effects apply to lobe jobs only") };
     let dielectric = matches!(scatter, Scatter::Dielectric { .. });
     match how {
@@ -135,7 +136,7 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
             let spec = sampler::find(lobe.kind, lobe.method);
             let fresnel = effects.fresnel != Fresnel::None;
             let masking = effects.masking != Masking::None && lobe.kind != LobeKind::Ward;
-            let mut kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &[spec]);
+            let mut kernel = compose::lobe_kernel(job, counting, job.bins() as u32, Precision::F32Accurate, &[spec]);
             let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
             kernel.job.push("override ANISOTROPIC: bool = true;\n");
             if fresnel {
@@ -150,26 +151,27 @@ pub fn compose_effects(job: &Job, effects: &Effects, workgroup_words: u32, how: 
         }
         Specialisation::Uber => {
             assert!(!dielectric, "the uber-kernel draws reflections only (Ward and bounded VNDF have no dielectric)");
-            Composed { source: compose_uber(job, workgroup_words), constants: Vec::new() }
+            Composed { source: compose_uber(job, counting), constants: Vec::new() }
         }
     }
 }
 
 /// The module a case runs: its weighted module (which holds its counting kernels too) with
-/// effects, else its counting module (`tile_bins` bins per pass where the histogram is tiled).
-pub fn case_module(job: &Job, effects: Option<&Effects>, workgroup_words: u32, tile_bins: u32) -> Composed {
+/// effects, else its counting module (`tile_bins` bins per pass where the histogram is tiled),
+/// counting as `counting` says.
+pub fn case_module(job: &Job, effects: Option<&Effects>, counting: Counting, tile_bins: u32) -> Composed {
     match (effects, job) {
-        (Some(e), Job::Lobe { .. }) => compose_effects(job, e, workgroup_words, Specialisation::Specialised),
-        _ => Composed { source: compose::compose_tile(job, workgroup_words, tile_bins), constants: Vec::new() },
+        (Some(e), Job::Lobe { .. }) => compose_effects(job, e, counting, Specialisation::Specialised),
+        _ => Composed { source: compose::compose_counting(job, counting, tile_bins, Precision::F32Accurate), constants: Vec::new() },
     }
 }
 
 /// The uber-kernel on `job`'s grid: every lobe and sampler, Fresnel and masking, switched at
 /// run time by `effect.modes` = (sampler id, Fresnel mode, masking mode, anisotropic).
-fn compose_uber(job: &Job, workgroup_words: u32) -> String {
+fn compose_uber(job: &Job, counting: Counting) -> String {
     let Job::Lobe { lobe, .. } = job else { panic!("the uber-kernel draws lobes") };
     let all: Vec<&SamplerSpec> = REGISTRY.iter().collect();
-    let kernel = compose::lobe_kernel(job, workgroup_words, job.bins() as u32, Precision::F32Accurate, &all);
+    let kernel = compose::lobe_kernel(job, counting, job.bins() as u32, Precision::F32Accurate, &all);
     weighted(kernel, &all, &UNIFORM, lobe.is_rotated(), true, true, false)
 }
 
@@ -198,7 +200,7 @@ mod tests {
             for fresnel in fresnels {
                 for masking in Masking::ALL {
                     let effects = Effects { fresnel, masking };
-                    let c = compose_effects(&job(kind, method, true), &effects, 4096, Specialisation::Specialised);
+                    let c = compose_effects(&job(kind, method, true), &effects, Counting::Workgroup, Specialisation::Specialised);
                     compose::validate("effects", &c.source).unwrap_or_else(|e| panic!("{kind:?} {method:?} {effects:?}: {e}"));
                 }
             }
@@ -209,7 +211,7 @@ mod tests {
                 for alpha_angle in [0.0, 30.0] {
                     let Job::Lobe { lobe, incident, grid, .. } = job(spec.kind, spec.method, true) else { unreachable!() };
                     let glass = Job::Lobe { lobe: Lobe { alpha_angle, ..lobe }, incident, grid, scatter: crate::engine::job::Scatter::Dielectric { eta: 1.5 } };
-                    let c = compose_effects(&glass, &Effects { fresnel: Fresnel::None, masking }, 4096, Specialisation::Specialised);
+                    let c = compose_effects(&glass, &Effects { fresnel: Fresnel::None, masking }, Counting::Workgroup, Specialisation::Specialised);
                     compose::validate("dielectric effects", &c.source).unwrap_or_else(|e| panic!("{} {masking:?}: {e}", spec.name()));
                     let d = spec.wgsl.dielectric_eval.unwrap();
                     for expr in [d.pdf, d.eval, d.weight] {
@@ -218,7 +220,7 @@ mod tests {
                 }
             }
         }
-        let c = compose_effects(&job(LobeKind::Ggx, Method::Vndf, false), &Effects::NONE, 4096, Specialisation::Uber);
+        let c = compose_effects(&job(LobeKind::Ggx, Method::Vndf, false), &Effects::NONE, Counting::Workgroup, Specialisation::Uber);
         compose::validate("uber", &c.source).unwrap();
         assert!(c.constants.is_empty());
         // a rotated lobe's weight, BRDF, density and G1 take world directions into its frame
@@ -227,7 +229,7 @@ mod tests {
             let Job::Lobe { lobe, incident, grid, scatter } = job(kind, method, true) else { unreachable!() };
             let rotated = Job::Lobe { lobe: Lobe { alpha_angle: 57.0, ..lobe }, incident, grid, scatter };
             for how in [Specialisation::Specialised, Specialisation::Uber] {
-                let c = compose_effects(&rotated, &effects, 4096, how);
+                let c = compose_effects(&rotated, &effects, Counting::Workgroup, how);
                 compose::validate("rotated effects", &c.source).unwrap_or_else(|e| panic!("{kind:?} {method:?} {how:?}: {e}"));
                 assert!(c.source.contains("    let s = sample_to_local(lobe_frame(), s_world);\n"));
             }

@@ -5,6 +5,7 @@ use super::compose;
 use super::layout::{N_REASONS, WG_SIZE};
 use super::precision::Precision;
 use super::context::{Gpu, GpuError};
+use super::counting::{Counting, Strategy};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
 use super::effects::{self, Composed, Specialisation};
 use super::library::File;
@@ -19,6 +20,9 @@ use std::sync::Arc;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
+/// The binding of the slabs (`shaders/passes/counting_slabs.wgsl`; 6 to 8 are the weighted pass's).
+const SLAB_BINDING: u32 = 9;
+
 /// The pipelines of one composed module.
 struct Kernel {
     sample: wgpu::ComputePipeline,
@@ -26,7 +30,7 @@ struct Kernel {
     directions: Option<wgpu::ComputePipeline>,
     explicit: Option<wgpu::ComputePipeline>,
     bin_explicit: Option<wgpu::ComputePipeline>,
-    in_workgroup: bool,
+    counting: Counting,
 }
 
 /// The result of a GPU histogram run.
@@ -37,8 +41,8 @@ pub struct GpuRun {
     pub gpu_seconds: Option<f64>,
     /// Wall time of the run, from the first submission to the readback.
     pub wall_seconds: f64,
-    /// Whether bins were counted in workgroup memory (else in global atomics).
-    pub workgroup_counting: bool,
+    /// How the bins were counted ([`Counting::choose`]).
+    pub counting: Counting,
     /// Passes over the samples: 1, or more where the histogram was split into tiles of bins to
     /// fit the adapter's storage limits (see [`GpuEngine::tiling`]).
     pub tiles: u64,
@@ -74,6 +78,9 @@ pub struct GpuEngine {
     /// per-sample kernels this engine composes: a test's deliberately broken copy of a library
     /// file (`tests/stress.rs`); empty otherwise.
     pub replaced: Vec<File>,
+    /// A counting strategy asked for in place of the adapter's ([`Counting::choose`]): tests
+    /// and `lobes bench` compare the two on one adapter. None otherwise.
+    pub force_counting: Option<Strategy>,
 }
 
 impl GpuEngine {
@@ -85,10 +92,11 @@ impl GpuEngine {
             storage_entry(3, true),
             storage_entry(4, true),
             storage_entry(5, false),
+            storage_entry(SLAB_BINDING, false),
         ];
         let (layout, pipeline_layout) = gpu.layout("lobes kernel", &entries);
         let weighted = WeightedPipelines::new(&gpu);
-        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate, replaced: Vec::new() }
+        Self { gpu, layout, pipeline_layout, cache: HashMap::new(), chunking: Chunking::default(), compiled: 0, weighted, precision: Precision::F32Accurate, replaced: Vec::new(), force_counting: None }
     }
 
     /// Opens the default adapter.
@@ -96,13 +104,15 @@ impl GpuEngine {
         Ok(Self::new(Gpu::new()?))
     }
 
-    fn workgroup_words(&self) -> u32 {
-        self.gpu.limits.max_compute_workgroup_storage_size / 4
+    /// How a tile of `tile_bins` bins is counted on this adapter ([`Counting::choose`]).
+    pub fn counting(&self, tile_bins: u32) -> Counting {
+        Counting::choose(self.gpu.info.device_type, &self.gpu.limits, tile_bins, self.force_counting)
     }
 
     /// The composed WGSL for `job` on this adapter, counting `tile` bins (all when `None`).
     pub fn source(&self, job: &Job, tile: Option<u32>) -> String {
-        let mut kernel = compose::kernel(job, self.workgroup_words(), tile.unwrap_or(job.bins() as u32), self.precision);
+        let tile_bins = tile.unwrap_or(job.bins() as u32);
+        let mut kernel = compose::kernel(job, self.counting(tile_bins), tile_bins, self.precision);
         kernel.chosen.extend(self.replaced.iter().cloned());
         kernel.source()
     }
@@ -153,7 +163,7 @@ impl GpuEngine {
     /// `params.tile_first` on.
     fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<Kernel>, GpuError> {
         let source = self.source(job, tile);
-        let in_workgroup = tile.unwrap_or(job.bins() as u32).div_ceil(2) <= self.workgroup_words();
+        let counting = self.counting(tile.unwrap_or(job.bins() as u32));
         if let Some(k) = self.cache.get(&source) {
             return Ok(k.clone());
         }
@@ -165,7 +175,7 @@ impl GpuEngine {
             directions: matches!(job, Job::Lobe { .. }).then(|| pipeline("directions")),
             explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("explicit_samples")),
             bin_explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("bin_explicit")),
-            in_workgroup,
+            counting,
         });
         self.gpu.check_errors()?;
         self.compiled += 1;
@@ -231,11 +241,13 @@ impl GpuEngine {
         let counts = gpu.buffer("chunk counts", cells * 4, storage);
         let totals = gpu.buffer("totals", cells * 8, storage);
         let dirs = gpu.buffer("directions (unused)", 16, wgpu::BufferUsages::STORAGE);
+        // the slabs start at 0 (wgpu zeroes a new buffer) and the fold leaves them 0
+        let slabs = gpu.buffer("slabs", kernel.counting.slab_bytes(tile_bins as u32), wgpu::BufferUsages::STORAGE);
         let (tf, tu) = self.tables(job);
-        let bind = self.bind_group([passes.params(), &counts, &totals, &tf, &tu, &dirs]);
+        let bind = self.bind_group([passes.params(), &counts, &totals, &tf, &tu, &dirs, &slabs]);
         let steps = |chunk: SampleRange| {
             vec![
-                Step { pipeline: &kernel.sample, groups: SamplingPasses::groups(chunk.count) },
+                Step { pipeline: &kernel.sample, groups: kernel.counting.groups(chunk.count) },
                 Step { pipeline: &kernel.fold, groups: cells.div_ceil(WG_SIZE as u64) },
             ]
         };
@@ -282,7 +294,7 @@ impl GpuEngine {
             counts: result,
             gpu_seconds,
             wall_seconds: start.elapsed().as_secs_f64(),
-            workgroup_counting: kernel.in_workgroup,
+            counting: kernel.counting,
             tiles: tiling.tiles,
         })
     }
@@ -346,24 +358,26 @@ impl GpuEngine {
         let out = gpu.buffer("per-sample output", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let unused = || gpu.buffer("unused", 16, wgpu::BufferUsages::STORAGE);
         gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&Params::new(job, range)));
-        let bind = self.bind_group([&params, &unused(), &unused(), input, &unused(), &out]);
+        let bind = self.bind_group([&params, &unused(), &unused(), input, &unused(), &out, &unused()]);
         gpu.dispatch(&[Pass { label: "per sample", bind: &bind, offset: Some(0), steps: vec![Step { pipeline, groups }] }])?;
         let bytes = gpu.read(&out, size)?;
         gpu.check_errors()?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
-    /// The kernel's bind group: `buffers[i]` at binding `i` (binding 0 the parameters).
-    fn bind_group(&self, buffers: [&wgpu::Buffer; 6]) -> wgpu::BindGroup {
+    /// The kernel's bind group: `buffers[i]` at binding `i` (binding 0 the parameters), the
+    /// last at [`SLAB_BINDING`].
+    fn bind_group(&self, buffers: [&wgpu::Buffer; 7]) -> wgpu::BindGroup {
         let [params, rest @ ..] = buffers;
         let mut entries = vec![Params::bind_entry(params)];
-        entries.extend(rest.iter().zip(1..).map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }));
+        let bindings = [1, 2, 3, 4, 5, SLAB_BINDING];
+        entries.extend(rest.iter().zip(bindings).map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }));
         self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("lobes kernel"), layout: &self.layout, entries: &entries })
     }
 
     /// The weighted module of `job` with `effects`, as [`GpuEngine::weighted`] compiles it.
     pub fn weighted_module(&self, job: &Job, effects: &Effects, how: Specialisation) -> Composed {
-        effects::compose_effects(job, effects, self.workgroup_words(), how)
+        effects::compose_effects(job, effects, self.counting(job.bins() as u32), how)
     }
 
     /// Number of weighted pipelines compiled so far (one per distinct module and constants).

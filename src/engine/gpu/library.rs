@@ -117,6 +117,9 @@ pub const ERF_F64: File = shader!("math/erf_f64.wgsl");
 /// `lobes::counting` in global memory (instead of packed workgroup counters), for histograms
 /// too large for the adapter's workgroup storage.
 pub const COUNTING_GLOBAL: File = shader!("passes/counting_global.wgsl");
+/// `lobes::counting` in per-invocation slabs of a storage buffer, on CPU adapters
+/// (src/engine/gpu/counting.rs).
+pub const COUNTING_SLABS: File = shader!("passes/counting_slabs.wgsl");
 /// `lobes::draw` of a discrete job (instead of a lobe's).
 pub const DISCRETE_DRAW: File = shader!("passes/discrete_draw.wgsl");
 /// `lobes::effect_fresnel` and `lobes::effect_masking` of a weighted case without the effect: 1.
@@ -366,7 +369,7 @@ mod tests {
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
+        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }

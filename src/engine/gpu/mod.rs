@@ -2,6 +2,7 @@
 
 pub mod compose;
 pub mod context;
+pub mod counting;
 pub mod dispatch;
 pub mod effects;
 pub mod engine;
@@ -14,6 +15,7 @@ pub mod stack;
 pub mod weighted;
 
 pub use context::{Gpu, GpuError};
+pub use counting::{Counting, Strategy};
 pub use dispatch::Chunking;
 pub use engine::{GpuEngine, GpuRun};
 pub use weighted::WeightedRun;

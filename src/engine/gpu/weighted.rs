@@ -142,7 +142,7 @@ mod tests {
     fn effect_layout() {
         let lobe = crate::reference::Lobe { kind: crate::reference::LobeKind::Ggx, method: crate::reference::Method::Vndf, alpha_x: 0.3, alpha_y: 0.3, alpha_angle: 0.0 };
         let job = Job::Lobe { lobe, incident: glam::DVec3::Z, grid: crate::stats::histogram::SphereGrid { rows: 4, cols: 8 }, scatter: crate::engine::job::Scatter::Reflect };
-        let source = effects::compose_effects(&job, &Effects::NONE, 4096, effects::Specialisation::Uber).source;
+        let source = effects::compose_effects(&job, &Effects::NONE, crate::engine::gpu::Counting::Workgroup, effects::Specialisation::Uber).source;
         let members = [("modes", offset_of!(EffectUniform, modes)), ("fresnel", offset_of!(EffectUniform, fresnel))];
         super::super::layout::check_struct(&source, "Effect", size_of::<EffectUniform>(), align_of::<EffectUniform>(), &members).unwrap();
     }
