@@ -1,5 +1,5 @@
 #define_import_path lobes::kernel
-#import lobes::job::{BINS, CELLS, COUNT_WG, SAMPLES_PER_THREAD, SLABS, TILE_BINS, WG_SIZE}
+#import lobes::job::{BINS, CELLS, COUNT_WG, SAMPLES_PER_THREAD, SLABS, TILE_BINS, WG_SIZE, slabs_used}
 #import lobes::bindings::{params, counts, totals}
 #import lobes::rng::add64
 #import lobes::counting::{count_bin, flush_bins, start_counting, take_count}
@@ -45,14 +45,14 @@ fn samples_of(at: Invocation, count: u32) -> u32 {
 
 // The samples invocation `at` counts of a dispatch of `count`: first + k * stride for k < n, as
 // (first, stride, n). With atomics (SLABS 0) the blocks of sample_of; with slabs invocation g of
-// the SLABS (workgroups of COUNT_WG) takes g, g + SLABS, g + 2 SLABS, ... whatever the count, so
-// every slab is busy; invocations of a grid's last row past SLABS take none.
+// the slabs_used(count) (workgroups of COUNT_WG) takes g, g + used, g + 2 used, ...; invocations
+// past those take none.
 fn counted_samples(at: Invocation, count: u32) -> vec3<u32> {
     if (SLABS == 0u) {
         return vec3<u32>(sample_of(at, 0u), WG_SIZE, samples_of(at, count));
     }
-    // (SLABS is not 0 here, but naga refuses a division by the constant 0 even where dead)
-    let slabs = max(SLABS, 1u);
+    // (not 0 here, but naga refuses a division by the constant 0 even where dead)
+    let slabs = max(slabs_used(count), 1u);
     let g = invocation_of(at);
     if (g >= slabs || g >= count) {
         return vec3<u32>(0u, 1u, 0u);

@@ -286,11 +286,21 @@ fn counting_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Pre
         _ => 0,
     };
     let count_wg = counting.workgroup_size();
+    // the slabs a chunk of `count` uses (shaders/passes/counting_slabs.wgsl): at most SLABS, each
+    // drawing at least 2 TILE_BINS samples (the fold reads and clears TILE_BINS words a slab),
+    // and at least 64 (8 workgroups, for the CPU's threads), in whole workgroups
+    let slabs_used = match counting {
+        Counting::Slabs { slabs } => {
+            let floor = slabs.min(64);
+            format!("fn slabs_used(count: u32) -> u32 {{\n    return clamp(count / (2u * TILE_BINS), {floor}u, SLABS) / COUNT_WG * COUNT_WG;\n}}\n")
+        }
+        _ => "fn slabs_used(count: u32) -> u32 {\n    return 0u;\n}\n".to_string(),
+    };
     let mut job_module = JobModule::new(describe(job));
     job_module.push(&format!(
         "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
          const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n\
-         const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\nconst COUNT_WG: u32 = {count_wg}u;\nconst SLABS: u32 = {slabs}u;\n{}",
+         const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\nconst COUNT_WG: u32 = {count_wg}u;\nconst SLABS: u32 = {slabs}u;\n{slabs_used}{}",
         layout::consts_wgsl()
     ));
     Kernel { roots: vec!["lobes::kernel"], chosen, job: job_module }
