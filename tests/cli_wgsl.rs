@@ -79,7 +79,9 @@ fn wgsl_wesl_out_dir_writes_a_package_the_wesl_crate_compiles() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let mut names: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     names.sort();
-    assert_eq!(names, ["fresnel.wesl", "ggx.wesl", "math.wesl", "microfacet.wesl", "reflect.wesl", "rng.wesl"]);
+    // a module's API in NAME.wesl, its internal helpers (if any) in NAME/internal.wesl
+    assert_eq!(names, ["fresnel", "fresnel.wesl", "ggx", "ggx.wesl", "math.wesl", "microfacet.wesl", "reflect.wesl", "rng.wesl"]);
+    assert!(dir.join("ggx/internal.wesl").is_file() && dir.join("fresnel/internal.wesl").is_file());
     std::fs::write(
         root.join("main.wesl"),
         "import package::lobes::ggx::{ggx_sample_vndf, ggx_pdf_vndf};\nimport package::lobes::fresnel::fresnel_schlick;\n\
@@ -91,6 +93,10 @@ fn wgsl_wesl_out_dir_writes_a_package_the_wesl_crate_compiles() {
     .unwrap();
     let compiled = wesl::Wesl::new(&root).compile(&"package::main".parse().unwrap()).unwrap_or_else(|e| panic!("{e}"));
     embed::validate(&compiled.to_string()).unwrap_or_else(|e| panic!("{e}\n{compiled}"));
+    // a helper is not in the module's API: importing it from there fails, naming it
+    std::fs::write(root.join("helper.wesl"), "import package::lobes::ggx::ggx_cap_sample;\n@compute @workgroup_size(1) fn main() { let h = ggx_cap_sample(vec2(0.3), vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), 0.5, 0.5, vec2(0.5)); }\n").unwrap();
+    let e = wesl::Wesl::new(&root).compile(&"package::helper".parse().unwrap()).map(|c| c.to_string()).unwrap_err().to_string();
+    assert!(e.contains("ggx_cap_sample"), "{e}");
     let usage = lobes(&["wgsl", "--wesl", "ggx"]);
     assert_eq!(usage.status.code(), Some(2), "--wesl needs --out-dir");
 }

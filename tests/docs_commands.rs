@@ -19,6 +19,10 @@
 //!   the subcommand and every flag and value before it prints the help), other lines must be
 //!   scheduler commands.
 //! - `sh dev`: development commands (cargo, duplicates, .ci scripts); nothing runs.
+//!
+//! Code blocks of docs/embedding.md run too (`the_embedding_pages_code_runs`): its `rust`
+//! blocks are doctests of `lobes::embed` (the page is included there), and its `wgsl` imports
+//! compile with the `wesl` crate against the files its `sh` line writes.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -335,6 +339,66 @@ fn every_documented_command_runs() {
     }
     assert!(errors.is_empty(), "{} documented command(s) failed:\n{}", errors.len(), errors.join("\n"));
     assert!(ran >= 20, "only {ran} documented commands ran: are the pages there?");
+}
+
+/// The info strings of a page's fenced ```rust blocks and the lines of its ```LANG blocks.
+fn code_blocks<'a>(text: &'a str, lang: &str) -> Vec<(&'a str, Vec<&'a str>)> {
+    let mut out = Vec::new();
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        let Some(info) = line.trim().strip_prefix("```") else { continue };
+        let body: Vec<&str> = lines.by_ref().take_while(|l| l.trim() != "```").collect();
+        if info.split([',', ' ']).next() == Some(lang) {
+            out.push((info, body));
+        }
+    }
+    out
+}
+
+/// docs/embedding.md's code runs too, not only its shell lines: its ```rust blocks are doctests
+/// (rustdoc compiles the page, which src/embed/mod.rs includes, and runs each block not marked
+/// `no_run`; none may be `ignore`d), and each WESL import of its ```wgsl block compiles, with the
+/// `wesl` crate as the page's build script uses it, in a shader beside the files the page's
+/// `lobes wgsl --wesl --out-dir shaders/lobes …` line writes: `import package::lobes::…` from
+/// that folder, `import lobes::…` from `embed::WESL_PACKAGE`; naga validates both.
+#[test]
+fn the_embedding_pages_code_runs() {
+    let page = read("docs/embedding.md");
+    let rust = code_blocks(&page, "rust");
+    assert!(rust.len() >= 3, "docs/embedding.md's Rust blocks were not found");
+    for (info, body) in &rust {
+        assert!(!info.contains("ignore"), "docs/embedding.md: a ```{info} block is not compiled:\n{}", body.join("\n"));
+    }
+    let include = "#[doc = include_str!(\"../../docs/embedding.md\")]";
+    assert!(read("src/embed/mod.rs").contains(include), "src/embed/mod.rs no longer includes docs/embedding.md as doctests ({include})");
+
+    let mut errors = Vec::new();
+    let write = shell_lines("docs/embedding.md", &page, &mut errors)
+        .into_iter()
+        .map(|l| l.text)
+        .find(|t| t.starts_with("lobes wgsl --wesl --out-dir shaders/lobes "))
+        .expect("docs/embedding.md writes the WESL package into shaders/lobes");
+    assert!(errors.is_empty(), "{errors:?}");
+    let tmp = tempfile::tempdir().unwrap();
+    let bin = bin_dir(tmp.path());
+    let out = bash(&write, tmp.path(), &bin, &[]).expect("lobes wgsl finishes");
+    assert!(out.status.success(), "`{write}`: {}", tail(&out.stderr));
+    let wgsl = code_blocks(&page, "wgsl");
+    let [(_, block)] = wgsl.as_slice() else { panic!("docs/embedding.md: expected one ```wgsl block, found {}", wgsl.len()) };
+    // every `import …;` of the block, in its code or in a comment that shows the other form
+    let imports: Vec<String> =
+        block.iter().flat_map(|l| l.split("import ").skip(1).filter_map(|rest| rest.split_once(';').map(|(path, _)| format!("import {path};")))).collect();
+    assert!(imports.iter().any(|i| i.starts_with("import package::lobes::")) && imports.iter().any(|i| i.starts_with("import lobes::")), "{imports:?}");
+    let kernel = "@group(0) @binding(0) var<storage, read_write> o: array<f32>;\n\
+                  @compute @workgroup_size(1) fn main() { o[0] = ggx_sample_vndf(vec2(0.3), vec3(0.0, 0.0, 1.0), vec2(0.25, 0.5)).pdf_r; }\n";
+    let shaders = tmp.path().join("shaders");
+    for import in &imports {
+        std::fs::write(shaders.join("main.wesl"), format!("{import}\n{kernel}")).unwrap();
+        let mut compiler = wesl::Wesl::new(&shaders);
+        compiler.add_package(&lobes::embed::WESL_PACKAGE);
+        let compiled = compiler.compile(&"package::main".parse().unwrap()).unwrap_or_else(|e| panic!("docs/embedding.md: `{import}`: {e}"));
+        lobes::embed::validate(&compiled.to_string()).unwrap_or_else(|e| panic!("docs/embedding.md: `{import}`: {e}"));
+    }
 }
 
 /// The ```toml block after `<!-- lobes scene --template -->` in docs/scenes.md.

@@ -579,39 +579,120 @@ fn a_plain_concatenation_consumer_matches_the_f64_albedo() {
     assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
 }
 
-/// WESL: the renderer's shader imports lobes' package (`import lobes::ggx::…;`), the `wesl`
-/// crate (0.4) compiles it with its own resolver and mangler, and wgpu runs the result.
-#[test]
-fn a_wesl_consumer_matches_the_f64_albedo() {
+/// The `wesl` crate (0.4) compiles `shader`, which imports lobes' package (`import
+/// lobes::ggx::…;`), with its own resolver and mangler.
+fn wesl_compile(shader: &str) -> String {
     use wesl::syntax::PathOrigin;
-    let shader = String::from("import lobes::ggx::{ggx_sample_vndf, ggx_eval};\nimport lobes::rng::rng_uniforms;\n")
-        + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", "ggx_sample_vndf(").replace("EVAL(", "ggx_eval(");
     let root = wesl::ModulePath::new(PathOrigin::Absolute, vec!["renderer".into()]);
     let mut local = wesl::VirtualResolver::new();
-    local.add_module(root.clone(), shader.into());
+    local.add_module(root.clone(), shader.to_string().into());
     let mut packages = wesl::PkgResolver::new();
     packages.add_package(&embed::WESL_PACKAGE);
     let mut router = wesl::Router::new();
     router.mount_resolver(wesl::ModulePath::new(PathOrigin::Absolute, vec![]), local);
     router.mount_fallback_resolver(packages);
-    let compiled = wesl::Wesl::new("").set_custom_resolver(router).compile(&root).unwrap_or_else(|e| panic!("{e}")).to_string();
-    assert!(compiled.contains("fn saturate(") && compiled.contains("const PI"), "the renderer's names stay its own:\n{compiled}");
-    assert_albedo("WESL (wesl 0.4)", consumer_albedo(&gpu(), &compiled), run_albedo());
+    wesl::Wesl::new("").set_custom_resolver(router).compile(&root).unwrap_or_else(|e| panic!("{e}")).to_string()
 }
 
-/// naga_oil (0.23, on naga 30): the renderer's shader imports lobes' naga_oil modules
-/// (`#import lobes::ggx::…`) beside its own names and composes and validates. (wgpu here has no
-/// `naga-ir` feature to run naga_oil's module; its code is the WESL consumer's, which runs.)
+/// WESL: the renderer's shader imports lobes' package (`import lobes::ggx::…;`), the `wesl`
+/// crate (0.4) compiles it, and wgpu runs the result; a density 1 % high fails.
 #[test]
-fn a_naga_oil_consumer_composes_and_validates() {
+fn a_wesl_consumer_matches_the_f64_albedo() {
+    let shader = |sampler: &str, extra: &str| {
+        String::from("import lobes::ggx::{ggx_sample_vndf, ggx_eval};\nimport lobes::rng::rng_uniforms;\nimport lobes::reflect::LobeSample;\n")
+            + extra
+            + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", &format!("{sampler}(")).replace("EVAL(", "ggx_eval(")
+    };
+    let gpu = gpu();
+    let reference = run_albedo();
+    let compiled = wesl_compile(&shader("ggx_sample_vndf", ""));
+    assert!(compiled.contains("fn saturate(") && compiled.contains("const PI"), "the renderer's names stay its own:\n{compiled}");
+    assert_albedo("WESL (wesl 0.4)", consumer_albedo(&gpu, &compiled), reference);
+    let broken = "fn broken(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {\n\
+                  var s = ggx_sample_vndf(a, wi, u);\n    s.pdf_r *= 1.01;\n    return s;\n}\n";
+    let (mean, se) = consumer_albedo(&gpu, &wesl_compile(&shader("broken", broken)));
+    let z = (mean - reference) / se;
+    println!("WESL, pdf 1 % high: albedo {mean:.6} ± {se:.2e}, z = {z:+.1}");
+    assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
+}
+
+/// The renderer's shader for the naga_oil consumers: imports of lobes' naga_oil modules, then
+/// [`ALBEDO_KERNEL`] with the short names; `sampler` is the sampling function it calls.
+fn naga_oil_shader(sampler: &str, extra: &str) -> String {
+    String::from("#import lobes::ggx::{ggx_sample_vndf, ggx_eval}\n#import lobes::rng::rng_uniforms\n")
+        + extra
+        + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", &format!("{sampler}(")).replace("EVAL(", "ggx_eval(")
+}
+
+/// A sampler of the naga_oil consumer's own whose density is 1 % high (`LobeSample` is lobes').
+const BROKEN_NAGA_OIL: &str = "#import lobes::reflect::LobeSample\n\
+                               fn broken(a: vec2<f32>, wi: vec3<f32>, u: vec2<f32>) -> LobeSample {\n\
+                               var s = ggx_sample_vndf(a, wi, u);\n    s.pdf_r *= 1.01;\n    return s;\n}\n";
+
+/// naga_oil 0.23 (on naga 30) composes `shader` with lobes' naga_oil modules; naga 30 validates
+/// the module and writes it back as WGSL (its `wgsl-out` backend), which wgpu runs.
+fn naga_oil_023_wgsl(shader: &str) -> String {
     use naga_oil::compose::{Composer, NagaModuleDescriptor};
-    let shader = String::from("#import lobes::ggx::{ggx_sample_vndf, ggx_eval}\n#import lobes::rng::rng_uniforms\n")
-        + &ALBEDO_KERNEL.replace("RNG(", "rng_uniforms(").replace("SAMPLE(", "ggx_sample_vndf(").replace("EVAL(", "ggx_eval(");
     let mut composer = Composer::default();
     embed::add_naga_oil_modules(&mut composer, &[Module::Rng, Module::Ggx]).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
     let module = composer
-        .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "renderer.wgsl", ..Default::default() })
+        .make_naga_module(NagaModuleDescriptor { source: shader, file_path: "renderer.wgsl", ..Default::default() })
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default()).validate(&module).unwrap();
     assert!(module.entry_points.iter().any(|e| e.name == "albedo"));
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default()).validate(&module).unwrap_or_else(|e| panic!("{e:?}"));
+    naga::back::wgsl::write_string(&module, &info, naga::back::wgsl::WriterFlags::empty()).unwrap()
+}
+
+/// naga_oil (0.23, on naga 30): the renderer's shader imports lobes' naga_oil modules
+/// (`#import lobes::ggx::…`) beside its own names; the composed module, validated and written as
+/// WGSL by naga, runs on the GPU and matches the f64 albedo; a density 1 % high does not.
+#[test]
+fn a_naga_oil_consumer_matches_the_f64_albedo() {
+    let gpu = gpu();
+    let reference = run_albedo();
+    let composed = naga_oil_023_wgsl(&naga_oil_shader("ggx_sample_vndf", ""));
+    assert!(composed.contains("fn fresnel_schlick(") && composed.contains("fn D_GGX("), "the renderer's names stay its own:\n{composed}");
+    assert_albedo("naga_oil 0.23", consumer_albedo(&gpu, &composed), reference);
+    let (mean, se) = consumer_albedo(&gpu, &naga_oil_023_wgsl(&naga_oil_shader("broken", BROKEN_NAGA_OIL)));
+    let z = (mean - reference) / se;
+    println!("naga_oil 0.23, pdf 1 % high: albedo {mean:.6} ± {se:.2e}, z = {z:+.1}");
+    assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
+}
+
+/// naga_oil 0.22 (Bevy 0.19's, on naga 29) composes `shader` with the same texts
+/// ([`embed::naga_oil_modules`]; `NagaOilModule::descriptor` is naga_oil 0.23's type); naga 29
+/// validates the module and writes it as WGSL, which wgpu 30 runs.
+fn naga_oil_022_wgsl(shader: &str) -> String {
+    use naga_oil_022::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
+    let mut composer = Composer::default();
+    for m in embed::naga_oil_modules(&[Module::Rng, Module::Ggx]) {
+        let descriptor = ComposableModuleDescriptor { source: m.source, file_path: &m.import_path, ..Default::default() };
+        if let Err(e) = composer.add_composable_module(descriptor) {
+            panic!("{}", e.emit_to_string(&composer));
+        }
+    }
+    let module = composer
+        .make_naga_module(NagaModuleDescriptor { source: shader, file_path: "renderer.wgsl", ..Default::default() })
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+    assert!(module.entry_points.iter().any(|e| e.name == "albedo"));
+    let info = naga_29::valid::Validator::new(naga_29::valid::ValidationFlags::all(), naga_29::valid::Capabilities::default())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    naga_29::back::wgsl::write_string(&module, &info, naga_29::back::wgsl::WriterFlags::empty()).unwrap()
+}
+
+/// naga_oil 0.22 (what Bevy 0.19 composes with): lobes' naga_oil texts compose beside the
+/// renderer's own names, naga 29 validates them, and the dispatch of its WGSL matches the f64
+/// albedo; a density 1 % high does not.
+#[test]
+fn a_naga_oil_022_consumer_matches_the_f64_albedo() {
+    let gpu = gpu();
+    let reference = run_albedo();
+    let composed = naga_oil_022_wgsl(&naga_oil_shader("ggx_sample_vndf", ""));
+    assert!(composed.contains("fn fresnel_schlick(") && composed.contains("fn D_GGX("), "the renderer's names stay its own:\n{composed}");
+    assert_albedo("naga_oil 0.22", consumer_albedo(&gpu, &composed), reference);
+    let (mean, se) = consumer_albedo(&gpu, &naga_oil_022_wgsl(&naga_oil_shader("broken", BROKEN_NAGA_OIL)));
+    let z = (mean - reference) / se;
+    println!("naga_oil 0.22, pdf 1 % high: albedo {mean:.6} ± {se:.2e}, z = {z:+.1}");
+    assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
 }

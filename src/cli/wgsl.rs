@@ -26,7 +26,8 @@ pub struct WgslArgs {
     #[arg(long, requires = "out_dir")]
     pub wesl: bool,
     /// Write one file per module into DIR (created if missing): NAME.wgsl (plain or naga_oil)
-    /// or NAME.wesl; the plain files do not overlap, so include each once, in any order.
+    /// or NAME.wesl, and NAME/internal.wgsl or .wesl for a naga_oil or WESL module's internal
+    /// helpers; the plain files do not overlap, so include each once, in any order.
     #[arg(long, value_name = "DIR")]
     pub out_dir: Option<PathBuf>,
     /// The bind group of the discrete module's two storage buffers (default 0).
@@ -60,20 +61,27 @@ pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
             Form::Plain => embed::wgsl_with(&modules, bindings),
             _ => embed::naga_oil_modules(&modules)
                 .into_iter()
-                .map(|m| format!("// ==== naga_oil module {} ====\n{}\n", m.import_path, text(m.module, form, bindings).trim_end()))
+                .map(|m| format!("// ==== naga_oil module {} ====\n{}\n", m.import_path, naga_oil_text(&m, bindings).trim_end()))
                 .collect(),
         });
     };
     let files: Vec<(String, String)> = match form {
         Form::Plain => resolved.iter().map(|&m| (format!("{}.wgsl", m.name()), plain_file(m, bindings))).collect(),
-        _ => {
-            let ext = if form == Form::Wesl { "wesl" } else { "wgsl" };
-            embed::naga_oil_modules(&modules).into_iter().map(|m| (format!("{}.{ext}", m.module.name()), text(m.module, form, bindings))).collect()
-        }
+        Form::NagaOil => embed::naga_oil_modules(&modules).into_iter().map(|m| (m.file_name("wgsl"), naga_oil_text(&m, bindings))).collect(),
+        Form::Wesl => embed::wesl_files(&modules)
+            .into_iter()
+            .map(|(name, text)| {
+                let text = if name == "discrete.wesl" { bindings.apply(text) } else { text.to_string() };
+                (name, text)
+            })
+            .collect(),
     };
     std::fs::create_dir_all(dir).with_context(|| format!("--out-dir {}: cannot create the folder", dir.display()))?;
     for (name, contents) in &files {
         let path = dir.join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).with_context(|| format!("--out-dir: cannot create {}", parent.display()))?;
+        }
         crate::atomic::write_atomic(&path, contents.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
@@ -82,10 +90,10 @@ pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The naga_oil or WESL text of `m`, with the discrete module's buffers at `bindings`.
-fn text(m: Module, form: Form, bindings: DiscreteBindings) -> String {
-    let source = if form == Form::Wesl { m.wesl_source() } else { m.naga_oil_source() };
-    if m == Module::Discrete { bindings.apply(source) } else { source.to_string() }
+/// The naga_oil text of `m` (a module's API or its internal helpers), with the discrete
+/// module's buffers at `bindings`.
+fn naga_oil_text(m: &embed::NagaOilModule, bindings: DiscreteBindings) -> String {
+    if m.module == Module::Discrete && !m.internal { bindings.apply(m.source) } else { m.source.to_string() }
 }
 
 /// One module's plain file of `--out-dir`: a header naming the files it needs, then its text

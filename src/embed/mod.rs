@@ -75,7 +75,23 @@ pub use namespace::prefixed;
 /// The texts, names and dependencies `build.rs` generates from `shaders/`, indexed by
 /// `Module as usize`.
 mod generated {
+    /// One naga_oil module / WESL file: a module's API (`lobes::ggx`) or its internal helpers
+    /// (`lobes::ggx::internal`), in dependency order (each after the units it imports).
+    pub(super) struct Unit {
+        pub module: usize,
+        pub internal: bool,
+        pub import_path: &'static str,
+        pub naga_oil: &'static str,
+        pub wesl: &'static str,
+        /// The units it imports from (indices into `UNITS`, each smaller than its own).
+        pub imports: &'static [usize],
+    }
     include!(concat!(env!("OUT_DIR"), "/embed_generated.rs"));
+
+    /// The unit of `module`'s API, or of its internal helpers.
+    pub(super) fn unit(module: usize, internal: bool) -> Option<&'static Unit> {
+        UNITS.iter().find(|u| u.module == module && u.internal == internal)
+    }
 }
 
 /// A WGSL module of lobes: what a renderer imports as one. The listed functions are the ones
@@ -106,7 +122,9 @@ pub enum Module {
     ///   such a sample carries no energy and must be discarded (or counted as zero).
     /// - `reflect_about(wi, h) -> vec3<f32>`, `reflect_sample(wi, h, pdf_h) -> LobeSample`
     ///   (p(ωr) = p(h) / (4 |ωr·h|)), `reflection_half_vector(wi, wr)`, `from_tan_theta`,
-    ///   `frame_to_local(r, w)` / `frame_to_world(r, w)` (rotated anisotropy), `const PI: f32`.
+    ///   `frame_to_local(r, w)` / `frame_to_world(r, w)` and `sample_to_local(r, s)` /
+    ///   `sample_to_world(r, s)` (rotated anisotropy), `lobe_sample(wi, h, wr, pdf_r)`,
+    ///   `const PI: f32`.
     Reflect,
     /// `shaders/lib/microfacet.wgsl` and `shaders/lib/microfacet_eval.wgsl`: `stretch(a, w)` =
     /// normalize(αx wx, αy wy, wz), `microfacet_ndf_weight(wi, h)`, and the BRDF and densities of
@@ -126,7 +144,8 @@ pub enum Module {
     /// - their densities `ggx_pdf_ndf`, `ggx_pdf_vndf`, `ggx_pdf_bounded`, all
     ///   `(a, wi, wr) -> f32`;
     /// - `ggx_eval(a, wi, wr)`: D G2 / (4 cos θi cos θr) with height-correlated Smith G2;
-    ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`, `ggx_vndf_weight`.
+    ///   `ggx_d(a, h)`, `ggx_g1(a, w)`, `ggx_lambda(a, w)`, `ggx_g2(a, wi, wr)`, and the estimator
+    ///   weights `ggx_vndf_weight(a, wi)`, `ggx_bounded_weight(a, wi)`.
     Ggx,
     /// `shaders/math/erf_f32.wgsl`, `shaders/lib/beckmann.wgsl` and
     /// `shaders/lib/beckmann_eval.wgsl`: Beckmann.
@@ -135,7 +154,8 @@ pub enum Module {
     ///   `(a, wi, u: vec2<f32>) -> LobeSample`;
     /// - densities `beckmann_pdf_ndf`, `beckmann_pdf_vndf`, `(a, wi, wr) -> f32`;
     /// - `beckmann_eval(a, wi, wr)`, `beckmann_d`, `beckmann_g1`, `beckmann_lambda`,
-    ///   `beckmann_g2`; `math_erfc` and the other Gaussian integrals of `erf_f32.wgsl`.
+    ///   `beckmann_g2`, `beckmann_vndf_weight` (`erf_f32.wgsl`'s Gaussian integrals are its
+    ///   internal helpers).
     Beckmann,
     /// `shaders/lib/fresnel.wgsl`: Fresnel reflectance at cos θ = ωi·h (CPU twin:
     /// `lobes::reference::fresnel`), each in [0, 1]. Needs [`Module::Math`] only.
@@ -182,7 +202,9 @@ pub enum Module {
     /// - `discrete_sample_cdf_blocks(u: vec2<f32>, n: u32, last_positive: u32) -> u32`: the same
     ///   for longer tables, in two levels (u.x picks a block of [`BLOCK`] items, u.y the item);
     /// - `discrete_sample_alias(u: vec2<f32>, n: u32) -> u32`: Walker's alias table, column
-    ///   ⌊u.x·n⌋, kept when u.y < its threshold.
+    ///   ⌊u.x·n⌋, kept when u.y < its threshold;
+    /// - `discrete_search(u: f32, first: u32, n: u32) -> u32`: the first i < n whose entry
+    ///   `discrete_f[first + i]` is ≥ u (binary search), and `DISCRETE_BLOCK` = [`BLOCK`].
     Discrete,
 }
 
@@ -248,8 +270,9 @@ impl Module {
         generated::WGSL[self as usize]
     }
 
-    /// The module as a naga_oil module (without its dependencies): `#define_import_path
-    /// lobes::NAME`, `#import`s of the other modules, the files' short names, in f32.
+    /// The module's API as a naga_oil module (without its dependencies): `#define_import_path
+    /// lobes::NAME`, `#import`s of the other modules (and of its own internal helpers, from
+    /// `lobes::NAME::internal`: see [`Module::api`]), the files' short names, in f32.
     /// [`Module::Discrete`] comes with its bindings at group 0, bindings 3 and 4
     /// ([`DiscreteBindings::apply`] moves them).
     ///
@@ -261,22 +284,42 @@ impl Module {
     /// assert!(!ggx.contains("Real") && !ggx.contains("f32 >"));
     /// ```
     pub fn naga_oil_source(self) -> &'static str {
-        generated::NAGA_OIL[self as usize]
+        generated::unit(self as usize, false).expect("every module has an API").naga_oil
     }
 
-    /// The module as a WESL module (without its dependencies), `NAME.wesl` of the package
+    /// The module's API as a WESL module (without its dependencies), `NAME.wesl` of the package
     /// `lobes` ([`wesl_files`]): `import super::reflect::{LobeSample, PI};` lines (relative, so the
     /// package works as an external package `lobes` and as a folder `lobes/` of your own
-    /// package), then the files' code under their short names, in f32.
+    /// package; its internal helpers come from `NAME/internal.wesl`, see [`Module::api`]), then
+    /// the files' code under their short names, in f32.
     ///
     /// ```
     /// use lobes::embed::Module;
-    /// let fresnel = Module::Fresnel.wesl_source();
-    /// assert!(fresnel.contains("fn fresnel_schlick(") && !fresnel.contains("import "));
-    /// assert!(Module::Ggx.wesl_source().starts_with("import super::math::{math_cos, math_sin};\n"));
+    /// let masking = Module::Masking.wesl_source();
+    /// assert!(masking.contains("fn masking_separable(") && !masking.contains("fn masking_stirling_d("));
+    /// assert!(masking.starts_with("import super::math::{math_exp, math_log};\nimport super::masking::internal::{HALF_LN_2PI, "));
     /// ```
     pub fn wesl_source(self) -> &'static str {
-        generated::WESL[self as usize]
+        generated::unit(self as usize, false).expect("every module has an API").wesl
+    }
+
+    /// The names the module offers a renderer: what `lobes::NAME` holds in the naga_oil and WESL
+    /// forms (their `#import` / `import` of any other name fails), each listed in the module's
+    /// documentation above and in docs/embedding.md. The module's other names
+    /// ([`Module::short_names`]) are its internal helpers, which those forms put in the
+    /// submodule `lobes::NAME::internal` (its API's code imports them from there; neither
+    /// naga_oil nor WESL hides a name, so nothing stops an import from `internal`, but they are
+    /// not API and may change in any release). The plain text holds both, prefixed.
+    ///
+    /// ```
+    /// use lobes::embed::Module;
+    /// assert!(Module::Ggx.api().contains(&"ggx_sample_vndf"));
+    /// assert!(!Module::Ggx.api().contains(&"ggx_cap_sample"));          // a helper of ggx_sample_vndf
+    /// assert!(Module::Ggx.short_names().contains(&"ggx_cap_sample"));
+    /// assert!(!Module::Ggx.wesl_source().contains("fn ggx_cap_sample("));
+    /// ```
+    pub fn api(self) -> &'static [&'static str] {
+        generated::API[self as usize]
     }
 
     /// The module named `name` (its [`Module::name`]).
@@ -474,69 +517,74 @@ impl DiscreteBindings {
     }
 }
 
-/// One of lobes' modules as a naga_oil module, for a renderer that composes its shaders with
-/// naga_oil (Bevy ≤ 0.19): add each with [`add_naga_oil_modules`] (feature `naga-oil`) or
-/// your own `Composer::add_composable_module`, then `#import lobes::ggx::ggx_sample_vndf` in
-/// your shader. naga_oil keeps modules apart by import path, so these carry the files' short
-/// names.
+/// One of lobes' naga_oil modules, for a renderer that composes its shaders with naga_oil
+/// (Bevy ≤ 0.19): a module's API (`lobes::ggx`) or its internal helpers
+/// (`lobes::ggx::internal`, which the API's code imports; see [`Module::api`]). Add each with
+/// [`add_naga_oil_modules`] (feature `naga-oil`) or your own
+/// `Composer::add_composable_module`, then `#import lobes::ggx::ggx_sample_vndf` in your shader.
+/// naga_oil keeps modules apart by import path, so these carry the files' short names.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct NagaOilModule {
     /// The module.
     pub module: Module,
-    /// The path its `#define_import_path` names (`"lobes::ggx"`).
+    /// Whether this is the module's internal helpers (`lobes::NAME::internal`) rather than its API.
+    pub internal: bool,
+    /// The path its `#define_import_path` names (`"lobes::ggx"`, `"lobes::ggx::internal"`).
     pub import_path: String,
-    /// The module's text: WGSL with naga_oil's `#define_import_path` and `#import` directives
-    /// ([`Module::naga_oil_source`]).
+    /// The text: WGSL with naga_oil's `#define_import_path` and `#import` directives
+    /// ([`Module::naga_oil_source`] for the API).
     pub source: &'static str,
+}
+
+impl NagaOilModule {
+    /// Its file in `lobes wgsl --naga-oil --out-dir` and in the WESL package: `ggx.EXT`, or
+    /// `ggx/internal.EXT` for the helpers.
+    ///
+    /// ```
+    /// use lobes::embed::{naga_oil_modules, Module};
+    /// let files: Vec<String> = naga_oil_modules(&[Module::Fresnel]).iter().map(|m| m.file_name("wesl")).collect();
+    /// assert_eq!(files, ["fresnel/internal.wesl", "fresnel.wesl"]);
+    /// ```
+    pub fn file_name(&self, ext: &str) -> String {
+        format!("{}{}.{ext}", self.module.name(), if self.internal { "/internal" } else { "" })
+    }
 }
 
 #[cfg(feature = "naga-oil")]
 impl NagaOilModule {
     /// The descriptor for `naga_oil::compose::Composer::add_composable_module` (naga_oil 0.23),
-    /// with the import path as the file path that naga_oil's messages name.
+    /// with the import path as the file path that naga_oil's messages name. (For naga_oil 0.22,
+    /// Bevy 0.19's, build its own descriptor from `source` and `import_path`.)
     pub fn descriptor(&self) -> naga_oil::compose::ComposableModuleDescriptor<'_> {
         naga_oil::compose::ComposableModuleDescriptor { source: self.source, file_path: &self.import_path, ..Default::default() }
     }
 }
 
-/// `modules` and their dependencies as naga_oil modules (see [`NagaOilModule`]), each after
+/// The units of `modules`' APIs and all they import, in dependency order.
+fn units(modules: &[Module]) -> Vec<&'static generated::Unit> {
+    let mut wanted = vec![false; generated::UNITS.len()];
+    let mut stack: Vec<usize> = modules.iter().map(|&m| generated::UNITS.iter().position(|u| u.module == m as usize && !u.internal).unwrap()).collect();
+    while let Some(i) = stack.pop() {
+        if !std::mem::replace(&mut wanted[i], true) {
+            stack.extend(generated::UNITS[i].imports);
+        }
+    }
+    generated::UNITS.iter().zip(wanted).filter(|(_, w)| *w).map(|(u, _)| u).collect()
+}
+
+/// `modules` and what they import as naga_oil modules (see [`NagaOilModule`]), each after
 /// the modules it imports (the order naga_oil's `add_composable_module` needs).
 ///
 /// ```
 /// use lobes::embed::{naga_oil_modules, Module};
 /// let paths: Vec<String> = naga_oil_modules(&[Module::Fresnel]).into_iter().map(|m| m.import_path).collect();
-/// assert_eq!(paths, ["lobes::fresnel"]); // in f32, Fresnel needs nothing of lobes::math
+/// assert_eq!(paths, ["lobes::fresnel::internal", "lobes::fresnel"]); // in f32, Fresnel needs nothing of lobes::math
 /// ```
 pub fn naga_oil_modules(modules: &[Module]) -> Vec<NagaOilModule> {
-    resolve(modules)
+    units(modules)
         .into_iter()
-        .filter(|m| !m.naga_oil_source().trim().is_empty() && (modules.contains(m) || needed_by_import(*m, modules)))
-        .map(|module| NagaOilModule { module, import_path: module.import_path(), source: module.naga_oil_source() })
+        .map(|u| NagaOilModule { module: Module::ALL[u.module], internal: u.internal, import_path: u.import_path.to_string(), source: u.naga_oil })
         .collect()
-}
-
-/// Whether `m` is imported (in the naga_oil and WESL forms, which import no `Real`) by one of
-/// `modules` or by what they import.
-fn needed_by_import(m: Module, modules: &[Module]) -> bool {
-    let imports = |k: Module| -> Vec<Module> {
-        let text = k.wesl_source();
-        Module::ALL.into_iter().filter(|d| text.lines().any(|l| l.starts_with(&format!("import super::{}::", d.name())))).collect()
-    };
-    let mut stack: Vec<Module> = modules.to_vec();
-    let mut seen = Vec::new();
-    while let Some(k) = stack.pop() {
-        if seen.contains(&k) {
-            continue;
-        }
-        seen.push(k);
-        for d in imports(k) {
-            if d == m {
-                return true;
-            }
-            stack.push(d);
-        }
-    }
-    false
 }
 
 /// Adds `modules` and what they import to a naga_oil composer, each after those it imports,
@@ -571,31 +619,28 @@ pub fn add_naga_oil_modules(composer: &mut naga_oil::compose::Composer, modules:
 }
 
 /// `modules` and what they import as the files of the WESL package `lobes`: (`"ggx.wesl"`,
-/// [`Module::wesl_source`]), each once. Write them into a folder `lobes/` beside your shaders,
-/// or hand them to your WESL resolver as the package `lobes`; then `import
-/// lobes::ggx::ggx_sample_vndf;`.
+/// [`Module::wesl_source`]) and, for a module with internal helpers, (`"ggx/internal.wesl"`,
+/// their text), each once. Write them into a folder `lobes/` beside your shaders, or hand them
+/// to your WESL resolver as the package `lobes`; then `import lobes::ggx::ggx_sample_vndf;`.
 ///
 /// ```
 /// use lobes::embed::{wesl_files, Module};
 /// let files: Vec<String> = wesl_files(&[Module::Ggx]).into_iter().map(|(name, _)| name).collect();
-/// assert_eq!(files, ["math.wesl", "reflect.wesl", "microfacet.wesl", "ggx.wesl"]);
+/// assert_eq!(files, ["math.wesl", "reflect.wesl", "microfacet.wesl", "ggx/internal.wesl", "ggx.wesl"]);
 /// ```
 pub fn wesl_files(modules: &[Module]) -> Vec<(String, &'static str)> {
-    naga_oil_modules(modules).into_iter().map(|m| (format!("{}.wesl", m.module.name()), m.module.wesl_source())).collect()
+    units(modules)
+        .into_iter()
+        .map(|u| (format!("{}{}.wesl", Module::ALL[u.module].name(), if u.internal { "/internal" } else { "" }), u.wesl))
+        .collect()
 }
 
 #[cfg(feature = "wesl")]
 mod wesl_package {
-    use super::generated::{NAMES, WESL};
+    use super::generated::UNITS;
     use wesl::{CodegenModule, CodegenPkg};
-    macro_rules! modules {
-        ($($i:literal)*) => {
-            static SUBMODULES: [CodegenModule; 11] = [$(CodegenModule { name: NAMES[$i], source: WESL[$i], submodules: &[] }),*];
-            static REFS: [&CodegenModule; 11] = [$(&SUBMODULES[$i]),*];
-        };
-    }
-    modules!(0 1 2 3 4 5 6 7 8 9 10);
-    static ROOT: CodegenModule = CodegenModule { name: "lobes", source: "", submodules: &REFS };
+    include!(concat!(env!("OUT_DIR"), "/embed_wesl_package.rs"));
+    static ROOT: CodegenModule = CodegenModule { name: "lobes", source: "", submodules: &MODULES };
     pub static WESL_PACKAGE: CodegenPkg = CodegenPkg { crate_name: "lobes", root: &ROOT, dependencies: &[] };
 }
 
@@ -613,6 +658,12 @@ mod wesl_package {
 /// ```
 #[cfg(feature = "wesl")]
 pub use wesl_package::WESL_PACKAGE;
+
+/// docs/embedding.md, whose Rust blocks rustdoc compiles and runs as doctests of this item
+/// (`cargo test --doc`; tests/docs_commands.rs checks that the page is included here).
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/embedding.md")]
+pub struct EmbeddingPage;
 
 /// A source given to [`validate`] that holds one of lobes' files twice (two texts of [`wgsl`]
 /// concatenated), or that naga rejects.
@@ -762,21 +813,106 @@ mod tests {
 
     #[test]
     fn naga_oil_and_wesl_texts_are_clean() {
-        for m in Module::ALL {
-            for text in [m.naga_oil_source(), m.wesl_source()] {
+        for u in generated::UNITS {
+            let m = Module::ALL[u.module];
+            for text in [u.naga_oil, u.wesl] {
                 let code: String = text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n");
                 assert!(!code.contains("Real") && !code.contains("f32 >") && !code.contains("f32 )"), "{m:?}:\n{text}");
                 assert!(!text.contains("lobes::math::Real") && !code.contains("alias "), "{m:?}");
             }
-            // each form imports only the modules the plain form depends on
-            for line in m.wesl_source().lines().filter(|l| l.starts_with("import ")) {
-                assert!(m.dependencies().iter().any(|d| line.starts_with(&format!("import super::{}::", d.name()))), "{m:?}: {line}");
+            // each unit imports only from the modules the plain form depends on, or its own helpers
+            let up = if u.internal { "import super::super::" } else { "import super::" };
+            for line in u.wesl.lines().filter(|l| l.starts_with("import ")) {
+                let from = line.strip_prefix(up).and_then(|r| r.split("::").next()).and_then(Module::from_name);
+                assert!(from.is_some_and(|d| m.dependencies().contains(&d) || (d == m && !u.internal)), "{}: {line}", u.import_path);
             }
         }
         for wanted in [Module::Fresnel, Module::Masking] {
             let paths: Vec<Module> = naga_oil_modules(&[wanted]).into_iter().map(|m| m.module).collect();
             assert!(!paths.contains(&Module::Reflect), "{wanted:?} brings {paths:?}");
         }
+    }
+
+    /// In the naga_oil and WESL forms `lobes::NAME` declares exactly the module's API, its
+    /// helpers are in `lobes::NAME::internal`, and together they are every name of its files.
+    #[test]
+    fn each_module_declares_its_api_and_its_helpers_apart() {
+        for m in Module::ALL {
+            let declared = |internal: bool| -> Vec<&str> {
+                let mut v = generated::unit(m as usize, internal).map_or(Vec::new(), |u| text::declared(u.wesl));
+                v.sort();
+                v
+            };
+            let mut api = m.api().to_vec();
+            api.sort();
+            assert_eq!(declared(false), api, "{m:?}");
+            let mut all: Vec<&str> = declared(false).into_iter().chain(declared(true)).collect();
+            all.sort();
+            let expected: Vec<&str> = m.short_names().iter().copied().filter(|&n| n != "Real").collect();
+            assert_eq!(all, expected, "{m:?}");
+            let naga_oil = generated::unit(m as usize, false).unwrap().naga_oil;
+            assert_eq!(text::declared(naga_oil).len(), api.len(), "{m:?}");
+        }
+        assert!(Module::ALL.iter().filter(|m| generated::unit(**m as usize, true).is_some()).count() >= 6);
+    }
+
+    /// A renderer that imports a helper from `lobes::ggx` gets an error naming it, in both forms;
+    /// the API's names compose (the renderer tests above use them), and the helpers are
+    /// where the documentation says, in `lobes::ggx::internal`.
+    #[test]
+    fn importing_a_helper_from_a_module_fails_clearly() {
+        use naga_oil::compose::{Composer, NagaModuleDescriptor};
+        let body = "@compute @workgroup_size(1) fn main() { let h = ggx_cap_sample(vec2(0.3), vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), 0.5, 0.5, vec2(0.5)); }\n";
+        let mut composer = Composer::default();
+        add_naga_oil_modules(&mut composer, &[Module::Ggx]).unwrap();
+        let compose = |composer: &mut Composer, import: &str| {
+            let source = format!("{import}\n{body}");
+            composer.make_naga_module(NagaModuleDescriptor { source: &source, file_path: "mine.wgsl", ..Default::default() }).map_err(|e| e.emit_to_string(composer))
+        };
+        let e = compose(&mut composer, "#import lobes::ggx::ggx_cap_sample").unwrap_err();
+        println!("naga_oil: {e}");
+        assert!(e.contains("ggx_cap_sample"), "{e}");
+        compose(&mut composer, "#import lobes::ggx::internal::ggx_cap_sample").unwrap_or_else(|e| panic!("{e}"));
+        compose(&mut composer, "#import lobes::ggx::ggx_sample_vndf").unwrap_err();
+
+        let wesl = |import: &str| -> Result<String, String> {
+            use wesl::syntax::PathOrigin;
+            let mut local = wesl::VirtualResolver::new();
+            let root = wesl::ModulePath::new(PathOrigin::Absolute, vec!["main".into()]);
+            local.add_module(root.clone(), format!("{import}\n{body}").into());
+            let mut packages = wesl::PkgResolver::new();
+            packages.add_package(&WESL_PACKAGE);
+            let mut router = wesl::Router::new();
+            router.mount_resolver(wesl::ModulePath::new(PathOrigin::Absolute, vec![]), local);
+            router.mount_fallback_resolver(packages);
+            wesl::Wesl::new("").set_custom_resolver(router).compile(&root).map(|c| c.to_string()).map_err(|e| e.to_string())
+        };
+        let e = wesl("import lobes::ggx::ggx_cap_sample;").unwrap_err();
+        println!("wesl: {e}");
+        assert!(e.contains("ggx_cap_sample"), "{e}");
+        let compiled = wesl("import lobes::ggx::internal::ggx_cap_sample;").unwrap_or_else(|e| panic!("{e}"));
+        validate(&compiled).unwrap();
+    }
+
+    /// docs/embedding.md's module table lists, per module, exactly its API ([`Module::api`]).
+    #[test]
+    fn the_docs_table_lists_each_modules_api() {
+        let page = include_str!("../../docs/embedding.md");
+        let all: Vec<&str> = Module::ALL.iter().flat_map(|m| m.short_names().iter().copied()).collect();
+        let mut rows = 0;
+        for m in Module::ALL {
+            let Some(row) = page.lines().find(|l| l.starts_with(&format!("| `{}` |", m.name()))) else { panic!("docs/embedding.md: no table row for {m:?}") };
+            rows += 1;
+            let defines = row.split('|').nth(3).unwrap();
+            let ident = |s: &str| s.split(|c: char| !(c.is_alphanumeric() || c == '_')).next().unwrap_or("").to_string();
+            let mut listed: Vec<String> = defines.split('`').skip(1).step_by(2).map(ident).filter(|n| all.contains(&n.as_str())).collect();
+            listed.sort();
+            listed.dedup();
+            let mut api: Vec<String> = m.api().iter().map(|s| s.to_string()).collect();
+            api.sort();
+            assert_eq!(listed, api, "docs/embedding.md's row for {m:?}");
+        }
+        assert_eq!(rows, Module::ALL.len());
     }
 
     /// naga's IR of a source as text, without the source positions (which the rename moves).
