@@ -359,10 +359,7 @@ pub(super) fn reserved(name: &str) -> bool {
 impl<'g> Passes<'g> {
     pub fn new(gpu: &'g Gpu, composed: &Composed) -> Result<Self, CheckError> {
         // `composed` is already validated with its errors mapped to the user's files
-        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("lobes check"),
-            source: wgpu::ShaderSource::Wgsl(composed.text.as_str().into()),
-        });
+        let module = gpu.module_unvalidated("lobes check", &composed.text)?;
         gpu.check_errors()?;
         Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default() })
     }
@@ -376,7 +373,15 @@ impl<'g> Passes<'g> {
     /// `out_bytes` of the buffer it writes (binding 2, or binding 3 for the histogram's counters).
     fn run(&self, entry: &str, params: &Params, input: &[[f32; 4]], invocations: u32, out_bytes: u64, counts: bool) -> Result<Vec<u8>, CheckError> {
         let gpu = self.gpu;
-        let pipeline = self.pipelines.borrow_mut().entry(entry.to_string()).or_insert_with(|| gpu.pipeline(&self.module, None, entry, &[])).clone();
+        let made = self.pipelines.borrow().get(entry).cloned();
+        let pipeline = match made {
+            Some(p) => p,
+            None => {
+                let p = gpu.pipeline(&self.module, None, entry, &[])?;
+                self.pipelines.borrow_mut().insert(entry.to_string(), p.clone());
+                p
+            }
+        };
         let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check params"),
             contents: bytemuck::bytes_of(params),

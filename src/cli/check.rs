@@ -286,6 +286,10 @@ struct Unfinished {
 /// The GPU may still be running the sampler: the device is abandoned, never waited for.
 fn unfinished(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs, e: &GpuError, seconds: f64) -> anyhow::Result<()> {
     let (status, reason) = match e {
+        GpuError::TimedOut { pass, .. } if pass.starts_with("pipeline creation") => (
+            Status::TimedOut,
+            format!("{e}; a shader the driver compiles for longer than the time limit (a very large sampler) ends here; raise --timeout to give it more"),
+        ),
         GpuError::TimedOut { .. } => (
             Status::TimedOut,
             format!("{e}; a sampler, pdf or eval that never returns (an endless loop) ends here; for a larger --samples raise --timeout"),
