@@ -284,6 +284,15 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bo
 /// back as WGSL.
 pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Source>, CheckError> {
     let code = compose_user(&sampler.sources, &sampler.composition)?;
+    // qualified names in call expressions, as the composed text names those items
+    let root = &sampler.sources[0].text;
+    let resolved = UserSampler {
+        sample: code.resolve_qualified("--sample", &sampler.sample, root)?,
+        pdf: code.resolve_qualified("--pdf", &sampler.pdf, root)?,
+        eval: sampler.eval.as_deref().map(|e| code.resolve_qualified("--eval", e, root)).transpose()?,
+        ..sampler.clone()
+    };
+    let sampler = &resolved;
     let returned = returned(&code, sampler)?;
     let rand = &sampler.composition.rand;
     if code.dialect == super::modules::Dialect::Wgsl {
