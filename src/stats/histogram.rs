@@ -47,14 +47,14 @@ impl SphereGrid {
             c if c == self.cols - 1 && y < 0.0 && self.cols > 1 => 0,
             c => c,
         };
-        if self.cols % 2 != 0 {
+        if !self.cols.is_multiple_of(2) {
             return col;
         }
         // φ ∈ [0, π) for y > 0, or y = 0 at x ≥ 0; else [−π, 0) (y = ±0 at x < 0 is φ = ±π: column 0)
         let upper = y > 0.0 || (y == 0.0 && x >= 0.0);
         let half = self.cols / 2;
         let (mut lo, mut n) = (if upper { half } else { 0 }, half);
-        if self.cols % 4 == 0 && y != 0.0 && x != 0.0 {
+        if self.cols.is_multiple_of(4) && y != 0.0 && x != 0.0 {
             // φ ∈ [−π/2, π/2) for x > 0
             let q = self.cols / 4;
             lo = match (x > 0.0, upper) {
