@@ -93,6 +93,12 @@ fn a_wesl_package_is_checked_as_it_is_and_passes() {
     let jac = v.iter().find(|c| c.0 == "jacobian").expect("a jacobian check");
     assert!(!jac.2.starts_with("not applicable"), "{}", jac.2);
     assert!(report_field(&out, "sampler").contains("random draws x,y"), "{}", report_field(&out, "sampler"));
+    // the pdf is named once, as written: "∫ggx_vndf_pdf(wi, d, p0) over the domain", never "…(d)(d)"
+    let norm = v.iter().find(|c| c.0 == "normalization").expect("a normalization check");
+    assert!(norm.2.starts_with("∫ggx_vndf_pdf(wi, d, p0) over the domain"), "{}", norm.2);
+    for (name, _, summary) in &v {
+        assert!(!summary.contains(")(d)"), "{name}: {summary}");
+    }
 }
 
 #[test]
@@ -150,6 +156,32 @@ fn a_shader_def_that_breaks_the_naga_oil_sampler_fails_chi2() {
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let v = verdicts(&out);
     assert!(!v.iter().find(|c| c.0 == "chi2").unwrap().1);
+}
+
+/// Qualified names in call expressions (issue 23 §5): naga_oil's `maths::PI` (the last segment
+/// of `#import common::maths::{PI, TAU}`) resolves to the composed name, and the cosine pdf
+/// written with it passes while the same with `maths::TAU` (half the density) fails χ²; a name
+/// no imported module holds, and a qualified name in plain WGSL, are refused naming what is
+/// there (they were WGSL parse errors in the generated glue).
+#[test]
+fn qualified_names_in_call_expressions_resolve_or_are_refused() {
+    let with_pdf = |pdf: &str| -> Vec<String> { oil_args(&[]).into_iter().map(|a| if a == "diffuse_pdf(d)" { pdf.into() } else { a }).collect() };
+    let out = run(&with_pdf("select(0.0, d.z / maths::PI, d.z > 0.0)"));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    for (name, passed, summary) in verdicts(&out) {
+        assert!(passed, "{name}: {summary}");
+    }
+    let half = run(&with_pdf("select(0.0, d.z / maths::TAU, d.z > 0.0)"));
+    assert_eq!(half.status.code(), Some(1), "{}", stderr(&half));
+    assert!(!verdicts(&half).iter().find(|c| c.0 == "chi2").unwrap().1);
+    let unknown = run(&with_pdf("d.z / maths::PIE"));
+    assert_eq!(unknown.status.code(), Some(2));
+    let e = stderr(&unknown);
+    assert!(e.contains("--pdf 'd.z / maths::PIE': no item `PIE` of a module `maths`") && e.contains("common::maths::PI"), "{e}");
+    let f = plain("qualified.wgsl", "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { return vec4<f32>(0.0, 0.0, 1.0, 1.0); }\n");
+    let out = lobes(&["check", f.to_str().unwrap(), "--sample", "s", "--pdf", "d.z / maths::PI"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("a qualified name (module::function) needs imports"), "{}", stderr(&out));
 }
 
 /// A copy of a fixture tree in a fresh folder, with `edit` applied to one file.

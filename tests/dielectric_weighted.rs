@@ -207,7 +207,7 @@ fn transmitted_g2_on_gpu(gpu: &Gpu, precision: Precision, g1s: &[f64]) -> Vec<f6
     let size = (n * n * if f64s { 8 } else { 4 }) as u64;
     let (group, layout) = gpu.layout("g2", &[storage_entry(0, true), storage_entry(1, false)]);
     let module = gpu.module("the transmitted G2 grid", &source).unwrap_or_else(|e| panic!("{e}"));
-    let pipeline = gpu.pipeline(&module, Some(&layout), "g2_grid", &[]);
+    let pipeline = gpu.pipeline(&module, Some(&layout), "g2_grid", &[]).unwrap_or_else(|e| panic!("{e}"));
     let input = gpu.buffer("G1", bytes.len() as u64, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST);
     gpu.queue.write_buffer(&input, 0, &bytes);
     let output = gpu.buffer("G2", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);

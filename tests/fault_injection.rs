@@ -9,7 +9,9 @@
 //! the rows that name `fault_injection` are exactly the faults run here, and each of them
 //! checks the row's exit code and the messages it quotes.
 //!
-//! Everything runs on the CPU engine (`--cpu`, no adapter needed) in well under a minute.
+//! Everything runs on the CPU engine (`--cpu`, no adapter needed) in well under a minute, but
+//! `lobes check --out` (the same folder rules), which runs on lavapipe and fails without an
+//! adapter.
 
 use lobes::report::output::{RunStatus, RunSummary};
 use lobes::run::shard::ShardFile;
@@ -200,7 +202,7 @@ fn quoted(row: &Row) -> Vec<String> {
 }
 
 /// The faults this suite injects, by the first cell of their row in docs/errors.md.
-const FAULTS: [&str; 12] = [
+const FAULTS: [&str; 14] = [
     "a second run into the same `--out` while one runs",
     "the same with `--wait`",
     "a second SIGINT (or SIGTERM) during `lobes run`",
@@ -213,6 +215,8 @@ const FAULTS: [&str; 12] = [
     "a shard whose counts were edited keeping the total; one whose sum wraps past 2⁶⁴",
     "a shard whose `backend` was edited",
     "`WGPU_BACKEND=bogus`",
+    "a `lobes check` into an `--out` in use by another lobes",
+    "a `lobes check` with bad input into the `--out` of an earlier check",
 ];
 
 /// Checks `outputs` against the row `key`: each has its exit code (128 + the signal for a
@@ -489,5 +493,73 @@ fn outputs_follow_the_umask() {
         }
         let mode = std::fs::metadata(dir.join(&out).join("c0")).unwrap().permissions().mode() & 0o777;
         assert_eq!(mode, dir_mode, "the case folder under umask {umask}");
+    }
+}
+
+/// `lobes check` of the GGX example into `out`, with `extra` flags.
+fn check_args(extra: &[&str]) -> Vec<String> {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/samplers/ggx_vndf.wgsl");
+    let mut a: Vec<String> = ["check", file.to_str().unwrap(), "--sample", "ggx_sample", "--pdf", "ggx_pdf", "--params", "0.5,0.5", "--samples", "65536", "--out", "out"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
+/// Issue 24: `lobes check --out` owns its folder as `lobes run` does (the same lock, the same
+/// cleaning, src/report/folder.rs): a check into a folder another lobes holds exits 2 naming it
+/// and touches nothing, or waits for it with `--wait`; bad input into the folder of an earlier
+/// check removes that check's report.json, pictures and composed.wgsl (no report.json is left to
+/// read as this check's pass) and the temporary files of a killed one, keeping a user's files;
+/// a check's files take the umask. Runs on a GPU adapter (lavapipe).
+#[test]
+fn a_check_owns_its_out_folder() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("check-out");
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let earlier = ["report.json", "measured.png", "composed.wgsl", ".lobes-Ab12Cd.tmp", "notes.txt"];
+    for f in earlier {
+        std::fs::write(out.join(f), "an earlier check's").unwrap();
+    }
+    let args = check_args(&[]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+
+    // another lobes holds the folder (this test, by the same lock): refused, nothing touched
+    let lock = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(out.join(".lobes.lock")).unwrap();
+    lock.try_lock().unwrap();
+    std::fs::write(out.join(".lobes.lock"), format!("pid {}: the test, since 0 (Unix time)\n", std::process::id())).unwrap();
+    let refused = lobes(&dir, &args);
+    holds("a `lobes check` into an `--out` in use by another lobes", &[&refused]);
+    assert!(text(&refused).contains(&format!("pid {}", std::process::id())), "names the holder: {}", text(&refused));
+    for f in earlier {
+        assert!(out.join(f).is_file(), "the refused check removed {f}");
+    }
+    // with --wait it waits for the lock, then runs
+    let mut waiting = Command::new(LOBES).current_dir(&dir).args(&args).arg("--wait").stdout(Stdio::null()).stderr(Stdio::piped()).spawn().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    assert!(waiting.try_wait().unwrap().is_none(), "a check with --wait ran while the folder was held");
+    drop(lock);
+    let waited = waiting.wait_with_output().unwrap();
+    assert_eq!(waited.status.code(), Some(0), "{}", String::from_utf8_lossy(&waited.stderr));
+    assert!(String::from_utf8_lossy(&waited.stderr).contains("lobes: waiting for --out out, in use by another lobes"));
+    assert!(temporary(&out).is_empty(), "the killed check's temporary file is removed: {:?}", files(&out));
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["passed"], true);
+
+    // bad input into the folder of that passing check: its outputs go, a user's stay
+    std::fs::write(out.join(".lobes-Ef34Gh.tmp"), "half").unwrap();
+    let typo: Vec<String> = check_args(&[]).into_iter().map(|a| if a.ends_with("ggx_vndf.wgsl") { "nope.wgsl".into() } else { a }).collect();
+    let bad = lobes(&dir, &typo.iter().map(String::as_str).collect::<Vec<_>>());
+    holds("a `lobes check` with bad input into the `--out` of an earlier check", &[&bad]);
+    assert_eq!(files(&out), [".lobes.lock", "notes.txt"], "only the lock and the user's file are left");
+
+    // the check's files under umask 027: 0640
+    let status = Command::new("bash").current_dir(&dir).args(["-c", "umask 027 && exec \"$0\" \"$@\"", LOBES]).args(&args).output().unwrap();
+    assert_eq!(status.status.code(), Some(0), "{}", text(&status));
+    for f in files(&out).into_iter().filter(|f| f != "notes.txt" && f != ".lobes.lock") {
+        let mode = std::fs::metadata(out.join(&f)).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640, "{f}: {mode:o} under umask 027");
     }
 }

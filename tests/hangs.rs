@@ -101,6 +101,44 @@ fn a_check_that_never_returns_fails_at_its_timeout() {
     assert_eq!((v["status"].as_str(), v["passed"].as_bool(), v["timeout_seconds"].as_f64()), (Some("timed_out"), Some(false), Some(1.0)), "{v}");
 }
 
+/// A shader the driver compiles for longer than --timeout (issue 24: a hang outside any wait on
+/// the device) fails the check at its timeout naming pipeline creation, and the process exits
+/// while the thread that creates the pipeline is still held. No shader small enough for a test
+/// keeps lavapipe compiling that long, so the test stands in a delay of 120 s before each
+/// pipeline creation (`LOBES_TEST_CREATION_DELAY_MS`); SIGINT during it ends the check at once.
+#[test]
+fn a_shader_that_compiles_past_the_timeout_fails_at_its_timeout() {
+    let dir = scratch("slow-compile");
+    let file = root().join("examples/samplers/henyey_greenstein.wgsl");
+    let spawn = |extra: &[&str]| {
+        Command::new(LOBES)
+            .arg("check")
+            .arg(&file)
+            .args(["--sample", "hg_sample", "--pdf", "hg_pdf", "--params", "0.3", "--samples", "65536"])
+            .args(extra)
+            .env("LOBES_TEST_CREATION_DELAY_MS", "120000")
+            .current_dir(&dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (out, took) = finish(spawn(&["--timeout", "2"]), Duration::from_secs(30));
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
+    let line = stdout.lines().find(|l| l.starts_with("timeout")).unwrap_or_else(|| panic!("no timeout row:\n{stdout}"));
+    assert!(line.contains("FAIL") && line.contains("no result within 2 s") && line.contains("pipeline creation of"), "{line}");
+    assert!(took < Duration::from_secs(20), "the process exits with the creating thread held: {took:?}");
+    let child = spawn(&["--timeout", "60"]);
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, "INT");
+    let sent = Instant::now();
+    let (out, _) = finish(child, Duration::from_secs(20));
+    assert_eq!(out.status.code(), Some(130), "{}{}", text(&out.stdout), text(&out.stderr));
+    assert!(sent.elapsed() < Duration::from_secs(5), "{:?} after the signal", sent.elapsed());
+    assert!(text(&out.stdout).contains("pipeline creation of"), "{}", text(&out.stdout));
+}
+
 /// SIGINT or SIGTERM during a check (here one that would run for minutes): exit 130 at once, a
 /// report that says it was interrupted, no verdict.
 #[test]

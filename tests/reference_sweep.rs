@@ -125,7 +125,8 @@ fn a_lobe_narrower_than_the_nodes_is_resolved() {
 /// α 1e-4, θi 89°, φi 0): across the plane of incidence the lobe is cos θi (57 times) narrower
 /// than within it, and cut only to its in-plane width the quadrature lost 1.3e-4 of the mass
 /// there (134 samples expected below the horizon of 10⁶, none drawn). (On lavapipe the same case
-/// still fails, χ² 405 on 1 dof, by the GPU's f32 binning at the seam: docs/statistics.md.)
+/// failed too, χ² 405 on 1 dof, by the f32 binning's rounding at the seam, until the seam's
+/// column was decided by the sign of y: tests/stress.rs, docs/statistics.md.)
 #[test]
 fn a_grazing_lobe_on_the_seam_keeps_its_mass() {
     let wi = spherical(89f64.to_radians(), 0.0);

@@ -115,6 +115,42 @@ fn binning_at_edges_poles_and_the_seam() {
     assert_eq!(tail, vec![63 * 128 + 64, 64, 32 * 128, 32 * 128, 57 * 128, 6 * 128]);
 }
 
+/// A mirror lobe narrower than f32 binning's rounding, on an edge of the grid that lies on an
+/// axis (issue 24): GGX visible normals at α 1e-4, θi 89°, 10⁶ samples, 64 × 128 bins. Across
+/// the plane of incidence the lobe is about 2α cos θi wide (the f32 directions' median |y| is
+/// 2e-6 at φi 0), while t = (φ + π)/2π rounds onto a column's edge from half an ulp below it
+/// (1.8e-7 rad at φ = π): before the sign test of `bin_of`, φi 0 split the lobe 510 066 to
+/// 489 934 between the seam's columns (χ² 301 on 6 dof, a false failure; the f64 engine
+/// passed). With it the f32 engine passes with the mirror on the seam (φi 0), on φ = 0 (φi π)
+/// and on φ = −π/2 (φi π/2), and a lobe turned off the plane of incidence by 1e-7 rad (1/20 of
+/// its median |y|: a sampler whose frame is that far off) fails against the untouched lobe.
+#[test]
+fn a_grazing_lobe_on_an_axis_edge_is_split_as_sampled() {
+    use lobes::reference::reflect::spherical;
+    use lobes::reference::{Lobe, LobeKind, Method};
+    use lobes::stats::histogram::SphereGrid;
+    const N: u64 = 1_000_000;
+    let mut e = engine();
+    let lobe = Lobe { kind: LobeKind::Ggx, method: Method::Vndf, alpha_x: 1e-4, alpha_y: 1e-4, alpha_angle: 0.0 };
+    let theta = 89f64.to_radians();
+    let job = |phi: f64| Job::Lobe { lobe, incident: spherical(theta, phi), grid: SphereGrid { rows: 64, cols: 128 }, scatter: Scatter::Reflect };
+    let phis = [0.0, std::f64::consts::PI, std::f64::consts::FRAC_PI_2];
+    let level = lobes::stats::chi2::sidak(0.01, phis.len());
+    for phi in phis {
+        let exp = compare::expected_counts(&job(phi), N, &Quadrature::default());
+        let counts = e.histogram(&job(phi), SampleRange::whole(7, N), &mut |_| {}).unwrap().counts;
+        let t = compare::chi2_test(&counts, &exp, level);
+        assert!(t.passed, "φi {phi}: a correct f32 sampler failed: {t:?}");
+        assert!(t.dof >= 1, "φi {phi}: the edge must split the lobe into two cells: {t:?}");
+        if phi == 0.0 {
+            let turned = e.histogram(&job(1e-7), SampleRange::whole(7, N), &mut |_| {}).unwrap().counts;
+            let t = compare::chi2_test(&turned, &exp, 0.01);
+            assert!(!t.passed && t.untested.is_none(), "a lobe turned by 1e-7 rad passed: {t:?}");
+            eprintln!("turned 1e-7 rad: χ² {:.1} on {} dof", t.statistic, t.dof);
+        }
+    }
+}
+
 /// A seeded random search beyond the listed cases: roughness log-uniform in [1e-6, 10] with
 /// anisotropy up to 1000:1, incidence from 0° to 90°, every sampler; the same assertions as
 /// the suite.

@@ -90,7 +90,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
     let size = xs.len() as u64 * 48;
     let ob = gpu.buffer("pairs", size, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
     let module = gpu.module("f32_pair probe", &source).expect("probe shader");
-    let pipeline = gpu.pipeline(&module, None, "main", &[]);
+    let pipeline = gpu.pipeline(&module, None, "main", &[]).expect("probe pipeline");
     let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &pipeline.get_bind_group_layout(0),

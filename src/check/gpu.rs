@@ -286,6 +286,15 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bo
 /// back as WGSL.
 pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Source>, CheckError> {
     let code = compose_user(&sampler.sources, &sampler.composition)?;
+    // qualified names in call expressions, as the composed text names those items
+    let root = &sampler.sources[0].text;
+    let resolved = UserSampler {
+        sample: code.resolve_qualified("--sample", &sampler.sample, root)?,
+        pdf: code.resolve_qualified("--pdf", &sampler.pdf, root)?,
+        eval: sampler.eval.as_deref().map(|e| code.resolve_qualified("--eval", e, root)).transpose()?,
+        ..sampler.clone()
+    };
+    let sampler = &resolved;
     let returned = returned(&code, sampler)?;
     let rand = &sampler.composition.rand;
     if code.dialect == super::modules::Dialect::Wgsl {
@@ -361,10 +370,7 @@ pub(super) fn reserved(name: &str) -> bool {
 impl<'g> Passes<'g> {
     pub fn new(gpu: &'g Gpu, composed: &Composed) -> Result<Self, CheckError> {
         // `composed` is already validated with its errors mapped to the user's files
-        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("lobes check"),
-            source: wgpu::ShaderSource::Wgsl(composed.text.as_str().into()),
-        });
+        let module = gpu.module_unvalidated("lobes check", &composed.text)?;
         gpu.check_errors()?;
         Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default() })
     }
@@ -378,7 +384,7 @@ impl<'g> Passes<'g> {
     /// `out_bytes` of the buffer it writes (binding 2, or binding 3 for the histogram's counters).
     fn run(&self, entry: &str, params: &Params, input: &[[f32; 4]], invocations: u32, out_bytes: u64, counts: bool) -> Result<Vec<u8>, CheckError> {
         let gpu = self.gpu;
-        let pipeline = self.pipeline(entry);
+        let pipeline = self.pipeline(entry)?;
         let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("check params"),
             contents: bytemuck::bytes_of(params),
@@ -471,7 +477,7 @@ impl<'g> Passes<'g> {
         let bytes = cells as u64 * 4;
         let counts = gpu.buffer("check counts", bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let slab_buffer = gpu.buffer("check slabs", slabs as u64 * bytes, wgpu::BufferUsages::STORAGE);
-        let (sample, reduce) = (self.pipeline("lobes_histogram_slabs"), self.pipeline("lobes_reduce_slabs"));
+        let (sample, reduce) = (self.pipeline("lobes_histogram_slabs")?, self.pipeline("lobes_reduce_slabs")?);
         let bind = |pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check slabs"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
@@ -487,8 +493,13 @@ impl<'g> Passes<'g> {
     }
 
     /// The pipeline of `entry`, made at its first use.
-    fn pipeline(&self, entry: &str) -> wgpu::ComputePipeline {
-        self.pipelines.borrow_mut().entry(entry.to_string()).or_insert_with(|| self.gpu.pipeline(&self.module, None, entry, &[])).clone()
+    fn pipeline(&self, entry: &str) -> Result<wgpu::ComputePipeline, CheckError> {
+        if let Some(p) = self.pipelines.borrow().get(entry) {
+            return Ok(p.clone());
+        }
+        let p = self.gpu.pipeline(&self.module, None, entry, &[])?;
+        self.pipelines.borrow_mut().insert(entry.to_string(), p.clone());
+        Ok(p)
     }
 
     /// Per-invocation weight sums of samples `first .. first + count` (user_passes.wgsl,

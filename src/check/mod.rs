@@ -119,6 +119,13 @@ pub struct UserSampler {
 pub const MAX_PARAMS: usize = 16;
 
 impl UserSampler {
+    /// The pdf at a sample's d as the user named it, for messages: `NAME(d)` for a function
+    /// name (`my_pdf(d)`), a call expression as written (`ggx_vndf_pdf(wi, d, p0)`, never
+    /// `ggx_vndf_pdf(wi, d, p0)(d)`).
+    pub fn pdf_at_d(&self) -> String {
+        if gpu::is_name(self.pdf.trim()) { format!("{}(d)", self.pdf.trim()) } else { self.pdf.clone() }
+    }
+
     /// Reads the files (in order) and checks the functions against the contract.
     pub fn from_files(paths: &[PathBuf], sample: &str, pdf: &str, eval: Option<&str>, domain: Domain) -> Result<Self, CheckError> {
         Self::from_repository(paths, sample, pdf, eval, domain, Composition::default())
@@ -483,7 +490,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let consistent = consistency.over_limit == 0 && consistency.pdf_function_not_finite == 0;
     let not_finite = match consistency.pdf_function_not_finite {
         0 => String::new(),
-        k => format!("; {}(d) NaN or ∞ at {k} of them", sampler.pdf),
+        k => format!("; {} NaN or ∞ at {k} of them", sampler.pdf_at_d()),
     };
     let widened = match (consistency.widened, consistency.over_limit) {
         (0, 0) => String::new(),
@@ -493,8 +500,8 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     checks.push(Check {
         passed: consistent,
         summary: format!(
-            "the pdf the sampler reports and {}(d) differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning) over {} samples{widened}{not_finite}",
-            sampler.pdf, consistency.max_relative_difference, consistency.compared
+            "the pdf the sampler reports and {} differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning) over {} samples{widened}{not_finite}",
+            sampler.pdf_at_d(), consistency.max_relative_difference, consistency.compared
         ),
         figures: Figures::PdfConsistency(consistency),
     });
@@ -559,15 +566,15 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let pdf_total: f64 = integrals.probabilities.iter().sum();
     // where the pdf is bad: its worst point on a fine grid (the WGSL pdf's, as the hard cases)
     let worst = if integrals.bad_parts > 0 { pdf_values::worst(&passes, &params, &sampler.domain, &sampler.conventions)? } else { None };
-    let worst_text = worst.as_ref().map(|w| w.describe(&sampler.pdf, plane));
+    let worst_text = worst.as_ref().map(|w| w.describe(&sampler.pdf_at_d(), plane));
     checks.push(Check {
         passed: integrals.bad_parts == 0,
         summary: if integrals.bad_parts == 0 {
-            format!("{}(d) finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf, integrals.parts)
+            format!("{} finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf_at_d(), integrals.parts)
         } else {
             format!(
-                "{}(d) returned NaN, ∞ or a negative value in {} of {} quadrature parts; {}",
-                sampler.pdf,
+                "{} returned NaN, ∞ or a negative value in {} of {} quadrature parts; {}",
+                sampler.pdf_at_d(),
                 integrals.bad_parts,
                 integrals.parts,
                 worst_text.clone().unwrap_or_else(|| "no such value on a fine grid of the domain: it lies between the grid's points".into())
@@ -600,8 +607,8 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     checks.push(Check {
         passed: (pdf_total - valid).abs() <= norm_tolerance,
         summary: format!(
-            "∫{}(d) over the domain = {pdf_total:.6} against the valid fraction {valid:.6} of the samples (tolerance {norm_tolerance:.1e})",
-            sampler.pdf
+            "∫{} over the domain = {pdf_total:.6} against the valid fraction {valid:.6} of the samples (tolerance {norm_tolerance:.1e})",
+            sampler.pdf_at_d()
         ),
         figures: Figures::Normalization(norm),
     });
@@ -644,8 +651,8 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         checks.push(Check {
             passed: judged <= 1.0,
             summary: format!(
-                "eval/pdf from the sampler and eval/{}(d) differ by at most {max_err:.2e} (limit {limit:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning){widened}",
-                sampler.pdf
+                "eval/pdf from the sampler and eval/{} differ by at most {max_err:.2e} (limit {limit:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning){widened}",
+                sampler.pdf_at_d()
             ),
             figures: Figures::Weights(wf),
         });

@@ -265,6 +265,72 @@ impl UserCode {
     }
 }
 
+impl UserCode {
+    /// `expr` (a call expression of --sample, --pdf or --eval) with each qualified name
+    /// `module::item` as the user wrote it (WESL's `ggx::pdf` or `package::sampling::ggx::pdf`,
+    /// naga_oil's `ggx::pdf` or an `#import … as alias`'s `alias::pdf`) replaced by that item's
+    /// name in the composed text. A module path matches an import's full path or its last
+    /// segments. A name no imported module holds is an error naming the imported items.
+    pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
+        if !expr.contains("::") {
+            return Ok(expr.to_string());
+        }
+        if self.dialect == Dialect::Wgsl {
+            return Err(CheckError::Input(format!(
+                "{flag} '{expr}': a qualified name (module::function) needs imports, and {} import nothing; name the function as it is declared",
+                self.files.join(", ")
+            )));
+        }
+        // naga_oil's `#import a::b as x`: x stands for a::b
+        let aliases: Vec<(String, String)> = root_text
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("#import "))
+            .filter_map(|l| l.split_once(" as ").map(|(m, a)| (a.trim().to_string(), m.trim().to_string())))
+            .collect();
+        let b = expr.as_bytes();
+        let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+        let (mut out, mut i) = (String::new(), 0);
+        while i < b.len() {
+            if !ident(b[i]) || (i > 0 && ident(b[i - 1])) {
+                out.push(expr[i..].chars().next().expect("in range"));
+                i += expr[i..].chars().next().expect("in range").len_utf8();
+                continue;
+            }
+            // a path: identifiers joined by ::
+            let start = i;
+            loop {
+                while i < b.len() && ident(b[i]) {
+                    i += 1;
+                }
+                if expr[i..].starts_with("::") && i + 2 < b.len() && ident(b[i + 2]) {
+                    i += 2;
+                } else {
+                    break;
+                }
+            }
+            let path = &expr[start..i];
+            let Some((module, item)) = path.rsplit_once("::") else {
+                out.push_str(path);
+                continue;
+            };
+            let module = aliases.iter().find(|(a, _)| a == module).map_or(module, |(_, m)| m.as_str());
+            let matches = |p: &str| p == module || p.ends_with(&format!("::{module}")) || format!("package::{module}") == p;
+            match self.origins.iter().find(|(_, p, it)| it == item && matches(p)) {
+                Some((name, _, _)) => out.push_str(name),
+                None => {
+                    let known: Vec<String> = self.origins.iter().map(|(_, p, it)| format!("{p}::{it}")).collect();
+                    return Err(CheckError::Input(format!(
+                        "{flag} '{expr}': no item `{item}` of a module `{module}` among what the sampler's file imports{} (imported: {}); name an item of a module the file imports, as its import names it",
+                        crate::suggest::did_you_mean(path, known.iter().map(String::as_str)),
+                        if known.is_empty() { "nothing".to_string() } else { known.join(", ") }
+                    )));
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
 /// The roots modules are looked up under: the given ones, else the first file's folder.
 fn roots(sources: &[Source], c: &Composition) -> Vec<PathBuf> {
     if !c.shader_roots.is_empty() {

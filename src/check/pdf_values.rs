@@ -23,8 +23,9 @@ pub struct Worst {
 }
 
 impl Worst {
-    /// "pdf(d) = NaN at d = (0.1, 0.2, 0.97) (θ 14.1°, φ 63.4°)" (θ, φ on the sphere only).
-    pub fn describe(&self, pdf: &str, plane: bool) -> String {
+    /// "pdf(d) = NaN at d = (0.1, 0.2, 0.97) (θ 14.1°, φ 63.4°)" (θ, φ on the sphere only), with
+    /// `pdf_at_d` the pdf at d as the user named it ([`super::UserSampler::pdf_at_d`]).
+    pub fn describe(&self, pdf_at_d: &str, plane: bool) -> String {
         let [x, y, z] = self.d.map(|v| show(v as f32));
         let angles = if plane {
             String::new()
@@ -32,7 +33,7 @@ impl Worst {
             let (t, p) = self.angles;
             format!(" (θ {t:.1}°, φ {p:.1}°)")
         };
-        format!("{pdf}(d) = {} at d = ({x}, {y}, {z}){angles}", show(self.value))
+        format!("{pdf_at_d} = {} at d = ({x}, {y}, {z}){angles}", show(self.value))
     }
 }
 
@@ -95,6 +96,6 @@ mod tests {
         assert!(badness(-2.0) > badness(-1.0));
         assert_eq!(badness(0.0), None);
         let w = Worst { d: [0.0, 0.0, -1.0], angles: angles([0.0, 0.0, -1.0]), value: -1.0 };
-        assert_eq!(w.describe("p", false), "p(d) = -1 at d = (0, 0, -1) (θ 180.0°, φ 0.0°)");
+        assert_eq!(w.describe("p(d)", false), "p(d) = -1 at d = (0, 0, -1) (θ 180.0°, φ 0.0°)");
     }
 }

@@ -1,12 +1,14 @@
 //! `lobes check`: judge a user's WGSL sampler (see [`crate::check`]).
 
 use super::{NumberList, OutputArgs, emit, emit_json, interrupt, parse_azimuth, parse_number_list, parse_polar_180, usage};
+use crate::report::check::CHECK_FILES;
+use crate::report::folder::{Access, OutFolder};
 use crate::report::table;
 use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Settings, UserSampler};
 use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// Where the user's sampler puts its points.
@@ -126,6 +128,10 @@ pub struct CheckArgs {
     /// and the composed WGSL to this folder (power.json with --power).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Where another lobes is writing --out, wait until it has finished (without it: exit 2,
+    /// naming that process). One run or check owns an output folder at a time.
+    #[arg(long)]
+    pub wait: bool,
     #[command(flatten)]
     pub output: OutputArgs,
 }
@@ -202,15 +208,38 @@ fn parse_timeout(s: &str) -> Result<f64, String> {
 }
 
 pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
-    let sampler = args.sampler()?;
-    let settings = args.settings()?;
-    settings.validate().map_err(input)?;
-    if sampler.domain == Domain::Sphere {
-        sampler.conventions.check_incident(settings.incident_theta).map_err(input)?;
-    }
-    if let Some(dir) = &args.out {
-        super::prepare_out(dir)?;
-        remove_stale(dir)?;
+    // An --out that exists is locked first (as `lobes run` does): where another lobes holds
+    // it, nothing is touched; bad input then removes the earlier check's outputs, so that no
+    // report.json is left that reads as this check's
+    let existing = args.out.as_deref().map(|dir| OutFolder::claim_existing(dir, Access::Owner, args.wait)).transpose()?.flatten();
+    let started = (|| {
+        let sampler = args.sampler()?;
+        let settings = args.settings()?;
+        settings.validate().map_err(input)?;
+        if sampler.domain == Domain::Sphere {
+            sampler.conventions.check_incident(settings.incident_theta).map_err(input)?;
+        }
+        Ok::<_, anyhow::Error>((sampler, settings))
+    })();
+    let (sampler, settings) = match started {
+        Ok(s) => s,
+        Err(e) => {
+            if let Some(folder) = &existing
+                && let Err(clean) = folder.clean_files(&CHECK_FILES)
+            {
+                eprintln!("lobes: error: {clean:#}");
+            }
+            return Err(e);
+        }
+    };
+    // held until the process ends: a second check or run into the folder waits or exits 2
+    let out_folder = match (existing, &args.out) {
+        (Some(folder), _) => Some(folder),
+        (None, Some(dir)) => Some(OutFolder::claim(dir, Access::Owner, args.wait)?),
+        (None, None) => None,
+    };
+    if let Some(folder) = &out_folder {
+        folder.clean_files(&CHECK_FILES)?;
     }
     // before the device opens: a signal while it does is seen at the first submission
     interrupt::watch("stopping the check now (interrupt again to end at once)")?;
@@ -240,18 +269,6 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     }
     if !report.passed {
         return Err(super::ChecksFailed(format!("{} failed: {}", report.sampler, report.failed().join(", "))).into());
-    }
-    Ok(())
-}
-
-/// The outputs of an earlier check in `dir`, which this one replaces (so that none is left
-/// looking like this check's when it ends early).
-fn remove_stale(dir: &Path) -> anyhow::Result<()> {
-    for name in [crate::report::check::REPORT_JSON, crate::report::check::POWER_JSON] {
-        match std::fs::remove_file(dir.join(name)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => anyhow::bail!("cannot remove the earlier {}: {e}", dir.join(name).display()),
-            _ => {}
-        }
     }
     Ok(())
 }
@@ -286,6 +303,10 @@ struct Unfinished {
 /// The GPU may still be running the sampler: the device is abandoned, never waited for.
 fn unfinished(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs, e: &GpuError, seconds: f64) -> anyhow::Result<()> {
     let (status, reason) = match e {
+        GpuError::TimedOut { pass, .. } if pass.starts_with("pipeline creation") => (
+            Status::TimedOut,
+            format!("{e}; a shader the driver compiles for longer than the time limit (a very large sampler) ends here; raise --timeout to give it more"),
+        ),
         GpuError::TimedOut { .. } => (
             Status::TimedOut,
             format!("{e}; a sampler, pdf or eval that never returns (an endless loop) ends here; for a larger --samples raise --timeout"),

@@ -19,6 +19,10 @@ pub const COMPOSED_WGSL: &str = "composed.wgsl";
 pub const REPORT_JSON: &str = "report.json";
 pub const POWER_JSON: &str = "power.json";
 
+/// Every file a check writes into its folder: an owner removes them all before it runs
+/// ([`super::folder::OutFolder::clean_files`]), so that none is left looking like this check's.
+pub const CHECK_FILES: [&str; 8] = [REPORT_JSON, POWER_JSON, COMPOSED_WGSL, MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, MARGINALS_PNG, super::compare::BARS_PNG];
+
 /// Writes the heat maps, `composed.wgsl` (the module that ran) and then `report.json` into `dir`.
 pub fn write(dir: &Path, report: &Report, composed: &str) -> anyhow::Result<()> {
     write_maps(dir, report)?;

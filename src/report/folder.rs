@@ -1,8 +1,8 @@
-//! The `--out` folder of `lobes run` and `lobes merge`: one run owns it at a time.
+//! The `--out` folder of `lobes run`, `lobes merge` and `lobes check`: one run owns it at a time.
 //!
 //! - A lock: [`OutFolder::claim`] takes an advisory lock (`flock(2)`, through std's
 //!   `File::try_lock`) on `OUT/.lobes.lock`, held until the process ends, however it ends (the
-//!   kernel drops it on SIGKILL too). A run or merge takes it exclusively; `lobes run --shard`
+//!   kernel drops it on SIGKILL too). A run, merge or check takes it exclusively; `lobes run --shard`
 //!   shares it with other shard runs, which write files of their own names. A second owner
 //!   exits with 2 naming the holder ([`FolderError`]), or waits for it with `--wait`.
 //! - Its own files only: an owner removes, before it runs anything, every output of an earlier
@@ -171,6 +171,18 @@ impl OutFolder {
         }
         stale.sort();
         Ok(stale)
+    }
+
+    /// Removes what an earlier `lobes check` left at the top of the folder: the files `names`
+    /// (its report, pictures and composed WGSL) and the temporary files of killed processes
+    /// (at the top and in subfolders, as [`OutFolder::clean`] does). A user's other files stay.
+    pub fn clean_files(&self, names: &[&str]) -> anyhow::Result<()> {
+        self.remove_temporary()?;
+        // files only: a folder of such a name is not lobes' (writing there fails and says so)
+        for path in names.iter().map(|name| self.path.join(name)).filter(|p| p.is_file()) {
+            remove_file(&path)?;
+        }
+        Ok(())
     }
 
     /// Removes the temporary files of killed runs, at the top and in the case folders.

@@ -30,7 +30,42 @@ impl SphereGrid {
         if col >= self.cols {
             col = 0;
         }
+        if !(w.x == 0.0 && w.y == 0.0) {
+            col = self.axis_exact_column(col, w.x, w.y);
+        }
         (row * self.cols + col) as usize
+    }
+
+    /// `col`, from the rounded t, moved across the seam by the sign of y, and into the half (for an
+    /// even `cols`) and quarter (for a multiple of 4) of the grid that the signs of x and y put w in: on the axes' edges
+    /// (φ = 0, ±π/2, ±π) the column is exact, whatever t rounded to (φ = π − 1e-17 gives t = 1,
+    /// column 0, in f64 as φ = π − 1e-7 does in f32). The WGSL twin is `axis_exact_column`.
+    fn axis_exact_column(&self, col: u32, x: f64, y: f64) -> u32 {
+        // the seam φ = ±π, an edge of every grid: column 0 lies below it (y ≤ 0), the last above
+        let col = match col {
+            0 if y > 0.0 && self.cols > 1 => self.cols - 1,
+            c if c == self.cols - 1 && y < 0.0 && self.cols > 1 => 0,
+            c => c,
+        };
+        if !self.cols.is_multiple_of(2) {
+            return col;
+        }
+        // φ ∈ [0, π) for y > 0, or y = 0 at x ≥ 0; else [−π, 0) (y = ±0 at x < 0 is φ = ±π: column 0)
+        let upper = y > 0.0 || (y == 0.0 && x >= 0.0);
+        let half = self.cols / 2;
+        let (mut lo, mut n) = (if upper { half } else { 0 }, half);
+        if self.cols.is_multiple_of(4) && y != 0.0 && x != 0.0 {
+            // φ ∈ [−π/2, π/2) for x > 0
+            let q = self.cols / 4;
+            lo = match (x > 0.0, upper) {
+                (true, true) => half,
+                (true, false) => q,
+                (false, true) => 3 * q,
+                (false, false) => 0,
+            };
+            n = q;
+        }
+        col.clamp(lo, lo + n - 1)
     }
 
     /// The cos θ edges, rows + 1 of them, from −1 to 1.
@@ -56,5 +91,28 @@ mod tests {
         assert_eq!(g.bin_of(DVec3::new(-1.0, 0.0, 0.0)) % 8, 0); // φ = +π wraps to column 0
         assert_eq!(g.bin_of(DVec3::new(-1.0, -0.0, 0.0)) % 8, 0); // φ = −π is column 0
         assert_eq!(g.bin_of(DVec3::new(1.0, 0.0, 0.0)) / 8, 2); // z = 0 is the edge: upper row
+    }
+
+    /// Beside an axis edge, closer than t resolves: φ = π − 1e-17 is the last column (t rounds
+    /// to 1, which would wrap to column 0), φ = −1e-17 the column below φ = 0's, and so on.
+    #[test]
+    fn axis_edges_are_exact_below_the_rounding_of_t() {
+        let g = SphereGrid { rows: 1, cols: 8 };
+        let e = 1e-17;
+        for (w, col) in [
+            ((-1.0, e), 7),
+            ((-1.0, -e), 0),
+            ((1.0, e), 4),
+            ((1.0, -e), 3),
+            ((e, 1.0), 5),
+            ((-e, 1.0), 6),
+            ((e, -1.0), 2),
+            ((-e, -1.0), 1),
+        ] {
+            assert_eq!(g.bin_of(DVec3::new(w.0, w.1, 0.0)), col, "{w:?}");
+        }
+        // the seam is an edge of every grid, an odd one too
+        assert_eq!(SphereGrid { rows: 1, cols: 3 }.bin_of(DVec3::new(-1.0, e, 0.0)), 2);
+        assert_eq!(SphereGrid { rows: 1, cols: 3 }.bin_of(DVec3::new(-1.0, -e, 0.0)), 0);
     }
 }

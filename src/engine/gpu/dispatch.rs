@@ -30,6 +30,13 @@ pub struct Bounds {
     abandoned: Mutex<Option<String>>,
 }
 
+/// A delay before each pipeline creation, from `LOBES_TEST_CREATION_DELAY_MS`:
+/// the tests' stand-in for a driver that compiles a shader for minutes (tests/hangs.rs), which
+/// lavapipe does for no shader small enough to keep in a test. Unset (always, outside tests): none.
+fn creation_delay() -> Duration {
+    std::env::var("LOBES_TEST_CREATION_DELAY_MS").ok().and_then(|v| v.parse().ok()).map_or(Duration::ZERO, Duration::from_millis)
+}
+
 /// Lifts a bound set by [`Gpu::deadline`] or [`Gpu::stop_when`] when dropped.
 #[must_use = "the bound lasts while this guard lives"]
 pub struct Bound<'g> {
@@ -75,28 +82,79 @@ impl Gpu {
         (group, pipeline)
     }
 
-    /// `source` validated by naga (errors name `what`) and made a shader module.
+    /// `source` validated by naga (errors name `what`) and made a shader module, within the
+    /// bounds ([`Gpu::bounded`]).
     pub fn module(&self, what: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
         compose::validate(what, source)?;
-        Ok(self.device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(what), source: wgpu::ShaderSource::Wgsl(source.into()) }))
+        self.module_unvalidated(what, source)
+    }
+
+    /// [`Gpu::module`] of a `source` already validated (with its errors mapped to a user's files).
+    pub fn module_unvalidated(&self, what: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
+        let (device, label, source) = (self.device.clone(), what.to_string(), source.to_string());
+        self.bounded(&format!("the shader module of {what}"), move || {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(&label), source: wgpu::ShaderSource::Wgsl(source.into()) })
+        })
     }
 
     /// The compute pipeline of `entry` in `module`; `layout` None: derived from the module.
+    /// The driver compiles the shader here, within the bounds ([`Gpu::bounded`]).
     pub fn pipeline(
         &self,
         module: &wgpu::ShaderModule,
         layout: Option<&wgpu::PipelineLayout>,
         entry: &str,
         constants: &[(&str, f64)],
-    ) -> wgpu::ComputePipeline {
-        self.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout,
-            module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            cache: self.pipeline_cache.as_ref().map(|c| &c.cache),
+    ) -> Result<wgpu::ComputePipeline, GpuError> {
+        let (device, module, layout, name) = (self.device.clone(), module.clone(), layout.cloned(), entry.to_string());
+        let constants: Vec<(String, f64)> = constants.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        let cache = self.pipeline_cache.as_ref().map(|c| c.cache.clone());
+        let delay = creation_delay();
+        self.bounded(&format!("pipeline creation of {entry} (the driver compiling the shader)"), move || {
+            std::thread::sleep(delay);
+            let constants: Vec<(&str, f64)> = constants.iter().map(|(k, v)| (k.as_str(), *v)).collect();
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&name),
+                layout: layout.as_ref(),
+                module: &module,
+                entry_point: Some(&name),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                cache: cache.as_ref(),
+            })
         })
+    }
+
+    /// Runs `create` (wgpu's parse of a shader module, the driver's compilation of a pipeline:
+    /// a pathological shader can keep a driver compiling for minutes, outside any wait on the
+    /// device) on a thread of its own with a [`super::stack::BIG_STACK`] stack, and waits for it
+    /// in slices of [`SLICE`] against the [`Bounds`]: past the deadline, or at a stop, it fails
+    /// with [`GpuError::TimedOut`] or [`GpuError::Stopped`] naming `what`, and the device is
+    /// abandoned with the thread still in the driver. Nothing joins that thread, so the process
+    /// can report and exit while it runs.
+    fn bounded<T: Send + 'static>(&self, what: &str, create: impl FnOnce() -> T + Send + 'static) -> Result<T, GpuError> {
+        self.bound_passed()?;
+        *self.bounds.pass.lock().unwrap() = what.to_string();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::Builder::new()
+            .name("lobes-pipeline".into())
+            .stack_size(super::stack::BIG_STACK)
+            .spawn(move || {
+                let _ = tx.send(create());
+            })
+            .map_err(|e| GpuError::Lost(format!("cannot start a thread to create {what} on: {e}")))?;
+        loop {
+            match rx.recv_timeout(SLICE) {
+                Ok(made) => return Ok(made),
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if let Err(e) = self.bound_passed() {
+                        self.bounds.abandoned.lock().unwrap().get_or_insert_with(|| e.to_string());
+                        return Err(e);
+                    }
+                }
+                // the thread panicked (wgpu panics on a validation error it cannot return)
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => return Err(GpuError::Lost(format!("{what} panicked"))),
+            }
+        }
     }
 
     /// A buffer of at least `size` bytes (16 at the least), not mapped.

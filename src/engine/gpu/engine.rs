@@ -169,12 +169,13 @@ impl GpuEngine {
         }
         let module = self.gpu.module(&compose::describe(job), &source)?;
         let pipeline = |entry: &str| self.gpu.pipeline(&module, Some(&self.pipeline_layout), entry, &[]);
+        let lobe = matches!(job, Job::Lobe { .. });
         let kernel = Arc::new(Kernel {
-            sample: pipeline("sample_histogram"),
-            fold: pipeline("fold"),
-            directions: matches!(job, Job::Lobe { .. }).then(|| pipeline("directions")),
-            explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("explicit_samples")),
-            bin_explicit: matches!(job, Job::Lobe { .. }).then(|| pipeline("bin_explicit")),
+            sample: pipeline("sample_histogram")?,
+            fold: pipeline("fold")?,
+            directions: lobe.then(|| pipeline("directions")).transpose()?,
+            explicit: lobe.then(|| pipeline("explicit_samples")).transpose()?,
+            bin_explicit: lobe.then(|| pipeline("bin_explicit")).transpose()?,
             counting,
         });
         self.gpu.check_errors()?;

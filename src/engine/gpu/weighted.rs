@@ -52,7 +52,7 @@ impl WeightedPipelines {
         }
         let what = format!("{} (weighted)", super::compose::describe(job));
         let module = gpu.module(&what, &composed.source)?;
-        let pipeline = Arc::new(gpu.pipeline(&module, Some(&self.pipeline_layout), "weighted_histogram", &composed.constants));
+        let pipeline = Arc::new(gpu.pipeline(&module, Some(&self.pipeline_layout), "weighted_histogram", &composed.constants)?);
         gpu.check_errors()?;
         self.compiled += 1;
         self.cache.insert(key, pipeline.clone());

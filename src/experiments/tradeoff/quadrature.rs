@@ -66,7 +66,7 @@ pub struct GpuQuadrature {
 pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: SphereGrid, n: usize) -> Result<GpuQuadrature, GpuError> {
     let gpu = &engine.gpu;
     let module = gpu.module("tradeoff quadrature", &gpu_source(lobe, grid, n))?;
-    let pipeline = gpu.pipeline(&module, None, "quadrature", &[]);
+    let pipeline = gpu.pipeline(&module, None, "quadrature", &[])?;
     let params = QuadParams {
         alpha: [lobe.alpha_x as f32, lobe.alpha_y as f32],
         _pad: [0.0; 2],
