@@ -473,3 +473,26 @@ fn a_sampler_that_rejects_every_sample_fails() {
     assert_eq!(f.chi2.untested, Some(lobes::stats::chi2::Untested::NoValidSample));
     assert_eq!(r.invalid.iter().sum::<u64>(), 262_144);
 }
+
+/// A pdf no quadrature resolves (white noise at the scale of an ulp,
+/// tests/fixtures/samplers/noisy_pdf.wgsl) gives no verdict: `check` returns
+/// `CheckError::NoVerdict` naming the bin error in σ (the command's exit 3, as a failure to do
+/// the work, never 0 or 1); the same sampler with a smooth pdf (its uniform density) still gets a
+/// verdict. (At 2¹⁶ samples the noisy pdf's quadrature converges to the tolerance of that N, and
+/// it passes: an error far below the counts' σ is no reason to withhold a verdict.)
+#[test]
+fn an_unconverged_quadrature_gives_no_verdict() {
+    let gpu = gpu();
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/samplers/noisy_pdf.wgsl");
+    let settings = Settings { samples: 1 << 18, bins: Some((4, 8)), ..Settings::default() };
+    let noisy = UserSampler::from_files(std::slice::from_ref(&path), "noisy_sample", "noisy_pdf", None, Domain::Sphere).unwrap();
+    match check(&gpu, &noisy, &settings) {
+        Err(lobes::check::CheckError::NoVerdict(m)) => assert!(m.contains("did not converge") && m.contains("no verdict"), "{m}"),
+        Err(e) => panic!("another error: {e}"),
+        Ok(r) => panic!("a verdict ({}) from an unconverged quadrature", if r.passed { "pass" } else { "fail" }),
+    }
+    // the uniform density, which the sampler draws: a verdict, a pass
+    let smooth = UserSampler::from_files(&[path], "noisy_sample", "0.25 / 3.14159265", None, Domain::Sphere).unwrap();
+    let r = check(&gpu, &smooth, &Settings { samples: 1 << 16, ..settings }).unwrap_or_else(|e| panic!("{e}"));
+    assert!(r.get("chi2").unwrap().passed, "{}", r.get("chi2").unwrap().summary);
+}

@@ -1,21 +1,16 @@
 //! No false verdicts: every correct sampler that lobes ships (`examples/samplers/*.wgsl` but the
-//! `broken_*` ones, and lobes' own samplers as `lobes check` judges them, `UserSampler::builtin`)
-//! is judged by `lobes check` at the default settings over the parameters its docs allow — α
-//! from 10⁻³ to 2, isotropic and 50:1 anisotropic, incidence from 0 to 89.9°, g from −0.95 to
-//! 0.95 — with no fail of a check that judges pointwise (`pdf_consistency`, `jacobian`,
-//! `pdf_values`, `weights`, `hard_cases`); and every deliberately broken example
-//! (`examples/samplers/broken_*.wgsl`) still fails by the check that should catch it, at its
-//! documented parameters and at a narrow lobe where the f32 allowances are widest.
-//!
-//! The statistical checks (`chi2`, `albedo`, `normalization`) are counted and printed, not
-//! asserted: besides chance fails (about α per run) five systematic ones remain (measured
-//! 2026-12-01 on lavapipe, p ≤ 10⁻⁸): `chi2` of beckmann_vndf at α 0.3, θi 89.9° (samples in
-//! cells whose f32 pdf integrates to 0) and at α (0.05, 0.001), θi 80°; `normalization` and
-//! `chi2` of ggx_vndf and the mixture at α (2, 0.04), θi 10° (∫pdf = 0.99958: the quadrature's
-//! initial width, 0.5/√p_max, is the isotropic lobe's, too wide for a 50:1 ridge); `chi2` of
-//! the builtin ggx-ndf at α 0.3, θi 89.9°. Henyey–Greenstein at |g| = 0.99 still fails
-//! `jacobian` (7 % of probes, worst ratio 1.14: its f32 inversion of cos θ near the peak), so
-//! the range asserted here stops at 0.95.
+//! `broken_*` ones, lobes' own samplers as `lobes check` judges them, `UserSampler::builtin`, and
+//! an IBL prefilter's `importanceSampleGGX` as renderers write it,
+//! `tests/fixtures/samplers/ibl_prefilter.wgsl`) is judged by `lobes check` at the default
+//! settings over the parameters its docs allow — α from 10⁻³ to 2, isotropic and 50:1
+//! anisotropic, incidence from 0 to 89.9°, g from −0.99 to 0.99 — with no fail of a check that
+//! judges pointwise (`pdf_consistency`, `jacobian`, `pdf_values`, `weights`, `hard_cases`), and
+//! statistical fails (`chi2`, `albedo`, `normalization`) no more than chance allows at the
+//! significance (a binomial bound over the runs, P(more) < 10⁻³) besides the known systematic
+//! ones listed in [`KNOWN`]; and every deliberately broken example (`examples/samplers/broken_*.wgsl`,
+//! and broken variants of Henyey–Greenstein and the IBL sampler) still fails by the check that
+//! should catch it, at its documented parameters and at a narrow lobe where the f32 allowances
+//! are widest.
 //!
 //! The grid is a fixed selection (each α with one incident angle, every angle met), to keep
 //! the test to about three minutes on two CPU cores with lavapipe.
@@ -41,6 +36,17 @@ fn sampler(names: &[&str], sample: &str, pdf: &str, eval: Option<&str>) -> UserS
 /// about α (`normalization` is a 4σ bound, far less).
 const STATISTICAL: [&str; 3] = ["chi2", "albedo", "normalization"];
 
+/// Statistical fails of correct samplers that are systematic, not chance (measured 2026-12-02 on
+/// lavapipe; the first two p ≤ 10⁻⁸), each with its cause as far as it is known; the sweep prints every fail
+/// and asserts the others stay within chance. Beckmann VNDF at α 0.3, θi 89.9°: 36 samples in
+/// the bin just below the horizon at the mirror's φ, whose f32 pdf the quadrature integrates to
+/// 0 (pdf > 0 there only in a sliver 0.0017 deep in z); at α (0.05, 0.001), θi 80°: a lobe
+/// 2 α cos θi ≈ 3.5·10⁻⁴ rad wide across the plane of incidence, split unevenly by f32 binning
+/// at a bin edge (docs/statistics.md, "Known limit"); the builtin GGX NDF at α 0.3, θi 89.9°
+/// (p ≤ 10⁻⁸ on 2026-12-01 before the quadrature's initial width was capped at 1/16 rad,
+/// 3.3·10⁻³ since: perhaps chance now, cause not established).
+const KNOWN: [&str; 3] = ["beckmann_vndf α (0.3, 0.3) θi 89.9", "beckmann_vndf α (0.05, 0.001) θi 80", "builtin ggx-ndf α (0.3, 0.3) θi 89.9"];
+
 /// (αx, αy, θi): α from 10⁻³ to 2, the 50:1 anisotropic pairs, every θi from 0 to 89.9°; the
 /// first two are the narrow lobes of issue 23 (α 10⁻³ and 0.0064 at 45°).
 const MICROFACET: [(f64, f64, f64); 8] =
@@ -51,6 +57,19 @@ struct Run {
     what: String,
     report: Report,
 }
+
+/// The IBL prefilter's sampler (tests/fixtures/samplers/ibl_prefilter.wgsl) as a renderer calls
+/// it: a Hammersley-style point (here u.xy), the normal +z, the perceptual roughness p0, a half
+/// vector returned, directions below the horizon discarded; `pdf` is the density of d.
+fn ibl(pdf: &str) -> UserSampler {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/samplers/ibl_prefilter.wgsl");
+    let composition = lobes::check::Composition::default().sample_returns(lobes::check::SampleReturns::HalfVector);
+    let s = UserSampler::from_repository(&[path], "importance_sample_ggx(u.xy, vec3<f32>(0.0, 0.0, 1.0), p0)", pdf, None, Domain::Sphere, composition)
+        .unwrap_or_else(|e| panic!("{e}"));
+    s.with_conventions(lobes::check::Conventions { reflection_only: true, ..Default::default() }).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const IBL_PDF: &str = "ibl_pdf(wi, d, p0)";
 
 fn run(gpu: &Gpu, what: String, s: &UserSampler, settings: Settings) -> Run {
     let started = std::time::Instant::now();
@@ -92,8 +111,12 @@ fn correct_samplers_pass_over_their_documented_range() {
         runs.push(run(&gpu, format!("ggx_diffuse_mixture α ({ax}, {ay}) w {w} θi {theta}"), &mixture, at(vec![ax, ay, w])));
     }
     let hg = sampler(&["henyey_greenstein.wgsl"], "hg_sample", "hg_pdf", Some("hg_eval"));
-    for g in [-0.95, -0.5, 0.0, 0.3, 0.9, 0.95] {
+    for g in [-0.99, -0.95, -0.5, 0.0, 0.3, 0.9, 0.95, 0.99] {
         runs.push(run(&gpu, format!("henyey_greenstein g {g}"), &hg, Settings { params: vec![g], ..Settings::default() }));
+    }
+    for (roughness, theta) in [(0.1, 30.0), (0.3, 60.0), (0.7, 10.0)] {
+        let settings = Settings { params: vec![roughness], incident_theta: theta, incident_phi: 20.0, ..Settings::default() };
+        runs.push(run(&gpu, format!("ibl_prefilter roughness {roughness} θi {theta}"), &ibl(IBL_PDF), settings));
     }
     let plane = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
     let env = UserSampler::from_files(&files(&["piecewise_2d.wgsl"]), "env_sample", "env_pdf", None, plane).unwrap();
@@ -114,6 +137,7 @@ fn correct_samplers_pass_over_their_documented_range() {
         .flat_map(|r| r.report.failed().into_iter().filter(|c| !STATISTICAL.contains(c)).map(move |c| format!("{}: {c}", r.what)))
         .collect();
     let statistical: Vec<&Run> = runs.iter().filter(|r| r.report.failed().iter().any(|c| STATISTICAL.contains(c))).collect();
+    let unexplained: Vec<&&Run> = statistical.iter().filter(|r| !KNOWN.iter().any(|k| r.what.starts_with(k))).collect();
     let n = runs.len() as u64;
     // each run's statistical checks: chi2 and, with an eval, albedo, each at α = 0.01
     let p = 2.0 * Settings::default().significance;
@@ -124,9 +148,12 @@ fn correct_samplers_pass_over_their_documented_range() {
         statistical.len()
     );
     for r in &statistical {
-        eprintln!("  statistical fail: {} {:?}", r.what, r.report.failed());
+        let known = if unexplained.iter().any(|u| u.what == r.what) { "" } else { " (known, KNOWN)" };
+        eprintln!("  statistical fail: {} {:?}{known}", r.what, r.report.failed());
     }
     assert!(pointwise.is_empty(), "correct samplers failed pointwise checks: {pointwise:#?}");
+    let listed: Vec<String> = unexplained.iter().map(|r| format!("{}: {:?}", r.what, r.report.failed())).collect();
+    assert!(unexplained.len() as u64 <= chance, "{} statistical fails beyond the known ones, more than chance allows ({chance}): {listed:#?}", unexplained.len());
 }
 
 /// Each broken example fails by its check at its documented parameters, and at a narrow lobe
@@ -144,6 +171,11 @@ fn broken_samplers_still_fail_by_their_check() {
         ("broken_dielectric reflection J", sampler(&["ggx_vndf.wgsl", "rough_dielectric.wgsl", "broken_dielectric.wgsl"], "brd_reflection_j_sample", "brd_reflection_j_pdf", None), vec![0.3, 0.3, 1.5], 30.0, &["jacobian"]),
         ("broken_mixture_weight", sampler(&["ggx_vndf.wgsl", "ggx_diffuse_mixture.wgsl", "broken_mixture_weight.wgsl"], "broken_mix_sample", "broken_mix_pdf", None), vec![0.2, 0.2, 0.25], 40.0, &["jacobian"]),
         ("broken_mixture_weight", sampler(&["ggx_vndf.wgsl", "ggx_diffuse_mixture.wgsl", "broken_mixture_weight.wgsl"], "broken_mix_sample", "broken_mix_pdf", None), vec![0.0064, 0.0064, 0.25], 45.0, &["jacobian"]),
+        // where the f32 staircase of the map is steepest: Henyey–Greenstein at g 0.99 judged
+        // against the density of g 0.989 (its peak 18 % lower)
+        ("henyey_greenstein pdf of g 0.989", sampler(&["henyey_greenstein.wgsl"], "hg_sample", "hg_density(0.989, clamp(dot(-wi, d), -1.0, 1.0))", None), vec![0.99], 30.0, &["jacobian"]),
+        // the IBL sampler at roughness 0.1 with the density of h for that of d (no 1/(4 v·h))
+        ("ibl_prefilter pdf of h", ibl("ibl_pdf(wi, d, p0) * 4.0 * max(dot(wi, normalize(wi + d)), 0.0)"), vec![0.1], 30.0, &["jacobian"]),
     ];
     let mut caught = 0;
     let mut missed = Vec::new();

@@ -4,7 +4,8 @@
 //! p(d) = 1 / |J(u)|, with |J| = |∂d/∂u₁ × ∂d/∂u₂| on the sphere (the area of the image of a unit
 //! square of u, per unit solid angle) and |det ∂(x, y)/∂(u₁, u₂)| on the plane (pbrt-v4 §2.4.1,
 //! "transforming between distributions"). The derivatives are central differences of the GPU's
-//! map, in f64 on the host, at steps ε · 2ᵏ ([`STEPS`]): at each step where the map is smooth
+//! map, in f64 on the host, at steps ε · 2ᵏ ([`STEPS`]; the steps below ε measure the map's
+//! f32 staircase, [`SUB_STEPS`]): at each step where the map is smooth
 //! (the second difference under a tenth of the first: no fold, seam or branch between lobes
 //! within it), and at the three consecutive steps that agree best, the first two extrapolated
 //! (Richardson) with the larger of their differences as the error. A narrow lobe needs the large steps (over 2ε its d moves
@@ -39,14 +40,24 @@ use serde::{Deserialize, Serialize};
 /// The smallest finite-difference step in u (2⁻¹²), and the probe's margin from the edges of
 /// [0, 1] is 2ε.
 pub const EPS: f32 = 1.0 / 4096.0;
-/// Steps of the central differences: ε · 2ᵏ for k < STEPS (2⁻¹² … 2⁻⁵). A small step is exact
+/// Steps of the central differences: ε · 2ᵏ⁻ˢ for k < STEPS, S = [`SUB_STEPS`] (2⁻¹⁶ … 2⁻⁵).
+/// A small step is exact
 /// for a curved map but reads the f32 rounding of d (≈ 6·10⁻⁸) over a change of d that a narrow
 /// lobe makes tiny: GGX at α = 0.0064 moves d by ≈ 6·10⁻⁶ over 2ε, so central differences at
 /// 2⁻¹² alone are off by percents. A large step averages the rounding out but meets the map's
-/// curvature. Each derivative is taken at the three consecutive steps that agree best,
+/// curvature. Each derivative is taken at the three consecutive steps from ε up that agree best,
 /// combined by Richardson extrapolation (4 D(h) − D(2h)) / 3, with the larger of |D(h) − D(2h)|
-/// and |D(2h) − D(4h)| as its error (three steps: two may agree by chance on a staircase).
-pub const STEPS: usize = 8;
+/// and |D(2h) − D(4h)| as its error (three steps: two may agree by chance on a staircase), or
+/// the f32 rounding the smaller steps show, if larger ([`SUB_STEPS`]).
+pub const STEPS: usize = 8 + SUB_STEPS;
+/// Steps below ε (ε/16 … ε/2) that only measure the f32 staircase of the map: a correct sampler
+/// whose d is resolved to treads about as long as ε (Henyey–Greenstein at g 0.99, where cos θ
+/// moves by an ulp per 1.2ε of u.x near the peak; an IBL prefilter's sin θh = √(1 − cos²θh)
+/// near the normal) reads the same whole number of treads per step at ε, 2ε and 4ε, three steps
+/// that agree exactly on a |J| up to 40 % off. Over a step h_j below the judged ones the central
+/// difference is off by the rounding of d there, |D_j − D| · 2h_j; the same rounding costs
+/// Richardson's value at h up to 0.75 × that / h, which joins the error.
+pub const SUB_STEPS: usize = 4;
 /// Uniforms probed around each probe sample: for u.x then u.y, for each step, u + h and u − h.
 pub const AROUND: usize = 4 * STEPS;
 /// A sample is off when |p · |J| / share − 1| exceeds this plus its allowance (for an event:
@@ -121,9 +132,9 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
-/// Step k: ε · 2ᵏ.
+/// Step k: ε · 2ᵏ⁻ˢ.
 fn step(k: usize) -> f32 {
-    EPS * (1u32 << k) as f32
+    EPS * (1u32 << k) as f32 / (1u32 << SUB_STEPS) as f32
 }
 
 /// The uniforms around `u` that the Jacobian needs (`AROUND` of them, in the order the module
@@ -164,7 +175,8 @@ fn derivative(u: [f32; 4], axis: usize, d0: [f64; 3], at: &[[f32; 4]], plane: bo
     // difference under a tenth of the first: no fold, seam or branch between lobes within it)
     let steps = around(u);
     let steps = &steps[axis * 2 * STEPS..(axis + 1) * 2 * STEPS];
-    let diffs: Vec<Option<[f64; 3]>> = (0..STEPS)
+    // (the raw central difference and its span too, smooth or not: what f32 does at small steps)
+    let raw: Vec<Option<([f64; 3], f64, bool)>> = (0..STEPS)
         .map(|k| {
             let (p, m) = (at[2 * k], at[2 * k + 1]);
             let span = steps[2 * k][axis] as f64 - steps[2 * k + 1][axis] as f64;
@@ -175,16 +187,23 @@ fn derivative(u: [f32; 4], axis: usize, d0: [f64; 3], at: &[[f32; 4]], plane: bo
             let (p, m) = (point(p), point(m));
             let first = sub(p, m);
             let second = norm([p[0] - 2.0 * d0[0] + m[0], p[1] - 2.0 * d0[1] + m[1], p[2] - 2.0 * d0[2] + m[2]]);
-            (norm(first) > 0.0 && second <= 0.1 * norm(first)).then(|| scale(first, 1.0 / span))
+            Some((scale(first, 1.0 / span), span, norm(first) > 0.0 && second <= 0.1 * norm(first)))
         })
         .collect();
+    let diffs: Vec<Option<[f64; 3]>> = raw.iter().map(|r| r.and_then(|(d, _, smooth)| smooth.then_some(d))).collect();
     // three consecutive steps must agree: two alone may agree by chance on a staircase whose
     // treads are as long as the steps
-    (0..STEPS - 2)
+    (SUB_STEPS..STEPS - 2)
         .filter_map(|k| {
             let (a, b, c) = (diffs[k]?, diffs[k + 1]?, diffs[k + 2]?);
             let value = scale(sub(scale(a, 4.0), b), 1.0 / 3.0);
-            Some(Derivative { value, error: norm(sub(a, b)).max(norm(sub(b, c))), h: step(k + 1) as f64 })
+            // The f32 staircase of the map ([`SUB_STEPS`]): at each smaller step j the central
+            // difference is off by its rounding (δ₊ − δ₋)/(2h_j), so |D_j − D| · 2h_j measures
+            // the rounding of d there (a flat tread, D_j = 0, reads |D| · 2h_j); the same rounding
+            // costs Richardson's value at h up to (4/(2h) + 1/(4h))/3 = 0.75/h times that.
+            let rounding = raw[..k].iter().flatten().map(|(d, span, _)| norm(sub(*d, value)) * span).fold(0.0, f64::max);
+            let h = step(k) as f64;
+            Some(Derivative { value, error: norm(sub(a, b)).max(norm(sub(b, c))).max(0.75 * rounding / h), h: step(k + 1) as f64 })
         })
         .min_by(|x, y| (x.error / norm(x.value)).total_cmp(&(y.error / norm(y.value))))
 }
@@ -342,17 +361,33 @@ mod tests {
         }
     }
 
-    /// Slope 10⁻³ with σ = 10⁻⁷ (f32's rounding at a narrow lobe): at step 2⁻¹² the difference
-    /// reads |J| 40 % high, the steps of 2⁻⁷ … 2⁻⁵ agree to 0.7 %, and the ratio there is 1
-    /// within the allowance; a pdf of half the density is off.
+    /// Slope 10⁻³ with σ = 3·10⁻⁸ (half an ulp of d ≈ 0.6, f32's rounding): at step 2⁻¹² the
+    /// difference reads |J| 12 % high, the steps of 2⁻⁷ … 2⁻⁵ agree to 0.3 %, and the ratio there
+    /// is 1 within the allowance; a pdf of half the density is off.
     #[test]
     fn a_map_resolved_only_by_large_steps_is_judged_at_them() {
-        let (p, at) = probed(noisy(1e-3, 1e-7), U, 1e3);
+        let (p, at) = probed(noisy(1e-3, 3e-8), U, 1e3);
         let c = judge_all(p, U, at);
         assert!(c.passed && c.compared == MIN_COMPARED && (c.median_ratio.unwrap() - 1.0).abs() < 2e-2 && c.largest_step >= 1.0 / 64.0, "{c:?}");
-        let (p, at) = probed(noisy(1e-3, 1e-7), U, 500.0);
+        let (p, at) = probed(noisy(1e-3, 3e-8), U, 500.0);
         let c = judge_all(p, U, at);
         assert!(!c.passed && (c.worst_ratio - 0.5).abs() < 2e-2, "{c:?}");
+    }
+
+    /// An f32 staircase: d.y = slope · u.y rounded to treads 1.2ε long (Henyey–Greenstein at g
+    /// 0.99 near its peak). At ε, 2ε and 4ε the differences count whole treads and can agree
+    /// exactly on a slope that is not the map's; the steps below ε show the treads, and the probe
+    /// is skipped or judged at steps long enough to average them, never read as off.
+    #[test]
+    fn a_staircase_is_not_read_as_a_wrong_jacobian() {
+        let tread = 1.2 * EPS as f64;
+        let slope = 1e-3;
+        for shift in [0.0, 0.1, 0.3, 0.5, 0.7, 0.9] {
+            let stairs = move |v: [f32; 4]| [v[0], (slope * tread * (v[1] as f64 / tread + shift).floor()) as f32, 0.0, (1.0 / slope) as f32];
+            let (p, at) = probed(stairs, U, 1e3);
+            let c = judge_all(p, U, at);
+            assert!(c.passed && c.off == 0, "shift {shift}: {c:?}");
+        }
     }
 
     /// Slope 10⁻² with σ = 10⁻⁵: no three steps agree to 1 %, and the probe is skipped as

@@ -77,6 +77,11 @@ pub enum CheckError {
     /// A fault of lobes itself.
     #[error("internal error in lobes check: {0}")]
     Internal(String),
+    /// The expected histogram is not accurate enough to judge by (the quadrature of the pdf did
+    /// not converge, [`quadrature::Integrals::converged`]): no verdict, neither pass nor fail
+    /// (exit 3, as `lobes run`'s unconverged reference).
+    #[error("{0}")]
+    NoVerdict(String),
 }
 
 impl CheckError {
@@ -546,8 +551,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     checks.push(Check { passed: jac.passed, summary, figures: Figures::Jacobian(jac) });
 
     // The expected histogram.
-    let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
-    let width = if plane { width } else { width.min(0.25) };
+    let width = quadrature::initial_width(p_max, plane);
     let integrals = match &settings.reference {
         None => quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples)?,
         Some(reference) => {
@@ -562,6 +566,11 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
             i
         }
     };
+    // a pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
+    // expected counts the quadrature could not resolve give no verdict
+    if integrals.bad_parts == 0 {
+        integrals.converged(settings.samples).map_err(CheckError::NoVerdict)?;
+    }
     let n = settings.samples as f64;
     let pdf_total: f64 = integrals.probabilities.iter().sum();
     // where the pdf is bad: its worst point on a fine grid (the WGSL pdf's, as the hard cases)

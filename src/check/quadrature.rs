@@ -11,6 +11,13 @@
 //! A fixed rule is not enough: a lobe narrower than a bin slips between its nodes (Mitsuba's
 //! fixed trapezoid rule fails correct peaked samplers for that reason).
 //!
+//! **No verdict from an unconverged quadrature.** A bin's error estimate (its accepted
+//! |fine − coarse| differences) is held to [`MAX_QUADRATURE_SIGMA`] of its count's standard
+//! deviation at N, as `lobes run` holds its f64 reference. The bins beyond it are integrated
+//! again from an initial split [`REFINE_FACTOR`] times finer per axis and [`MAX_DEPTH`] + 2
+//! levels deep, up to [`RETRIES`] times, and keep the new values; where a bin is still beyond it
+//! ([`Integrals::converged`] says so) `lobes check` draws no verdict (exit 3).
+//!
 //! Sphere bins are integrated over (a, φ) with a = 1 − |cos θ| per hemisphere (see
 //! `lobes_domain_point`), so that parts next to a pole keep their f32 resolution.
 //!
@@ -22,6 +29,7 @@ use super::gpu::{self, Params, Passes};
 
 use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
 use crate::engine::gpu::Gpu;
+pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::gauss_legendre::GaussLegendre;
 use serde::{Deserialize, Serialize};
 
@@ -31,6 +39,10 @@ pub const MAX_DEPTH: u32 = 8;
 pub const MAX_INITIAL_SPLIT: u32 = 16;
 /// Parts evaluated in one round at most; beyond it, parts are accepted unrefined and counted.
 const MAX_PARTS: usize = 1 << 22;
+/// Times the bins beyond [`MAX_QUADRATURE_SIGMA`] are integrated again, each time from an initial
+/// split [`REFINE_FACTOR`] times finer per axis (its cap too) and two levels deeper.
+pub const RETRIES: u32 = 2;
+pub const REFINE_FACTOR: u32 = 4;
 
 /// Per-bin integrals and what their accuracy is.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -41,7 +53,9 @@ pub struct Integrals {
     pub eval: Vec<f64>,
     /// Σ over bins of the accepted |fine − coarse| differences of the pdf's integral.
     pub error_estimate: f64,
-    /// Largest bin error in units of its count's standard deviation at the run's N.
+    /// Largest bin error in units of its count's standard deviation at the run's N: the
+    /// |fine − coarse| of its parts accepted unconverged summed, plus those of its converged
+    /// parts in quadrature (independent errors of either sign).
     pub max_error_sigma: f64,
     /// Parts accepted at the depth limit without agreeing.
     pub unconverged_parts: u64,
@@ -50,6 +64,30 @@ pub struct Integrals {
     /// Parts evaluated in all, and refinement rounds.
     pub parts: u64,
     pub rounds: u32,
+}
+
+impl Integrals {
+    /// `Err` with what is wrong where a bin's error estimate is beyond [`MAX_QUADRATURE_SIGMA`] of
+    /// its count's standard deviation at `samples` (after the retries of [`integrate`]): expected
+    /// counts that uncertain give no verdict, neither a pass nor a fail.
+    ///
+    /// ```
+    /// use lobes::check::quadrature::Integrals;
+    /// let mut i = Integrals { probabilities: vec![0.5, 0.5], eval: vec![0.0; 2], error_estimate: 0.0, max_error_sigma: 0.05,
+    ///     unconverged_parts: 0, bad_parts: 0, parts: 2, rounds: 1 };
+    /// assert!(i.converged(1_000_000).is_ok());
+    /// i.max_error_sigma = 2.0;
+    /// assert!(i.converged(1_000_000).unwrap_err().contains("no verdict"));
+    /// ```
+    pub fn converged(&self, samples: u64) -> Result<(), String> {
+        if self.max_error_sigma <= MAX_QUADRATURE_SIGMA {
+            return Ok(());
+        }
+        Err(format!(
+            "the quadrature of the pdf did not converge: a bin's error estimate is {:.3}σ of its count at {samples} samples (at most {MAX_QUADRATURE_SIGMA}σ gives a verdict; {} parts accepted at the depth limit or the parts' budget after {RETRIES} finer retries), so no verdict is drawn; a pdf with an edge or a peak narrower than the quadrature resolves (a small cone, a near-delta lobe) needs fewer --samples or more --bins",
+            self.max_error_sigma, self.unconverged_parts
+        ))
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -137,14 +175,32 @@ impl Integrand for CpuPdf<'_> {
     }
 }
 
+/// The widest initial part on the sphere (radians): a sixteenth of a radian. A lobe's width from
+/// its peak density, 0.5/√p_max, is an isotropic lobe's; a 50:1 anisotropic one (GGX α (2, 0.04)
+/// at θi 10°) is a ridge far narrower than that across, and where it crosses the tall bins next
+/// to a pole (0.25 rad in θ at 64 rows) the 5 × 5 and 3 × 3 rules of one part agreed on a value
+/// 16 % low (∫pdf 0.99958, measured on lavapipe; split to at most 1/16 rad, 1.000000).
+pub const MAX_SPHERE_WIDTH: f64 = 0.0625;
+
+/// The width the bins are first split to: 0.5/√p_max (p_max the largest pdf the probes reported),
+/// within [10⁻⁴, 1], and at most [`MAX_SPHERE_WIDTH`] on the sphere.
+pub(super) fn initial_width(p_max: f64, plane: bool) -> f64 {
+    let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
+    if plane { width } else { width.min(MAX_SPHERE_WIDTH) }
+}
+
 /// The parts a bin starts as: on the sphere its (a, φ) rectangle per hemisphere it touches,
-/// each split `m × m` where `m` is its angular extent over `width`.
-fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64) -> Vec<Part> {
+/// each split `m × m` where `m` is its angular extent over `width`, at most `cap`; only the
+/// bins `only` marks, where given.
+fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, only: Option<&[bool]>) -> Vec<Part> {
     let mut parts = Vec::new();
-    let split = |extent: f64| ((extent / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
+    let split = |extent: f64| ((extent / width).ceil() as u32).clamp(1, cap);
     for r in 0..rows {
         for c in 0..cols {
             let bin = r * cols + c;
+            if only.is_some_and(|o| !o[bin as usize]) {
+                continue;
+            }
             // (a range, b range, hemisphere, initial split per axis)
             let mut pieces: Vec<Piece> = Vec::new();
             match *domain {
@@ -192,12 +248,64 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64) -> Vec<Part>
 
 /// Integrates the user's pdf and eval over every bin. `width` is the narrowest feature expected,
 /// in radians on the sphere or domain units on the plane; `samples` the run's sample count.
+/// Bins whose error estimate is beyond [`MAX_QUADRATURE_SIGMA`] are integrated again, finer
+/// (the module doc); [`Integrals::converged`] says whether any is left.
 pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64) -> Result<Integrals, CheckError> {
-    refine(f, initial_parts(domain, rows, cols, width), (rows * cols) as usize, samples)
+    let bins = (rows * cols) as usize;
+    let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH)?;
+    let mut rounds = out.rounds;
+    for retry in 1..=RETRIES {
+        let over: Vec<bool> = b.error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples) > MAX_QUADRATURE_SIGMA).collect();
+        if !over.contains(&true) {
+            break;
+        }
+        let factor = REFINE_FACTOR.pow(retry);
+        // (at most (cap)² parts per hemisphere of a bin: beyond the parts' budget, no retry)
+        let cap = MAX_INITIAL_SPLIT * factor;
+        if over.iter().filter(|o| **o).count() * 2 * (cap * cap) as usize > MAX_PARTS {
+            break;
+        }
+        let parts = initial_parts(domain, rows, cols, width / factor as f64, cap, Some(&over));
+        let (again, a) = refine(f, parts, bins, samples, MAX_DEPTH + 2 * retry)?;
+        for i in (0..bins).filter(|&i| over[i]) {
+            out.probabilities[i] = again.probabilities[i];
+            out.eval[i] = again.eval[i];
+            b.error[i] = a.error[i];
+            b.linear[i] = a.linear[i];
+            b.unconverged[i] = a.unconverged[i];
+        }
+        out.parts += again.parts;
+        out.bad_parts = out.bad_parts.max(again.bad_parts);
+        rounds += again.rounds;
+    }
+    out.rounds = rounds;
+    out.unconverged_parts = b.unconverged.iter().sum();
+    out.error_estimate = b.linear.iter().sum();
+    out.max_error_sigma = b.error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max);
+    Ok(out)
 }
 
-/// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says.
-fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) -> Result<Integrals, CheckError> {
+/// A bin's error `e` in units of its count's standard deviation √(N p) at N = `samples`, taken
+/// as at least one count (as [`crate::stats::expected::Expected::max_error_sigma_at`]).
+fn sigmas(e: f64, p: f64, samples: u64) -> f64 {
+    let n = samples.max(1) as f64;
+    e / (p.max(1.0 / n) / n).sqrt()
+}
+
+/// Per bin, what [`refine`] knows of its error: the estimate a verdict is held to (the
+/// |fine − coarse| of parts accepted unconverged summed, plus those of converged parts summed in
+/// quadrature: each is a bound on a part's error of either sign, and their plain sum over the
+/// k parts of a finely split bin grows as k while the error of the bin grows as √k), the plain
+/// sum of every part's (`error_estimate`), and the parts accepted unconverged.
+struct Bins {
+    error: Vec<f64>,
+    linear: Vec<f64>,
+    unconverged: Vec<u64>,
+}
+
+/// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says
+/// down to `max_depth`; with each bin's error estimate and its parts accepted unconverged.
+fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, max_depth: u32) -> Result<(Integrals, Bins), CheckError> {
     let n = samples.max(1) as f64;
     let rounding = f.rounding();
     let tolerance = |v: f64, n: f64| tolerance(v, n, rounding);
@@ -211,17 +319,26 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) 
         parts: 0,
         rounds: 0,
     };
+    // per bin: the errors of parts accepted unconverged, summed, and of converged parts, squared
     let mut bin_error = vec![0.0; bins];
+    let mut bin_converged_sq = vec![0.0; bins];
+    let mut bin_linear = vec![0.0; bins];
+    let mut bin_unconverged = vec![0u64; bins];
     while !pending.is_empty() {
         out.rounds += 1;
         out.parts += pending.len() as u64;
         let rects: Vec<([f64; 4], f32)> = pending.iter().map(Part::rect).collect();
         let values = f.rules(&rects)?;
         let mut next = Vec::new();
-        let mut accept = |out: &mut Integrals, part: &Part, pdf: f64, eval: f64, err: f64| {
+        let mut accept = |out: &mut Integrals, part: &Part, pdf: f64, eval: f64, err: f64, converged: bool| {
             out.probabilities[part.bin as usize] += pdf;
             out.eval[part.bin as usize] += eval;
-            bin_error[part.bin as usize] += err;
+            bin_linear[part.bin as usize] += err;
+            if converged {
+                bin_converged_sq[part.bin as usize] += err * err;
+            } else {
+                bin_error[part.bin as usize] += err;
+            }
         };
         let bad = |v: &[f64; 4]| !(v[0].is_finite() && v[1].is_finite() && v[0] >= 0.0 && v[1] >= 0.0);
         let room = |len: usize| len + 4 <= MAX_PARTS;
@@ -235,8 +352,9 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) 
                     if bad(&v) {
                         out.bad_parts += 1;
                     } else if ((p5 - p3).abs() <= tolerance(p5, n) && (e5 - e3).abs() <= tolerance(e5, n)) || !room(next.len()) {
-                        out.unconverged_parts += u64::from((p5 - p3).abs() > tolerance(p5, n));
-                        accept(&mut out, &part, p5, e5, (p5 - p3).abs());
+                        let converged = (p5 - p3).abs() <= tolerance(p5, n);
+                        bin_unconverged[part.bin as usize] += u64::from(!converged);
+                        accept(&mut out, &part, p5, e5, (p5 - p3).abs(), converged);
                     } else {
                         next.extend(part.quarters((p5, e5)));
                     }
@@ -253,9 +371,9 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) 
                     let fine: f64 = group.iter().map(|v| v[0]).sum();
                     let fine_e: f64 = group.iter().map(|v| v[2]).sum();
                     let agree = (fine - cp).abs() <= tolerance(fine, n) && (fine_e - ce).abs() <= tolerance(fine_e, n);
-                    if agree || part.depth >= MAX_DEPTH || !room(next.len() + 12) {
-                        out.unconverged_parts += u64::from(!agree);
-                        accept(&mut out, &part, fine, fine_e, (fine - cp).abs());
+                    if agree || part.depth >= max_depth || !room(next.len() + 12) {
+                        bin_unconverged[part.bin as usize] += u64::from(!agree);
+                        accept(&mut out, &part, fine, fine_e, (fine - cp).abs(), agree);
                     } else {
                         for (k, q) in pending[i..i + 4].iter().enumerate() {
                             next.extend(q.quarters((group[k][0], group[k][2])));
@@ -267,13 +385,13 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64) 
         }
         pending = next;
     }
-    out.error_estimate = bin_error.iter().sum();
-    out.max_error_sigma = bin_error
-        .iter()
-        .zip(&out.probabilities)
-        .map(|(e, p)| e / (p.max(1.0 / n) / n).sqrt())
-        .fold(0.0, f64::max);
-    Ok(out)
+    out.unconverged_parts = bin_unconverged.iter().sum();
+    out.error_estimate = bin_linear.iter().sum();
+    for (e, sq) in bin_error.iter_mut().zip(&bin_converged_sq) {
+        *e += sq.sqrt();
+    }
+    out.max_error_sigma = bin_error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max);
+    Ok((out, Bins { error: bin_error, linear: bin_linear, unconverged: bin_unconverged }))
 }
 
 /// ∫ f(d) dω over the unit sphere ([`WgslIntegrand::integrate`], [`sphere_integral_f64`]).
@@ -323,7 +441,7 @@ fn graded_parts() -> Vec<Part> {
 }
 
 fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
-    let i = refine(f, graded_parts(), 1, SPHERE_SAMPLES)?;
+    let (i, _) = refine(f, graded_parts(), 1, SPHERE_SAMPLES, MAX_DEPTH)?;
     Ok(SphereIntegral { value: i.probabilities[0], error_estimate: i.error_estimate, unconverged_parts: i.unconverged_parts, bad_parts: i.bad_parts, parts: i.parts })
 }
 

@@ -46,11 +46,7 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
     }
 }
 
-/// The largest quadrature error of any bin allowed for a verdict, in units of its count's
-/// standard deviation at the run's N ([`Expected::max_error_sigma_at`]). The default tolerance is a
-/// hundredth of that σ per part (at N ≥ 10⁸, less below), and the bins of every documented
-/// configuration stay below 0.05 (docs/statistics.md).
-pub const MAX_QUADRATURE_SIGMA: f64 = 0.1;
+pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 
 /// Whether the expected counts of a run of `samples` samples are accurate enough to judge by:
 /// `Err` with what is wrong where the quadrature has not converged, so that no verdict is drawn

@@ -81,6 +81,12 @@ pub struct Expected {
     pub unconverged_parts: u64,
 }
 
+/// The largest quadrature error of any bin allowed for a verdict, in units of its count's
+/// standard deviation at the run's N ([`Expected::max_error_sigma_at`]; `lobes check`'s
+/// quadrature alike). The default tolerance is a hundredth of that σ per part (at N ≥ 10⁸, less
+/// below), and the bins of every documented configuration stay below 0.05 (docs/statistics.md).
+pub const MAX_QUADRATURE_SIGMA: f64 = 0.1;
+
 impl Expected {
     /// The largest quadrature error of a bin in units of its count's standard deviation in a run
     /// of `samples` samples, √(N p), taken as at least one count (where a bin expects less than
