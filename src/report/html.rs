@@ -235,7 +235,7 @@ mod tests {
             passed,
             failed_checks: None,
             failure: None,
-            measured: error.is_none().then_some(CaseMeasured { gpu_seconds: None, wall_seconds: 0.5, chi2: 12.0, dof: 10, p_value: 0.28, albedo: None, max_angle_rad: None }),
+            measured: error.is_none().then_some(CaseMeasured { gpu_seconds: None, wall_seconds: 0.5, chi2: 12.0, dof: 10, p_value: 0.28, family_p_value: None, family: Vec::new(), albedo: None, max_angle_rad: None }),
             error: error.map(String::from),
             output: None,
         }

@@ -26,6 +26,7 @@ use crate::run::shard::ShardFile;
 use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
 use crate::stats::chi2::Chi2;
+use crate::stats::family::FamilyTest;
 use crate::run::compare::AngleCheck;
 use crate::stats::weighted::{AlbedoCheck, WeightedSums};
 use schemars::JsonSchema;
@@ -288,7 +289,7 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonSty
         Domain::Plane { bounds } => Bins::Plane { rows, cols, bounds },
     };
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
-    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), r.chi2.p_value));
+    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), &r.chi2));
     compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
     let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
     files.write(&folder, [rows, cols], style)
@@ -345,7 +346,7 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
         Job::Discrete { .. } => Bins::Items(cols),
     };
     let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();
-    let mut verdict = caption::verdict(r.passed(), r.chi2.p_value);
+    let mut verdict = caption::verdict(r.passed(), &r.chi2);
     if r.weighted.as_ref().is_some_and(|w| !w.check.passed) {
         verdict += ", albedo check failed";
     }
@@ -496,9 +497,17 @@ pub struct CaseSummary {
 pub struct CaseMeasured {
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
+    /// The fine grid's χ² test.
     pub chi2: f64,
     pub dof: u64,
     pub p_value: f64,
+    /// The family's p-value (Holm's smallest) that the verdict compares with the per-case
+    /// significance, and every test's p-values, the fine grid first
+    /// ([`crate::stats::family::judge`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family_p_value: Option<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub family: Vec<FamilyTest>,
     pub albedo: Option<AlbedoSummary>,
     pub max_angle_rad: Option<f64>,
 }
@@ -534,6 +543,8 @@ impl CaseSummary {
                 chi2: r.chi2.statistic,
                 dof: r.chi2.dof,
                 p_value: r.chi2.p_value,
+                family_p_value: r.chi2.family_p_value,
+                family: r.chi2.family.clone(),
                 albedo: r.weighted.as_ref().map(|w| AlbedoSummary {
                     albedo: w.check.reflected.albedo,
                     reference: w.check.reflected.reference,
@@ -569,6 +580,8 @@ impl CaseSummary {
                 chi2: r.chi2.statistic,
                 dof: r.chi2.dof,
                 p_value: r.chi2.p_value,
+                family_p_value: r.chi2.family_p_value,
+                family: r.chi2.family.clone(),
                 albedo: r.albedo.map(|a| AlbedoSummary {
                     albedo: a.mean_weight,
                     reference: a.quadrature,
