@@ -46,5 +46,6 @@ fn write_maps(dir: &Path, report: &Report) -> anyhow::Result<()> {
     );
     let caption = format!("{} ({} samples): {verdict}", report.sampler, report.samples);
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
-    compare::write(dir, &Comparison { bins, measured: &counts, expected: &report.expected, caption: &caption, note: &note })
+    let coarse = report.figures::<Chi2Figures>().and_then(|c| crate::stats::family::caught_grid(&c.chi2));
+    compare::write(dir, &Comparison { bins, measured: &counts, expected: &report.expected, caption: &caption, note: &note, coarse })
 }

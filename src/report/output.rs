@@ -26,7 +26,7 @@ use crate::run::shard::ShardFile;
 use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
 use crate::stats::chi2::Chi2;
-use crate::stats::family::FamilyTest;
+use crate::stats::family::{self, FamilyTest};
 use crate::run::compare::AngleCheck;
 use crate::stats::weighted::{AlbedoCheck, WeightedSums};
 use schemars::JsonSchema;
@@ -290,7 +290,8 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonSty
     };
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
     let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), &r.chi2));
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
+    let coarse = family::caught_grid(&r.chi2);
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "", coarse })?;
     let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
     files.write(&folder, [rows, cols], style)
 }
@@ -353,7 +354,8 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
     let caption = format!("{} ({}): {verdict}", r.case.name, caption::parameters(&doc.description));
     let invalid: u64 = r.counts.invalid.iter().sum();
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note })?;
+    let coarse = family::caught_grid(&r.chi2);
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note, coarse })?;
     if let Some(w) = &r.weighted {
         let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
         let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);

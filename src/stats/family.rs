@@ -219,6 +219,16 @@ pub fn caught(c: &Chi2) -> Option<String> {
     Some(format!("caught at {}{fine}", rejected.join(", ")))
 }
 
+/// The rows × cols of the grid (both > 1: not a marginal) that caught a defect the fine grid did
+/// not, with the smallest Holm p-value: the level whose residual shows it.
+pub fn caught_grid(c: &Chi2) -> Option<(usize, usize)> {
+    if c.family.first().is_none_or(|fine| fine.rejected) {
+        return None;
+    }
+    let grids = c.family.iter().filter(|t| t.rejected && t.rows > 1 && t.cols > 1);
+    grids.min_by(|a, b| a.holm_p_value.total_cmp(&b.holm_p_value)).map(|t| (t.rows as usize, t.cols as usize))
+}
+
 /// The test with the smallest Holm p-value: the level that caught a defect, or came closest.
 pub fn strongest(c: &Chi2) -> Option<&FamilyTest> {
     c.family.iter().min_by(|a, b| a.holm_p_value.total_cmp(&b.holm_p_value))
@@ -361,6 +371,7 @@ mod tests {
         let t = judge(grid, (&counts, &expected), (&[0], &[0.0]), 0.01);
         assert!(t.family[0].p_value > 0.01, "the fine grid sees only noise: {:?}", t.family[0]);
         assert!(!t.passed);
+        assert!(caught_grid(&t).is_some_and(|(r, c)| r > 1 && c > 1 && r < 64));
         let caught = caught(&t).unwrap();
         assert!(caught.starts_with("caught at") && caught.contains("2 × 4: ") && caught.ends_with(&format!("64 × 128: p = {:.1e}", t.p_value)), "{caught}");
     }
