@@ -83,7 +83,7 @@ fn expected_from(pdf: &(dyn Fn(DVec3) -> f64 + Sync), right: &ExpectedCounts, n:
     let right_total: f64 = right.bins.iter().sum();
     let bins = e.probabilities.iter().map(|p| p / total * right_total).collect();
     let _ = n;
-    ExpectedCounts { bins, invalid: right.invalid, quadrature: None }
+    ExpectedCounts { bins, invalid: right.invalid, quadrature: None, grid: right.grid }
 }
 
 /// The same test rejects a reflected pdf without the 1/(4|ωr·h|) Jacobian and a Ward pdf

@@ -109,6 +109,10 @@ fn three_shards_merge_to_exactly_the_unsharded_run() {
         assert_eq!(a.expected, b.expected, "{}", what("expected"));
         assert_eq!(a.expected_invalid, b.expected_invalid, "{}", what("expected_invalid"));
         assert_eq!(a.chi2, b.chi2, "{}", what("chi2"));
+        // and so is the family of tests, every level's figures (lobes::stats::family)
+        if case != "alias" {
+            assert!(a.chi2.family.len() > 4 && a.chi2.family_p_value.is_some(), "{case}: {:?}", a.chi2.family);
+        }
         assert_eq!(a.per_sample_check, b.per_sample_check, "{}", what("per_sample_check"));
         assert_eq!(a.description, b.description, "{}", what("params, rows, cols"));
         assert_eq!((&a.adapter, &a.backend), (&b.adapter, &b.backend), "{}", what("adapter, backend"));

@@ -55,7 +55,7 @@ pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
 use crate::reference::rng;
-use crate::stats::chi2;
+use crate::stats::family;
 use report::{AlbedoFigures, Chi2Figures, ConsistencyFigures, NormalizationFigures, PdfValuesFigures, REPORT_VERSION, WeightFigures};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -621,16 +621,21 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         ),
         figures: Figures::Normalization(norm),
     });
-    let chi2 = chi2::judge((&totals[..bins], &expected), (&[invalid.iter().sum()], &[expected_invalid]), settings.significance);
+    let grid = if plane { family::Grid::plane(rows, cols) } else { family::Grid::sphere(rows, cols) };
+    let chi2 = family::judge(grid, (&totals[..bins], &expected), (&[invalid.iter().sum()], &[expected_invalid]), settings.significance);
+    let family_p = chi2.family_p_value.unwrap_or(chi2.p_value);
     let summary = format!(
-        "{}χ² = {:.1} on {} dof, p = {:.3e} (significance {}){}{}; ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
+        "{}{}χ² = {:.1} on {} dof, p = {:.3e}; over {} grids and marginals (Holm) p = {:.3e} (significance {}){}{}; ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ",
         chi2.untested.map_or(String::new(), |u| format!("{}; ", u.describe())),
+        family::caught(&chi2).map_or(String::new(), |c| format!("{c}; ")),
         chi2.statistic,
         chi2.dof,
         chi2.p_value,
+        chi2.family.len(),
+        family_p,
         settings.significance,
         report::invalid_dominates(&invalid, expected_invalid, chi2.statistic).map_or(String::new(), |m| format!("; {m}")),
-        report::borderline(chi2.p_value, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}")),
+        report::borderline(family_p, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}")),
         pdf_total,
         chi2.in_impossible_cells,
         integrals.max_error_sigma

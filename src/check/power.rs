@@ -12,7 +12,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct PowerPoint {
     pub samples: u64,
-    /// The χ² test's p-value and verdict at this count.
+    /// The χ² family's p-value (Holm's smallest, [`crate::stats::family::judge`]) and verdict at
+    /// this count.
     pub p_value: f64,
     pub chi2_passed: bool,
     /// The normalisation check's verdict at this count.
@@ -107,7 +108,7 @@ pub fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Po
             let chi2 = r.figures::<Chi2Figures>().expect("every check has chi2");
             Ok(PowerPoint {
                 samples,
-                p_value: chi2.chi2.p_value,
+                p_value: chi2.chi2.family_p_value.unwrap_or(chi2.chi2.p_value),
                 chi2_passed: chi2.chi2.passed,
                 normalization_passed: r.get("normalization").expect("every check has normalization").passed,
                 passed: r.passed,

@@ -3,6 +3,8 @@
 
 use super::label::compact;
 use crate::run::record::{CaseDescription, Params};
+use crate::stats::chi2::Chi2;
+use crate::stats::family;
 
 /// The lobe, method and parameters, e.g. `ggx vndf, α 0.3 × 0.1, θi 40°, φi 60°`.
 pub fn parameters(d: &CaseDescription) -> String {
@@ -31,9 +33,14 @@ pub fn parameters(d: &CaseDescription) -> String {
     }
 }
 
-/// The verdict in words: `pass` or `FAIL`, and the χ² p-value.
-pub fn verdict(passed: bool, p_value: f64) -> String {
-    format!("{}, χ² p = {}", if passed { "pass" } else { "FAIL" }, compact(p_value))
+/// The verdict in words: `pass` or `FAIL`, the fine grid's χ² p-value, and the test of the
+/// family that caught a defect where the fine grid did not (`caught at 8 × 16: p = 5e-8`).
+pub fn verdict(passed: bool, chi2: &Chi2) -> String {
+    let mut text = format!("{}, χ² p = {}", if passed { "pass" } else { "FAIL" }, compact(chi2.p_value));
+    if let Some(t) = family::strongest(chi2).filter(|t| t.rejected && chi2.family.first().is_some_and(|fine| !fine.rejected)) {
+        text += &format!(", caught at {}: p = {}", t.test, compact(t.p_value));
+    }
+    text
 }
 
 #[cfg(test)]
@@ -66,6 +73,12 @@ mod tests {
         assert_eq!(parameters(&glass), "ggx vndf dielectric η 1.5, α 0.3, θi 40°");
         let d = CaseDescription { lobe: "discrete".into(), method: "alias".into(), params: Params::Discrete { weights: vec![0.0, 3.0, 1e-3] }, rows: 1, cols: 3 };
         assert_eq!(parameters(&d), "discrete alias, weights [0, 3, 1e-3]");
-        assert_eq!(verdict(false, 1.5e-7), "FAIL, χ² p = 1.5e-7");
+        let fine = crate::stats::chi2::test(&[1000, 1300], &[1150.0, 1150.0], 0.01);
+        assert_eq!(verdict(false, &fine), format!("FAIL, χ² p = {}", compact(fine.p_value)));
+        // a smooth tilt of 1.5 % over 4 × 4 bins: the fine grid's p = 0.09, the 2 × 2 grid's 4.9e-5
+        let counts: Vec<u64> = (0..16).map(|i| if i % 4 < 2 { 6344 } else { 6156 }).collect();
+        let grid = crate::stats::family::Grid::plane(4, 4);
+        let c = crate::stats::family::judge(grid, (&counts, &[6250.0; 16]), (&[0], &[0.0]), 0.01);
+        assert_eq!(verdict(false, &c), format!("FAIL, χ² p = {}, caught at 2 × 2: p = {}", compact(c.p_value), compact(c.family[1].p_value)));
     }
 }

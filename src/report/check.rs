@@ -7,7 +7,6 @@
 
 use super::atomic::write_atomic;
 use super::compare::{self, Bins, Comparison};
-use super::label::compact;
 use crate::check::power::PowerSweep;
 use crate::check::report::Chi2Figures;
 use crate::check::{Domain, Report};
@@ -45,9 +44,12 @@ fn write_maps(dir: &Path, report: &Report) -> anyhow::Result<()> {
     };
     let counts: Vec<f64> = report.counts.iter().map(|&c| c as f64).collect();
     let invalid: u64 = report.invalid.iter().sum();
-    let verdict = if report.passed { "pass" } else { "FAIL" };
-    let p = report.figures::<Chi2Figures>().map_or(String::new(), |c| format!(", χ² p = {}", compact(c.chi2.p_value)));
-    let caption = format!("{} ({} samples): {verdict}{p}", report.sampler, report.samples);
+    let verdict = report.figures::<Chi2Figures>().map_or_else(
+        || (if report.passed { "pass" } else { "FAIL" }).to_string(),
+        |c| super::caption::verdict(report.passed, &c.chi2),
+    );
+    let caption = format!("{} ({} samples): {verdict}", report.sampler, report.samples);
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
-    compare::write(dir, &Comparison { bins, measured: &counts, expected: &report.expected, caption: &caption, note: &note })
+    let coarse = report.figures::<Chi2Figures>().and_then(|c| crate::stats::family::caught_grid(&c.chi2));
+    compare::write(dir, &Comparison { bins, measured: &counts, expected: &report.expected, caption: &caption, note: &note, coarse })
 }

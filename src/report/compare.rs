@@ -8,7 +8,10 @@
 //! - `residual.png`, (measured − expected)/√expected per bin, the bin's signed contribution to
 //!   χ² (diverging, 0 white, over ±[`RESIDUAL_LIMIT`]; see [`residual`]); samples in a bin that
 //!   expects nothing have no finite residual and are grey ("nan" on the key);
-//! - `marginals.png`, the two marginals with their ±2σ bands ([`super::marginals`]).
+//! - `marginals.png`, the two marginals with their ±2σ bands ([`super::marginals`]);
+//! - `residual_coarse.png`, where a coarser grid of the χ² family caught a defect that the fine
+//!   grid did not ([`crate::stats::family::caught_grid`]): the residual of its blocks, where a
+//!   smooth defect that reads as noise bin by bin shows (a dipole, a ring).
 //!
 //! Rows at the top or bottom of the grid with neither a sample nor half an expected count (the
 //! lower hemisphere of a reflection lobe) are left out, and the axes show the range drawn; on
@@ -31,6 +34,7 @@ pub const MEASURED_PNG: &str = "measured.png";
 pub const EXPECTED_PNG: &str = "expected.png";
 pub const RESIDUAL_PNG: &str = "residual.png";
 pub const MARGINALS_PNG: &str = "marginals.png";
+pub const RESIDUAL_COARSE_PNG: &str = "residual_coarse.png";
 pub const BARS_PNG: &str = "bars.png";
 
 /// The residual map's colour scale runs over ±5 in every picture: a correct sampler's residuals
@@ -61,6 +65,21 @@ pub struct Comparison<'a> {
     pub caption: &'a str,
     /// What the measured counts leave out, e.g. "12 invalid samples not shown" (may be empty).
     pub note: &'a str,
+    /// The rows × cols of the coarser grid whose test caught a defect the fine grid did not, for
+    /// `residual_coarse.png` (none: no such picture).
+    pub coarse: Option<(usize, usize)>,
+}
+
+/// The bins of a rows × cols grid added into `coarse` blocks, row r into ⌊r · R′/R⌋ and column c
+/// into ⌊c · C′/C⌋, as the χ² family groups them ([`crate::stats::family::Test::cells`]).
+fn aggregate(values: &[f64], rows: usize, cols: usize, (cr, cc): (usize, usize)) -> Vec<f64> {
+    let mut out = vec![0.0; cr * cc];
+    for r in 0..rows {
+        for k in 0..cols {
+            out[r * cr / rows * cc + k * cc / cols] += values[r * cols + k];
+        }
+    }
+    out
 }
 
 /// The residual of one bin as drawn: (m − e)/√e; NaN for samples where nothing is expected;
@@ -135,6 +154,23 @@ fn title(c: &Comparison, what: &str) -> String {
 }
 
 fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::Result<()> {
+    draw(dir, c, rows, cols, None)?;
+    match c.coarse {
+        Some((cr, cc)) if cr > 1 && cc > 1 && (cr, cc) != (rows, cols) && c.measured.len() == rows * cols => {
+            let (measured, expected) = (aggregate(c.measured, rows, cols, (cr, cc)), aggregate(c.expected, rows, cols, (cr, cc)));
+            let bins = match c.bins {
+                Bins::Plane { bounds, .. } => Bins::Plane { rows: cr, cols: cc, bounds },
+                _ => Bins::Sphere { rows: cr, cols: cc },
+            };
+            draw(dir, &Comparison { bins, measured: &measured, expected: &expected, coarse: None, ..*c }, cr, cc, Some(RESIDUAL_COARSE_PNG))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The maps and marginals of a grid; with `residual_only`, its residual map alone into that file
+/// (a coarse grid's, titled with its size).
+fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Option<&str>) -> anyhow::Result<()> {
     anyhow::ensure!(
         c.measured.len() == rows * cols && c.expected.len() == rows * cols,
         "a {rows} × {cols} histogram with {} measured and {} expected bins",
@@ -191,12 +227,22 @@ fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::R
             Mapping::Symmetric { lim },
         )
     };
+    let residual_title = format!("(measured − expected)/√expected{pooled}{clipped}{grey}");
+    if let Some(file) = residual_only {
+        let what = format!("{residual_title}, in {rows} × {cols} blocks: the grid whose χ² test caught the defect");
+        return heatmap::write_png_scaled(
+            &Heatmap { title: &title(c, &what), values: &residuals, scale: Scale::Diverging, ..base },
+            Mapping::Symmetric { lim: RESIDUAL_LIMIT },
+            &dir.join(file),
+        )
+        .map_err(Into::into);
+    }
     let maps = [
         (MEASURED_PNG, title(c, &measured_title), &measured, Scale::Sequential, counts),
         (EXPECTED_PNG, title(c, &expected_title), &expected, expected_scale, expected_mapping),
         (
             RESIDUAL_PNG,
-            title(c, &format!("(measured − expected)/√expected{pooled}{clipped}{grey}")),
+            title(c, &residual_title),
             &residuals,
             Scale::Diverging,
             Mapping::Symmetric { lim: RESIDUAL_LIMIT },
@@ -282,17 +328,29 @@ mod tests {
         assert_eq!(residual(13.0, 9.0), 4.0 / 3.0);
     }
 
+    /// Blocks as the χ² family groups them: 3 × 4 into 2 × 2 takes rows {0, 1}, {2} and
+    /// columns {0, 1}, {2, 3}.
+    #[test]
+    fn aggregated_blocks() {
+        let v: Vec<f64> = (0..12).map(f64::from).collect();
+        assert_eq!(aggregate(&v, 3, 4, (2, 2)), [10.0, 18.0, 17.0, 21.0]);
+    }
+
     #[test]
     fn the_pictures_of_a_grid_and_of_items() {
         let dir = tempfile::tempdir().unwrap();
         let lobe = grid(|r, c| if r >= 2 { 50.0 + 10.0 * c as f64 } else { 0.0 });
-        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &lobe, expected: &lobe, caption: "lobe", note: "" };
+        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &lobe, expected: &lobe, caption: "lobe", note: "", coarse: None };
         write(dir.path(), &c).unwrap();
         for png in [MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, MARGINALS_PNG] {
             assert!(dir.path().join(png).is_file(), "{png}");
         }
+        assert!(!dir.path().join(RESIDUAL_COARSE_PNG).exists());
+        // the grid that caught a defect: its residual in blocks
+        write(dir.path(), &Comparison { coarse: Some((2, 4)), ..c }).unwrap();
+        assert!(dir.path().join(RESIDUAL_COARSE_PNG).is_file());
         // two drawn rows: the map is as tall as its smallest size, not four rows
-        let items = Comparison { bins: Bins::Items(3), measured: &[1.0, 2.0, 3.0], expected: &[1.0, 2.0, 3.0], caption: "d", note: "" };
+        let items = Comparison { bins: Bins::Items(3), measured: &[1.0, 2.0, 3.0], expected: &[1.0, 2.0, 3.0], caption: "d", note: "", coarse: None };
         write(dir.path(), &items).unwrap();
         assert!(dir.path().join(BARS_PNG).is_file());
         let short = Comparison { measured: &lobe[..5], ..c };

@@ -10,7 +10,7 @@
 //! `N` pictures decoded or `broken K of N` (what a test reads back from a headless browser).
 
 use super::caption;
-use super::compare::{BARS_PNG, EXPECTED_PNG, MARGINALS_PNG, MEASURED_PNG, RESIDUAL_PNG};
+use super::compare::{BARS_PNG, EXPECTED_PNG, MARGINALS_PNG, MEASURED_PNG, RESIDUAL_COARSE_PNG, RESIDUAL_PNG};
 use super::label::compact;
 use super::output::{CaseSummary, HistogramFile};
 use std::fmt::Write;
@@ -20,11 +20,12 @@ use std::path::Path;
 pub use crate::folder_names::INDEX_HTML;
 
 /// The pictures a case folder may hold, in the order shown, with what each shows.
-const PICTURES: [(&str, &str); 6] = [
+const PICTURES: [(&str, &str); 7] = [
     (MEASURED_PNG, "measured counts"),
     (EXPECTED_PNG, "expected counts, same colour scale"),
     (RESIDUAL_PNG, "residual (measured − expected)/√expected"),
     (MARGINALS_PNG, "marginals against expected ± 2σ"),
+    (RESIDUAL_COARSE_PNG, "residual in the blocks of the grid that caught the defect"),
     (BARS_PNG, "items against expected ± 2σ"),
     ("albedo.png", "albedo per bin"),
 ];
@@ -235,7 +236,7 @@ mod tests {
             passed,
             failed_checks: None,
             failure: None,
-            measured: error.is_none().then_some(CaseMeasured { gpu_seconds: None, wall_seconds: 0.5, chi2: 12.0, dof: 10, p_value: 0.28, albedo: None, max_angle_rad: None }),
+            measured: error.is_none().then_some(CaseMeasured { gpu_seconds: None, wall_seconds: 0.5, chi2: 12.0, dof: 10, p_value: 0.28, family_p_value: None, family: Vec::new(), albedo: None, max_angle_rad: None }),
             error: error.map(String::from),
             output: None,
         }

@@ -36,6 +36,11 @@ pub fn to_xml(summary: &RunSummary) -> anyhow::Result<String> {
                 Property::new("dof", m.dof.to_string()),
                 Property::new("p_value", m.p_value.to_string()),
             ]);
+            // the family's p-value, and each test's (the fine grid, aggregations, marginals)
+            if let Some(p) = m.family_p_value {
+                test.add_property(Property::new("family_p_value", p.to_string()));
+            }
+            test.add_properties(m.family.iter().map(|t| Property::new(format!("p_value {}", t.test), t.p_value.to_string())));
         }
         suite.add_test_case(test);
     }
@@ -83,6 +88,8 @@ mod tests {
                 chi2: 3.0,
                 dof: 2,
                 p_value: 0.2,
+                family_p_value: Some(0.4),
+                family: vec![crate::stats::family::FamilyTest { test: "2 × 4".into(), rows: 2, cols: 4, statistic: 3.0, dof: 2, p_value: 0.2, holm_p_value: 0.4, rejected: false }],
                 albedo: None,
                 max_angle_rad: None,
             }),
@@ -118,6 +125,9 @@ mod tests {
         assert_eq!(by_name("ok").time, Some(Duration::from_secs_f64(1.5)));
         let adapter = suite.properties.iter().find(|p| p.name.as_str() == "adapter").unwrap();
         assert_eq!(adapter.value.as_str(), "lavapipe <x> & \"y\"");
+        // every test of the family's p-value
+        let property = |n: &str| by_name("ok").properties.iter().find(|p| p.name.as_str() == n).map(|p| p.value.to_string());
+        assert_eq!((property("family_p_value"), property("p_value 2 × 4")), (Some("0.4".into()), Some("0.2".into())));
         assert!(xml.contains("&lt;worse&gt;") && xml.contains("&amp;"), "{xml}");
     }
 }

@@ -26,6 +26,7 @@ use crate::run::shard::ShardFile;
 use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
 use crate::stats::chi2::Chi2;
+use crate::stats::family::{self, FamilyTest};
 use crate::run::compare::AngleCheck;
 use crate::stats::weighted::{AlbedoCheck, WeightedSums};
 use schemars::JsonSchema;
@@ -292,8 +293,9 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonSty
         Domain::Plane { bounds } => Bins::Plane { rows, cols, bounds },
     };
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
-    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), r.chi2.p_value));
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "" })?;
+    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), &r.chi2));
+    let coarse = family::caught_grid(&r.chi2);
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "", coarse })?;
     let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
     files.write(&folder, [rows, cols], style)
 }
@@ -349,14 +351,15 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
         Job::Discrete { .. } => Bins::Items(cols),
     };
     let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();
-    let mut verdict = caption::verdict(r.passed(), r.chi2.p_value);
+    let mut verdict = caption::verdict(r.passed(), &r.chi2);
     if r.weighted.as_ref().is_some_and(|w| !w.check.passed) {
         verdict += ", albedo check failed";
     }
     let caption = format!("{} ({}): {verdict}", r.case.name, caption::parameters(&doc.description));
     let invalid: u64 = r.counts.invalid.iter().sum();
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note })?;
+    let coarse = family::caught_grid(&r.chi2);
+    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note, coarse })?;
     if let Some(w) = &r.weighted {
         let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
         let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
@@ -500,9 +503,17 @@ pub struct CaseSummary {
 pub struct CaseMeasured {
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
+    /// The fine grid's χ² test.
     pub chi2: f64,
     pub dof: u64,
     pub p_value: f64,
+    /// The family's p-value (Holm's smallest) that the verdict compares with the per-case
+    /// significance, and every test's p-values, the fine grid first
+    /// ([`crate::stats::family::judge`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family_p_value: Option<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub family: Vec<FamilyTest>,
     pub albedo: Option<AlbedoSummary>,
     pub max_angle_rad: Option<f64>,
 }
@@ -538,6 +549,8 @@ impl CaseSummary {
                 chi2: r.chi2.statistic,
                 dof: r.chi2.dof,
                 p_value: r.chi2.p_value,
+                family_p_value: r.chi2.family_p_value,
+                family: r.chi2.family.clone(),
                 albedo: r.weighted.as_ref().map(|w| AlbedoSummary {
                     albedo: w.check.reflected.albedo,
                     reference: w.check.reflected.reference,
@@ -573,6 +586,8 @@ impl CaseSummary {
                 chi2: r.chi2.statistic,
                 dof: r.chi2.dof,
                 p_value: r.chi2.p_value,
+                family_p_value: r.chi2.family_p_value,
+                family: r.chi2.family.clone(),
                 albedo: r.albedo.map(|a| AlbedoSummary {
                     albedo: a.mean_weight,
                     reference: a.quadrature,

@@ -7,7 +7,8 @@ use crate::engine::job::{Counts, Job, Scatter};
 use crate::reference::dielectric::RoughDielectric;
 use crate::reference::Invalid;
 use crate::reference::effects::Effects;
-use crate::stats::chi2::{self, Chi2};
+use crate::stats::chi2::Chi2;
+use crate::stats::family::{self, Grid};
 use crate::stats::expected::{self, Expected, Quadrature};
 use crate::stats::weighted::{AlbedoCheck, AlbedoTest, WEIGHT_ERROR_LIMIT, WeightedSums, two_sided};
 use glam::DVec3;
@@ -22,6 +23,18 @@ pub struct ExpectedCounts {
     pub invalid: [f64; Invalid::COUNT],
     /// The quadrature's accuracy (lobes).
     pub quadrature: Option<Expected>,
+    /// The grid the bins lie on, for the family of tests ([`family::judge`]): a lobe's sphere
+    /// grid, a discrete table's 1 × entries.
+    pub grid: Grid,
+}
+
+/// The grid of a job's bins: a lobe's rows over cos θ and columns over φ, a discrete
+/// distribution's entries in one row.
+pub fn grid(job: &Job) -> Grid {
+    match job {
+        Job::Lobe { grid, .. } => Grid::sphere(grid.rows, grid.cols),
+        Job::Discrete { dist, .. } => Grid { rows: 1, cols: dist.len() as u32, axes: ["", "entry"] },
+    }
 }
 
 /// N × (the pdf integrated over each bin), N × pmf for a discrete job; the quadrature's
@@ -38,10 +51,10 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
             let e = expected::lobe_probabilities(lobe, *incident, *grid, q);
             let mut invalid = [0.0; Invalid::COUNT];
             invalid[Invalid::BelowHorizon.code() as usize - 1] = n * e.below_horizon;
-            ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e) }
+            ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Grid::sphere(grid.rows, grid.cols) }
         }
         Job::Discrete { dist, .. } => {
-            ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; Invalid::COUNT], quadrature: None }
+            ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; Invalid::COUNT], quadrature: None, grid: grid(job) }
         }
     }
 }
@@ -98,30 +111,34 @@ fn dielectric_expected(glass: &RoughDielectric, wi: DVec3, grid: crate::stats::h
     let mut invalid = [0.0; Invalid::COUNT];
     invalid[Invalid::BelowHorizon.code() as usize - 1] = n * below;
     invalid[Invalid::RefractedNearSide.code() as usize - 1] = n * near;
-    ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e) }
+    ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Grid::sphere(grid.rows, grid.cols) }
 }
 
 /// Pearson's χ² over all cells, bins and invalid reasons alike: a sampler that puts mass below
-/// the horizon at the wrong rate fails like one that puts it in the wrong bin.
-/// ([`chi2::judge`]: no valid sample, or a single cell, is never a pass.)
+/// the horizon at the wrong rate fails like one that puts it in the wrong bin; on the fine grid,
+/// its aggregations and marginals, Holm-corrected ([`family::judge`], as `lobes check` judges).
+/// ([`crate::stats::chi2::judge`]: no valid sample, or a single cell, is never a pass.)
 pub fn chi2_test(counts: &Counts, expected: &ExpectedCounts, significance: f64) -> Chi2 {
-    chi2::judge((&counts.bins, &expected.bins), (&counts.invalid, &expected.invalid), significance)
+    family::judge(expected.grid, (&counts.bins, &expected.bins), (&counts.invalid, &expected.invalid), significance)
 }
 
-/// Why a failed χ² test failed, one phrase each: what left it untested ([`chi2::Untested`]), the
-/// statistic against the level, the samples in bins the reference gives no probability, and the
+/// Why a failed χ² test failed, one phrase each: what left it untested ([`crate::stats::chi2::Untested`]), the
+/// tests of the family that caught it against the fine grid's figures ([`family::caught`]), the samples in bins the reference gives no probability, and the
 /// invalid samples of a reason it expects none of, by name (they are no bin's).
 ///
 /// ```
 /// use lobes::{engine::job::Counts, run::compare::{ExpectedCounts, chi2_failure, chi2_test}};
 /// let counts = Counts { bins: vec![500, 480], invalid: [0, 0, 20, 0, 0] };
-/// let expected = ExpectedCounts { bins: vec![500.0, 500.0], invalid: [0.0; 5], quadrature: None };
+/// let grid = lobes::stats::family::Grid::sphere(1, 2);
+/// let expected = ExpectedCounts { bins: vec![500.0, 500.0], invalid: [0.0; 5], quadrature: None, grid };
 /// let why = chi2_failure(&counts, &expected, &chi2_test(&counts, &expected, 0.01));
 /// assert_eq!(why[1], "20 samples rejected as non_finite_pdf, where the reference expects none");
 /// ```
 pub fn chi2_failure(counts: &Counts, expected: &ExpectedCounts, c: &Chi2) -> Vec<String> {
     let mut why: Vec<String> = c.untested.map(|u| u.describe().to_string()).into_iter().collect();
-    if c.untested.is_none() || c.p_value < c.significance {
+    if let Some(caught) = family::caught(c) {
+        why.push(format!("{caught} (the case's level {:.3e}; χ² = {:.1} with {} dof at the fine grid)", c.significance, c.statistic, c.dof));
+    } else if c.untested.is_none() || c.p_value < c.significance {
         why.push(format!("χ² = {:.1} with {} dof, p = {:.3e} below the case's level {:.3e}", c.statistic, c.dof, c.p_value, c.significance));
     }
     let in_empty_bins: u64 = counts.bins.iter().zip(&expected.bins).filter(|(_, e)| **e <= 0.0).map(|(o, _)| o).sum();

@@ -24,6 +24,14 @@ pub struct Chi2 {
     /// p-value (absent where the test judged).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub untested: Option<Untested>,
+    /// The family's p-value where a family judged ([`super::family::judge`]): the smallest of
+    /// its tests' Holm-adjusted p-values, which `passed` compares with the significance
+    /// (`statistic`, `dof` and `p_value` above are the fine grid's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family_p_value: Option<f64>,
+    /// Every test of the family, the fine grid first: the aggregations and the marginals.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub family: Vec<super::family::FamilyTest>,
 }
 
 /// Why a χ² test judged nothing. Neither is a pass: a test that tested nothing says nothing of
@@ -118,7 +126,7 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
     let dof = cells.len().saturating_sub(1) as u64;
     let p = if impossible > 0 { 0.0 } else { p_value(statistic, dof) };
     let untested = (dof == 0).then_some(Untested::OneCell);
-    Chi2 { statistic, dof, p_value: p, significance, passed: p >= significance && untested.is_none(), in_impossible_cells: impossible, untested }
+    Chi2 { statistic, dof, p_value: p, significance, passed: p >= significance && untested.is_none(), in_impossible_cells: impossible, untested, family_p_value: None, family: Vec::new() }
 }
 
 /// The test of a sampler's histogram, the one `lobes run`, `lobes merge` and `lobes check` judge

@@ -1,7 +1,9 @@
-//! Statistics: binning, Gauss–Legendre quadrature, expected counts, and the χ² test.
+//! Statistics: binning, Gauss–Legendre quadrature, expected counts, and the χ² test and its family over
+//! resolutions.
 
 pub mod chi2;
 pub mod expected;
+pub mod family;
 pub mod gauss_legendre;
 pub mod histogram;
 pub mod median;
