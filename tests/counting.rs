@@ -22,7 +22,7 @@ fn engine(strategy: Strategy) -> GpuEngine {
     open(strategy, |l| l)
 }
 
-fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, rows: u32, cols: u32, scatter: Scatter) -> Job {
+fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64, theta_deg: f64, (rows, cols): (u32, u32), scatter: Scatter) -> Job {
     Job::Lobe {
         lobe: Lobe { kind, method, alpha_x: ax, alpha_y: ay, alpha_angle: 0.0 },
         incident: reflect::spherical(theta_deg.to_radians(), 0.4),
@@ -53,12 +53,12 @@ fn slabs_count_exactly_as_workgroup_atomics() {
     let reflect = Scatter::Reflect;
     let jobs = [
         // θi 60°, α 0.6: a share of the samples below the horizon, an invalid reason
-        lobe(Ggx, Method::Vndf, 0.6, 0.2, 60.0, 64, 128, reflect),
-        lobe(Ggx, Method::Ndf, 0.3, 0.3, 45.0, 64, 128, reflect),
-        lobe(Ggx, Method::Bounded, 0.5, 0.5, 80.0, 32, 64, reflect),
-        lobe(Beckmann, Method::Vndf, 0.4, 0.4, 75.0, 32, 96, reflect),
-        lobe(Ward, Method::Ndf, 0.2, 0.1, 0.0, 8, 16, reflect),
-        lobe(Ggx, Method::Vndf, 0.3, 0.3, 30.0, 64, 128, Scatter::Dielectric { eta: 1.5 }),
+        lobe(Ggx, Method::Vndf, 0.6, 0.2, 60.0, (64, 128), reflect),
+        lobe(Ggx, Method::Ndf, 0.3, 0.3, 45.0, (64, 128), reflect),
+        lobe(Ggx, Method::Bounded, 0.5, 0.5, 80.0, (32, 64), reflect),
+        lobe(Beckmann, Method::Vndf, 0.4, 0.4, 75.0, (32, 96), reflect),
+        lobe(Ward, Method::Ndf, 0.2, 0.1, 0.0, (8, 16), reflect),
+        lobe(Ggx, Method::Vndf, 0.3, 0.3, 30.0, (64, 128), Scatter::Dielectric { eta: 1.5 }),
         discrete(1000, DiscreteMethod::Cdf),
         discrete(5000, DiscreteMethod::Cdf), // more than a block: the blocked CDF
         discrete(1000, DiscreteMethod::Alias),
@@ -83,7 +83,7 @@ fn slabs_count_exactly_as_workgroup_atomics() {
 /// a run continued on the device from earlier counts, give the one-chunk histogram.
 #[test]
 fn slabs_are_exact_across_chunks_and_continued_runs() {
-    let job = lobe(LobeKind::Beckmann, Method::Ndf, 0.3, 0.3, 40.0, 64, 128, Scatter::Reflect);
+    let job = lobe(LobeKind::Beckmann, Method::Ndf, 0.3, 0.3, 40.0, (64, 128), Scatter::Reflect);
     let range = SampleRange::whole(8, 1_500_001);
     let want = run(&mut engine(Strategy::Atomics), &job, range).counts;
     let mut e = engine(Strategy::Slabs);
@@ -104,8 +104,8 @@ fn slabs_are_exact_across_chunks_and_continued_runs() {
 /// slabs.
 #[test]
 fn slabs_under_small_limits_equal_the_full_limits_bit_for_bit() {
-    let ward = lobe(LobeKind::Ward, Method::Ndf, 0.2, 0.2, 20.0, 8, 16, Scatter::Reflect); // 128 bins: 512 bytes a slab
-    let big = lobe(LobeKind::Ggx, Method::Vndf, 0.3, 0.3, 45.0, 64, 128, Scatter::Reflect);
+    let ward = lobe(LobeKind::Ward, Method::Ndf, 0.2, 0.2, 20.0, (8, 16), Scatter::Reflect); // 128 bins: 512 bytes a slab
+    let big = lobe(LobeKind::Ggx, Method::Vndf, 0.3, 0.3, 45.0, (64, 128), Scatter::Reflect);
     let table = discrete(20_000, DiscreteMethod::Alias);
     let n = 1_000_003;
     let mut reference = engine(Strategy::Atomics);
