@@ -660,8 +660,9 @@ mod wesl_package {
 pub use wesl_package::WESL_PACKAGE;
 
 /// docs/embedding.md, whose Rust blocks rustdoc compiles and runs as doctests of this item
-/// (`cargo test --doc`; tests/docs_commands.rs checks that the page is included here).
-#[cfg(doctest)]
+/// (`cargo test --doc`, with the features the page uses; tests/docs_commands.rs checks that the
+/// page is included here).
+#[cfg(all(doctest, feature = "naga-oil", feature = "wgpu", feature = "wesl"))]
 #[doc = include_str!("../../docs/embedding.md")]
 pub struct EmbeddingPage;
 
@@ -856,11 +857,11 @@ mod tests {
         assert!(Module::ALL.iter().filter(|m| generated::unit(**m as usize, true).is_some()).count() >= 6);
     }
 
-    /// A renderer that imports a helper from `lobes::ggx` gets an error naming it, in both forms;
+    /// A renderer that imports a helper from naga_oil's `lobes::ggx` gets an error naming it;
     /// the API's names compose (the renderer tests above use them), and the helpers are
     /// where the documentation says, in `lobes::ggx::internal`.
     #[test]
-    fn importing_a_helper_from_a_module_fails_clearly() {
+    fn importing_a_helper_from_a_naga_oil_module_fails_clearly() {
         use naga_oil::compose::{Composer, NagaModuleDescriptor};
         let body = "@compute @workgroup_size(1) fn main() { let h = ggx_cap_sample(vec2(0.3), vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), 0.5, 0.5, vec2(0.5)); }\n";
         let mut composer = Composer::default();
@@ -874,7 +875,14 @@ mod tests {
         assert!(e.contains("ggx_cap_sample"), "{e}");
         compose(&mut composer, "#import lobes::ggx::internal::ggx_cap_sample").unwrap_or_else(|e| panic!("{e}"));
         compose(&mut composer, "#import lobes::ggx::ggx_sample_vndf").unwrap_err();
+    }
 
+    /// The same in WESL: `import lobes::ggx::ggx_cap_sample;` fails naming the item, and
+    /// `lobes::ggx::internal` holds it.
+    #[cfg(feature = "wesl")]
+    #[test]
+    fn importing_a_helper_from_a_wesl_module_fails_clearly() {
+        let body = "@compute @workgroup_size(1) fn main() { let h = ggx_cap_sample(vec2(0.3), vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), 0.5, 0.5, vec2(0.5)); }\n";
         let wesl = |import: &str| -> Result<String, String> {
             use wesl::syntax::PathOrigin;
             let mut local = wesl::VirtualResolver::new();
