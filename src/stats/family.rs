@@ -205,18 +205,25 @@ pub fn judge(grid: Grid, bins: (&[u64], &[f64]), invalid: (&[u64], &[f64]), sign
     verdict
 }
 
-/// Which tests caught the defect, for a verdict's line: "caught at 8 × 16: p = 5.0e-8 (Holm
-/// 4.0e-7), φ: p = 8.0e-8 (Holm 5.6e-7); 64 × 128: p = 4.7e-2", or `None` where no test of
-/// the family rejected (or the verdict has no family).
+/// Which tests caught the defect, for a verdict's line: the fine grid first where it rejected,
+/// then the others by Holm p-value, three at most, and the fine grid's p where it did not
+/// reject: "caught at 2 × 4: p = 9.2e-10 (Holm 7.4e-9), 4 × 8: p = 2.6e-7 (Holm 1.8e-6), φ: p =
+/// 8.0e-4 (Holm 4.8e-3) and 1 more; 64 × 128: p = 6.2e-1". `None` where no test of the family
+/// rejected (or the verdict has no family).
 pub fn caught(c: &Chi2) -> Option<String> {
-    let rejected: Vec<String> =
-        c.family.iter().filter(|t| t.rejected).map(|t| format!("{}: p = {:.1e} (Holm {:.1e})", t.test, t.p_value, t.holm_p_value)).collect();
+    let fine = c.family.first()?;
+    let mut rejected: Vec<&FamilyTest> = c.family.iter().skip(1).filter(|t| t.rejected).collect();
+    rejected.sort_by(|a, b| a.holm_p_value.total_cmp(&b.holm_p_value));
+    if fine.rejected {
+        rejected.insert(0, fine);
+    }
     if rejected.is_empty() {
         return None;
     }
-    let fine = &c.family[0];
+    let shown: Vec<String> = rejected.iter().take(3).map(|t| format!("{}: p = {:.1e} (Holm {:.1e})", t.test, t.p_value, t.holm_p_value)).collect();
+    let more = if rejected.len() > 3 { format!(" and {} more", rejected.len() - 3) } else { String::new() };
     let fine = if fine.rejected { String::new() } else { format!("; {}: p = {:.1e}", fine.test, fine.p_value) };
-    Some(format!("caught at {}{fine}", rejected.join(", ")))
+    Some(format!("caught at {}{more}{fine}", shown.join(", ")))
 }
 
 /// The rows × cols of the grid (both > 1: not a marginal) that caught a defect the fine grid did
@@ -373,7 +380,21 @@ mod tests {
         assert!(!t.passed);
         assert!(caught_grid(&t).is_some_and(|(r, c)| r > 1 && c > 1 && r < 64));
         let caught = caught(&t).unwrap();
-        assert!(caught.starts_with("caught at") && caught.contains("2 × 4: ") && caught.ends_with(&format!("64 × 128: p = {:.1e}", t.p_value)), "{caught}");
+        assert!(caught.starts_with("caught at") && caught.ends_with(&format!("64 × 128: p = {:.1e}", t.p_value)), "{caught}");
+    }
+
+    /// The verdict's line: the fine grid first where it caught it, then by Holm p, three at most.
+    #[test]
+    fn caught_names_the_strongest_tests() {
+        let test = |name: &str, p: f64, holm: f64| FamilyTest { test: name.into(), rows: 2, cols: 2, statistic: 0.0, dof: 3, p_value: p, holm_p_value: holm, rejected: holm < 0.01 };
+        let mut c = chi2::test(&[10, 10], &[10.0, 10.0], 0.01);
+        c.family = vec![test("64 × 128", 0.5, 1.0), test("8 × 16", 1e-4, 5e-4), test("4 × 8", 1e-6, 7e-6), test("2 × 4", 1e-3, 3e-3), test("φ", 2e-3, 4e-3)];
+        assert_eq!(caught(&c).unwrap(), "caught at 4 × 8: p = 1.0e-6 (Holm 7.0e-6), 8 × 16: p = 1.0e-4 (Holm 5.0e-4), 2 × 4: p = 1.0e-3 (Holm 3.0e-3) and 1 more; 64 × 128: p = 5.0e-1");
+        c.family[0] = test("64 × 128", 1e-9, 8e-9);
+        assert!(caught(&c).unwrap().starts_with("caught at 64 × 128: p = 1.0e-9 (Holm 8.0e-9), 4 × 8: "));
+        assert!(!caught(&c).unwrap().contains("; 64 × 128"));
+        c.family.iter_mut().for_each(|t| t.rejected = false);
+        assert_eq!(caught(&c), None);
     }
 
     #[test]
