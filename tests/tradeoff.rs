@@ -139,13 +139,17 @@ fn chi2_at(e: &mut GpuEngine, s: Sampler, prec: Precision, n: u64) -> (chi2::Chi
     (compare::chi2_test(&r.counts, &exp, 0.01), tradeoff::l1_distance(&r.counts, &p), noise)
 }
 
-/// GGX's fast kernel still passes χ² at 2^20 ≈ 1e6 samples; Ward's does not hide its bias at
-/// 2^22 (its fast −ln u is off by ~1e-4 absolute near u = 1, i.e. near the lobe's peak).
+/// GGX's fast kernel still passes the single-grid χ² at 2^20 ≈ 1e6 samples, but not the test
+/// family: its fast sine (absolute error ~1e-3, a smooth error in φ) shows in the φ marginal
+/// (measured p 1.7e-6 on lavapipe); Ward's does not hide its bias at 2^22 (its fast −ln u is off
+/// by ~1e-4 absolute near u = 1, i.e. near the lobe's peak).
 #[test]
 fn fast_kernels_pass_chi2_at_a_million_and_show_their_bias_later() {
     let mut e = engine();
     let (t, _, _) = chi2_at(&mut e, GGX_VNDF, Precision::F32Fast, 1 << 20);
-    assert!(t.passed, "ggx-vndf f32-fast at 2^20: {t:?}");
+    assert!(t.p_value >= t.significance, "ggx-vndf f32-fast at 2^20, 64 × 128: {t:?}");
+    let phi = t.family.iter().find(|f| f.test == "φ").expect("a φ marginal");
+    assert!(!t.passed && phi.rejected, "ggx-vndf f32-fast at 2^20: the φ marginal should see the fast sine: {t:?}");
     let (t, l1, noise) = chi2_at(&mut e, WARD, Precision::F32Fast, 1 << 22);
     assert!(t.p_value < 1e-6 && l1 > 1.1 * noise, "ward-ndf f32-fast at 2^22: {t:?}, L1 {l1} vs noise {noise}");
     let (t, l1, noise) = chi2_at(&mut e, WARD, Precision::F32Accurate, 1 << 22);

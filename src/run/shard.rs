@@ -447,7 +447,7 @@ pub(crate) mod tests {
         let mut old = good.clone();
         old.as_object_mut().unwrap().remove("format_version");
         old["version"] = 1.into();
-        assert!(err(old).contains("d/x.json: shard format version 1 is not supported (this lobes reads version 3)"));
+        assert!(err(old).contains(&format!("d/x.json: shard format version 1 is not supported (this lobes reads version {SHARD_VERSION})")));
         let mut other = good.clone();
         other["format"] = "lobes-histogram".into();
         assert!(err(other).contains("not a lobes shard file"));
