@@ -261,6 +261,7 @@ mod tests {
     /// The cells of an aggregation, summed by hand: 3 × 4 into 2 × 2 groups rows {0, 1}, {2}
     /// (⌊r · 2/3⌋) and columns {0, 1}, {2, 3}.
     #[test]
+    #[allow(clippy::identity_op, reason = "the sums spell out each group's cell indices, 0 included")]
     fn aggregated_cells() {
         let counts: Vec<u64> = (0..12).collect();
         let expected: Vec<f64> = (0..12).map(|i| i as f64 + 0.5).collect();
