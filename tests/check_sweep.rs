@@ -15,6 +15,7 @@
 //! The grid is a fixed selection (each α with one incident angle, every angle met), to keep
 //! the test to about three minutes on two CPU cores with lavapipe.
 
+use statrs::distribution::{Binomial, DiscreteCDF};
 use lobes::check::{Domain, Report, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 use lobes::reference::sampler::REGISTRY;
@@ -81,17 +82,6 @@ fn run(gpu: &Gpu, what: String, s: &UserSampler, settings: Settings) -> Run {
     Run { what, report }
 }
 
-/// P(X > k) for X ~ Binomial(n, p).
-fn binomial_tail(n: u64, p: f64, k: u64) -> f64 {
-    let mut term = (1.0 - p).powi(n as i32);
-    let mut cdf = term;
-    for i in 0..k {
-        term *= (n - i) as f64 / (i + 1) as f64 * p / (1.0 - p);
-        cdf += term;
-    }
-    (1.0 - cdf).max(0.0)
-}
-
 #[test]
 fn correct_samplers_pass_over_their_documented_range() {
     let gpu = gpu();
@@ -141,7 +131,7 @@ fn correct_samplers_pass_over_their_documented_range() {
     let n = runs.len() as u64;
     // each run's statistical checks: chi2 and, with an eval, albedo, each at α = 0.01
     let p = 2.0 * Settings::default().significance;
-    let chance = (0..n).find(|&k| binomial_tail(n, p, k) < 1e-3).unwrap();
+    let chance = (0..n).find(|&k| Binomial::new(p, n).unwrap().sf(k) < 1e-3).unwrap();
     eprintln!(
         "correct samplers: {n} runs, {} failed a pointwise check, {} a statistical one (chance alone: at most {chance}, P(more) < 1e-3 at {p} per run)",
         pointwise.len(),

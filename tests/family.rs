@@ -18,6 +18,7 @@
 //! docs/statistics.md; by default they stop at 4× the family's count, which is all the
 //! assertion needs.
 
+use statrs::distribution::{Binomial, DiscreteCDF};
 use lobes::check::jacobian::JacobianCheck;
 use lobes::check::report::Chi2Figures;
 use lobes::check::{Domain, Report, Settings, UserSampler, check};
@@ -170,17 +171,6 @@ fn the_family_catches_smooth_defects_with_fewer_samples() {
     eprintln!("| defect | 64 × 128 alone | the family | caught at (seeds {SEEDS:?}) |\n|---|---|---|---|\n{}", rows.join("\n"));
 }
 
-/// P(X > k) for X ~ Binomial(n, p).
-fn binomial_tail(n: u64, p: f64, k: u64) -> f64 {
-    let mut term = (1.0 - p).powi(n as i32);
-    let mut cdf = term;
-    for i in 0..k {
-        term *= (n - i) as f64 / (i + 1) as f64 * p / (1.0 - p);
-        cdf += term;
-    }
-    (1.0 - cdf).max(0.0)
-}
-
 #[test]
 fn no_more_false_alarms_than_chance() {
     let gpu = gpu();
@@ -220,7 +210,7 @@ fn no_more_false_alarms_than_chance() {
         }
     }
     let alpha = Settings::default().significance;
-    let chance = (0..runs).find(|&k| binomial_tail(runs, alpha, k) < 1e-3).unwrap();
+    let chance = (0..runs).find(|&k| Binomial::new(alpha, runs).unwrap().sf(k) < 1e-3).unwrap();
     eprintln!(
         "correct samplers: {runs} runs, the family rejected {} (chance alone: at most {chance}, P(more) < 1e-3), the fine grid alone {fine_rejected}; smallest family p {:.3} ({})",
         rejected.len(),

@@ -1,7 +1,11 @@
 //! The example renderer crate (examples/renderer), which uses lobes as a dev-dependency the way
 //! a renderer would, passes its own `cargo test`: its diffuse sampler passes `lobes::check` and a
 //! pdf off by a factor of two is caught. It is a crate of its own (its own `[workspace]`), so it is
-//! run here with cargo, in lobes' target directory so that lobes' dependencies are not rebuilt.
+//! run here with cargo, in lobes' target directory. Its dependencies are built anew all the same:
+//! lobes with the `check` feature alone, and the rest without the features lobes' own
+//! dev-dependencies and command line add. So it runs as a renderer's plain `cargo test` does (the
+//! dev profile), without debug info: on 2 cores that built in 3.5 min of CPU against 9.0 with
+//! `--release`, and its tests ran 28 s against 14 s.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -22,14 +26,15 @@ fn renderer_example_passes_its_own_tests() {
     assert!(manifest.is_file(), "{} is missing: this test runs in lobes' repository, not a packaged crate", manifest.display());
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let output = Command::new(&cargo)
-        .args(["test", "--release", "--manifest-path"])
+        .args(["test", "--manifest-path"])
         .arg(&manifest)
         .env("CARGO_TARGET_DIR", target_dir(root))
+        .env("CARGO_PROFILE_DEV_DEBUG", "0")
         .current_dir(root)
         .output()
         .unwrap_or_else(|e| panic!("cannot run {}: {e}", Path::new(&cargo).display()));
     let text = format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
-    assert!(output.status.success(), "`cargo test --release --manifest-path {}` failed ({}):\n{text}", manifest.display(), output.status);
+    assert!(output.status.success(), "`cargo test --manifest-path {}` failed ({}):\n{text}", manifest.display(), output.status);
     // the renderer's tests ran, each by name (not a build that found no tests)
     for test in [
         "diffuse_lobe_passes",
