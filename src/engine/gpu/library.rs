@@ -201,8 +201,12 @@ fn real_scalar(order: &[&File]) -> String {
 
 /// The plain WGSL of the modules `roots` and all they import, each file once and after those it
 /// imports, the files of `chosen` taking the place of the built-in ones of their import paths.
-/// Every file is first validated by naga_oil as a root of its own (errors at its file and line).
-/// Cached: a run composes the same few sets again and again.
+/// The joined text is validated by naga; only when that fails is every file built by naga_oil as
+/// a root of its own, to report the error at its file and line. That per-file build (which also
+/// refuses a name used without its `#import`) took as long as the rest of a process's start-up
+/// (BENCHMARKS.md, "Where start-up goes"); the unit tests still run it ([`validate_files`]) on
+/// every kernel they compose, and they compose every kind. Cached: a run composes the same few
+/// sets again and again.
 pub fn compose(roots: &[&str], chosen: &[File]) -> Result<String, GpuError> {
     type Cache = Mutex<HashMap<(Vec<String>, Vec<File>), String>>;
     static CACHE: OnceLock<Cache> = OnceLock::new();
@@ -211,8 +215,12 @@ pub fn compose(roots: &[&str], chosen: &[File]) -> Result<String, GpuError> {
     if let Some(hit) = cache.lock().unwrap().get(&key) {
         return Ok(hit.clone());
     }
-    validate(&in_import_order(roots, chosen)?)?;
-    let out: String = pieces(roots, chosen)?.iter().map(|(path, text)| format!("// ---- {path} ----\n{text}\n")).collect();
+    let order = in_import_order(roots, chosen)?;
+    let out: String = order.iter().map(|f| format!("// ---- {} ----\n{}\n", f.path, plain(&f.source))).collect();
+    if let Err(joined) = validate_module("the composed module", &out) {
+        validate(&order)?;
+        return Err(joined);
+    }
     cache.lock().unwrap().insert(key, out.clone());
     Ok(out)
 }
