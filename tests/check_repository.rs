@@ -262,6 +262,49 @@ fn an_error_in_an_imported_wesl_module_names_its_file_and_module() {
     assert!(e.contains("package::utils"), "{e}");
 }
 
+/// A type error only naga finds (the wesl crate composes without validating, and writes the tree
+/// anew): reported at the user's file, line and column, not at the composed text's.
+#[test]
+fn a_type_error_in_a_wesl_file_is_at_its_file_line_and_column() {
+    let file = "tests/fixtures/repository/wesl/shaders/sampling/ggx_type_error.wesl";
+    let out = run(&wesl_args(file, &[]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    // line 35: `    let z2: u32 = w.z * w.z;`
+    let line = std::fs::read_to_string(root().join(file)).unwrap().lines().position(|l| l.contains("let z2: u32")).unwrap() + 1;
+    assert_eq!(line, 35);
+    // the `z2` of `let z2: u32`, column 9, found through its line (z2 occurs three times in ggx_g1)
+    assert!(e.contains(&format!("{file}:35:9: the type of `z2` is expected to be `u32`")), "{e}");
+    assert!(e.contains("in `ggx_g1` of module package::sampling::ggx_type_error"), "{e}");
+    // the composed position only in the note
+    assert!(!e.starts_with("lobes: error: <"), "{e}");
+}
+
+/// The same in an imported module: its file, its line and column, the item as the module names it
+/// (not its mangled name).
+#[test]
+fn a_type_error_in_an_imported_wesl_module_is_at_its_file_line_and_column() {
+    // utils.wesl's rand_f: a u32 times an f32
+    let dir = copy_tree("wesl-type-error", WESL, "shaders/utils.wesl", |t| {
+        t.replace("return f32(pcg_next(state) >> 8u) * (1.0 / 16777216.0);", "return (pcg_next(state) >> 8u) * (1.0 / 16777216.0);")
+    });
+    let file = dir.join("shaders/sampling/ggx.wesl");
+    let roots = dir.join("shaders");
+    let stub = root().join(WESL).join("stubs/bindings.wesl");
+    let stub = format!("package::bindings={}", stub.display());
+    let out = lobes(&[
+        "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub,
+        "--sample", "sample_ggx_vndf(wi, p0, rng)", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--rand", "rand_f",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = stderr(&out);
+    let utils = dir.join("shaders/utils.wesl");
+    // naga calls the function invalid, at its declaration: `fn rand_f(` on line 11 of utils.wesl
+    let line = std::fs::read_to_string(&utils).unwrap().lines().position(|l| l.starts_with("fn rand_f(")).unwrap() + 1;
+    assert!(e.contains(&format!("{}:{line}:1: Function", utils.display())), "{e}");
+    assert!(e.contains("`rand_f` of module package::utils"), "{e}");
+}
+
 /// A plain WGSL sampler with a global rand(), as GLSL ports write it.
 fn plain(name: &str, text: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-repository-plain");

@@ -81,18 +81,93 @@ pub(super) const PDF: Signature = Signature {
 };
 pub(super) const EVAL: Signature = Signature { role: "eval", ..PDF };
 
+/// Where one declaration of a composed tree was written. The wesl crate writes a tree anew from
+/// its syntax (its source map is per declaration: a mangled name's module and item, and each
+/// module's text), so a line of its output maps back to a declaration, not to a line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DeclOrigin {
+    /// The declaration's lines in the composed part, 1-based, inclusive.
+    pub lines: (u32, u32),
+    /// The file it was read from, as messages name it, and its module path (`package::utils`).
+    pub file: String,
+    pub module: String,
+    /// Its name in that file.
+    pub name: String,
+    /// Its text in the file, and the file's line and column (1-based) where that text starts.
+    pub text: String,
+    pub at: (u32, u32),
+    /// (name in the composed text, name in the file) of the items renamed by the composition.
+    pub renames: Vec<(String, String)>,
+}
+
+impl DeclOrigin {
+    /// The file's line and column of `snippet` (text of the composed declaration, on the
+    /// composed `line`) where it, or else that line, occurs exactly once in the declaration as
+    /// written (its renamed items named as the file names them).
+    fn find(&self, snippet: &str, line: &str) -> Option<(u32, u32)> {
+        let written = |t: &str| self.renames.iter().fold(t.to_string(), |t, (composed, item)| replace_word(&t, composed, item));
+        let once = |t: &str| {
+            let mut hits = self.text.match_indices(t);
+            let (at, _) = hits.next()?;
+            hits.next().is_none().then_some(at)
+        };
+        let snippet = written(snippet);
+        let snippet = snippet.trim();
+        if snippet.is_empty() {
+            return None;
+        }
+        // the offending text itself, or (it occurs more than once) its whole line, then the
+        // text within that line
+        let at = once(snippet).or_else(|| {
+            let line = written(line);
+            let line = line.trim();
+            let start = once(line).filter(|_| !line.is_empty())?;
+            Some(start + line.find(snippet)?)
+        })?;
+        let before = &self.text[..at];
+        let lines = before.matches('\n').count() as u32;
+        let column = match before.rfind('\n') {
+            Some(nl) => before[nl + 1..].chars().count() as u32 + 1,
+            None => before.chars().count() as u32 + self.at.1,
+        };
+        Some((self.at.0 + lines, column))
+    }
+}
+
+/// `text` with every whole word `from` (an identifier) replaced by `to`.
+fn replace_word(text: &str, from: &str, to: &str) -> String {
+    let ident = |c: char| c.is_alphanumeric() || c == '_';
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find(from) {
+        let starts = rest[..i].chars().next_back().is_none_or(|c| !ident(c));
+        let ends = rest[i + from.len()..].chars().next().is_none_or(|c| !ident(c));
+        out.push_str(&rest[..i]);
+        out.push_str(if starts && ends { to } else { from });
+        rest = &rest[i + from.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Composed text with the first line of each part, for mapping diagnostics back.
 #[derive(Debug, Clone, Default)]
 pub struct Composed {
     pub text: String,
-    /// (first line, 1-based, of the part in `text`; the part's name).
-    parts: Vec<(u32, String)>,
+    /// (first line, 1-based, of the part in `text`; the part's name; where its declarations
+    /// came from, for a tree that the wesl crate wrote).
+    parts: Vec<(u32, String, Vec<DeclOrigin>)>,
 }
 
 impl Composed {
     pub fn push(&mut self, name: &str, text: &str) {
+        self.push_mapped(name, text, Vec::new());
+    }
+
+    /// [`Self::push`] of a part whose declarations map back to their files ([`DeclOrigin`]).
+    pub fn push_mapped(&mut self, name: &str, text: &str, decls: Vec<DeclOrigin>) {
         let line = self.text.lines().count() as u32 + 1;
-        self.parts.push((line, name.to_string()));
+        self.parts.push((line, name.to_string(), decls));
         self.text.push_str(text);
         if !text.ends_with('\n') {
             self.text.push('\n');
@@ -101,10 +176,17 @@ impl Composed {
 
     /// `file:line:column` of a composed line and column.
     pub fn locate(&self, line: u32, column: u32) -> String {
-        match self.parts.iter().rev().find(|(first, _)| *first <= line) {
-            Some((first, name)) => format!("{name}:{}:{column}", line - first + 1),
+        match self.parts.iter().rev().find(|(first, _, _)| *first <= line) {
+            Some((first, name, _)) => format!("{name}:{}:{column}", line - first + 1),
             None => format!("<composed>:{line}:{column}"),
         }
+    }
+
+    /// The declaration of a mapped part ([`Self::push_mapped`]) that holds a composed line.
+    fn declaration(&self, line: u32) -> Option<&DeclOrigin> {
+        let (first, _, decls) = self.parts.iter().rev().find(|(first, _, _)| *first <= line)?;
+        let line = line - first + 1;
+        decls.iter().find(|d| (d.lines.0..=d.lines.1).contains(&line))
     }
 
     /// The source line at a composed line number.
@@ -114,12 +196,39 @@ impl Composed {
 
     /// A diagnostic at `span`: "file:line:col: error: message", the offending line and a caret.
     fn diagnostic(&self, span: Option<naga::SourceLocation>, message: &str, labels: &[String]) -> String {
+        let caret = |column: u32, length: u32| " ".repeat(column.saturating_sub(1) as usize) + &"^".repeat((length as usize).clamp(1, 60));
         let mut out = match span {
             Some(loc) => {
                 let at = self.locate(loc.line_number, loc.line_position);
                 let src = self.line(loc.line_number);
-                let caret = " ".repeat(loc.line_position.saturating_sub(1) as usize) + &"^".repeat((loc.length as usize).clamp(1, 60));
-                format!("{at}: {message}\n    {src}\n    {caret}")
+                let snippet = self.text.get(loc.offset as usize..(loc.offset + loc.length) as usize).unwrap_or("");
+                match self.declaration(loc.line_number) {
+                    // the user's own line and column, where the offending text is found in the declaration
+                    Some(d) => match d.find(snippet, src) {
+                        Some((line, column)) => {
+                            let user_line = d.text.lines().nth((line - d.at.0) as usize).unwrap_or("");
+                            let user_line = if line == d.at.0 { format!("{}{user_line}", " ".repeat(d.at.1 as usize - 1)) } else { user_line.to_string() };
+                            let length = snippet.lines().next().map_or(1, |l| l.chars().count() as u32);
+                            format!(
+                                "{}:{line}:{column}: {message}\n    {user_line}\n    {}\n    note: in `{}` of module {} (wesl composed it as {at})",
+                                d.file,
+                                caret(column, length),
+                                d.name,
+                                d.module
+                            )
+                        }
+                        // else the declaration's line, and the composed line
+                        None => format!(
+                            "{}:{}: in the declaration `{}` of module {}: {message}\n    note: wesl composed that declaration anew; at {at} of its text:\n    {src}\n    {}",
+                            d.file,
+                            d.at.0,
+                            d.name,
+                            d.module,
+                            caret(loc.line_position, loc.length)
+                        ),
+                    },
+                    None => format!("{at}: {message}\n    {src}\n    {}", caret(loc.line_position, loc.length)),
+                }
             }
             None => format!("error: {message}"),
         };
@@ -164,13 +273,15 @@ impl Composed {
 /// The user's files alone, validated, with each named function checked against its signature.
 /// (Any capability is allowed here: what the passes cannot run is the final composition's to
 /// refuse, once a composed tree is cut to what the sampler reaches.)
-pub(super) fn check_user(sources: &[Source], functions: &[(&str, Signature)]) -> Result<naga::Module, CheckError> {
+///
+/// `decls`: where the declarations of a tree the wesl crate composed (one part) came from.
+pub(super) fn check_user(sources: &[Source], decls: &[DeclOrigin], functions: &[(&str, Signature)]) -> Result<naga::Module, CheckError> {
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
     let mut composed = Composed::default();
     for s in sources {
-        composed.push(&s.name, &s.text);
+        composed.push_mapped(&s.name, &s.text, if sources.len() == 1 { decls.to_vec() } else { Vec::new() });
     }
     let module = composed.validate_with(naga::valid::Capabilities::all())?.0;
     let files = sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");

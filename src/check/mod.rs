@@ -210,7 +210,7 @@ impl UserSampler {
             functions.push((e.as_str(), compose::EVAL));
         }
         functions.retain(|(n, _)| gpu::is_name(n));
-        let module = compose::check_user(&code.parts, &functions)?;
+        let module = compose::check_user(&code.parts, &code.decls, &functions)?;
         let imported = |n: &String| code.origins.iter().any(|o| &o.0 == n);
         if let Some(name) = compose::global_names(&module).into_iter().find(|n| gpu::reserved(n) && !imported(n)) {
             return Err(CheckError::Input(format!(

@@ -247,6 +247,8 @@ pub(super) struct UserCode {
     pub origins: Vec<Origin>,
     /// The files the tree was read from (for messages).
     pub files: Vec<String>,
+    /// Where the declarations of a WESL tree came from (the wesl crate writes the tree anew).
+    pub decls: Vec<super::compose::DeclOrigin>,
 }
 
 impl UserCode {
@@ -394,19 +396,21 @@ pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCo
             if let Some((m, _)) = c.stubs.first() {
                 return Err(CheckError::Input(format!("--stub {m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
             }
-            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files })
+            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new() })
         }
         Dialect::NagaOil => naga_oil_tree(sources, c).map(|(text, origins)| UserCode {
             dialect: d,
             parts: vec![Source { name: format!("<{} with its modules, composed by naga_oil>", sources[0].name), text }],
             origins,
             files,
+            decls: Vec::new(),
         }),
-        Dialect::Wesl => wesl_tree(sources, c).map(|(text, origins)| UserCode {
+        Dialect::Wesl => wesl_tree(sources, c).map(|(text, origins, decls)| UserCode {
             dialect: d,
             parts: vec![Source { name: format!("<{} with its modules, composed by wesl>", sources[0].name), text }],
             origins,
             files,
+            decls,
         }),
     }
 }
@@ -623,8 +627,11 @@ fn undo_digit_suffix(text: &str) -> String {
     out
 }
 
+/// A composed WESL tree: its text, the origins of its mangled names, and of its declarations.
+type WeslTree = (String, Vec<Origin>, Vec<super::compose::DeclOrigin>);
+
 #[cfg(not(feature = "wesl"))]
-fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
+fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<WeslTree, CheckError> {
     Err(CheckError::Input(format!("{}: WESL imports need lobes built with the feature \"wesl\" (the CLI has it)", sources[0].name)))
 }
 
@@ -682,9 +689,9 @@ impl wesl::Resolver for Roots {
 }
 
 /// The tree of `sources[0]` composed by the wesl crate: WGSL text (the root's names as written,
-/// imported ones mangled) and each mangled name's origin.
+/// imported ones mangled), each mangled name's origin, and each declaration's.
 #[cfg(feature = "wesl")]
-fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
+fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError> {
     use wesl::SourceMap;
     if let Some(s) = sources.get(1) {
         return Err(CheckError::Input(format!(
@@ -721,7 +728,9 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>
     let components: Vec<String> = rel.iter().map(|c| c.to_string_lossy().into_owned()).collect();
     let root_path = wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components };
     let _ = base;
-    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known };
+    let root_path_shown = root_path.to_string();
+    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known: known.clone() };
+    let resolver_files = Roots { roots: roots.clone(), stubs: Vec::new(), known };
     let mut features = wesl::Features::default();
     for (n, v) in &c.defines {
         let on = match v.as_deref() {
@@ -747,22 +756,88 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>
     let result = compiler.compile(&root_path).map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
     let mut origins = Vec::new();
     use wesl::syntax::GlobalDeclaration as G;
+    let ident = |decl: &G| match decl {
+        G::Declaration(d) => Some(d.ident.name().to_string()),
+        G::TypeAlias(d) => Some(d.ident.name().to_string()),
+        G::Struct(d) => Some(d.ident.name().to_string()),
+        G::Function(d) => Some(d.ident.name().to_string()),
+        _ => None,
+    };
     for decl in &result.syntax.global_declarations {
-        let id = match decl.node() {
-            G::Declaration(d) => Some(&d.ident),
-            G::TypeAlias(d) => Some(&d.ident),
-            G::Struct(d) => Some(&d.ident),
-            G::Function(d) => Some(&d.ident),
-            _ => None,
-        };
-        if let Some(id) = id {
-            let name = id.name().to_string();
-            if let Some((path, item)) = result.sourcemap.as_ref().and_then(|m| m.get_decl(&name)) {
-                origins.push((name.clone(), path.to_string(), item.to_string()));
-            }
+        if let Some(name) = ident(decl.node())
+            && let Some((path, item)) = result.sourcemap.as_ref().and_then(|m| m.get_decl(&name))
+        {
+            origins.push((name.clone(), path.to_string(), item.to_string()));
         }
     }
-    Ok((result.to_string(), origins))
+    let text = result.to_string();
+    let renames: Vec<(String, String)> = origins.iter().map(|(m, _, item)| (m.clone(), item.clone())).collect();
+    // each declaration as the crate writes it, found in order in the text; its span is in its
+    // own module's text (the root's, or the source map's of the module its mangled name names)
+    let mut decls = Vec::new();
+    let mut from = 0;
+    for decl in &result.syntax.global_declarations {
+        let Some(name) = ident(decl.node()) else { continue };
+        let written = decl.to_string();
+        let Some(at) = text[from..].find(&written).map(|i| from + i) else { continue };
+        from = at + written.len();
+        let first = text[..at].matches('\n').count() as u32 + 1;
+        let lines = (first, first + written.trim_end().matches('\n').count() as u32);
+        let map = result.sourcemap.as_ref();
+        let (file, module, item, source) = match map.and_then(|m| m.get_decl(&name)) {
+            Some((path, item)) if path.to_string() != root_path_shown => {
+                let m = map.expect("a source map holds the declaration");
+                let file = m.get_display_name(path).map(str::to_string).or_else(|| resolver_files.file(path).map(|f| f.display().to_string()));
+                let Some(file) = file else { continue };
+                let source = match m.get_source(path) {
+                    Some(s) => s.to_string(),
+                    None => match std::fs::read_to_string(&file) {
+                        Ok(s) => s,
+                        Err(_) => continue,
+                    },
+                };
+                (file, path.to_string(), item.to_string(), source)
+            }
+            _ => (sources[0].name.clone(), root_path_shown.clone(), name.clone(), sources[0].text.clone()),
+        };
+        // the declaration's text in its file: its span there, or (a span that does not hold its
+        // name) from the line that declares it to the next declaration
+        let span = decl.span();
+        let (start, original) = match source.get(span.start..span.end).filter(|t| t.contains(item.as_str())) {
+            Some(t) => (span.start, t.to_string()),
+            None => match declaration_text(&source, &item) {
+                Some(found) => found,
+                None => continue,
+            },
+        };
+        let before = &source[..start];
+        let at = (before.matches('\n').count() as u32 + 1, before.rsplit('\n').next().unwrap_or("").chars().count() as u32 + 1);
+        decls.push(super::compose::DeclOrigin { lines, file, module, name: item, text: original, at, renames: renames.clone() });
+    }
+    Ok((text, origins, decls))
+}
+
+/// Where the declaration of `name` starts in a WGSL/WESL text (a line `fn NAME(`, `const NAME`,
+/// `struct NAME`, …, attributes before it included), and its text up to the next line that
+/// starts a declaration at the margin.
+#[cfg(feature = "wesl")]
+fn declaration_text(source: &str, name: &str) -> Option<(usize, String)> {
+    let keywords = ["fn", "const", "var", "override", "struct", "alias"];
+    let starts = |line: &str| keywords.iter().any(|k| line.strip_prefix(k).is_some_and(|r| r.starts_with([' ', '<'])));
+    let declares = |line: &str| {
+        starts(line) && line.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).nth(1) == Some(name)
+    };
+    let mut offset = 0;
+    let mut found = None;
+    for line in source.split_inclusive('\n') {
+        match found {
+            None if declares(line) => found = Some(offset),
+            Some(start) if starts(line) || line.starts_with('@') => return Some((start, source[start..offset].to_string())),
+            _ => {}
+        }
+        offset += line.len();
+    }
+    found.map(|start| (start, source[start..].to_string()))
 }
 
 /// Replaces the body of each function in `functions` (handles of `module`, parsed from `text`)
@@ -838,6 +913,34 @@ mod tests {
         assert!(out.contains("fn r(s: ptr<function, u32>) -> f32 { return 0.5; }"), "{out}");
         assert_eq!(out.lines().nth(7), Some("fn b() -> f32 { return 2.0; }"));
         naga::front::wgsl::parse_str(&out).unwrap();
+    }
+
+    #[cfg(feature = "wesl")]
+    #[test]
+    fn declarations_are_found_by_name() {
+        let text = "const PI: f32 = 3.14;\n// a comment\nfn g1(w: vec3<f32>) -> f32 {\n  let z2 = w.z;\n  return z2;\n}\nfn other() {}\n";
+        let (start, decl) = declaration_text(text, "g1").unwrap();
+        assert_eq!(&text[start..start + 6], "fn g1(");
+        assert_eq!(decl, "fn g1(w: vec3<f32>) -> f32 {\n  let z2 = w.z;\n  return z2;\n}\n");
+        assert!(declaration_text(text, "g").is_none());
+        assert_eq!(declaration_text(text, "PI").unwrap().0, 0);
+    }
+
+    /// The fixture's WESL tree: every declaration of the root and of the modules it imports maps
+    /// back to its file and line.
+    #[cfg(feature = "wesl")]
+    #[test]
+    fn wesl_declarations_map_back_to_their_files() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/repository/wesl");
+        let file = dir.join("shaders/sampling/ggx.wesl");
+        let sources = vec![Source::read(&file).unwrap()];
+        let c = Composition::default().shader_root(dir.join("shaders")).stub("package::bindings", dir.join("stubs/bindings.wesl"));
+        let (text, _, decls) = wesl_tree(&sources, &c).unwrap();
+        let g1 = decls.iter().find(|d| d.name == "ggx_g1").unwrap_or_else(|| panic!("{decls:#?}\n{text}"));
+        assert_eq!((g1.file.as_str(), g1.at.0), (sources[0].name.as_str(), 33), "{g1:#?}");
+        assert!(text.lines().nth(g1.lines.0 as usize - 1).unwrap().contains("fn ggx_g1("), "{g1:#?}\n{text}");
+        let rand = decls.iter().find(|d| d.name == "rand_f").unwrap_or_else(|| panic!("{decls:#?}"));
+        assert!(rand.file.ends_with("utils.wesl") && rand.module == "package::utils" && rand.at.0 == 11, "{rand:#?}");
     }
 
     #[test]

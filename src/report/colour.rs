@@ -26,6 +26,10 @@ pub enum Scale {
 /// Colour of NaN / infinite / missing values; absent from both colormaps.
 pub const NAN_GREY: Rgb<u8> = Rgb([128, 128, 128]);
 
+/// Colour of cells a map marks (a residual where the expected count is below 0: the pdf is
+/// negative there); absent from both colormaps and far from grey.
+pub const MARKED: Rgb<u8> = Rgb([230, 0, 200]);
+
 /// Above this max / min-positive ratio a sequential scale goes logarithmic.
 const LOG_RATIO: f64 = 1e3;
 

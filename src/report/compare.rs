@@ -7,7 +7,9 @@
 //!   equal counts;
 //! - `residual.png`, (measured − expected)/√expected per bin, the bin's signed contribution to
 //!   χ² (diverging, 0 white, over ±[`RESIDUAL_LIMIT`]; see [`residual`]); samples in a bin that
-//!   expects nothing have no finite residual and are grey ("nan" on the key);
+//!   expects nothing have no finite residual and are grey ("nan" on the key); a bin whose
+//!   expected count is below 0 (the pdf is negative there) is magenta ("pdf < 0" on the key)
+//!   here and in `expected.png`, never drawn as 0;
 //! - `marginals.png`, the two marginals with their ±2σ bands ([`super::marginals`]);
 //! - `residual_coarse.png`, where a coarser grid of the χ² family caught a defect that the fine
 //!   grid did not ([`crate::stats::family::caught_grid`]): the residual of its blocks, where a
@@ -41,6 +43,9 @@ pub const BARS_PNG: &str = "bars.png";
 /// are about standard normal, pale on this scale, and a bin beyond ±5 (p < 6e-7 alone) is
 /// saturated whatever else the map holds, so maps compare across cases.
 pub const RESIDUAL_LIMIT: f64 = 5.0;
+
+/// The residual map's key for a bin whose expected count is below 0 ([`residual`]).
+const PDF_BELOW_ZERO: &str = "pdf < 0";
 
 /// How the bins of a histogram lie.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,13 +87,16 @@ fn aggregate(values: &[f64], rows: usize, cols: usize, (cr, cc): (usize, usize))
     out
 }
 
-/// The residual of one bin as drawn: (m − e)/√e; NaN for samples where nothing is expected;
+/// The residual of one bin as drawn: (m − e)/√e; −∞ (drawn magenta, "pdf < 0") where the
+/// expected count is below 0, whatever was measured; NaN for samples where nothing is expected;
 /// 0 where fewer than [`MIN_EXPECTED`] samples are expected: the χ² test judges those bins
 /// pooled, and one stray sample where 0.01 is expected would read as +10 although Poisson finds
 /// nothing wrong with it. (Zeroing only bins whose count is small too would leave exactly the
 /// sparse bins that happen to be high, a red fringe around every lobe.)
 pub fn residual(measured: f64, expected: f64) -> f64 {
-    if measured > 0.0 && expected <= 0.0 {
+    if expected < 0.0 {
+        f64::NEG_INFINITY
+    } else if measured > 0.0 && expected <= 0.0 {
         f64::NAN
     } else if expected < MIN_EXPECTED {
         0.0
@@ -208,30 +216,30 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
         col_label,
         row_range: (row_edge(drawn.start), row_edge(drawn.end)),
         col_range: (c0, c1),
+        marked_key: "",
     };
-    let counts = Mapping::counts(&[&measured[..], &expected[..]].concat());
     let measured_title = if c.note.is_empty() { "measured counts".to_string() } else { format!("measured counts ({})", c.note) };
     let clipped = if residuals.iter().any(|r| r.abs() > RESIDUAL_LIMIT) { format!(", colours clipped at ±{RESIDUAL_LIMIT}") } else { String::new() };
     let grey = if residuals.iter().any(|r| r.is_nan()) { "; grey: samples where nothing is expected" } else { "" };
     let pooled = format!("; 0 where under {MIN_EXPECTED} are expected (pooled by χ²)");
-    // a pdf below 0 somewhere: the expected map on a diverging scale, its negative bins blue,
-    // instead of drawn as 0 on the counts' scale
+    // a pdf below 0 somewhere: those bins magenta ("pdf < 0") on the expected and the residual
+    // map (never drawn as 0), the rest on the counts' shared scale
     let negative = expected.iter().filter(|&&e| e < 0.0).count();
-    let (expected_title, expected_scale, expected_mapping) = if negative == 0 {
-        ("expected counts, N × ∫pdf (same colour scale)".to_string(), Scale::Sequential, counts)
+    let lowest = expected.iter().copied().fold(0.0, f64::min);
+    let expected_drawn: Vec<f64> = expected.iter().map(|&e| if e < 0.0 { f64::NEG_INFINITY } else { e }).collect();
+    // one scale for both maps, over the counts and the expectation at or above 0
+    let counts = Mapping::counts(&[&measured[..], &expected_drawn[..]].concat());
+    let expected_title = if negative == 0 {
+        "expected counts, N × ∫pdf (same colour scale)".to_string()
     } else {
-        let lim = expected.iter().map(|e| e.abs()).fold(0.0, f64::max).max(1.0);
-        (
-            format!("expected counts, N × ∫pdf: {negative} bins below 0 (blue), where the pdf is negative; a linear scale, not the measured one"),
-            Scale::Diverging,
-            Mapping::Symmetric { lim },
-        )
+        format!("expected counts, N × ∫pdf (same colour scale); magenta: {negative} bins below 0 (down to {}), where the pdf is negative", super::label::compact(lowest))
     };
-    let residual_title = format!("(measured − expected)/√expected{pooled}{clipped}{grey}");
+    let below = if negative > 0 { format!("; magenta: {negative} bins whose expected count is below 0") } else { String::new() };
+    let residual_title = format!("(measured − expected)/√expected{pooled}{clipped}{grey}{below}");
     if let Some(file) = residual_only {
         let what = format!("{residual_title}, in {rows} × {cols} blocks: the grid whose χ² test caught the defect");
         return heatmap::write_png_scaled(
-            &Heatmap { title: &title(c, &what), values: &residuals, scale: Scale::Diverging, ..base },
+            &Heatmap { title: &title(c, &what), values: &residuals, scale: Scale::Diverging, marked_key: PDF_BELOW_ZERO, ..base },
             Mapping::Symmetric { lim: RESIDUAL_LIMIT },
             &dir.join(file),
         )
@@ -239,7 +247,7 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
     }
     let maps = [
         (MEASURED_PNG, title(c, &measured_title), &measured, Scale::Sequential, counts),
-        (EXPECTED_PNG, title(c, &expected_title), &expected, expected_scale, expected_mapping),
+        (EXPECTED_PNG, title(c, &expected_title), &expected_drawn, Scale::Sequential, counts),
         (
             RESIDUAL_PNG,
             title(c, &residual_title),
@@ -251,7 +259,8 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
     // The maps are independent: encoded in parallel; the marginals follow once all three are
     // written (a map that cannot be written stops the case's pictures there, as before).
     maps.par_iter().try_for_each(|(file, title, values, scale, mapping)| {
-        heatmap::write_png_scaled(&Heatmap { title, values, scale: *scale, ..base }, *mapping, &dir.join(file))
+        let marked_key = if *file == MEASURED_PNG { "" } else { PDF_BELOW_ZERO };
+        heatmap::write_png_scaled(&Heatmap { title, values, scale: *scale, marked_key, ..base }, *mapping, &dir.join(file))
     })?;
 
     // the marginals: sums over the columns of each drawn row, and over the drawn rows of each column
@@ -326,6 +335,37 @@ mod tests {
         assert_eq!(residual(12.0, 4.0), 0.0);
         assert_eq!(residual(16.0, 25.0), -1.8);
         assert_eq!(residual(13.0, 9.0), 4.0 / 3.0);
+        // a negative expectation (the pdf below 0) is marked whatever was measured
+        assert_eq!(residual(0.0, -2.0), f64::NEG_INFINITY);
+        assert_eq!(residual(7.0, -1e-9), f64::NEG_INFINITY);
+    }
+
+    /// A pdf below 0 in some bins: `expected.png` and `residual.png` draw them magenta with the
+    /// key "pdf < 0", `measured.png` not; the rows holding them are not cropped.
+    #[test]
+    fn negative_expected_counts_are_drawn() {
+        use crate::report::colour::MARKED;
+        let dir = tempfile::tempdir().unwrap();
+        // 4 × 8: a lobe in the upper rows, −3 expected in row 0's columns 0 and 1, nothing
+        // measured in rows 0 and 1
+        let expected = grid(|r, c| if r >= 2 { 100.0 } else if r == 0 && c < 2 { -3.0 } else { 0.0 });
+        let measured = grid(|r, _| if r >= 2 { 100.0 } else { 0.0 });
+        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &measured, expected: &expected, caption: "negative", note: "", coarse: None };
+        write(dir.path(), &c).unwrap();
+        let read = |f: &str| image::open(dir.path().join(f)).unwrap().to_rgb8();
+        let count = |img: &image::RgbImage, rgb: [u8; 3]| img.pixels().filter(|p| p.0 == rgb).count();
+        let residual = read(RESIDUAL_PNG);
+        let magenta = count(&residual, MARKED.0);
+        // two cells (each at least 32 px wide on a map of 8 columns) and the key's swatch
+        assert!(magenta > 2 * 32 * 4, "{magenta} magenta pixels");
+        let expected_png = count(&read(EXPECTED_PNG), MARKED.0);
+        assert!(expected_png > 2 * 32 * 4, "{expected_png} magenta pixels");
+        assert_eq!(count(&read(MEASURED_PNG), MARKED.0), 0);
+        // without negative bins: no magenta
+        let plain = grid(|r, _| if r >= 2 { 100.0 } else { 0.0 });
+        write(dir.path(), &Comparison { expected: &plain, ..c }).unwrap();
+        assert_eq!(count(&read(RESIDUAL_PNG), MARKED.0), 0);
+        assert_eq!(count(&read(EXPECTED_PNG), MARKED.0), 0);
     }
 
     /// Blocks as the χ² family groups them: 3 × 4 into 2 × 2 takes rows {0, 1}, {2} and

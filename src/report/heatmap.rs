@@ -3,10 +3,11 @@
 //! A [`Heatmap`] is a row-major grid of values over (cos θ, φ). [`render`] lays it out as an
 //! RGB image: the cells scaled up to a few pixels each (row 0 at the *bottom*), a vertical
 //! colour bar with min/mid/max tick labels on the right (captioned "log" on a log scale, see
-//! [`super::colour`]), a grey "nan" key when some cells are not finite, the title on top and
-//! the axis range labels. [`write_png`] writes the image atomically ([`super::atomic`]).
+//! [`super::colour`]), a grey "nan" key when some cells are not finite (and, when the map
+//! names one, a magenta key for cells marked −∞: e.g. a residual where the expectation is below
+//! 0), the title on top and the axis range labels. [`write_png`] writes the image atomically ([`super::atomic`]).
 
-use super::colour::{NAN_GREY, colour, value_colour};
+use super::colour::{MARKED, NAN_GREY, colour, value_colour};
 use super::label::{axis_text, compact};
 use super::text::{LINE_H, draw_text, text_width};
 use image::{Rgb, RgbImage};
@@ -37,6 +38,9 @@ pub struct Heatmap<'a> {
     pub row_range: (f64, f64),
     /// Value range of the columns: (left edge, right edge), e.g. (-π, π).
     pub col_range: (f64, f64),
+    /// What a cell of value −∞ means, written beside its [`MARKED`] swatch under the colour bar
+    /// (e.g. "pdf < 0"); empty: −∞ is drawn grey like NaN.
+    pub marked_key: &'a str,
 }
 
 /// Background.
@@ -72,14 +76,12 @@ pub fn render(h: &Heatmap) -> RgbImage {
 /// all their values) can be compared colour for colour.
 pub fn render_scaled(h: &Heatmap, mapping: Mapping) -> RgbImage {
     let ticks = tick_labels(&mapping);
-    let has_bad = (0..h.rows * h.cols).any(|i| !cell(h, i).is_finite());
-    let lay = Layout::new(h, &ticks, has_bad);
+    let keys = keys(h);
+    let lay = Layout::new(h, &ticks, &keys);
     let mut img = RgbImage::from_pixel(lay.width, lay.height, BG);
     draw_cells(&mut img, h, &mapping, &lay);
     draw_colour_bar(&mut img, h.scale, &mapping, &ticks, &lay);
-    if has_bad {
-        draw_nan_key(&mut img, &lay);
-    }
+    draw_keys(&mut img, &keys, &lay);
     draw_axis_labels(&mut img, h, &lay);
     for (k, line) in h.title.split('\n').enumerate() {
         let x = (lay.width as i64 - text_width(line) as i64) / 2;
@@ -109,6 +111,35 @@ fn cell(h: &Heatmap, i: usize) -> f64 {
     h.values.get(i).copied().unwrap_or(f64::NAN)
 }
 
+/// Whether a value is drawn [`MARKED`]: −∞ on a map that names what it means.
+fn marked(h: &Heatmap, v: f64) -> bool {
+    v == f64::NEG_INFINITY && !h.marked_key.is_empty()
+}
+
+/// The colour of one cell's value.
+fn cell_colour(h: &Heatmap, mapping: &Mapping, v: f64) -> Rgb<u8> {
+    if marked(h, v) { MARKED } else { value_colour(h.scale, mapping, v) }
+}
+
+/// The keys under the colour bar, each a swatch and its text: "nan" when some cell is not finite
+/// (and not marked), the map's `marked_key` when some cell is marked.
+fn keys<'a>(h: &Heatmap<'a>) -> Vec<(Rgb<u8>, &'a str)> {
+    let values = (0..h.rows * h.cols).map(|i| cell(h, i));
+    let (mut bad, mut mark) = (false, false);
+    for v in values {
+        bad |= !v.is_finite() && !marked(h, v);
+        mark |= marked(h, v);
+    }
+    let mut keys = Vec::new();
+    if bad {
+        keys.push((NAN_GREY, "nan"));
+    }
+    if mark {
+        keys.push((MARKED, h.marked_key));
+    }
+    keys
+}
+
 /// The values that belong to cells (a longer slice's tail is ignored).
 fn cell_values<'a>(h: &Heatmap<'a>) -> &'a [f64] {
     &h.values[..h.values.len().min(h.rows.saturating_mul(h.cols))]
@@ -129,9 +160,9 @@ struct Layout {
 }
 
 impl Layout {
-    /// Places map, colour bar and labels; `ticks` are the colour bar labels, `has_bad`
-    /// whether a NaN key is drawn under the bar.
-    fn new(h: &Heatmap, ticks: &[String; 3], has_bad: bool) -> Self {
+    /// Places map, colour bar and labels; `ticks` are the colour bar labels, `keys` the keys
+    /// drawn under the bar, one a line.
+    fn new(h: &Heatmap, ticks: &[String; 3], keys: &[(Rgb<u8>, &str)]) -> Self {
         let cell_w = cell_size(h.cols);
         let cell_h = cell_size(h.rows).max(MIN_MAP_H.div_ceil(h.rows.max(1) as u32));
         let (map_w, map_h) = (cell_w * h.cols as u32, cell_h * h.rows as u32);
@@ -146,16 +177,12 @@ impl Layout {
         let map_y = PAD + title_lines * LINE_H + GAP + LINE_H + GAP + LINE_H / 2;
         let bar_x = left + map_w + BAR_GAP;
         let tick_w = ticks.iter().map(|s| text_width(s)).max().unwrap_or(0);
-        let key_w = if has_bad {
-            LINE_H + GAP + text_width("nan")
-        } else {
-            0
-        };
+        let key_w = keys.iter().map(|(_, k)| LINE_H + GAP + text_width(k)).max().unwrap_or(0);
         let right = bar_x + BAR_W + TICK_LEN + GAP + tick_w.max(key_w).max(text_width("log")) + PAD;
         let title_w = h.title.split('\n').map(text_width).max().unwrap_or(0);
         let width = right.max((title_w + 2 * PAD).min(MAX_WIDTH));
-        // below the map: the column labels, and (lower, clear of the last tick label) the NaN key
-        let height = nan_key_y(map_y, map_h) + LINE_H + PAD;
+        // below the map: the column labels, and (lower, clear of the last tick label) the keys
+        let height = key_y(map_y, map_h) + keys.len().max(1) as u32 * LINE_H + PAD;
         Layout {
             cell_w,
             cell_h,
@@ -180,7 +207,7 @@ fn draw_cells(img: &mut RgbImage, h: &Heatmap, mapping: &Mapping, lay: &Layout) 
     for r in 0..h.rows {
         let y = lay.map_y + (h.rows - 1 - r) as u32 * lay.cell_h;
         for c in 0..h.cols {
-            let rgb = value_colour(h.scale, mapping, cell(h, r * h.cols + c));
+            let rgb = cell_colour(h, mapping, cell(h, r * h.cols + c));
             let x = lay.map_x + c as u32 * lay.cell_w;
             fill_rect(img, x, y, lay.cell_w, lay.cell_h, rgb);
         }
@@ -216,17 +243,19 @@ fn draw_colour_bar(
     }
 }
 
-/// Top of the NaN key: under the colour bar, below the half line the bottom tick label
+/// Top of the first key: under the colour bar, below the half line the bottom tick label
 /// overhangs.
-fn nan_key_y(map_y: u32, map_h: u32) -> u32 {
+fn key_y(map_y: u32, map_h: u32) -> u32 {
     map_y + map_h + LINE_H / 2 + GAP
 }
 
-/// Draws the grey swatch and "nan" under the colour bar.
-fn draw_nan_key(img: &mut RgbImage, lay: &Layout) {
-    let y = nan_key_y(lay.map_y, lay.map_h);
-    fill_rect(img, lay.bar_x, y + 2, LINE_H - 4, LINE_H - 4, NAN_GREY);
-    draw_text(img, (lay.bar_x + LINE_H + GAP) as i64, y as i64, "nan", INK);
+/// Draws each key's swatch and text under the colour bar, one a line.
+fn draw_keys(img: &mut RgbImage, keys: &[(Rgb<u8>, &str)], lay: &Layout) {
+    for (k, (rgb, text)) in keys.iter().enumerate() {
+        let y = key_y(lay.map_y, lay.map_h) + k as u32 * LINE_H;
+        fill_rect(img, lay.bar_x, y + 2, LINE_H - 4, LINE_H - 4, *rgb);
+        draw_text(img, (lay.bar_x + LINE_H + GAP) as i64, y as i64, text, INK);
+    }
 }
 
 /// Draws the axis range labels and axis names: rows to the left, columns underneath.
@@ -299,14 +328,14 @@ mod tests {
             col_label: "φ",
             row_range: (-1.0, 1.0),
             col_range: (-PI, PI),
+            marked_key: "",
         }
     }
 
     /// The pixel at the centre of cell (r, c) in the rendered image.
     fn cell_pixel(h: &Heatmap, img: &RgbImage, r: usize, c: usize) -> Rgb<u8> {
         let m = Mapping::fit(h.scale, cell_values(h));
-        let has_bad = (0..h.rows * h.cols).any(|i| !cell(h, i).is_finite());
-        let lay = Layout::new(h, &tick_labels(&m), has_bad);
+        let lay = Layout::new(h, &tick_labels(&m), &keys(h));
         let x = lay.map_x + c as u32 * lay.cell_w + lay.cell_w / 2;
         let y = lay.map_y + (h.rows - 1 - r) as u32 * lay.cell_h + lay.cell_h / 2;
         *img.get_pixel(x, y)
@@ -349,7 +378,7 @@ mod tests {
         assert_eq!(cell_pixel(&h, &img, 0, 2), Rgb(VIRIDIS[8]));
         assert_eq!(cell_pixel(&h, &img, 0, 0), Rgb(VIRIDIS[0]));
         // the bottom-most map row of pixels belongs to row 0
-        let lay = Layout::new(&h, &tick_labels(&Mapping::fit(h.scale, &v)), false);
+        let lay = Layout::new(&h, &tick_labels(&Mapping::fit(h.scale, &v)), &[]);
         let x = lay.map_x + 2 * lay.cell_w + 1;
         assert_eq!(
             *img.get_pixel(x, lay.map_y + lay.map_h - 1),
@@ -383,6 +412,24 @@ mod tests {
         // a short slice: missing cells are NaN too
         let short = map(2, 3, &v[..4], Scale::Diverging);
         assert_eq!(cell_pixel(&short, &render(&short), 1, 2), NAN_GREY);
+    }
+
+    #[test]
+    fn marked_cells_are_magenta_with_their_key() {
+        let v = [-1.0, 1.0, f64::NEG_INFINITY, f64::NAN];
+        let plain = map(2, 2, &v, Scale::Diverging);
+        let h = Heatmap { marked_key: "pdf < 0", ..plain };
+        let img = render(&h);
+        assert_eq!(cell_pixel(&h, &img, 1, 0), MARKED);
+        assert_eq!(cell_pixel(&h, &img, 1, 1), NAN_GREY);
+        assert_eq!(keys(&h), [(NAN_GREY, "nan"), (MARKED, "pdf < 0")]);
+        // the key's swatch is drawn under the bar: more magenta pixels than the one cell holds
+        let lay = Layout::new(&h, &tick_labels(&Mapping::fit(h.scale, &v)), &keys(&h));
+        let magenta = img.pixels().filter(|p| **p == MARKED).count() as u32;
+        assert_eq!(magenta, lay.cell_w * lay.cell_h + (LINE_H - 4) * (LINE_H - 4));
+        // without a key −∞ is grey like NaN, and no key is drawn for it
+        assert_eq!(cell_pixel(&plain, &render(&plain), 1, 0), NAN_GREY);
+        assert_eq!(keys(&plain), [(NAN_GREY, "nan")]);
     }
 
     #[test]

@@ -364,7 +364,7 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
         let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
         let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
         let pi = std::f64::consts::PI;
-        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi) };
+        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi), marked_key: "" };
         heatmap::write_png(&map, &folder.join("albedo.png"))?;
     }
     let files = CaseFiles { counts: &r.counts.bins, expected: &r.expected.bins, timing: TimingFile::new(r), histogram: doc };
