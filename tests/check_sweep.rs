@@ -79,6 +79,15 @@ fn run(gpu: &Gpu, what: String, s: &UserSampler, settings: Settings) -> Run {
     for c in report.checks.iter().filter(|c| !c.passed) {
         eprintln!("    {}: {}", c.name(), c.summary);
     }
+    if let Some(j) = report.figures::<lobes::check::jacobian::JacobianCheck>() {
+        eprintln!(
+            "    jacobian systematic: {} of {} resolved off (limit {:.0}), median |pdf · |J| − 1| {:.1e}",
+            j.systematic_off,
+            j.resolved,
+            j.systematic_limit,
+            j.median_deviation.unwrap_or(f64::NAN)
+        );
+    }
     Run { what, report }
 }
 

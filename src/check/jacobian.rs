@@ -72,6 +72,19 @@ pub const UNRESOLVED: f64 = 1e-2;
 pub const MAX_SHARE_OFF: f64 = 1e-2;
 /// Fewer compared samples than this and the check does not apply.
 pub const MIN_COMPARED: u64 = 100;
+/// The systematic test: a smooth error of the map (a density 0.5 % off over a whole region) is
+/// under [`TOLERANCE`] at every sample, but it is there at most of them. Over the probes whose
+/// |J| and pdf f32 resolves to [`RESOLVED`] (allowance 2 · error + ulps · conditioning; no
+/// event chosen, whose ratio may exceed 1 by another event's density), a probe is off by this
+/// much when |p · |J| − 1| exceeds it plus its allowance.
+pub const SYSTEMATIC_TOLERANCE: f64 = 1e-3;
+/// A probe joins the systematic test where its allowance is at most this.
+pub const RESOLVED: f64 = 1e-3;
+/// The systematic test fails when more than half the resolved probes are off by
+/// [`SYSTEMATIC_TOLERANCE`] beyond chance: a one-sided sign test of "the median of
+/// |p · |J| − 1| − allowance is at most SYSTEMATIC_TOLERANCE" at this z (P ≈ 10⁻⁶ under the
+/// hypothesis, the probes being independent draws).
+pub const SIGN_TEST_Z: f64 = 4.75;
 
 /// What the comparison found.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq, schemars::JsonSchema)]
@@ -113,6 +126,25 @@ pub struct JacobianCheck {
     pub tolerance: f64,
     /// Whether enough samples could be compared for a verdict.
     pub applicable: bool,
+    /// The systematic test ([`SYSTEMATIC_TOLERANCE`]): the compared samples with no event whose
+    /// allowance is at most [`RESOLVED`].
+    #[serde(default)]
+    pub resolved: u64,
+    /// Those of them with |p · |J| − 1| over SYSTEMATIC_TOLERANCE plus their allowance.
+    #[serde(default)]
+    pub systematic_off: u64,
+    /// The median of |p · |J| − 1| over the resolved samples (none without them).
+    #[serde(default)]
+    pub median_deviation: Option<f64>,
+    #[serde(default)]
+    pub systematic_tolerance: f64,
+    /// The most of them that may be off: resolved / 2 + SIGN_TEST_Z · √resolved / 2.
+    #[serde(default)]
+    pub systematic_limit: f64,
+    /// Whether the systematic test failed: more than half the resolved samples off beyond
+    /// chance (only with at least [`MIN_COMPARED`] resolved samples).
+    #[serde(default)]
+    pub systematic: bool,
     pub passed: bool,
 }
 
@@ -270,9 +302,16 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
         largest_step: 0.0,
         tolerance: TOLERANCE,
         applicable: false,
+        resolved: 0,
+        systematic_off: 0,
+        median_deviation: None,
+        systematic_tolerance: SYSTEMATIC_TOLERANCE,
+        systematic_limit: 0.0,
+        systematic: false,
         passed: true,
     };
     let mut ratios = Vec::new();
+    let mut deviations = Vec::new();
     let mut worst = 0.0;
     for (((p, u), at), kappa) in probes.iter().zip(u).zip(at).zip(conditioning) {
         match local(p, *u, at, plane) {
@@ -287,6 +326,11 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
                 let limit = TOLERANCE + 2.0 * error + ulps * kappa;
                 let event = share < 1.0;
                 let deviation = if event { (1.0 - ratio).max(0.0) } else { (ratio - 1.0).abs() };
+                let allowance = limit - TOLERANCE;
+                if !event && allowance <= RESOLVED {
+                    deviations.push(deviation);
+                    c.systematic_off += u64::from(deviation > SYSTEMATIC_TOLERANCE + allowance);
+                }
                 c.compared_events += event as u64;
                 c.above_events += (event && ratio > 1.0 + limit) as u64;
                 if deviation > limit {
@@ -308,7 +352,15 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
         c.share_off = c.off as f64 / c.compared as f64;
     }
     c.applicable = c.compared >= MIN_COMPARED;
-    c.passed = !c.applicable || c.share_off <= MAX_SHARE_OFF;
+    c.resolved = deviations.len() as u64;
+    if !deviations.is_empty() {
+        deviations.sort_by(f64::total_cmp);
+        c.median_deviation = Some(deviations[deviations.len() / 2]);
+    }
+    let n = c.resolved as f64;
+    c.systematic_limit = n / 2.0 + SIGN_TEST_Z * n.sqrt() / 2.0;
+    c.systematic = c.resolved >= MIN_COMPARED && c.systematic_off as f64 > c.systematic_limit;
+    c.passed = !c.applicable || (c.share_off <= MAX_SHARE_OFF && !c.systematic);
     c
 }
 
@@ -388,6 +440,38 @@ mod tests {
             let c = judge_all(p, U, at);
             assert!(c.passed && c.off == 0, "shift {shift}: {c:?}");
         }
+    }
+
+    /// A smooth error of the map: d = (u.x + ε sin(2π u.x)/(2π), u.y) on the plane, |J| = 1 + ε
+    /// cos(2π u.x), reported pdf 1, at 400 probes spread over u.x. At ε = 0.5 % every probe is
+    /// within the pointwise 1 %, but |ε cos| exceeds 0.1 % at 87 % of them (|cos| > 0.2): the
+    /// systematic test fails. At ε = 0.15 % it exceeds 0.1 % plus the allowance at about half
+    /// (|cos| > ⅔: 208 of the 400), within the sign test's margin (at most 200 + 4.75 · 20/2 =
+    /// 247): the test passes; the correct map (ε = 0) has no probe off.
+    #[test]
+    fn a_smooth_error_under_the_tolerance_is_seen_systematically() {
+        let judged = |eps: f64| {
+            let map = move |v: [f32; 4]| {
+                let x = v[0] as f64;
+                [(x + eps * (2.0 * std::f64::consts::PI * x).sin() / (2.0 * std::f64::consts::PI)) as f32, v[1], 0.0, 1.0]
+            };
+            let (mut probes, mut us, mut ats) = (Vec::new(), Vec::new(), Vec::new());
+            for i in 0..400 {
+                let u = [0.01 + 0.98 * (i as f32 + 0.5) / 400.0, 0.5, 0.0, 0.0];
+                let (p, at) = probed(map, u, 1.0);
+                probes.push(p);
+                us.push(u);
+                ats.push(at);
+            }
+            judge(&probes, &us, &ats, &vec![0.0; 400], 4.0, true)
+        };
+        let c = judged(5e-3);
+        assert!(c.share_off == 0.0 && c.resolved == 400 && c.systematic && !c.passed, "{c:?}");
+        assert!((c.median_deviation.unwrap() - 5e-3 * std::f64::consts::FRAC_1_SQRT_2).abs() < 2e-4, "{c:?}");
+        let c = judged(1.5e-3);
+        assert!(!c.systematic && c.passed && (150..248).contains(&c.systematic_off), "{c:?}");
+        let c = judged(0.0);
+        assert!(c.passed && c.systematic_off == 0 && c.median_deviation.unwrap() < 1e-5, "{c:?}");
     }
 
     /// Slope 10⁻² with σ = 10⁻⁵: no three steps agree to 1 %, and the probe is skipped as

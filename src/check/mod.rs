@@ -527,9 +527,21 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         Some(l) if !plane && !jac.passed && !hard::is_unit(l) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
         _ => String::new(),
     };
+    let systematic = match jac.median_deviation {
+        Some(m) if jac.resolved >= jacobian::MIN_COMPARED => format!(
+            "; systematically: {} of {} samples resolved to {:.1}% off by more than {:.1}% + their f32 resolution (at most {:.0} may be: half, plus chance), median |pdf · |J| − 1| {:.1e}",
+            jac.systematic_off,
+            jac.resolved,
+            100.0 * jacobian::RESOLVED,
+            100.0 * jac.systematic_tolerance,
+            jac.systematic_limit.floor(),
+            m
+        ),
+        _ => format!("; systematic test not applicable: {} samples resolved to {:.1}%", jac.resolved, 100.0 * jacobian::RESOLVED),
+    };
     let summary = if jac.applicable {
         format!(
-            "pdf · |J| has median {:.4} and worst {:.4} (allowed ±{:.1}% there); {:.2}% of {} samples off by more than {:.0}% + the f32 resolution of |J| and of the pdf (limit {:.0}%){}{unresolved}{not_unit}",
+            "pdf · |J| has median {:.4} and worst {:.4} (allowed ±{:.1}% there); {:.2}% of {} samples off by more than {:.0}% + the f32 resolution of |J| and of the pdf (limit {:.0}%){}{systematic}{unresolved}{not_unit}",
             jac.median_ratio.unwrap_or(f64::NAN),
             jac.worst_ratio,
             100.0 * jac.worst_limit,
