@@ -265,13 +265,21 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
 /// Integrates the user's pdf and eval over every bin. `width` is the narrowest feature expected,
 /// in radians on the sphere or domain units on the plane; `samples` the run's sample count.
 /// Bins whose error estimate is beyond [`MAX_QUADRATURE_SIGMA`] are integrated again, finer
-/// (the module doc); [`Integrals::converged`] says whether any is left.
-pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64) -> Result<Integrals, CheckError> {
+/// (the module doc), and so are bins that the integral gives no probability where the
+/// histogram `observed` (per bin, where given) has samples: a spot of the pdf smaller than the
+/// nodes' spacing gives 0 by both rules, which agree (Beckmann visible normals at α 0.3, θi
+/// 89.9°: the lobe's tail below the horizon, 0.0017 rad deep, in one bin of 64 × 128, 37.2
+/// samples of 2²² by f64 quadrature of the f64 pdf, 36 observed, 0 expected before). Where the
+/// pdf is 0 there, the finer integral is 0 too and the samples still fail the test.
+/// [`Integrals::converged`] says whether any bin is left beyond the limit.
+pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<Integrals, CheckError> {
     let bins = (rows * cols) as usize;
     let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH)?;
     let mut rounds = out.rounds;
+    let unseen = |i: usize, p: f64| observed.is_some_and(|o| o[i] > 0) && p <= 0.0;
     for retry in 1..=RETRIES {
-        let over: Vec<bool> = b.error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples) > MAX_QUADRATURE_SIGMA).collect();
+        let over: Vec<bool> =
+            b.error.iter().zip(&out.probabilities).enumerate().map(|(i, (e, p))| sigmas(*e, *p, samples) > MAX_QUADRATURE_SIGMA || unseen(i, *p)).collect();
         if !over.contains(&true) {
             break;
         }
