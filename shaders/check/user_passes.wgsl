@@ -1,6 +1,7 @@
 #define_import_path lobes::check
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::check_params::lobes_check
+#import lobes::bins::lobes_axis_column
 #import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
 
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
@@ -26,17 +27,27 @@ fn lobes_positive(x: f32) -> bool {
     return (bits & 0x7f800000u) != 0x7f800000u && x > 0.0;
 }
 
-// The point of the domain at coordinates (a, b) of a rectangle in hemisphere `h` (±1): on the
-// sphere, a = 1 − |cos θ| (the distance from the nearer pole, exact in f32 where a peak sits at
-// a pole) and b = φ, so the direction is (s cos φ, s sin φ, h (1 − a)) with s = √(a (2 − a)), and
-// the solid-angle element is da dφ: a rectangle's integral needs no Jacobian. On the plane, the
-// point (a, b).
-fn lobes_domain_point(a: f32, b: f32, h: f32) -> vec3<f32> {
+// The point of the domain at coordinates (a, b) of a rectangle in hemisphere `h` (±1) and
+// quadrant `k`: on the sphere, a = 1 − |cos θ| (the distance from the nearer pole, exact in f32
+// where a peak sits at a pole) and b = φ − k π/2, φ measured from the axis nearest the rectangle
+// (the host chooses k), so the direction is (s cos φ, s sin φ, h (1 − a)) with s = √(a (2 − a)),
+// (cos φ, sin φ) being (cos b, sin b) turned by k quarter turns, which is exact; and the
+// solid-angle element is da dφ: a rectangle's integral needs no Jacobian. So an edge on an axis
+// is exactly where the binning puts it (f32(π) is 8.7·10⁻⁸ past π: with φ itself in f32 the two
+// columns of the seam overlapped by twice that, 2.5 % of a grazing lobe of α 10⁻⁴ counted twice),
+// and one off the axes within an ulp of b (≤ 4.7·10⁻⁸ rad) rather than of φ (2.4·10⁻⁷ near ±π).
+// On the plane, the point (a, b).
+fn lobes_domain_point(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
     if (LOBES_DOMAIN_PLANE) {
         return vec3<f32>(a, b, 0.0);
     }
     let s = sqrt(max(0.0, a * (2.0 - a)));
-    return vec3<f32>(s * cos(b), s * sin(b), h * (1.0 - a));
+    let e = vec2<f32>(cos(b), sin(b));
+    var t = e;
+    t = select(t, vec2<f32>(-e.y, e.x), k == 1u);
+    t = select(t, -e, k == 2u);
+    t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
+    return vec3<f32>(s * t.x, s * t.y, h * (1.0 - a));
 }
 
 // 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30),
@@ -47,13 +58,14 @@ const LOBES_GL_X = array<f32, 8>(-0.906179845938664, -0.538469310105683, 0.0, 0.
 const LOBES_GL_W = array<f32, 8>(0.236926885056189, 0.478628670499367, 0.568888888888889, 0.478628670499367, 0.236926885056189,
                                  0.555555555555556, 0.888888888888889, 0.555555555555556);
 
-// (∫ pdf, ∫ eval) over the rectangle of centre c and half-widths hw in hemisphere h by the tensor
+// (∫ pdf, ∫ eval) over the rectangle of centre c and half-widths hw in hemisphere h and quadrant
+// `quadrant` (lobes_domain_point) by the tensor
 // rule of nodes first .. first + n of LOBES_GL_*, without the area factor ha hb.
-fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, wi: vec3<f32>) -> vec2<f32> {
+fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, quadrant: u32, wi: vec3<f32>) -> vec2<f32> {
     var sum = vec2<f32>(0.0);
     for (var j = first; j < first + n; j++) {
         for (var k = first; k < first + n; k++) {
-            let d = lobes_domain_point(c.x + hw.x * LOBES_GL_X[j], c.y + hw.y * LOBES_GL_X[k], h);
+            let d = lobes_domain_point(c.x + hw.x * LOBES_GL_X[j], c.y + hw.y * LOBES_GL_X[k], h, quadrant);
             let w = LOBES_GL_W[j] * LOBES_GL_W[k];
             sum += w * vec2<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d));
         }
@@ -61,7 +73,8 @@ fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, wi: vec3<
     return sum;
 }
 
-// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign in lobes_in[count + i].x,
+// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign and quadrant in
+// lobes_in[count + i].xy (b measured from the quadrant's axis, lobes_domain_point),
 // integrated with the 5 × 5 and the 3 × 3 tensor
 // Gauss–Legendre rules: (∫ pdf by 5 × 5, by 3 × 3, ∫ eval by 5 × 5, by 3 × 3). A pdf that is
 // NaN, infinite or negative at a node is returned as such: the host reports it.
@@ -73,11 +86,12 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     }
     let r = lobes_in[i];
     let h = lobes_in[lobes_check.count + i].x;
+    let quadrant = u32(lobes_in[lobes_check.count + i].y);
     let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
     let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
     let wi = lobes_check.wi.xyz;
-    let r5 = lobes_rule(0u, 5u, c, hw, h, wi);
-    let r3 = lobes_rule(5u, 3u, c, hw, h, wi);
+    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, wi);
+    let r3 = lobes_rule(5u, 3u, c, hw, h, quadrant, wi);
     lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (hw.x * hw.y);
 }
 
@@ -369,8 +383,9 @@ fn lobes_finite3(d: vec3<f32>) -> bool {
 
 // The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1 (a rejection,
 // pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`). Bins as lobes bins
-// directions (src/stats/histogram.rs): rows uniform in cos θ over [−1, 1], columns in φ over
-// [−π, π), φ = π wrapping to column 0; on the plane, rows in y and columns in x over the bounds.
+// directions (shaders/lib/histogram.wgsl's bin_of, src/stats/histogram.rs): rows uniform in cos θ
+// over [−1, 1], columns in φ over [−π, π), φ = π wrapping to column 0, the column exact on the
+// axes' edges (shaders/lib/bins.wgsl); on the plane, rows in y and columns in x over the bounds.
 fn lobes_cell(s: vec4<f32>) -> u32 {
     let bins = lobes_check.rows * lobes_check.cols;
     if (!lobes_finite3(s.xyz)) {
@@ -402,10 +417,8 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
         if (s.x != 0.0 || s.y != 0.0) {
             t = (atan2(s.y, s.x) + 3.14159265358979) * (0.5 / 3.14159265358979);
         }
-        col = u32(max(t, 0.0) * f32(lobes_check.cols));
-        if (col >= lobes_check.cols) {
-            col = 0u;
-        }
+        // the column made exact on the axes' edges (the φ = ±π seam above all), as lobes run's
+        col = lobes_axis_column(u32(max(t, 0.0) * f32(lobes_check.cols)), lobes_check.cols, s.x, s.y);
     }
     let bits = bitcast<u32>(s.w);
     if ((bits & 0x7f800000u) == 0x7f800000u) {

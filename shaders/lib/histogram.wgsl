@@ -2,6 +2,7 @@
 #import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF, REASON_REFRACTED_NEAR_SIDE}
 #import lobes::math::{Real, math_atan2, math_is_finite}
 #import lobes::reflect::PI
+#import lobes::bins::lobes_axis_column
 
 // Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
 // grid and REASON_* the codes of src/engine/gpu/layout.rs, from the generated `lobes::job`.
@@ -34,45 +35,15 @@ fn classify_scattered(wi: vec3<Real>, wo: vec3<Real>, pdf: Real, reflected: bool
 }
 
 // Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over
-// [-pi, pi); phi = pi wraps to column 0, cos th = 1 falls in the top row.
+// [-pi, pi); phi = pi wraps to column 0, cos th = 1 falls in the top row. The column t gives is
+// made exact on the axes' edges by lobes_axis_column (shaders/lib/bins.wgsl), which `lobes
+// check` bins with too. CPU twin: SphereGrid::bin_of.
 fn bin_of(w: vec3<Real>) -> u32 {
     let z = clamp(w.z, -1.0, 1.0);
     let row = min(u32((z + 1.0) * 0.5 * Real(ROWS)), ROWS - 1u);
     // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
     let pole = w.x == 0.0 && w.y == 0.0;
     let t = select((math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI)), 0.5, pole);
-    let col = u32(max(t, 0.0) * Real(COLS));
-    return row * COLS + axis_exact_column(select(col, 0u, col >= COLS), w.x, w.y, pole);
-}
-
-// The column t gives is within one of the exact one, but not exact: t rounds, and a value within
-// half an ulp of t below a column's edge rounds onto it (at phi = pi - 1e-7, t = 1: column 0).
-// On the seam (phi = +-pi, an edge of every grid) and where the grid has an edge on another axis
-// (phi = 0 for an even COLS, +-pi/2 too for a multiple of 4), the signs of x and y say exactly which side of it w is, and the column is
-// moved into that half (quarter): a mirror lobe narrower than an ulp of t on an axis edge
-// (phi_i = 0 at grazing incidence: 2 alpha cos th_i wide) is split as w itself is, not by the
-// rounding (docs/statistics.md). CPU twin: SphereGrid::bin_of.
-fn axis_exact_column(col_t: u32, x: Real, y: Real, pole: bool) -> u32 {
-    if (pole || COLS < 2u) {
-        return col_t;
-    }
-    // the seam phi = +-pi, an edge of every grid: column 0 lies below it (y <= 0), the last above
-    var col = select(col_t, COLS - 1u, col_t == 0u && y > 0.0);
-    col = select(col, 0u, col == COLS - 1u && y < 0.0);
-    if (COLS % 2u != 0u) {
-        return col;
-    }
-    // phi in [-pi, 0) (y < 0, or y = 0 at x < 0: phi = -pi or pi, column 0) or [0, pi) (y > 0, or y = 0 at x >= 0)
-    let upper = y > 0.0 || (y == 0.0 && x >= 0.0);
-    let half = COLS / 2u;
-    var lo = select(0u, half, upper);
-    var hi = lo + half - 1u;
-    if (COLS % 4u == 0u && y != 0.0 && x != 0.0) {
-        // phi in [-pi/2, pi/2) (x > 0) or outside it
-        let q = COLS / 4u;
-        let inner = x > 0.0;
-        lo = select(select(0u, 3u * q, upper), select(q, half, upper), inner);
-        hi = lo + q - 1u;
-    }
-    return clamp(col, lo, hi);
+    // the signs, not f32(w.x) and f32(w.y), which an f64 kernel's tiny values would round to 0
+    return row * COLS + lobes_axis_column(u32(max(t, 0.0) * Real(COLS)), COLS, f32(sign(w.x)), f32(sign(w.y)));
 }

@@ -414,12 +414,14 @@ impl<'g> Passes<'g> {
         Ok(gpu.read(&out, out_bytes)?)
     }
 
-    /// Per rectangle (a0, a1, b0, b1) in hemisphere h: (∫pdf 5×5, ∫pdf 3×3, ∫eval 5×5, ∫eval 3×3).
-    pub fn integrate(&self, params: &Params, rects: &[([f32; 4], f32)]) -> Result<Vec<[f32; 4]>, CheckError> {
+    /// Per rectangle (a0, a1, b0, b1) in hemisphere h and quadrant k, `(rect, [h, k])` (b measured
+    /// from the axis k quarter turns from +x, `lobes_domain_point`): (∫pdf 5×5, ∫pdf 3×3, ∫eval
+    /// 5×5, ∫eval 3×3).
+    pub fn integrate(&self, params: &Params, rects: &[([f32; 4], [f32; 2])]) -> Result<Vec<[f32; 4]>, CheckError> {
         let mut out = Vec::with_capacity(rects.len());
         let per_call = 1 << 20;
         for chunk in rects.chunks(per_call) {
-            let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1, 0.0, 0.0, 0.0])).collect();
+            let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], 0.0, 0.0])).collect();
             let p = Params { count: chunk.len() as u32, ..*params };
             let bytes = self.run("lobes_integrate_rects", &p, &input, chunk.len() as u32, chunk.len() as u64 * 16, false)?;
             out.extend_from_slice(bytemuck::cast_slice(&bytes));

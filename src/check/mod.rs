@@ -565,15 +565,15 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     // The expected histogram.
     let width = quadrature::initial_width(p_max, plane);
     let integrals = match &settings.reference {
-        None => quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples)?,
+        None => quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?,
         Some(reference) => {
             let wi = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
             let pdf = |d: glam::DVec3| (reference.0)(wi, d);
             let cpu = quadrature::CpuPdf { pdf: &pdf, plane };
-            let mut i = quadrature::integrate(&cpu, &sampler.domain, rows, cols, width, settings.samples)?;
+            let mut i = quadrature::integrate(&cpu, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
             // eval has no f64 twin: its integral stays the GPU's
             if sampler.eval.is_some() {
-                i.eval = quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples)?.eval;
+                i.eval = quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?.eval;
             }
             i
         }

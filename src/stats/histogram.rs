@@ -1,4 +1,5 @@
-//! Binning of directions: the CPU twin of `shaders/lib/histogram.wgsl`.
+//! Binning of directions: the CPU twin of `shaders/lib/histogram.wgsl`'s `bin_of` and
+//! `shaders/lib/bins.wgsl`.
 //!
 //! Bins are uniform in cos θ ∈ [−1, 1] (rows) and φ ∈ [−π, π) (columns), so every bin spans
 //! the same solid angle 4π / (rows · cols) (Archimedes' hat-box theorem).
@@ -39,7 +40,8 @@ impl SphereGrid {
     /// `col`, from the rounded t, moved across the seam by the sign of y, and into the half (for an
     /// even `cols`) and quarter (for a multiple of 4) of the grid that the signs of x and y put w in: on the axes' edges
     /// (φ = 0, ±π/2, ±π) the column is exact, whatever t rounded to (φ = π − 1e-17 gives t = 1,
-    /// column 0, in f64 as φ = π − 1e-7 does in f32). The WGSL twin is `axis_exact_column`.
+    /// column 0, in f64 as φ = π − 1e-7 does in f32). The WGSL twin is `lobes_axis_column`
+    /// (`shaders/lib/bins.wgsl`), which the engine's `bin_of` and `lobes check`'s binning share.
     fn axis_exact_column(&self, col: u32, x: f64, y: f64) -> u32 {
         // the seam φ = ±π, an edge of every grid: column 0 lies below it (y ≤ 0), the last above
         let col = match col {

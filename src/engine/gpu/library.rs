@@ -75,7 +75,7 @@ macro_rules! shader {
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 31] = [
+static FILES: [File; 32] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -91,6 +91,7 @@ static FILES: [File; 31] = [
     shader!("lib/fresnel.wgsl"),
     shader!("lib/masking.wgsl"),
     shader!("lib/discrete.wgsl"),
+    shader!("lib/bins.wgsl"),
     shader!("lib/histogram.wgsl"),
     shader!("math/f32.wgsl"),
     shader!("math/erf_f32.wgsl"),
