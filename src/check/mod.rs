@@ -34,6 +34,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod budget;
 mod builtin;
 pub mod compose;
 pub mod conventions;
@@ -371,15 +372,9 @@ pub const PDF_CONSISTENCY_LIMIT: f64 = 1e-3;
 /// call sites, differ by that much. A sampler's d carries a few ulps of rounding: 4 of them.
 pub const CONDITIONING_ULPS: f64 = 4.0;
 
-/// Runs every check of `sampler` on `gpu`.
-pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
-    let started = std::time::Instant::now();
-    settings.validate()?;
-    let _deadline = gpu.deadline(settings.timeout);
-    sampler.validate()?;
-    if !matches!(sampler.domain, Domain::Plane { .. }) {
-        sampler.conventions.check_incident(settings.incident_theta)?;
-    }
+/// The passes' parameters of a check: the user's numbers, the incident direction, the seed and
+/// the grid.
+fn params_of(sampler: &UserSampler, settings: &Settings) -> gpu::Params {
     let (rows, cols) = settings.grid(&sampler.domain);
     let mut user = [[0f32; 4]; 4];
     for (i, p) in settings.params.iter().enumerate() {
@@ -390,7 +385,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         Domain::Plane { bounds } => bounds.map(|b| b as f32),
         Domain::Sphere => [0.0; 4],
     };
-    let params = gpu::Params {
+    gpu::Params {
         user,
         wi: [wi[0], wi[1], wi[2], 0.0],
         bounds,
@@ -404,36 +399,85 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         slabs: 0,
         _pad_b: 0,
         _pad_c: 0,
-    };
+    }
+}
+
+/// The sampler's passes, with the user's --rand draws (at most four) in the order lobes' probe
+/// finds them unless --rand-order gave it, and the note on that order for the report.
+fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, params: &gpu::Params) -> Result<(gpu::Passes<'g>, String), CheckError> {
     let mut passes = gpu::Passes::new(gpu, &gpu::compose(sampler)?)?;
-    // the user's --rand draws: at most four, and (without --rand-order) in the order lobes' probe finds
     let mut draws = String::new();
     if !sampler.composition.rand.is_empty() {
-        let (order, note) = gpu::rand_order(&passes, &params, sampler, settings.seed)?;
+        let (order, note) = gpu::rand_order(&passes, params, sampler, settings.seed)?;
         if sampler.composition.rand_order.is_none() && order != Draw::components(&[]) {
             passes = gpu::Passes::new(gpu, &gpu::compose_ordered(sampler, order)?)?;
         }
         draws = note;
     }
-    let plane = matches!(sampler.domain, Domain::Plane { .. });
-    let mut checks = Vec::new();
+    Ok((passes, draws))
+}
 
-    // The histogram, in dispatches of at most 2^26 samples.
-    let bins = (rows * cols) as usize;
+/// The most samples of one dispatch of the histogram and weights passes.
+const CHUNK: u64 = 1 << 26;
+
+/// The histogram of `samples` samples: counts per bin, then per invalid reason, in dispatches
+/// of at most [`CHUNK`] samples.
+fn histogram(passes: &gpu::Passes, params: &gpu::Params, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
     let mut totals = vec![0u64; bins + 4];
-    let chunk = 1u64 << 26;
     let mut first = 0;
-    while first < settings.samples {
-        let n = chunk.min(settings.samples - first) as u32;
-        for (t, c) in totals.iter_mut().zip(passes.histogram(&params, first, n, bins + 4, None)?) {
+    while first < samples {
+        let n = CHUNK.min(samples - first) as u32;
+        for (t, c) in totals.iter_mut().zip(passes.histogram(params, first, n, bins + 4, None)?) {
             *t += c as u64;
         }
         first += n as u64;
     }
     let counted: u64 = totals.iter().sum();
-    if counted != settings.samples {
-        return Err(CheckError::Internal(format!("{counted} samples counted for {} drawn", settings.samples)));
+    if counted != samples {
+        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
     }
+    Ok(totals)
+}
+
+/// The histograms alone (none of the other checks) of `sampler` at each (samples, seed) of
+/// `runs`, the passes composed once: counts per bin then per reason of [`REASONS`], and the
+/// wall seconds of each histogram. For measurements over many seeds and counts (`lobes
+/// tradeoff`'s detection table), judged against the expected counts of one [`check`] of the
+/// same settings.
+pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &[(u64, u64)]) -> Result<Vec<(Vec<u64>, f64)>, CheckError> {
+    settings.validate()?;
+    let _deadline = gpu.deadline(settings.timeout);
+    sampler.validate()?;
+    let (rows, cols) = settings.grid(&sampler.domain);
+    let (passes, _) = compose_passes(gpu, sampler, settings, &params_of(sampler, settings))?;
+    runs.iter()
+        .map(|&(samples, seed)| {
+            let params = params_of(sampler, &Settings { seed, ..settings.clone() });
+            let started = std::time::Instant::now();
+            let counts = histogram(&passes, &params, samples, (rows * cols) as usize)?;
+            Ok((counts, started.elapsed().as_secs_f64()))
+        })
+        .collect()
+}
+
+/// Runs every check of `sampler` on `gpu`.
+pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
+    let started = std::time::Instant::now();
+    settings.validate()?;
+    let _deadline = gpu.deadline(settings.timeout);
+    sampler.validate()?;
+    if !matches!(sampler.domain, Domain::Plane { .. }) {
+        sampler.conventions.check_incident(settings.incident_theta)?;
+    }
+    let (rows, cols) = settings.grid(&sampler.domain);
+    let wi = incident(settings.incident_theta, settings.incident_phi);
+    let params = params_of(sampler, settings);
+    let (passes, draws) = compose_passes(gpu, sampler, settings, &params)?;
+    let plane = matches!(sampler.domain, Domain::Plane { .. });
+    let mut checks = Vec::new();
+
+    let bins = (rows * cols) as usize;
+    let totals = histogram(&passes, &params, settings.samples, bins)?;
 
     // The probe: uniforms away from the edges by 2ε, so that u ± ε stays in [0, 1].
     let margin = 2.0 * jacobian::EPS as f64;
@@ -661,7 +705,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         let (mut sw, mut sw2, mut max_err, mut sum_err, mut judged) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
         let mut first = 0;
         while first < settings.samples {
-            let n = chunk.min(settings.samples - first) as u32;
+            let n = CHUNK.min(settings.samples - first) as u32;
             for [v, e] in passes.weights(&params, first, n)? {
                 sw += v[0] as f64;
                 sw2 += v[1] as f64;

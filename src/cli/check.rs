@@ -29,6 +29,15 @@ pub enum ReturnsChoice {
     HalfVector,
 }
 
+/// A named time budget (`lobes::check::budget::Profile`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ProfileChoice {
+    /// 20 s a check: a CI job on a CPU runner.
+    Ci,
+    /// 300 s a check: a nightly job.
+    Thorough,
+}
+
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// The WGSL files that define the sampler, in order.
@@ -107,6 +116,15 @@ pub struct CheckArgs {
     /// Samples drawn for the histogram (and the weights), 1 to 2^40.
     #[arg(long, value_name = "N", default_value_t = 1 << 22, value_parser = clap::value_parser!(u64).range(1..=crate::scene::MAX_SAMPLES))]
     pub samples: u64,
+    /// Pick --samples for a time budget: short pilot checks measure this sampler's fixed time
+    /// and time per sample on this adapter, and the check runs at the largest count whose
+    /// predicted wall time fits SECONDS (the pilots' time comes on top). Not with --samples.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_budget, conflicts_with_all = ["samples", "profile"])]
+    pub budget: Option<f64>,
+    /// A named --budget: ci (20 s: the panel of subtly broken samplers caught on lavapipe) or
+    /// thorough (300 s, a nightly job). Not with --samples or --budget.
+    #[arg(long, value_enum, conflicts_with = "samples")]
+    pub profile: Option<ProfileChoice>,
     /// Seconds the whole check may take (default 600): a sampler that is still running then (an
     /// endless loop) fails the check with the pass it was in; raise it for a large --samples.
     #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
@@ -199,6 +217,14 @@ impl CheckArgs {
     }
 }
 
+/// `--budget`: seconds, a number > 0 and at most [`check::MAX_TIMEOUT_SECONDS`].
+fn parse_budget(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t > 0.0 && t <= check::MAX_TIMEOUT_SECONDS => Ok(t),
+        _ => Err(format!("'{s}' is not a time budget; give seconds, a number > 0 and at most {:e}", check::MAX_TIMEOUT_SECONDS)),
+    }
+}
+
 /// `--timeout`: seconds, a number > 0 and at most [`check::MAX_TIMEOUT_SECONDS`].
 fn parse_timeout(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
@@ -245,6 +271,23 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     interrupt::watch("stopping the check now (interrupt again to end at once)")?;
     let gpu = Gpu::new()?;
     let _stop = gpu.stop_when(interrupt::requested);
+    let profile = args.profile.map(|p| match p {
+        ProfileChoice::Ci => check::budget::Profile::Ci,
+        ProfileChoice::Thorough => check::budget::Profile::Thorough,
+    });
+    let settings = match args.budget.or(profile.map(|p| p.seconds())) {
+        None => settings,
+        Some(budget) => {
+            let pick = check::budget::pick(&gpu, &sampler, &settings, budget, profile).map_err(input)?;
+            // the reason on stdout before the table; with --json (one object on stdout) on stderr
+            if args.output.json {
+                eprintln!("lobes: {}", pick.explain());
+            } else {
+                emit(&format!("{}\n", pick.explain()))?;
+            }
+            Settings { samples: pick.samples, ..settings }
+        }
+    };
     if args.power {
         return power(&gpu, &sampler, &settings, args);
     }
@@ -367,6 +410,20 @@ fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, args: &CheckArgs
                     seconds(p.gpu_seconds),
                     format!("{:.2}", p.seconds),
                 ]
+            }),
+        );
+        t += "\nfrom which count each test of the χ² family and each check catches the error:\n";
+        t += &table::render(
+            &["test", "kind", "caught from", "GPU s", "wall s"],
+            sweep.tests.iter().map(|r| {
+                let kind = match r.kind {
+                    check::power::TestKind::Chi2Family => "chi2 family",
+                    check::power::TestKind::Check => "check",
+                };
+                match &r.caught {
+                    Some(c) => vec![r.test.clone(), kind.into(), c.samples.to_string(), seconds(c.gpu_seconds), format!("{:.2}", c.seconds)],
+                    None => vec![r.test.clone(), kind.into(), "-".into(), "-".into(), "-".into()],
+                }
             }),
         );
         t += &sweep.verdict();

@@ -4,6 +4,7 @@
 use super::{OutputArgs, emit, emit_json, usage};
 use crate::engine::gpu::GpuEngine;
 use crate::report::tradeoff::{self as report, Report};
+use crate::experiments::tradeoff::detection::{self, DetectionSettings};
 use crate::experiments::tradeoff::{self, MethodSettings, Precision, Sampler, SweepSettings};
 use clap::Args;
 use std::path::PathBuf;
@@ -42,9 +43,23 @@ pub struct TradeoffArgs {
     /// Largest sample count of the --long sampler, as log2 (10 ..= 34).
     #[arg(long, default_value_t = 28, value_parser = clap::value_parser!(u32).range(10..=34))]
     pub long_max_log2: u32,
-    /// Which parts to run, comma-separated: sweep, methods, quadrature.
+    /// Which parts to run, comma-separated: sweep, methods, quadrature, detection (the
+    /// detection table: minutes on lavapipe, so not by default).
     #[arg(long, value_name = "LIST", default_value = "sweep,methods,quadrature")]
     pub parts: String,
+    /// The detection table's turn sizes ε in radians, comma-separated, each in (0, 0.5].
+    #[arg(long, value_name = "LIST", default_value = "0.005,0.01,0.02")]
+    pub detection_epsilons: String,
+    /// The detection table's seeds per sample count (its power is the share of them that
+    /// reject), 1 ..= 1000.
+    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub detection_seeds: u64,
+    /// The detection table's counts, as log2: from --detection-min-log2 doubling up to
+    /// --detection-max-log2 (10 ..= 34).
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u32).range(10..=34))]
+    pub detection_min_log2: u32,
+    #[arg(long, default_value_t = 27, value_parser = clap::value_parser!(u32).range(10..=34))]
+    pub detection_max_log2: u32,
     /// Seed of the random numbers.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -61,6 +76,9 @@ pub struct TradeoffArgs {
     #[command(flatten)]
     pub output: OutputArgs,
 }
+
+/// The parts `--parts` names.
+const PARTS: [&str; 4] = ["sweep", "methods", "quadrature", "detection"];
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
     let x = super::parse_number(s)?;
@@ -87,7 +105,14 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
     let all = Sampler::ALL.map(|s| s.name()).join(", ");
     let samplers = list("--samplers", &args.samplers, Sampler::parse, &all)?;
     let precisions = list("--precisions", &args.precisions, Precision::parse, "f32-fast, f32-accurate, f64")?;
-    let parts = list("--parts", &args.parts, |s| ["sweep", "methods", "quadrature"].contains(&s).then(|| s.to_string()), "sweep, methods, quadrature")?;
+    let parts = list("--parts", &args.parts, |s| PARTS.contains(&s).then(|| s.to_string()), &PARTS.join(", "))?;
+    let epsilons = list("--detection-epsilons", &args.detection_epsilons, |s| s.parse::<f64>().ok().filter(|e| *e > 0.0 && *e <= 0.5), "numbers in (0, 0.5], e.g. 0.005,0.01")?;
+    if args.detection_min_log2 > args.detection_max_log2 {
+        return Err(usage(format!(
+            "--detection-min-log2 {} is above --detection-max-log2 {}; give min ≤ max",
+            args.detection_min_log2, args.detection_max_log2
+        )));
+    }
     let long = match args.long.trim() {
         "none" => None,
         s => Some(Sampler::parse(s).ok_or_else(|| usage(format!("--long: '{s}' is unknown; use none or {all}")))?),
@@ -132,6 +157,18 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
             quadrature.extend(tradeoff::compare_quadrature(&engine, ggx_vndf, alpha, args.incident_theta, &[1, 2, 4, 8], args.runs as usize)?);
         }
     }
+    let detection = if has("detection") {
+        let set = DetectionSettings {
+            epsilons,
+            seeds: args.detection_seeds,
+            log2_min: args.detection_min_log2,
+            log2_max: args.detection_max_log2,
+            ..Default::default()
+        };
+        Some(detection::detection(&engine.gpu, &set, &mut log).map_err(|e| if e.is_input() { usage(e.to_string()) } else { e.into() })?)
+    } else {
+        None
+    };
     let command = std::iter::once("lobes".to_string()).chain(std::env::args().skip(1)).collect::<Vec<_>>().join(" ");
     let r = Report {
         adapter,
@@ -143,6 +180,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
         sweep,
         methods,
         quadrature,
+        detection,
     };
     if let Some(out) = &args.out {
         report::write(out, &r)?;

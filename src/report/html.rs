@@ -12,7 +12,7 @@
 use super::caption;
 use super::compare::{BARS_PNG, EXPECTED_PNG, MARGINALS_PNG, MEASURED_PNG, RESIDUAL_COARSE_PNG, RESIDUAL_PNG};
 use super::label::compact;
-use super::output::{CaseSummary, HistogramFile};
+use super::output::{CaseMeasured, CaseSummary, HistogramFile};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -81,17 +81,26 @@ pub fn page(out: &Path, heading: &[String], cases: &[CaseSummary]) -> String {
         let _ = writeln!(h, "<p class=\"heading\">{}</p>", escape(line));
     }
     let _ = writeln!(h, "<p class=\"tally\"><span class=\"fail\">{failed} failed</span> · <span class=\"error\">{errors} could not run</span> · <span class=\"pass\">{passed} passed</span></p>");
-    h += "<table class=\"cases\">\n<tr><th>case</th><th>verdict</th><th>χ²</th><th>dof</th><th>p-value</th></tr>\n";
+    // the verdict's p (the family's) and the test that decided it first; the fine grid's
+    // figures after them, named by its grid
+    h += "<table class=\"cases\">\n<tr><th>case</th><th>verdict</th><th>p-value (family)</th><th>decided by</th><th>fine grid χ² / dof</th><th>fine grid p</th></tr>\n";
     for c in &order {
         let o = Outcome::of(c);
-        let (chi2, dof, p) = c.measured.as_ref().map_or(("-".into(), "-".into(), "-".into()), |m| (format!("{:.1}", m.chi2), m.dof.to_string(), compact(m.p_value)));
+        let cells = c.measured.as_ref().map_or(["-".to_string(), "-".into(), "-".into(), "-".into()], |m| {
+            let fine = m.family.first().map_or(String::new(), |f| format!(" ({})", f.test));
+            [compact(family_p(m)), decided_by(m), format!("{:.1} / {}{fine}", m.chi2, m.dof), compact(m.p_value)]
+        });
         let _ = writeln!(
             h,
-            "<tr class=\"{}\"><td><a href=\"#{}\">{}</a></td><td class=\"verdict\">{}</td><td>{chi2}</td><td>{dof}</td><td>{p}</td></tr>",
+            "<tr class=\"{}\"><td><a href=\"#{}\">{}</a></td><td class=\"verdict\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             o.class(),
             escape(&anchor(&c.case)),
             escape(&c.case),
-            o.word()
+            o.word(),
+            escape(&cells[0]),
+            escape(&cells[1]),
+            escape(&cells[2]),
+            escape(&cells[3]),
         );
     }
     h += "</table>\n";
@@ -120,8 +129,10 @@ fn case_section(h: &mut String, out: &Path, c: &CaseSummary) {
     }
     let mut figures = vec![("samples", c.samples.to_string())];
     if let Some(m) = &c.measured {
-        figures.push(("χ² / dof", format!("{:.1} / {}", m.chi2, m.dof)));
-        figures.push(("p-value", compact(m.p_value)));
+        figures.push(("p-value (family)", compact(family_p(m))));
+        figures.push(("decided by", decided_by(m)));
+        let fine = m.family.first().map_or("fine grid".to_string(), |f| format!("fine grid {}", f.test));
+        figures.push(("χ² / dof", format!("{:.1} / {} ({fine}, p = {})", m.chi2, m.dof, compact(m.p_value))));
         figures.push(match m.gpu_seconds {
             Some(g) => ("GPU time", format!("{g:.3} s")),
             None => ("wall time", format!("{:.3} s", m.wall_seconds)),
@@ -156,6 +167,22 @@ fn case_section(h: &mut String, out: &Path, c: &CaseSummary) {
         let _ = writeln!(h, "<figure{wide}><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a><figcaption>{1}</figcaption></figure>", escape(&src), escape(what));
     }
     h.push_str("</div>\n</section>\n");
+}
+
+/// The p-value the verdict compares with the significance: the family's (Holm's smallest,
+/// [`crate::stats::family::judge`]), or the fine grid's where the case has no family.
+fn family_p(m: &CaseMeasured) -> f64 {
+    m.family_p_value.unwrap_or(m.p_value)
+}
+
+/// The test of the family with the smallest Holm p-value, with its own p: the one that caught
+/// the defect (or came closest to), e.g. "8 × 16: p = 5e-8 (Holm 4e-7)"; a case without a
+/// family (an older summary) is decided by the fine grid.
+fn decided_by(m: &CaseMeasured) -> String {
+    match m.family.iter().min_by(|a, b| a.holm_p_value.total_cmp(&b.holm_p_value)) {
+        Some(t) => format!("{}: p = {} (Holm {})", t.test, compact(t.p_value), compact(t.holm_p_value)),
+        None => "fine grid".into(),
+    }
 }
 
 /// The element id of a case's section.
@@ -225,7 +252,7 @@ addEventListener('load', () => {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::output::CaseMeasured;
+    use crate::stats::family::FamilyTest;
 
     fn case(name: &str, passed: bool, error: Option<&str>) -> CaseSummary {
         CaseSummary {
@@ -255,6 +282,33 @@ mod tests {
         assert!(page.contains("1 failed") && page.contains("1 could not run") && page.contains("2 passed"));
         // no network: no absolute URL anywhere
         assert!(!page.contains("http:") && !page.contains("https:") && !page.contains("//cdn"));
+    }
+
+    /// A case the fine grid passes (p 0.28) and the 8 × 16 grid catches: its row shows the
+    /// family's p beside FAIL, and the test that decided it, not the fine grid's p alone.
+    #[test]
+    fn the_case_table_shows_the_family_p_and_the_deciding_test() {
+        let test = |name: &str, rows, cols, p: f64, holm: f64| FamilyTest {
+            test: name.into(),
+            rows,
+            cols,
+            statistic: 1.0,
+            dof: 1,
+            p_value: p,
+            holm_p_value: holm,
+            rejected: holm < 0.01,
+        };
+        let mut caught = case("caught-coarse", false, None);
+        let m = caught.measured.as_mut().unwrap();
+        m.family = vec![test("64 × 128", 64, 128, 0.28, 1.0), test("8 × 16", 8, 16, 5e-8, 4e-7), test("φ", 1, 128, 0.02, 0.1)];
+        m.family_p_value = Some(4e-7);
+        let page = page(Path::new("/nonexistent"), &[], &[caught]);
+        let row = page.lines().find(|l| l.starts_with("<tr class=\"fail\">")).expect("the case's row");
+        let cells: Vec<&str> = row.split("<td").skip(1).map(|c| c.split_once('>').unwrap().1.trim_end_matches("</td></tr>").trim_end_matches("</td>")).collect();
+        assert_eq!(cells[1..], ["FAIL", "4e-7", "8 × 16: p = 5e-8 (Holm 4e-7)", "12.0 / 10 (64 × 128)", "0.28"], "{row}");
+        assert!(page.contains("<th>p-value (family)</th><th>decided by</th>"));
+        // the case's figures say the same
+        assert!(page.contains("<dt>p-value (family)</dt><dd>4e-7</dd><dt>decided by</dt><dd>8 × 16: p = 5e-8 (Holm 4e-7)</dd>"), "{page}");
     }
 
     #[test]

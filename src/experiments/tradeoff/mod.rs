@@ -5,8 +5,10 @@
 //! reference; it compares GGX's two visible-normal samplers (spherical caps and bounded VNDF) by
 //! time per sample and by the variance of the albedo estimator; and it measures the expected
 //! histogram's quadrature at fixed resolutions on the CPU (f64) and the GPU (f32) against the
-//! adaptive f64 quadrature that `lobes run` uses.
+//! adaptive f64 quadrature that `lobes run` uses; and ([`detection`]) the samples and seconds
+//! each χ² test needs to catch a defect of size ε at 90 % power.
 
+pub mod detection;
 pub mod quadrature;
 pub use crate::engine::gpu::precision::Precision;
 

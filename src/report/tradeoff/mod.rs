@@ -8,6 +8,7 @@ pub mod tables;
 pub use tables::{methods_table, quadrature_table, summary_table, sweep_table};
 
 use super::atomic::write_atomic;
+use crate::experiments::tradeoff::detection::Detection;
 use crate::experiments::tradeoff::{MethodPoint, QuadraturePoint, Sweep};
 use serde::Serialize;
 use std::path::Path;
@@ -25,6 +26,8 @@ pub struct Report {
     pub sweep: Sweep,
     pub methods: Vec<MethodPoint>,
     pub quadrature: Vec<QuadraturePoint>,
+    /// The detection table (`--parts detection`): null when not run.
+    pub detection: Option<Detection>,
 }
 
 /// The whole markdown document.
@@ -62,6 +65,28 @@ pub fn markdown(r: &Report) -> String {
               standard deviations of a count at 10⁸ samples (the adaptive row gives its own error estimate). GPU time: \
               the dispatch, compilation excluded.\n\n";
         s += &quadrature_table(&r.quadrature);
+    }
+    if let Some(d) = &r.detection {
+        s += &format!(
+            "\n## Samples to catch a defect: the family against the fine grid\n\n\
+             GGX visible normals (α {}, θi {}°) turned about the normal by ε sin φ (density off by about ε cos φ; \
+             tests/fixtures/family/broken_turn.wgsl is ε = 0.005). Each cell: the smallest N = 2^k from which the test rejects \
+             (p < {}) in at least {:.0} % of {} seeds, at N and at every larger N measured; the search doubles N until the family \
+             and the fine grid reject in every seed, so \"> N\" says the test had not by the last N. A test alone: its own p < α \
+             (the fine grid alone is the test before the family); the family: Holm's smallest p < α, the check's verdict. \
+             Seconds: one whole `lobes check` at that N on this adapter, t = {:.2} s + N × {:.3e} s (the line through whole checks \
+             at the smallest and largest N). {} × {} bins.\n\n",
+            d.alpha,
+            d.incident_theta_deg,
+            d.significance,
+            100.0 * d.power,
+            d.seeds,
+            d.fixed_seconds,
+            d.seconds_per_sample,
+            d.rows,
+            d.cols
+        );
+        s += &tables::detection_table(d);
     }
     s
 }

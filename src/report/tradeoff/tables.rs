@@ -1,5 +1,6 @@
 //! The markdown tables of `tradeoff.md`.
 
+use crate::experiments::tradeoff::detection::{Detected, Detection};
 use crate::experiments::tradeoff::{MethodPoint, Precision, QuadraturePoint, Sweep, SweepPoint};
 
 fn sci(x: f64) -> String {
@@ -133,5 +134,41 @@ pub fn quadrature_table(q: &[QuadraturePoint]) -> String {
             opt(p.gpu_vs_cpu_l1_rel, &sci),
         );
     }
+    t
+}
+
+/// The detection table: a row per test (the family first, then each test alone), a column per
+/// ε; each cell the count from which the test catches the turn at the table's power, and the
+/// seconds of a whole check there. Then the other checks' verdicts per ε.
+pub fn detection_table(d: &Detection) -> String {
+    let mut t = String::from("| test |");
+    for e in &d.epsilons {
+        t += &format!(" ε = {} |", e.epsilon);
+    }
+    t += "\n|---|";
+    t += &"---|".repeat(d.epsilons.len());
+    t += "\n";
+    let tests = d.epsilons.first().map_or(&[][..], |e| &e.tests[..]);
+    for (k, test) in tests.iter().enumerate() {
+        t += &format!("| {test} |");
+        for e in &d.epsilons {
+            let cell = match e.detected.get(k) {
+                Some(Detected { samples: Some(n), seconds, .. }) => format!("{} ({:.1} s)", pow2(*n), seconds.unwrap_or(f64::NAN)),
+                _ => format!("> {}", e.points.last().map_or("-".into(), |p| pow2(p.samples))),
+            };
+            t += &format!(" {cell} |");
+        }
+        t += "\n";
+    }
+    for e in &d.epsilons {
+        let failed: Vec<&str> = e.other_checks_passed.iter().filter(|(_, ok)| !ok).map(|(n, _)| n.as_str()).collect();
+        let checks: Vec<&str> = e.other_checks_passed.iter().map(|(n, _)| n.as_str()).collect();
+        t += &if failed.is_empty() {
+            format!("\nε = {}: the other checks ({}) pass at {}: only the χ² tests see the turn.", e.epsilon, checks.join(", "), pow2(e.checked_at))
+        } else {
+            format!("\nε = {}: other checks see it too: {} failed at {}.", e.epsilon, failed.join(", "), pow2(e.checked_at))
+        };
+    }
+    t += "\n";
     t
 }

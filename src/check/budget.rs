@@ -1,0 +1,152 @@
+//! `lobes check --budget SECONDS` and `--profile ci|thorough`: the largest sample count whose
+//! check fits a time budget on this adapter. A check's wall time is a fixed part (composing and
+//! compiling the passes, the quadrature of the pdf, the probe passes: independent of N) plus N
+//! times the time per sample of the histogram (and weights) passes; short pilot checks measure
+//! both on the adapter at hand, and the count is the largest whose predicted time
+//! t₀ + N · s is within the budget (docs/testing-your-own-sampler.md).
+
+use super::{CheckError, Settings, UserSampler, check};
+use crate::engine::gpu::Gpu;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The named budgets of `--profile`, in seconds of one check's wall time.
+///
+/// `ci`: 20 s. On lavapipe (2 vCPU, loaded) a check of GGX's visible normals measured 0.7–2.3 s
+/// fixed and 0.08–0.23 µs a sample, so 20 s buys 2²⁶–2²⁷ samples: past the 2²³ from which the
+/// family catches every defect of the panel of subtly broken samplers (docs/statistics.md), and
+/// about the 2²⁵–2²⁶ from which the fine grid alone does.
+///
+/// `thorough`: 300 s, five minutes: a nightly job, about 15× the samples of `ci` on the same
+/// machine: a defect about 4× smaller (the count a χ² test needs grows as 1/ε²).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Profile {
+    Ci,
+    Thorough,
+}
+
+impl Profile {
+    pub fn seconds(self) -> f64 {
+        match self {
+            Profile::Ci => 20.0,
+            Profile::Thorough => 300.0,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Profile::Ci => "ci",
+            Profile::Thorough => "thorough",
+        }
+    }
+}
+
+/// The first pilot count, and the granularity of a picked count.
+pub const PILOT_SAMPLES: u64 = 1 << 16;
+
+/// One pilot check.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Pilot {
+    pub samples: u64,
+    /// Its wall time and GPU time (null without timestamp queries).
+    pub seconds: f64,
+    pub gpu_seconds: Option<f64>,
+}
+
+/// What `--budget` picked and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct BudgetPick {
+    /// The budget: seconds of wall time for the one check at the picked count.
+    pub budget_seconds: f64,
+    /// The profile that named it, if one did.
+    pub profile: Option<String>,
+    /// The pilot checks, in order (the first warms the driver's pipelines and is not used).
+    pub pilots: Vec<Pilot>,
+    /// The fitted model t(N) = fixed_seconds + N · seconds_per_sample.
+    pub fixed_seconds: f64,
+    pub seconds_per_sample: f64,
+    /// The count picked (a multiple of [`PILOT_SAMPLES`], at most 2⁴⁰) and its predicted time.
+    pub samples: u64,
+    pub predicted_seconds: f64,
+}
+
+impl BudgetPick {
+    /// One line saying what was picked and why.
+    pub fn explain(&self) -> String {
+        let named = self.profile.as_ref().map_or(String::new(), |p| format!(" (--profile {p})"));
+        let rate = if self.seconds_per_sample > 0.0 { format!("{:.3e} samples/s", 1.0 / self.seconds_per_sample) } else { "no measurable time per sample".into() };
+        let capped = if self.samples == crate::engine::job::MAX_SAMPLES { ", capped at 2^40" } else { "" };
+        format!(
+            "budget {:.1} s{named}: {} samples picked{capped}, predicted {:.2} s: {} pilot checks on this adapter measured {:.2} s fixed + {rate}",
+            self.budget_seconds,
+            self.samples,
+            self.predicted_seconds,
+            self.pilots.len(),
+            self.fixed_seconds,
+        )
+    }
+}
+
+/// The count that fits `budget` seconds: from the pilots' fixed part `fixed` and time per
+/// sample `per_sample`, the largest multiple of [`PILOT_SAMPLES`] with fixed + N · per_sample ≤
+/// budget, at most 2⁴⁰; `None` when not even [`PILOT_SAMPLES`] fit.
+///
+/// ```
+/// use lobes::check::budget::fit;
+/// // 1 s fixed, 10⁷ samples/s: 10 s buys 9·10⁷ samples, rounded down to a multiple of 2¹⁶
+/// assert_eq!(fit(10.0, 1.0, 1e-7), Some(89980928));
+/// assert_eq!(fit(1.0, 1.5, 1e-7), None);
+/// ```
+pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
+    let max = crate::engine::job::MAX_SAMPLES;
+    let n = if per_sample > 0.0 { ((budget - fixed) / per_sample).min(max as f64) } else { max as f64 };
+    let n = (n.max(0.0) as u64) / PILOT_SAMPLES * PILOT_SAMPLES;
+    (n >= PILOT_SAMPLES && fixed + n as f64 * per_sample <= budget).then_some(n)
+}
+
+/// Measures the check's time on `gpu` by pilot checks and picks the count for `budget` seconds.
+/// The pilots: one at [`PILOT_SAMPLES`] that warms the driver's pipelines (not used), one more
+/// there (the fixed part), then 2²⁰, 2²², … until the samples' share of the time is measurable
+/// (half the fixed part, or an eighth of the budget), and the line through the last two.
+pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, profile: Option<Profile>) -> Result<BudgetPick, CheckError> {
+    let run = |samples: u64| -> Result<Pilot, CheckError> {
+        let r = check(gpu, sampler, &Settings { samples, ..settings.clone() })?;
+        Ok(Pilot { samples, seconds: r.wall_seconds, gpu_seconds: r.gpu_seconds })
+    };
+    let mut pilots = vec![run(PILOT_SAMPLES)?, run(PILOT_SAMPLES)?];
+    let base = pilots[1].clone();
+    if base.seconds >= budget {
+        return Err(CheckError::Input(format!(
+            "--budget {budget} s is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
+            base.seconds,
+            2.0 * base.seconds
+        )));
+    }
+    let mut n = 1u64 << 20;
+    loop {
+        let p = run(n)?;
+        pilots.push(p.clone());
+        if p.seconds - base.seconds >= 0.5 * base.seconds || p.seconds >= budget / 8.0 || n >= crate::engine::job::MAX_SAMPLES / 4 {
+            break;
+        }
+        n *= 4;
+    }
+    let last = pilots.last().expect("a pilot");
+    let per_sample = ((last.seconds - base.seconds) / (last.samples - base.samples) as f64).max(0.0);
+    let fixed = (base.seconds - per_sample * base.samples as f64).max(0.0);
+    let samples = fit(budget, fixed, per_sample).ok_or_else(|| {
+        CheckError::Input(format!(
+            "--budget {budget} s is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
+            fixed + 2.0 * per_sample * PILOT_SAMPLES as f64 + 0.5
+        ))
+    })?;
+    Ok(BudgetPick {
+        budget_seconds: budget,
+        profile: profile.map(|p| p.name().to_string()),
+        pilots,
+        fixed_seconds: fixed,
+        seconds_per_sample: per_sample,
+        samples,
+        predicted_seconds: fixed + per_sample * samples as f64,
+    })
+}
