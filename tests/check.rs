@@ -392,8 +392,9 @@ fn a_reported_pdf_off_by_a_factor_fails_the_weights_and_the_albedo() {
 }
 
 /// `lobes check --power` exits 1 when some count fails and says from which count, and after
-/// how much GPU time, the error is caught: Mitsuba's rational G1 fails the normalisation at
-/// every count (the χ² test alone would need about 2²⁶ samples). Bad input exits 2.
+/// how much GPU time, the error is caught: Mitsuba's rational G1 fails the normalisation and the
+/// Jacobian's systematic test (its map off by about 0.3 % everywhere) at every count (the χ² test
+/// alone would need about 2²⁶ samples). Bad input exits 2.
 #[test]
 fn power_sweep_exits_1_and_says_from_which_count_an_error_is_caught() {
     let samplers = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers");
@@ -411,7 +412,7 @@ fn power_sweep_exits_1_and_says_from_which_count_an_error_is_caught() {
     let (code, stdout, stderr) = lobes(&["--samples", "262144"]);
     assert_eq!(code, Some(1), "{stdout}{stderr}");
     let verdict = stdout.lines().last().unwrap();
-    assert!(verdict.starts_with("caught from 65536 samples (normalization failing), after "), "{stdout}");
+    assert!(verdict.starts_with("caught from 65536 samples (jacobian, normalization failing), after "), "{stdout}");
     assert!(verdict.contains(" s of GPU time") || verdict.contains("no GPU timestamps"), "{verdict}");
     assert!(stdout.lines().any(|l| l.starts_with("262144 ")), "a row per count: {stdout}");
     assert!(stderr.contains("caught from 65536 samples"), "{stderr}");
@@ -420,7 +421,7 @@ fn power_sweep_exits_1_and_says_from_which_count_an_error_is_caught() {
     assert_eq!(code, Some(1));
     let sweep: lobes::check::power::PowerSweep = serde_json::from_str(&stdout).unwrap();
     assert!(!sweep.passed && sweep.points.iter().all(|p| !p.normalization_passed));
-    assert_eq!(sweep.caught.map(|c| (c.samples, c.failed)), Some((65536, vec!["normalization".to_string()])));
+    assert_eq!(sweep.caught.map(|c| (c.samples, c.failed)), Some((65536, vec!["jacobian".to_string(), "normalization".to_string()])));
 
     let (code, _, stderr) = lobes(&["--samples", "0"]);
     assert_eq!(code, Some(2), "{stderr}");
