@@ -163,6 +163,38 @@ fn a_user_sampler_that_rejects_every_sample_fails_the_run() {
     assert!(reason.contains("no sample was valid"), "{reason}");
 }
 
+/// A case with `budget = 4`: pilot checks pick its count (issue 25 item 5, as `lobes check
+/// --budget`); the case runs at that count, which fits the budget by the fitted model, and
+/// histogram.json says how it was picked.
+#[test]
+fn a_budget_picks_the_cases_sample_count() {
+    let dir = scratch("budget");
+    std::fs::copy(root().join("examples/samplers/ggx_vndf.wgsl"), dir.join("ggx.wgsl")).unwrap();
+    let scene = dir.join("s.toml");
+    std::fs::write(&scene, "[[case]]\nname = \"timed\"\nsampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\nparams = [0.3, 0.3]\nbudget = 4\n").unwrap();
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("‡ the count the case's budget picked"), "{table}");
+    let h = HistogramFile::read(&out_dir.join("timed/histogram.json")).unwrap();
+    let pick = h.user_sampler.as_ref().unwrap().budget.clone().expect("user_sampler.budget");
+    assert_eq!(h.samples, pick.samples, "the case ran at the picked count");
+    assert!(table.lines().any(|l| l.starts_with("timed") && l.contains(&format!("{}‡", pick.samples))), "{table}");
+    assert!(pick.samples >= 1 << 16 && pick.samples % (1 << 16) == 0, "{pick:?}");
+    assert!(pick.budget_seconds == 4.0 && pick.profile.is_none());
+    assert!(pick.predicted_seconds <= 4.0 && pick.fixed_seconds + pick.seconds_per_sample * pick.samples as f64 <= 4.0 + 1e-9, "{pick:?}");
+    // the next count up would not fit: the pick is the largest
+    let next = pick.samples + (1 << 16);
+    assert!(pick.fixed_seconds + pick.seconds_per_sample * next as f64 > 4.0 || pick.samples == lobes::engine::job::MAX_SAMPLES, "{pick:?}");
+    // `lobes run --samples N` sets every case's count: the budget is not used
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--samples", "131072", "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let h = HistogramFile::read(&out_dir.join("timed/histogram.json")).unwrap();
+    assert_eq!(h.samples, 131072);
+    assert!(h.user_sampler.unwrap().budget.is_none());
+}
+
 /// Writes a scene whose case uses ggx_vndf.wgsl through a path relative to the scene file.
 fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
     let scene = dir.join("bad.toml");
@@ -176,7 +208,7 @@ fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
 fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let dir = scratch("bad");
     let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
-    let cases: [(&str, &[&str]); 10] = [
+    let cases: [(&str, &[&str]); 14] = [
         ("sampler = \"ggx.wgsl\"\n", &["bad.toml:6:", "expected a sampler table { wgsl = [\"file.wgsl\"]"]),
         ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no pdf function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
@@ -187,6 +219,10 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
         (&format!("{good}alpha = 0.3\n"), &["bad.toml:7:", "alpha does not apply to a user sampler"]),
         (&format!("{good}params = [[0.3, 0.3], [0.1, \"x\"]]\n"), &["bad.toml:7:", "params must be a number"]),
         ("lobe = \"ggx\"\nalpha = 0.3\nparams = [0.3]\n", &["bad.toml:8:", "params only applies to a user sampler"]),
+        (&format!("{good}samples = 4096\nbudget = 5\n"), &["bad.toml:7:", "samples and budget both set the case's sample count"]),
+        (&format!("{good}budget = \"nightly\"\n"), &["bad.toml:7:", "budget = \"nightly\" is not a budget", "\"ci\" (20 s)"]),
+        (&format!("{good}budget = 0\n"), &["bad.toml:7:", "budget = 0 is not a budget", "a number > 0"]),
+        ("lobe = \"ggx\"\nalpha = 0.3\nbudget = 5\n", &["bad.toml:8:", "budget only applies to a user sampler"]),
     ];
     for (lines, want) in cases {
         let scene = bad_scene(&dir, lines);

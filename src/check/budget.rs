@@ -41,6 +41,39 @@ impl Profile {
     }
 }
 
+/// A time budget as the user wrote it: seconds, or a [`Profile`]'s name (`lobes check --budget` /
+/// `--profile`, and a scene case's `budget` key).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Budget {
+    pub seconds: f64,
+    pub profile: Option<Profile>,
+}
+
+impl Budget {
+    /// What a budget may be, for messages.
+    pub fn allowed() -> String {
+        let (ci, thorough) = (Profile::Ci, Profile::Thorough);
+        format!(
+            "a budget is seconds of one check's wall time, a number > 0 and at most {:e}, or \"{}\" ({} s) or \"{}\" ({} s)",
+            super::MAX_TIMEOUT_SECONDS,
+            ci.name(),
+            ci.seconds(),
+            thorough.name(),
+            thorough.seconds()
+        )
+    }
+
+    /// `"ci"` or `"thorough"`.
+    pub fn named(name: &str) -> Option<Self> {
+        [Profile::Ci, Profile::Thorough].into_iter().find(|p| p.name() == name).map(|p| Budget { seconds: p.seconds(), profile: Some(p) })
+    }
+
+    /// Seconds, > 0 and at most [`super::MAX_TIMEOUT_SECONDS`].
+    pub fn seconds(seconds: f64) -> Option<Self> {
+        (seconds > 0.0 && seconds <= super::MAX_TIMEOUT_SECONDS).then_some(Budget { seconds, profile: None })
+    }
+}
+
 /// The first pilot count, and the granularity of a picked count.
 pub const PILOT_SAMPLES: u64 = 1 << 16;
 

@@ -347,6 +347,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         if user_rows {
             text += "\n† a WGSL sampler of your own: wall time of all its checks (lobes check); FAIL names the checks that failed\n";
         }
+        if rows.iter().any(|r| r[1].ends_with(output::BUDGET_MARK)) {
+            text += &format!("\n{} the count the case's budget picked: pilot checks measured its time on this adapter (histogram.json: user_sampler.budget)\n", output::BUDGET_MARK);
+        }
         if !summary.not_run.is_empty() {
             text += &format!("\ninterrupted: {} of {n} cases not run ({})\n", summary.not_run.len(), summary.not_run.join(", "));
         }

@@ -138,6 +138,10 @@ pub struct UserSamplerRecord {
     pub invalid: UserInvalid,
     /// The expected count of the pooled invalid cell.
     pub expected_invalid: f64,
+    /// With the case's `budget`: the pilot checks, the fitted time model and the count picked
+    /// (the `samples` above).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<crate::check::budget::BudgetPick>,
 }
 
 /// Invalid samples of a user's sampler by reason.
@@ -246,6 +250,7 @@ impl HistogramFile {
                 checks: report.checks.to_vec(),
                 invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
                 expected_invalid: r.expected_invalid,
+                budget: r.budget.clone(),
             }),
         }
     }
@@ -723,7 +728,7 @@ pub fn user_table_row(r: &UserResult) -> [String; 9] {
     let failed = r.failed_checks();
     [
         r.case.name.clone(),
-        r.case.settings.samples.to_string(),
+        format!("{}{}", r.case.settings.samples, if r.budget.is_some() { BUDGET_MARK } else { "" }),
         format!("{:.3} s†", r.wall_seconds),
         format!("{:.1}", r.chi2.statistic),
         r.chi2.dof.to_string(),
@@ -733,6 +738,9 @@ pub fn user_table_row(r: &UserResult) -> [String; 9] {
         r.albedo.map_or("-".into(), |a| format!("{:.5} ({:+.1e})", a.mean_weight, a.relative_error())),
     ]
 }
+
+/// The mark of a sample count picked by a case's `budget` in the run table.
+pub const BUDGET_MARK: &str = "‡";
 
 pub const TABLE_HEADER: [&str; 9] = ["case", "samples", "GPU time", "chi2", "dof", "p-value", "verdict", "max angle err", "albedo (rel err)"];
 

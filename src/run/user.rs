@@ -7,6 +7,7 @@
 //! cases) are not sums over sample ranges, so `lobes run --shard` refuses scenes that have one.
 
 use super::Backend;
+use crate::check::budget::BudgetPick;
 use crate::check::report::{AlbedoFigures, Chi2Figures, WeightFigures};
 use crate::check::{self, CheckError, Report, Settings};
 use crate::scene::UserCase;
@@ -16,7 +17,10 @@ use std::time::Instant;
 /// What the checks of a user's case found.
 #[derive(Debug, Clone)]
 pub struct UserResult {
+    /// The case as it ran: with a `budget`, `settings.samples` is the count picked.
     pub case: UserCase,
+    /// With a `budget`: what the pilot checks measured and the count they picked.
+    pub budget: Option<BudgetPick>,
     pub report: Report,
     /// The χ² test of the histogram against the quadrature of the user's pdf.
     pub chi2: Chi2,
@@ -24,7 +28,7 @@ pub struct UserResult {
     pub expected_invalid: f64,
     /// The albedo check, where the sampler has an eval.
     pub albedo: Option<Albedo>,
-    /// Wall time of all the checks.
+    /// Wall time of all the checks (a budget's pilot checks included).
     pub wall_seconds: f64,
 }
 
@@ -74,7 +78,14 @@ pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow
         anyhow::bail!("case '{}' is a WGSL sampler and runs on a GPU adapter only; none is in use (CPU engine)", case.name);
     };
     let t = Instant::now();
-    let settings = Settings { significance, ..case.settings.clone() };
+    let mut settings = Settings { significance, ..case.settings.clone() };
+    let budget = match case.budget {
+        Some(b) => Some(check::budget::pick(&engine.gpu, &case.sampler, &settings, b.seconds, b.profile).map_err(run_error)?),
+        None => None,
+    };
+    if let Some(pick) = &budget {
+        settings.samples = pick.samples;
+    }
     let report = check::check(&engine.gpu, &case.sampler, &settings).map_err(run_error)?;
     let wall_seconds = t.elapsed().as_secs_f64();
     let chi2_figures = report.figures::<Chi2Figures>().ok_or_else(|| anyhow::anyhow!("the check report has no chi2 check"))?;
@@ -90,7 +101,8 @@ pub fn run_user(backend: &Backend, case: &UserCase, significance: f64) -> anyhow
         }),
         _ => None,
     };
-    Ok(UserResult { case: case.clone(), report, chi2, expected_invalid, albedo, wall_seconds })
+    let case = UserCase { settings: Settings { samples: settings.samples, ..case.settings.clone() }, ..case.clone() };
+    Ok(UserResult { case, budget, report, chi2, expected_invalid, albedo, wall_seconds })
 }
 
 #[cfg(test)]

@@ -154,6 +154,7 @@ struct RawCase {
     domain: Option<Val>,
     bounds: Option<Val>,
     timeout: Option<Val>,
+    budget: Option<Val>,
 }
 
 impl RawCase {
@@ -578,7 +579,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, room: u64
         Some(raw) => Some(user::sampler(ctx, c, &points[0], raw)?),
         None => {
             let user_keys =
-                [("params", points[0].get("params")), ("domain", c.domain.as_ref()), ("bounds", c.bounds.as_ref()), ("timeout", c.timeout.as_ref())];
+                [("params", points[0].get("params")), ("domain", c.domain.as_ref()), ("bounds", c.bounds.as_ref()), ("timeout", c.timeout.as_ref()), ("budget", c.budget.as_ref())];
             reject_keys(ctx, &user_keys, "only applies to a user sampler (sampler = { wgsl = [...], sample = ..., pdf = ... }); remove it")?;
             None
         }
@@ -608,7 +609,7 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, room: u64
             };
             let common = Common { name, samples, seed };
             match &sampler {
-                Some(s) => user::case(ctx, d, &point, common, s, c.timeout.as_ref()).map(Parsed::User),
+                Some(s) => user::case(ctx, d, &point, common, s, (c.timeout.as_ref(), c.budget.as_ref())).map(Parsed::User),
                 None => validate_case(ctx, spanned, d, &point, common).map(Parsed::Lobe),
             }
         })

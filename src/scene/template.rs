@@ -66,6 +66,8 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 # incident_theta = {user_theta:?}   # degrees, 0 ≤ θ ≤ 180 (a user sampler's default)
 # bins = [{srows}, {scols}]        # default [{srows}, {scols}] on the sphere, [{prows}, {pcols}] on the plane
 # timeout = {timeout}           # seconds all its checks may take (a sampler that loops forever fails here)
+# budget = "ci"           # seconds, or "ci" (20 s) / "thorough" (300 s): pilot checks pick the
+#                         # samples one check fits in on this adapter (not with samples)
 "#,
         samples = DEFAULT_SAMPLES,
         max_samples = MAX_SAMPLES,

@@ -6,6 +6,7 @@
 
 use super::sweep::Point;
 use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
+use crate::check::budget::Budget;
 use crate::check::{Conventions, DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
 use serde::Deserialize;
 use std::path::Path;
@@ -40,7 +41,10 @@ pub(super) struct RawSampler {
 pub struct UserCase {
     pub name: String,
     pub sampler: Arc<UserSampler>,
+    /// `settings.samples` is the case's count, or with a `budget` the count pilot checks pick
+    /// when the case runs ([`crate::check::budget::pick`]).
     pub settings: Settings,
+    pub budget: Option<Budget>,
 }
 
 const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\", frame = \"y-up\"; paths relative to the scene file)";
@@ -211,8 +215,25 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
     }
 }
 
+/// `budget = SECONDS` or `"ci"` / `"thorough"`: the case's count picked by pilot checks when it
+/// runs, as `lobes check --budget`; not with the case's own `samples`. A `--samples` given to
+/// `lobes run` sets every case's count, so there the budget is not used.
+fn budget(ctx: &Ctx, d: &Defaults, point: &Point, v: &Val) -> Result<Option<Budget>, SceneError> {
+    if let Some(s) = point.get("samples") {
+        return Err(ctx.err(s.span(), "samples and budget both set the case's sample count; keep one (budget picks the count that fits its seconds on the adapter)".to_string()));
+    }
+    let budget = match v.get_ref() {
+        Value::String(name) => Budget::named(name),
+        Value::Integer(i) => Budget::seconds(*i as f64),
+        Value::Float(x) => Budget::seconds(*x),
+        _ => None,
+    };
+    let budget = budget.ok_or_else(|| ctx.err(v.span(), format!("budget = {} is not a budget; {}", v.get_ref(), Budget::allowed())))?;
+    Ok(d.overrides.samples.is_none().then_some(budget))
+}
+
 /// One case of a user's sampler at one point of its sweeps.
-pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, timeout: Option<&Val>) -> Result<UserCase, SceneError> {
+pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, (timeout, budget_v): (Option<&Val>, Option<&Val>)) -> Result<UserCase, SceneError> {
     let defaults = Settings::default();
     let incident_theta = match point.get("incident_theta") {
         Some(t) => {
@@ -242,9 +263,13 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
         }
         None => defaults.timeout,
     };
+    let budget = match budget_v {
+        Some(v) => budget(ctx, d, point, v)?,
+        None => None,
+    };
     let Common { name, samples, seed } = common;
     let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, timeout, ..defaults };
-    Ok(UserCase { name, sampler: sampler.clone(), settings })
+    Ok(UserCase { name, sampler: sampler.clone(), settings, budget })
 }
 
 /// `params = [p1, p2, ...]`: at most [`MAX_PARAMS`] finite numbers.
