@@ -181,7 +181,7 @@ fn a_budget_picks_the_cases_sample_count() {
     let pick = h.user_sampler.as_ref().unwrap().budget.clone().expect("user_sampler.budget");
     assert_eq!(h.samples, pick.samples, "the case ran at the picked count");
     assert!(table.lines().any(|l| l.starts_with("timed") && l.contains(&format!("{}‡", pick.samples))), "{table}");
-    assert!(pick.samples >= 1 << 16 && pick.samples % (1 << 16) == 0, "{pick:?}");
+    assert!(pick.samples >= 1 << 16 && pick.samples.is_multiple_of(1 << 16), "{pick:?}");
     assert!(pick.budget_seconds == 4.0 && pick.profile.is_none());
     assert!(pick.predicted_seconds <= 4.0 && pick.fixed_seconds + pick.seconds_per_sample * pick.samples as f64 <= 4.0 + 1e-9, "{pick:?}");
     // the next count up would not fit: the pick is the largest
