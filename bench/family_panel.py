@@ -55,7 +55,7 @@ SIGNIFICANCE = 0.01  # lobes check's default --significance, and Mitsuba's run()
 # name, defect, (files, sample, pdf, params) broken, (...) correct twin
 PANEL = [
     ("turn", "azimuthal turn 0.005 sin φ (GGX VNDF α 0.3, θi 30°)",
-     ([EX + "ggx_vndf.wgsl", FX + "broken_turn.wgsl"], "turn_sample", "turn_pdf", "0.3,0.3"),
+     ([EX + "ggx_vndf.wgsl", "src/experiments/tradeoff/turn.wgsl"], "turn_sample", "turn_pdf", "0.3,0.3,0.005"),
      ([EX + "ggx_vndf.wgsl"], "ggx_sample", "ggx_pdf", "0.3,0.3")),
     ("radial", "radial warp 0.5 % (cosine-weighted)",
      ([FX + "broken_radial_warp.wgsl"], "radial_sample", "radial_pdf", None),

@@ -37,7 +37,12 @@ fn gpu() -> Gpu {
 
 fn file(name: &str) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    if name.starts_with("broken_") { root.join("tests/fixtures/family").join(name) } else { root.join("examples/samplers").join(name) }
+    match name {
+        // the detection table's ε-turn (`lobes tradeoff`), ε = params[0].z
+        "turn.wgsl" => root.join("src/experiments/tradeoff/turn.wgsl"),
+        _ if name.starts_with("broken_") => root.join("tests/fixtures/family").join(name),
+        _ => root.join("examples/samplers").join(name),
+    }
 }
 
 fn sampler(names: &[&str], sample: &str, pdf: &str) -> UserSampler {
@@ -58,8 +63,8 @@ fn panel() -> Vec<Subtle> {
     vec![
         Subtle {
             name: "azimuthal turn 0.005 sin φ (GGX VNDF α 0.3, θi 30°)",
-            broken: sampler(&["ggx_vndf.wgsl", "broken_turn.wgsl"], "turn_sample", "turn_pdf"),
-            params: vec![0.3, 0.3],
+            broken: sampler(&["ggx_vndf.wgsl", "turn.wgsl"], "turn_sample", "turn_pdf"),
+            params: vec![0.3, 0.3, 0.005],
             jacobian_catches: true,
         },
         Subtle {

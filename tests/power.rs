@@ -1,7 +1,7 @@
 //! How many samples a sampler's test needs (issue 25): `lobes check --power`'s count per test of
 //! the χ² family and per check, `--budget` and `--profile`, and `lobes tradeoff`'s detection
 //! table, on lavapipe at small scale (the panel's turned GGX sampler,
-//! tests/fixtures/family/broken_turn.wgsl, and the detection table's ε-turn).
+//! src/experiments/tradeoff/turn.wgsl at ε = 0.005, the detection table's ε-turn).
 
 use lobes::check::power::{PowerSweep, TestKind};
 use lobes::check::{Domain, Report, Settings, UserSampler, check};
@@ -24,12 +24,13 @@ fn lobes_check(turn: bool, extra: &[&str]) -> (Option<i32>, String, String) {
     let mut files = vec![root().join("examples/samplers/ggx_vndf.wgsl")];
     let (sample, pdf) = if turn { ("turn_sample", "turn_pdf") } else { ("ggx_sample", "ggx_pdf") };
     if turn {
-        files.push(root().join("tests/fixtures/family/broken_turn.wgsl"));
+        files.push(root().join("src/experiments/tradeoff/turn.wgsl"));
     }
     let out = Command::new(env!("CARGO_BIN_EXE_lobes"))
         .arg("check")
         .args(files)
-        .args(["--sample", sample, "--pdf", pdf, "--params", "0.3,0.3"])
+        // the turn's ε = 0.005 is params[0].z
+        .args(["--sample", sample, "--pdf", pdf, "--params", if turn { "0.3,0.3,0.005" } else { "0.3,0.3" }])
         .args(extra)
         .output()
         .unwrap();
@@ -66,7 +67,7 @@ fn power_names_the_count_each_test_catches_from_and_the_check_agrees() {
     let caught = test.caught.as_ref().unwrap();
     assert!(caught.gpu_seconds.is_none_or(|s| s > 0.0) && caught.seconds > 0.0);
     // the same count, another seed: the check fails, by that test or another of the family
-    let seed2 = check(&gpu(), &sampler(), &Settings { samples: n, seed: 2, params: vec![0.3, 0.3], ..Settings::default() }).unwrap();
+    let seed2 = check(&gpu(), &sampler(), &Settings { samples: n, seed: 2, params: vec![0.3, 0.3, 0.005], ..Settings::default() }).unwrap();
     assert_eq!(seed2.failed(), ["jacobian", "chi2"], "at {n} samples, seed 2");
     // the terminal table: a row per test
     let (code, text, _) = turned(&["--samples", "4194304", "--power"]);
@@ -76,7 +77,7 @@ fn power_names_the_count_each_test_catches_from_and_the_check_agrees() {
 }
 
 fn sampler() -> UserSampler {
-    let files = [root().join("examples/samplers/ggx_vndf.wgsl"), root().join("tests/fixtures/family/broken_turn.wgsl")];
+    let files = [root().join("examples/samplers/ggx_vndf.wgsl"), root().join("src/experiments/tradeoff/turn.wgsl")];
     UserSampler::from_files(&files, "turn_sample", "turn_pdf", None, Domain::Sphere).unwrap()
 }
 

@@ -70,7 +70,7 @@ pub fn markdown(r: &Report) -> String {
         s += &format!(
             "\n## Samples to catch a defect: the family against the fine grid\n\n\
              GGX visible normals (α {}, θi {}°) turned about the normal by ε sin φ (density off by about ε cos φ; \
-             tests/fixtures/family/broken_turn.wgsl is ε = 0.005). Each cell: the smallest N = 2^k from which the test rejects \
+             src/experiments/tradeoff/turn.wgsl; the panel's turn is ε = 0.005). Each cell: the smallest N = 2^k from which the test rejects \
              (p < {}) in at least {:.0} % of {} seeds, at N and at every larger N measured; the search doubles N until the family \
              and the fine grid reject in every seed, so \"> N\" says the test had not by the last N. A test alone: its own p < α \
              (the fine grid alone is the test before the family); the family: Holm's smallest p < α, the check's verdict. \
