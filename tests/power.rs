@@ -3,6 +3,7 @@
 //! table, on lavapipe at small scale (the panel's turned GGX sampler,
 //! src/experiments/tradeoff/turn.wgsl at ε = 0.005, the detection table's ε-turn).
 
+use lobes::check::budget::{self, PILOT_SAMPLES};
 use lobes::check::power::{PowerSweep, TestKind};
 use lobes::check::{Domain, Report, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
@@ -85,8 +86,10 @@ fn correct() -> UserSampler {
     UserSampler::from_files(&[root().join("examples/samplers/ggx_vndf.wgsl")], "ggx_sample", "ggx_pdf", None, Domain::Sphere).unwrap()
 }
 
-/// `--budget` picks a count whose check's measured time is within the budget, and twice that
-/// count's is not; it says what it picked and why.
+/// `--budget` picks the largest count that its pilots' model t(N) = t₀ + N · s fits in the
+/// budget, runs the check at that count and says what it picked and why. Whether the check then
+/// takes the budget is a measurement of this machine, not asserted here (tests run in parallel:
+/// a pilot slowed by another test picks a smaller count); docs/statistics.md has measured ones.
 #[test]
 fn budget_picks_the_largest_count_that_fits() {
     let budget = 4.0;
@@ -95,9 +98,18 @@ fn budget_picks_the_largest_count_that_fits() {
     let report: Report = serde_json::from_str(&stdout).unwrap();
     let line = stderr.lines().find(|l| l.starts_with("lobes: budget 4.0 s: ")).unwrap_or_else(|| panic!("{stderr}"));
     assert!(line.contains(&format!("{} samples picked", report.samples)) && line.contains("pilot checks"), "{line}");
-    assert!(report.wall_seconds <= budget, "{} samples took {} s for a budget of {budget} s ({line})", report.samples, report.wall_seconds);
-    let twice = check(&gpu(), &correct(), &Settings { samples: 2 * report.samples, params: vec![0.3, 0.3], ..Settings::default() }).unwrap();
-    assert!(twice.wall_seconds > budget, "twice the count, {} samples, took {} s: within the budget of {budget} s ({line})", twice.samples, twice.wall_seconds);
+    assert!(report.samples >= PILOT_SAMPLES && report.samples.is_multiple_of(PILOT_SAMPLES), "{line}");
+    // the library's pick: its count is the model's largest, and the model is the pilots' line
+    let settings = Settings { params: vec![0.3, 0.3], ..Settings::default() };
+    let pick = budget::pick(&gpu(), &correct(), &settings, budget, None).unwrap();
+    let t = |n: u64| pick.fixed_seconds + pick.seconds_per_sample * n as f64;
+    assert!(pick.samples >= PILOT_SAMPLES && pick.samples.is_multiple_of(PILOT_SAMPLES), "{pick:?}");
+    assert!(t(pick.samples) <= budget && (t(pick.samples + PILOT_SAMPLES) > budget || pick.samples == lobes::engine::job::MAX_SAMPLES), "{pick:?}");
+    assert!((pick.predicted_seconds - t(pick.samples)).abs() < 1e-9, "{pick:?}");
+    let (base, last) = (&pick.pilots[1], pick.pilots.last().unwrap());
+    assert!(pick.pilots[0].samples == PILOT_SAMPLES && base.samples == PILOT_SAMPLES && last.samples > base.samples, "{pick:?}");
+    let slope = ((last.seconds - base.seconds) / (last.samples - base.samples) as f64).max(0.0);
+    assert!((pick.seconds_per_sample - slope).abs() <= 1e-12 * slope.max(1e-12), "{pick:?}");
 }
 
 /// `--profile` and `--budget` conflict with `--samples` and with each other (exit 2), and a
