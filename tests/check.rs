@@ -223,7 +223,8 @@ fn broken_input_is_reported_at_the_users_file() {
 
 /// A sampler whose pdf is NaN, infinite or negative in places is counted by reason and judged,
 /// never a crash: uniform directions whose reported pdf is NaN for z > 0.9 and negative for
-/// z < −0.9, with a pdf function that is negative on the same cap.
+/// z < −0.9, with a pdf function that is negative on the same cap (the report's expected counts
+/// negative there, as its pictures draw them).
 #[test]
 fn bad_pdf_values_are_counted_by_reason() {
     let src = temp_wgsl(
@@ -248,6 +249,18 @@ fn bad_pdf_values_are_counted_by_reason() {
     assert!(!r.get("pdf_values").unwrap().passed);
     assert!(!r.get("hard_cases").unwrap().passed);
     assert!(!r.passed);
+    // the report's expected counts are the pdf's signed integral (what the pictures draw
+    // magenta): rows 0–2 of 64 lie inside the cap, each bin N × (−1) × its solid angle 4π/8192
+    let want = -n * 4.0 * std::f64::consts::PI / (64.0 * 128.0);
+    for (i, e) in r.expected[..3 * 128].iter().enumerate() {
+        assert!((e - want).abs() <= 1e-4 * want.abs(), "bin {i}: expected count {e}, the pdf integrates to {want}");
+    }
+    // over the sphere they sum to the signed integral, 0.95 × 1 − (0.05 × 4π) × 1 = 0.95 − 0.2π
+    // (to 10⁻²: a part across the cap's rim is bad, so left unsplit, its rule across a jump)
+    let signed = r.expected.iter().sum::<f64>() / n;
+    assert!((signed - (0.95 - 0.2 * std::f64::consts::PI)).abs() < 1e-2, "Σ expected / N = {signed}");
+    let c = r.figures::<lobes::check::report::Chi2Figures>().unwrap();
+    assert_eq!(c.quadrature.dropped.len(), 64 * 128);
 }
 
 /// A piecewise-constant 2-D distribution on the plane passes, and its zero-weight cells get no

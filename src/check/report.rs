@@ -40,7 +40,8 @@ pub struct Report {
     /// Counts per bin (row-major), and per reason of [`REASONS`].
     pub counts: Vec<u64>,
     pub invalid: [u64; 4],
-    /// Expected counts per bin from the quadrature of the pdf.
+    /// Expected counts per bin from the quadrature of the pdf: N ∫pdf, signed (below 0 in a bin
+    /// where the pdf is negative, which `pdf_values` fails; the χ² counts those parts as 0).
     pub expected: Vec<f64>,
 }
 
@@ -112,6 +113,11 @@ pub struct Chi2Figures {
     pub invalid: [u64; 4],
     pub expected_invalid: f64,
     pub quadrature: Integrals,
+    /// Column edges off the axes closer to the lobe than f32 binning places them
+    /// ([`crate::check::quadrature::EDGE_RESOLUTION`]): the two bins beside each are one cell of
+    /// the χ² (the counts and `expected` of the report stay per bin).
+    #[serde(default)]
+    pub joined_edges: u64,
 }
 
 impl Chi2Figures {
