@@ -657,20 +657,15 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     };
     let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
     // The mass the pdf leaves to invalid samples, 1 − ∫pdf, is known no better than the
-    // quadrature of ∫pdf (its error estimate and the f32 rounding of the sum): the invalid cell
-    // expects the value within that band closest to what was observed, so that neither a
-    // rejection the pdf allows nor the quadrature's own error reads as a sampler's fault
-    // (and no better than the f32 pdf itself: each node's value is uncertain by
-    // CONDITIONING_ULPS × the pdf's conditioning there, whose pdf-weighted mean the probes,
-    // drawn from the sampler, estimate)
+    // quadrature of ∫pdf (its error estimate and the f32 rounding of the sum; `invalid_expectation`
+    // says what the invalid cell makes of it), and no better than the f32 pdf itself: each node's
+    // value is uncertain by CONDITIONING_ULPS × the pdf's conditioning there, whose pdf-weighted
+    // mean the probes, drawn from the sampler, estimate
     let valid_kappa: Vec<f64> = probes.iter().zip(&kappa).filter(|(p, _)| p[0][3] > 0.0 && p[0][3].is_finite()).map(|(_, k)| *k).collect();
     let mean_kappa = valid_kappa.iter().sum::<f64>() / valid_kappa.len().max(1) as f64;
     let resolution = integrals.error_estimate + 2e-6 * pdf_total + CONDITIONING_ULPS * mean_kappa.min(1.0) * pdf_total;
     let observed_invalid = totals[bins..].iter().sum::<u64>() as f64 / n;
-    let missing = 1.0 - pdf_total;
-    // (a rejection rate under the resolution is below what this test can see, even where the
-    // pdf integrates to more than 1)
-    let expected_invalid = n * observed_invalid.clamp((missing - resolution).max(0.0), (missing + resolution).max(resolution));
+    let expected_invalid = invalid_expectation(settings.samples, totals[bins..].iter().sum(), pdf_total, resolution);
     // Normalisation: ∫pdf over the domain is the probability of a valid sample, which the
     // histogram measures as the valid fraction f (standard error √(f(1 − f)/N)).
     let valid = 1.0 - observed_invalid;
@@ -844,6 +839,30 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         invalid,
         expected: signed,
     })
+}
+
+/// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf
+/// integrates to `pdf_total` over the domain, known to `resolution`: N × the observed invalid
+/// fraction clamped into 1 − ∫pdf ± 2 × resolution, the value within that band closest to what
+/// was observed, so that neither a rejection the pdf allows nor the quadrature's own error reads
+/// as a sampler's fault (a rejection rate under the band is below what the test can see, even
+/// where the pdf integrates to more than 1). Twice the resolution, as `normalization`'s
+/// tolerance: the error estimate is the coarse rule's, and across a jump of the pdf the accepted
+/// finer value is off by as much (a uniform cone of half-angle 0.3 rad about the normal: ∫pdf
+/// 0.999830 with an error estimate of 1.65·10⁻⁴; within 1× the cell expected 12 samples where
+/// none can be, a false fail at 2 of 3 seeds).
+///
+/// ```
+/// // a pdf that integrates to 0.9998 known to 10⁻⁴: 0 or 500 rejected of 10⁶ both read as allowed
+/// assert_eq!(lobes::check::invalid_expectation(1_000_000, 0, 0.9998, 1e-4), 0.0);
+/// assert!((lobes::check::invalid_expectation(1_000_000, 500, 0.9998, 1e-4) - 500.0).abs() < 1e-6);
+/// // 2 000 rejected is beyond 1 − ∫pdf + 2 × 10⁻⁴: the cell expects 400
+/// assert!((lobes::check::invalid_expectation(1_000_000, 2_000, 0.9998, 1e-4) - 400.0).abs() < 1e-6);
+/// ```
+pub fn invalid_expectation(samples: u64, invalid: u64, pdf_total: f64, resolution: f64) -> f64 {
+    let n = samples.max(1) as f64;
+    let (missing, band) = (1.0 - pdf_total, 2.0 * resolution);
+    n * (invalid as f64 / n).clamp((missing - band).max(0.0), (missing + band).max(band))
 }
 
 /// "my_sample/my_pdf in file.wgsl", and the conventions declared: "… (--reflection-only)".

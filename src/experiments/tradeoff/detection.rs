@@ -166,7 +166,7 @@ pub fn detection(gpu: &Gpu, set: &DetectionSettings, log: &mut dyn FnMut(&str)) 
         times = (small.wall_seconds, whole.wall_seconds);
         let p: Vec<f64> = whole.expected.iter().map(|e| e / last as f64).collect();
         let norm = whole.figures::<NormalizationFigures>().expect("every check has normalization");
-        let (missing, resolution) = (1.0 - whole.figures::<Chi2Figures>().expect("every check has chi2").pdf_integral, norm.resolution);
+        let (pdf_total, resolution) = (whole.figures::<Chi2Figures>().expect("every check has chi2").pdf_integral, norm.resolution);
         let other_checks_passed = whole.checks.iter().filter(|c| c.name() != "chi2").map(|c| (c.name().to_string(), c.passed)).collect();
         let mut points: Vec<DetectionPoint> = Vec::new();
         for &n in &counts {
@@ -175,11 +175,9 @@ pub fn detection(gpu: &Gpu, set: &DetectionSettings, log: &mut dyn FnMut(&str)) 
             let mut rejected = vec![0u64; tests.len()];
             for (h, _) in &hists {
                 let expected: Vec<f64> = p.iter().map(|q| q * n as f64).collect();
-                // the invalid cell as the check expects it: 1 − ∫pdf within the quadrature's
-                // resolution, the value closest to what was observed (crate::check::check)
+                // the invalid cell as the check expects it
                 let invalid: u64 = h[bins..].iter().sum();
-                let observed = invalid as f64 / n as f64;
-                let expected_invalid = n as f64 * observed.clamp((missing - resolution).max(0.0), (missing + resolution).max(resolution));
+                let expected_invalid = crate::check::invalid_expectation(n, invalid, pdf_total, resolution);
                 let verdict = family::judge(grid, (&h[..bins], &expected), (&[invalid], &[expected_invalid]), set.significance);
                 rejected[0] += u64::from(!verdict.passed);
                 for (k, t) in verdict.family.iter().enumerate() {
