@@ -225,6 +225,15 @@ fn an_ill_conditioned_pdf_is_judged_against_its_f32_conditioning() {
     assert!(!r.get("pdf_consistency").unwrap().passed, "{}", r.get("pdf_consistency").unwrap().summary);
 }
 
+/// The example GGX visible-normal sampler (`sample`: its function or an expression over it,
+/// judged against `ggx_pdf`) at θi 89°, isotropic α, φi `phi` in degrees: its run and χ² figures.
+fn grazing_ggx(gpu: &Gpu, sample: &str, alpha: f64, phi: f64, note: &str) -> (Run, lobes::check::report::Chi2Figures) {
+    let settings = Settings { params: vec![alpha, alpha], incident_theta: 89.0, incident_phi: phi, ..Settings::default() };
+    let r = run(gpu, format!("ggx_vndf α {alpha:e} θi 89 φi {phi} {note}"), &sampler(&["ggx_vndf.wgsl"], sample, "ggx_pdf", None), settings);
+    let c = r.report.figures::<lobes::check::report::Chi2Figures>().unwrap().clone();
+    (r, c)
+}
+
 /// A grazing mirror lobe on the φ = ±π seam (GGX visible normals, α 10⁻⁴, θi 89°, φi 0): across
 /// the plane of incidence it is about 2α cos θi = 3.5·10⁻⁶ rad wide, and f32's t = (φ + π)/2π
 /// rounds onto the seam from half an ulp below it (φ = π − 10⁻⁷ gave t = 1: column 0), while the
@@ -237,15 +246,12 @@ fn an_ill_conditioned_pdf_is_judged_against_its_f32_conditioning() {
 #[test]
 fn a_grazing_lobe_on_the_seam_is_judged_as_sampled() {
     let gpu = gpu();
-    let settings = Settings { params: vec![1e-4, 1e-4], incident_theta: 89.0, incident_phi: 0.0, ..Settings::default() };
-    let r = run(&gpu, "ggx_vndf α 1e-4 θi 89 φi 0 (the seam)".into(), &sampler(&["ggx_vndf.wgsl"], "ggx_sample", "ggx_pdf", None), settings.clone());
-    let c = r.report.figures::<lobes::check::report::Chi2Figures>().unwrap();
+    let (r, c) = grazing_ggx(&gpu, "ggx_sample", 1e-4, 0.0, "(the seam)");
     assert!(r.report.passed, "{:?}: χ² {:?}", r.report.failed(), c.chi2);
     assert!((c.pdf_integral - 1.0).abs() < 1e-3, "∫pdf = {}", c.pdf_integral);
     assert!(c.chi2.dof >= 1, "the seam must split the lobe into two cells: {:?}", c.chi2);
     // wi turned by ε about the normal, (x − ε y, y + ε x, z); the pdf judged at the untouched wi
-    let turned = sampler(&["ggx_vndf.wgsl"], "ggx_sample(vec3<f32>(wi.x - 1e-7 * wi.y, wi.y + 1e-7 * wi.x, wi.z), u, params).xyz", "ggx_pdf", None);
-    let r = run(&gpu, "ggx_vndf α 1e-4 θi 89 φi 0, sampled 1e-7 rad turned".into(), &turned, settings);
+    let (r, _) = grazing_ggx(&gpu, "ggx_sample(vec3<f32>(wi.x - 1e-7 * wi.y, wi.y + 1e-7 * wi.x, wi.z), u, params).xyz", 1e-4, 0.0, "sampled 1e-7 rad turned");
     assert!(r.report.failed().contains(&"chi2"), "a lobe turned 1e-7 rad passed: {:?}", r.report.failed());
 }
 
@@ -298,12 +304,10 @@ fn a_ridge_between_the_nodes_is_integrated_again() {
 #[test]
 fn a_grazing_lobe_on_an_off_axis_edge_is_judged_as_one_cell() {
     let gpu = gpu();
-    let settings = Settings { params: vec![1e-3, 1e-3], incident_theta: 89.0, incident_phi: 2.8125, ..Settings::default() };
-    let r = run(&gpu, "ggx_vndf α 1e-3 θi 89 φi 2.8125 (an off-axis edge)".into(), &sampler(&["ggx_vndf.wgsl"], "ggx_sample", "ggx_pdf", None), settings.clone());
-    let c = r.report.figures::<lobes::check::report::Chi2Figures>().unwrap();
+    let (r, c) = grazing_ggx(&gpu, "ggx_sample", 1e-3, 2.8125, "(an off-axis edge)");
     assert!(r.report.passed, "{:?}: χ² {:?}", r.report.failed(), c.chi2);
     assert!(c.joined_edges >= 1 && c.chi2.dof >= 10, "joined {} edges, {} dof", c.joined_edges, c.chi2.dof);
-    let rougher = sampler(&["ggx_vndf.wgsl"], "ggx_sample(wi, u, array<vec4<f32>, 4>(params[0] * 1.1, params[1], params[2], params[3])).xyz", "ggx_pdf", None);
-    let r = run(&gpu, "ggx_vndf α 1e-3 θi 89 φi 2.8125, sampled 10 % rougher".into(), &rougher, settings);
+    let rougher = "ggx_sample(wi, u, array<vec4<f32>, 4>(params[0] * 1.1, params[1], params[2], params[3])).xyz";
+    let (r, _) = grazing_ggx(&gpu, rougher, 1e-3, 2.8125, "sampled 10 % rougher");
     assert!(r.report.failed().contains(&"chi2"), "a lobe 10 % rougher passed: {:?}", r.report.failed());
 }

@@ -853,10 +853,11 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
 /// none can be, a false fail at 2 of 3 seeds).
 ///
 /// ```
-/// // a pdf that integrates to 0.9998 known to 10⁻⁴: 0 or 500 rejected of 10⁶ both read as allowed
+/// // a pdf that integrates to 0.9998 known to 10⁻⁴ leaves 2·10⁻⁴ ± 2·10⁻⁴ to rejections:
+/// // 0 or 300 rejected of 10⁶ both read as allowed
 /// assert_eq!(lobes::check::invalid_expectation(1_000_000, 0, 0.9998, 1e-4), 0.0);
-/// assert!((lobes::check::invalid_expectation(1_000_000, 500, 0.9998, 1e-4) - 500.0).abs() < 1e-6);
-/// // 2 000 rejected is beyond 1 − ∫pdf + 2 × 10⁻⁴: the cell expects 400
+/// assert!((lobes::check::invalid_expectation(1_000_000, 300, 0.9998, 1e-4) - 300.0).abs() < 1e-6);
+/// // 2 000 rejected is beyond 4·10⁻⁴: the cell expects 400
 /// assert!((lobes::check::invalid_expectation(1_000_000, 2_000, 0.9998, 1e-4) - 400.0).abs() < 1e-6);
 /// ```
 pub fn invalid_expectation(samples: u64, invalid: u64, pdf_total: f64, resolution: f64) -> f64 {
