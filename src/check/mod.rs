@@ -608,20 +608,20 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
 
     // The expected histogram.
     let width = quadrature::initial_width(p_max, plane);
-    let integrals = match &settings.reference {
-        None => quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?,
-        Some(reference) => {
-            let wi = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
-            let pdf = |d: glam::DVec3| (reference.0)(wi, d);
-            let cpu = quadrature::CpuPdf { pdf: &pdf, plane };
-            let mut i = quadrature::integrate(&cpu, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
-            // eval has no f64 twin: its integral stays the GPU's
-            if sampler.eval.is_some() {
-                i.eval = quadrature::integrate(&(&passes, &params), &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?.eval;
-            }
-            i
-        }
+    // what integrates the pdf: the WGSL pdf on the GPU, or the f64 reference on the CPU
+    let gpu_integrand = (&passes, &params);
+    let wi64 = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
+    let reference_pdf = settings.reference.as_ref().map(|r| move |d: glam::DVec3| (r.0)(wi64, d));
+    let cpu_integrand = reference_pdf.as_ref().map(|pdf| quadrature::CpuPdf { pdf, plane });
+    let pdf_integrand: &dyn quadrature::Integrand = match &cpu_integrand {
+        Some(cpu) => cpu,
+        None => &gpu_integrand,
     };
+    let mut integrals = quadrature::integrate(pdf_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
+    if cpu_integrand.is_some() && sampler.eval.is_some() {
+        // eval has no f64 twin: its integral stays the GPU's
+        integrals.eval = quadrature::integrate(&gpu_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?.eval;
+    }
     // a pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
     // expected counts the quadrature could not resolve give no verdict
     if integrals.bad_parts == 0 {
@@ -684,14 +684,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let (judged_counts, judged_expected, joined) = if plane {
         (totals[..bins].to_vec(), expected.clone(), 0)
     } else {
-        let strips = match &settings.reference {
-            None => quadrature::edge_strips(&(&passes, &params), rows, cols, width, settings.samples, &integrals.probabilities)?,
-            Some(reference) => {
-                let wi = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
-                let pdf = |d: glam::DVec3| (reference.0)(wi, d);
-                quadrature::edge_strips(&quadrature::CpuPdf { pdf: &pdf, plane }, rows, cols, width, settings.samples, &integrals.probabilities)?
-            }
-        };
+        let strips = quadrature::edge_strips(pdf_integrand, rows, cols, width, settings.samples, &integrals.probabilities)?;
         quadrature::join_unresolved_edges(&totals[..bins], &expected, &strips, rows, cols, settings.samples)
     };
     let grid = if plane { family::Grid::plane(rows, cols) } else { family::Grid::sphere(rows, cols) };

@@ -33,6 +33,7 @@ use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
 use crate::engine::gpu::Gpu;
 pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::gauss_legendre::GaussLegendre;
+use crate::stats::histogram::SphereGrid;
 use serde::{Deserialize, Serialize};
 
 /// Deepest split of a part (a quarter per level).
@@ -240,18 +241,10 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
                     pieces.push((a, b, 0.0, split(dx.max(dy))));
                 }
                 Domain::Sphere => {
-                    let z = |i: u32| -1.0 + 2.0 * i as f64 / rows as f64;
-                    let (z0, z1) = (z(r), z(r + 1));
-                    let tau = std::f64::consts::TAU;
-                    let b = (-std::f64::consts::PI + tau * c as f64 / cols as f64, -std::f64::consts::PI + tau * (c + 1) as f64 / cols as f64);
-                    // the parts of [z0, z1] in each hemisphere, as a = 1 − |z|
-                    for (lo, hi, h) in [(z0.max(0.0), z1.max(0.0), 1.0f32), (z0.min(0.0), z1.min(0.0), -1.0)] {
-                        if hi > lo {
-                            let a = (1.0 - hi.abs().max(lo.abs()), 1.0 - hi.abs().min(lo.abs()));
-                            let dtheta = lo.clamp(-1.0, 1.0).acos() - hi.clamp(-1.0, 1.0).acos();
-                            let smax = (1.0 - lo.abs().min(hi.abs()).powi(2)).sqrt();
-                            pieces.push((a, b, h, split(dtheta.max((b.1 - b.0) * smax))));
-                        }
+                    let phi = SphereGrid { rows, cols }.phi_edges();
+                    let b = (phi[c as usize], phi[c as usize + 1]);
+                    for z in row_zones(rows, r) {
+                        pieces.push((z.a, b, z.h, split(z.dtheta.max((b.1 - b.0) * z.smax))));
                     }
                 }
             }
@@ -366,10 +359,29 @@ pub const EDGE_RESOLUTION: f64 = 5e-7;
 /// one cell.
 pub const EDGE_SIGMA: f64 = 0.3;
 
-/// Whether the left edge of column `c` of `cols` lies on an axis, where the binning is exact:
-/// the seam, and φ = 0 and ±π/2 where the columns divide them.
-pub fn axis_edge(c: u32, cols: u32) -> bool {
-    c == 0 || (cols % 2 == 0 && c == cols / 2) || (cols % 4 == 0 && (c == cols / 4 || c == 3 * cols / 4))
+/// The part of row `r` of a sphere grid in each hemisphere it touches, in the quadrature's
+/// coordinate a = 1 − |cos θ| (`lobes_domain_point`): its a range, the hemisphere's sign, its
+/// extent in θ and the largest sin θ in it.
+struct Zone {
+    a: (f64, f64),
+    h: f32,
+    dtheta: f64,
+    smax: f64,
+}
+
+fn row_zones(rows: u32, r: u32) -> Vec<Zone> {
+    let z = SphereGrid { rows, cols: 1 }.cos_theta_edges();
+    let (z0, z1) = (z[r as usize], z[r as usize + 1]);
+    [(z0.max(0.0), z1.max(0.0), 1.0f32), (z0.min(0.0), z1.min(0.0), -1.0)]
+        .into_iter()
+        .filter(|(lo, hi, _)| hi > lo)
+        .map(|(lo, hi, h)| Zone {
+            a: (1.0 - hi.abs().max(lo.abs()), 1.0 - hi.abs().min(lo.abs())),
+            h,
+            dtheta: lo.clamp(-1.0, 1.0).acos() - hi.clamp(-1.0, 1.0).acos(),
+            smax: (1.0 - lo.abs().min(hi.abs()).powi(2)).sqrt(),
+        })
+        .collect()
 }
 
 /// Per bin of the sphere grid, the pdf's integral over the strip within [`EDGE_RESOLUTION`] of
@@ -379,26 +391,21 @@ pub fn axis_edge(c: u32, cols: u32) -> bool {
 pub(super) fn edge_strips(f: &dyn Integrand, rows: u32, cols: u32, width: f64, samples: u64, probabilities: &[f64]) -> Result<Vec<f64>, CheckError> {
     let bins = (rows * cols) as usize;
     let n = samples.max(1) as f64;
+    let grid = SphereGrid { rows, cols };
+    let phi = grid.phi_edges();
     let mut parts = Vec::new();
     for r in 0..rows {
-        for c in (0..cols).filter(|&c| !axis_edge(c, cols)) {
+        for c in (0..cols).filter(|&c| !grid.exact_phi_edge(c)) {
             let bin = r * cols + c;
             if n * (probabilities[bin as usize] + probabilities[bin as usize - 1]) < 1.0 {
                 continue;
             }
-            let phi = -std::f64::consts::PI + std::f64::consts::TAU * c as f64 / cols as f64;
-            let b = (phi - EDGE_RESOLUTION, phi + EDGE_RESOLUTION);
-            let z = |i: u32| -1.0 + 2.0 * i as f64 / rows as f64;
-            let (z0, z1) = (z(r), z(r + 1));
-            for (lo, hi, h) in [(z0.max(0.0), z1.max(0.0), 1.0f32), (z0.min(0.0), z1.min(0.0), -1.0)] {
-                if hi > lo {
-                    let a = (1.0 - hi.abs().max(lo.abs()), 1.0 - hi.abs().min(lo.abs()));
-                    let dtheta = lo.clamp(-1.0, 1.0).acos() - hi.clamp(-1.0, 1.0).acos();
-                    let m = ((dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
-                    let da = (a.1 - a.0) / m as f64;
-                    for i in 0..m {
-                        parts.push(Part { a: (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da), b, h, bin, depth: 0, coarse: None });
-                    }
+            let b = (phi[c as usize] - EDGE_RESOLUTION, phi[c as usize] + EDGE_RESOLUTION);
+            for z in row_zones(rows, r) {
+                let m = ((z.dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
+                let da = (z.a.1 - z.a.0) / m as f64;
+                for i in 0..m {
+                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, bin, depth: 0, coarse: None });
                 }
             }
         }
@@ -424,8 +431,7 @@ pub fn join_unresolved_edges(counts: &[u64], expected: &[f64], strips: &[f64], r
         let mut target = row;
         for c in 0..cols as usize {
             let i = row + c;
-            let strip = strips.get(i).copied().unwrap_or(0.0);
-            let unresolved = c > 0 && strip > 0.0 && n * strip > EDGE_SIGMA * original[i].min(original[i - 1]).max(1.0).sqrt();
+            let unresolved = c > 0 && strips[i] > 0.0 && n * strips[i] > EDGE_SIGMA * original[i].min(original[i - 1]).max(1.0).sqrt();
             if unresolved {
                 counts[target] += counts[i];
                 expected[target] += expected[i];

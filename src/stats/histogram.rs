@@ -70,6 +70,14 @@ impl SphereGrid {
         col.clamp(lo, lo + n - 1)
     }
 
+    /// Whether the left edge of column `c` is one that `axis_exact_column` decides by the signs of
+    /// x and y, exactly: the seam, and φ = 0 and ±π/2 where the columns divide them. Any other
+    /// column edge is where the rounded t puts it (about 2·10⁻⁷ rad in f32).
+    pub fn exact_phi_edge(&self, c: u32) -> bool {
+        let cols = self.cols;
+        c == 0 || (cols.is_multiple_of(2) && c == cols / 2) || (cols.is_multiple_of(4) && (c == cols / 4 || c == 3 * cols / 4))
+    }
+
     /// The cos θ edges, rows + 1 of them, from −1 to 1.
     pub fn cos_theta_edges(&self) -> Vec<f64> {
         (0..=self.rows).map(|i| -1.0 + 2.0 * i as f64 / self.rows as f64).collect()
@@ -116,5 +124,24 @@ mod tests {
         // the seam is an edge of every grid, an odd one too
         assert_eq!(SphereGrid { rows: 1, cols: 3 }.bin_of(DVec3::new(-1.0, e, 0.0)), 2);
         assert_eq!(SphereGrid { rows: 1, cols: 3 }.bin_of(DVec3::new(-1.0, -e, 0.0)), 0);
+    }
+
+    /// The edges called exact are the axes' that the columns divide, and `bin_of` places each of
+    /// them to 10⁻¹⁷ rad on either side.
+    #[test]
+    fn exact_phi_edges_are_the_axes() {
+        for (cols, exact) in [(8, vec![0, 2, 4, 6]), (6, vec![0, 3]), (5, vec![0])] {
+            let g = SphereGrid { rows: 1, cols };
+            assert_eq!((0..cols).filter(|&c| g.exact_phi_edge(c)).collect::<Vec<_>>(), exact, "{cols} columns");
+            for &c in &exact {
+                // an axis: its direction exactly (f64's sin π is 1.2e-16, not 0)
+                let phi = g.phi_edges()[c as usize];
+                let (s, co) = (phi.sin().round(), phi.cos().round());
+                // turned by ±1e-17 about z: above the edge column c, below it the one before
+                let turn = |e: f64| DVec3::new(co - e * s, s + e * co, 0.0);
+                assert_eq!(g.bin_of(turn(1e-17)), c as usize, "{cols} columns, edge {c}");
+                assert_eq!(g.bin_of(turn(-1e-17)), ((c + cols - 1) % cols) as usize, "{cols} columns, edge {c}");
+            }
+        }
     }
 }
