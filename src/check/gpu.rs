@@ -352,9 +352,12 @@ pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Sour
     c.push(&parts[0].name, &parts[0].text);
     c.push(GLUE, &glue(sampler, returned, order, true));
     let (mut module, _) = c.validate_with(naga::valid::Capabilities::all())?;
-    naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
-    module.entry_points.clear();
-    let text = super::modules::write_wgsl(&module, naga::valid::Capabilities::all())?;
+    // compacted and written on a large stack, as parsed (a tree thousands of calls deep)
+    let text = crate::engine::gpu::stack::with_big_stack(move || {
+        naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
+        module.entry_points.clear();
+        super::modules::write_wgsl(&module, naga::valid::Capabilities::all())
+    })?;
     Ok(vec![Source { name: code.parts[0].name.clone(), text }])
 }
 

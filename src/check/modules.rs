@@ -403,8 +403,59 @@ fn line_col(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
-/// The user's files composed as their dialect composes them.
+/// What a composed tree was made from: the files given, the composition, and each file under
+/// the roots and each stub by its path, size and modification time.
+type TreeKey = (Vec<Source>, Composition, Vec<(PathBuf, u64, Option<std::time::SystemTime>)>);
+
+/// The trees this process composed (a check composes its sampler's tree for validation, for
+/// each --rand order probed and for the passes; a run composes each case's): naga_oil's
+/// composer is superlinear in a tree's depth (each module's header holds its imports' imports),
+/// so a tree is composed once per process, and again only when a file under its roots changed.
+static TREES: std::sync::Mutex<Vec<(TreeKey, UserCode)>> = std::sync::Mutex::new(Vec::new());
+
+/// The trees kept: a run's cases share a few.
+const TREES_KEPT: usize = 8;
+
+fn tree_key(sources: &[Source], c: &Composition) -> TreeKey {
+    let mut files = Vec::new();
+    for r in roots(sources, c) {
+        scan(&r, &["wgsl", "wesl"], &mut files);
+    }
+    files.extend(c.stubs.iter().map(|(_, f)| f.clone()));
+    let stamp = files
+        .into_iter()
+        .map(|f| {
+            let m = std::fs::metadata(&f).ok();
+            let len = m.as_ref().map_or(0, std::fs::Metadata::len);
+            let modified = m.and_then(|m| m.modified().ok());
+            (f, len, modified)
+        })
+        .collect();
+    (sources.to_vec(), c.clone(), stamp)
+}
+
+/// The user's files composed as their dialect composes them (a tree composed before in this
+/// process, from the same files, is taken from [`TREES`]).
 pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
+    if sources.is_empty() || (dialect(sources) == Dialect::Wgsl && c.defines.is_empty()) {
+        return compose_anew(sources, c);
+    }
+    let key = tree_key(sources, c);
+    let kept = TREES.lock().unwrap_or_else(|p| p.into_inner()).iter().find(|(k, _)| *k == key).map(|(_, code)| code.clone());
+    if let Some(code) = kept {
+        return Ok(code);
+    }
+    // on a large stack: naga_oil recurses once per module along a chain of imports
+    let code = crate::engine::gpu::stack::with_big_stack(|| compose_anew(sources, c))?;
+    let mut trees = TREES.lock().unwrap_or_else(|p| p.into_inner());
+    if trees.len() >= TREES_KEPT {
+        trees.remove(0);
+    }
+    trees.push((key, code.clone()));
+    Ok(code)
+}
+
+fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
