@@ -844,6 +844,22 @@ struct Resolved {
 }
 
 #[cfg(feature = "wesl")]
+impl Resolved {
+    /// The resolver's own error, else a `--stub` that no import reached.
+    fn refusal(&self, c: &Composition, root: &str) -> Result<(), CheckError> {
+        if let Some(why) = &self.error {
+            return Err(CheckError::Input(why.clone()));
+        }
+        match c.stubs.iter().find(|(m, _)| !self.stubs_used.contains(m)) {
+            Some((m, _)) => Err(CheckError::Input(format!(
+                "--stub {m}: no import of {root} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the import names it: package::a::b)"
+            ))),
+            None => Ok(()),
+        }
+    }
+}
+
+#[cfg(feature = "wesl")]
 impl Roots {
     /// The files that `path` names: `a/b.wesl` and `a/b.wgsl` under every root.
     fn files(&self, path: &wesl::ModulePath) -> Vec<PathBuf> {
@@ -971,17 +987,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
             file.strip_prefix(&r).ok().map(|rel| (r.clone(), rel.with_extension("")))
         })
         .ok_or_else(|| CheckError::Input(format!("{}: not under any shader root ({}); WESL's `package::` paths start at a root", sources[0].name, show_roots(&roots))))?;
-    let mut known = Vec::new();
-    for r in &roots {
-        let mut files = Vec::new();
-        scan(r, &["wesl", "wgsl"], &mut files);
-        for f in files {
-            if let Ok(rel) = f.strip_prefix(r) {
-                let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
-                known.push(format!("package::{}", comps.join("::")));
-            }
-        }
-    }
+    let known = wesl_known(&roots);
     let components: Vec<String> = rel.iter().map(|c| c.to_string_lossy().into_owned()).collect();
     let root_path = wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components };
     let _ = base;
@@ -1004,17 +1010,8 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
     let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
     compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
     let result = compiler.compile(&root_path);
-    let seen = seen.borrow();
-    if let Some(why) = &seen.error {
-        return Err(CheckError::Input(why.clone()));
-    }
+    seen.borrow().refusal(c, &sources[0].name)?;
     let result = result.map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
-    if let Some((m, _)) = c.stubs.iter().find(|(m, _)| !seen.stubs_used.contains(m)) {
-        return Err(CheckError::Input(format!(
-            "--stub {m}: no import of {} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the import names it: package::a::b)",
-            sources[0].name
-        )));
-    }
     let mut origins = Vec::new();
     use wesl::syntax::GlobalDeclaration as G;
     let ident = |decl: &G| match decl {
@@ -1044,23 +1041,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         from = at + written.len();
         let first = text[..at].matches('\n').count() as u32 + 1;
         let lines = (first, first + written.trim_end().matches('\n').count() as u32);
-        let map = result.sourcemap.as_ref();
-        let (file, module, item, source) = match map.and_then(|m| m.get_decl(&name)) {
-            Some((path, item)) if path.to_string() != root_path_shown => {
-                let m = map.expect("a source map holds the declaration");
-                let file = m.get_display_name(path).map(str::to_string).or_else(|| resolver_files.file(path).map(|f| f.display().to_string()));
-                let Some(file) = file else { continue };
-                let source = match m.get_source(path) {
-                    Some(s) => s.to_string(),
-                    None => match std::fs::read_to_string(&file) {
-                        Ok(s) => s,
-                        Err(_) => continue,
-                    },
-                };
-                (file, path.to_string(), item.to_string(), source)
-            }
-            _ => (sources[0].name.clone(), root_path_shown.clone(), name.clone(), sources[0].text.clone()),
-        };
+        let Some((file, module, item, source)) = declared_in(result.sourcemap.as_ref(), &name, &root_path_shown, &resolver_files, &sources[0]) else { continue };
         // the declaration's text in its file: its span there, or (a span that does not hold its
         // name) from the line that declares it to the next declaration
         let span = decl.span();
@@ -1076,6 +1057,42 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         decls.push(super::compose::DeclOrigin { lines, file, module, name: item, text: original, at, renames: renames.clone() });
     }
     Ok((text, origins, decls))
+}
+
+/// Where the declaration `name` of a composed WESL tree comes from: (its file, module path,
+/// name there, the file's text); the root's own declarations are the sampler's file's.
+#[cfg(feature = "wesl")]
+fn declared_in(map: Option<&wesl::BasicSourceMap>, name: &str, root_path: &str, roots: &Roots, root: &Source) -> Option<(String, String, String, String)> {
+    use wesl::SourceMap;
+    match map.and_then(|m| m.get_decl(name)) {
+        Some((path, item)) if path.to_string() != root_path => {
+            let m = map.expect("a source map holds the declaration");
+            let file = m.get_display_name(path).map(str::to_string).or_else(|| roots.file(path).map(|f| f.display().to_string()))?;
+            let source = match m.get_source(path) {
+                Some(s) => s.to_string(),
+                None => std::fs::read_to_string(&file).ok()?,
+            };
+            Some((file, path.to_string(), item.to_string(), source))
+        }
+        _ => Some((root.name.clone(), root_path.to_string(), name.to_string(), root.text.clone())),
+    }
+}
+
+/// The module paths (`package::a::b`) of the WESL and WGSL files under the roots.
+#[cfg(feature = "wesl")]
+fn wesl_known(roots: &[PathBuf]) -> Vec<String> {
+    let mut known = Vec::new();
+    for r in roots {
+        let mut files = Vec::new();
+        scan(r, &["wesl", "wgsl"], &mut files);
+        for f in files {
+            if let Ok(rel) = f.strip_prefix(r) {
+                let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
+                known.push(format!("package::{}", comps.join("::")));
+            }
+        }
+    }
+    known
 }
 
 /// `--define` values as WESL's `@if` features: true or false.
