@@ -455,3 +455,79 @@ proptest! {
         }
     }
 }
+
+/// Issue 34 §2: a call expression names what the sampler's file imports as the file names it
+/// (`PI` of `#import common::maths::{PI, TAU}`), not only by a qualified path: the cosine pdf
+/// written with it passes, and with `TAU` (half the density) fails.
+#[test]
+fn a_call_expression_names_an_imported_item_as_the_file_does() {
+    let dir = scratch("imported-names");
+    copy_tree(&root().join(OIL), &dir);
+    let with_pdf = |pdf: &str| {
+        let file = dir.join("shaders/sampling/diffuse.wgsl");
+        let roots = dir.join("shaders");
+        let stub = format!("common::view={}", dir.join("stubs/view.wgsl").display());
+        lobes(&[
+            "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--sample", "sample_diffuse(wi)",
+            "--pdf", pdf, "--rand", "rand", "--samples", "262144",
+        ])
+    };
+    let out = with_pdf("select(0.0, d.z / PI, d.z > 0.0)");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let out = with_pdf("select(0.0, d.z / TAU, d.z > 0.0)");
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+}
+
+/// Issue 34 §2: `--rand rand_f` where `rand_f` lives in a module whose path has underscores
+/// (Bevy's `bevy_pbr::render_utils`, mangled `…_1rand_f` by the wesl crate): found, and the GGX
+/// sampler passes.
+#[test]
+fn a_rand_function_of_a_module_with_underscores_in_its_path_is_found() {
+    let dir = scratch("wesl-underscores");
+    copy_tree(&root().join(WESL), &dir);
+    let moved = dir.join("shaders/bevy_pbr/render_utils.wesl");
+    std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
+    std::fs::rename(dir.join("shaders/utils.wesl"), &moved).unwrap();
+    let file = dir.join("shaders/sampling/ggx.wesl");
+    let source = std::fs::read_to_string(&file).unwrap();
+    let edited = source.replace("import package::utils::rand_vec2f;", "import package::bevy_pbr::render_utils::rand_vec2f;");
+    assert_ne!(edited, source);
+    std::fs::write(&file, edited).unwrap();
+    let roots = dir.join("shaders");
+    let stub = format!("package::bindings={}", dir.join("stubs/bindings.wesl").display());
+    let out = lobes(&[
+        "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--sample", "sample_ggx_vndf(wi, p0, rng)",
+        "--sample-returns", "half-vector", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--rand", "rand_f", "--params", "0.5", "--incident-theta", "40",
+        "--samples", "262144",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("random draws x,y"), "{}", text(&out.stdout));
+}
+
+/// Issue 34 §2: a renderer's own preprocessor line (RedGPU's `#redgpu_include`) is named, with
+/// what to do, not a WGSL parse error at `#`.
+#[test]
+fn a_custom_preprocessor_line_is_named_with_what_to_do() {
+    let dir = scratch("custom-directive");
+    let file = dir.join("ibl.wgsl");
+    write(&file, &format!("#redgpu_include SYSTEM_UNIFORM\n{SPHERE}"));
+    let out = lobes(&["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "p(d)"]);
+    bad_input(&out, &[&format!("{}:1: `#redgpu_include SYSTEM_UNIFORM`", file.display()), "pre-expanded", "--stub", "--define"]);
+}
+
+/// Issue 34 §2: an unresolved import among many modules lists the closest few, not all of them.
+#[test]
+fn an_unresolved_import_among_many_modules_lists_the_closest_few() {
+    let dir = scratch("many-modules");
+    for i in 0..40 {
+        write(&dir.join(format!("shaders/pbr/m{i}.wgsl")), &format!("#define_import_path pbr::module_{i}\nfn f{i}() -> f32 {{ return 1.0; }}\n"));
+    }
+    write(&dir.join("shaders/pbr/lighting.wgsl"), "#define_import_path pbr::lighting\nfn light() -> f32 { return 1.0; }\n");
+    let file = dir.join("shaders/sampler.wgsl");
+    write(&file, &format!("#import pbr::lightning::light\n{SPHERE}fn lit(d: vec3<f32>) -> f32 {{ return light() * 0.0795; }}\n"));
+    let roots = dir.join("shaders");
+    let out = lobes(&["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "lit(d)"]);
+    let e = bad_input(&out, &["closest: `pbr::lighting`", "41 modules found"]);
+    let listed = e.matches("pbr::module_").count();
+    assert!(listed <= 8, "{listed} module names listed: {e}");
+}

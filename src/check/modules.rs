@@ -283,7 +283,7 @@ impl UserCode {
     /// name in the composed text. A module path matches an import's full path or its last
     /// segments. A name no imported module holds is an error naming the imported items.
     pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
-        if !expr.contains("::") {
+        if self.dialect == Dialect::Wgsl && !expr.contains("::") {
             return Ok(expr.to_string());
         }
         if self.dialect == Dialect::Wgsl {
@@ -321,7 +321,8 @@ impl UserCode {
             }
             let path = &expr[start..i];
             let Some((module, item)) = path.rsplit_once("::") else {
-                out.push_str(path);
+                let member = out.trim_end().ends_with('.');
+                out.push_str(self.imported(path, root_text).filter(|_| !member).unwrap_or(path));
                 continue;
             };
             let module = aliases.iter().find(|(a, _)| a == module).map_or(module, |(_, m)| m.as_str());
@@ -339,6 +340,19 @@ impl UserCode {
             }
         }
         Ok(out)
+    }
+}
+
+impl UserCode {
+    /// The composed name of `name` where the sampler's file imports it by that name (naga_oil's
+    /// `#import a::b::{name}`, WESL's `import package::a::name;`): an expression names it as the
+    /// file does. `None` where no import line names it, or two modules hold an item of that name.
+    fn imported(&self, name: &str, root_text: &str) -> Option<&str> {
+        let word = |l: &str| l.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == name);
+        let imports = root_text.lines().map(str::trim_start).any(|l| (l.starts_with("#import ") || l.starts_with("import ")) && word(l));
+        let mut held = self.origins.iter().filter(|(_, _, item)| item == name).map(|(composed, _, _)| composed.as_str());
+        let first = held.next()?;
+        (imports && held.all(|c| c == first)).then_some(first)
     }
 }
 
@@ -459,6 +473,7 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
+    foreign_directives(sources)?;
     let files = sources.iter().map(|s| s.name.clone()).collect();
     let mut d = dialect(sources);
     if d == Dialect::Wgsl && !c.defines.is_empty() {
@@ -489,6 +504,31 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
             renamed: Vec::new(),
         }),
     }
+}
+
+/// The directives lobes composes: naga_oil's (WGSL and WESL have none at the start of a line).
+const DIRECTIVES: [&str; 9] = ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if", "#else", "#endif", "#elif", "#define"];
+
+/// A line of the user's files that starts with a preprocessor directive lobes does not know
+/// (a renderer's own, RedGPU's `#redgpu_include`): an error saying what it is and how to
+/// proceed, rather than WGSL's parse error at `#`.
+fn foreign_directives(sources: &[Source]) -> Result<(), CheckError> {
+    for s in sources {
+        for (n, line) in s.text.lines().enumerate() {
+            let l = line.trim_start();
+            let Some(word) = l.strip_prefix('#').map(|r| r.split(|c: char| !(c.is_alphanumeric() || c == '_')).next().unwrap_or("")) else { continue };
+            if word.is_empty() || DIRECTIVES.iter().any(|d| d[1..] == *word) {
+                continue;
+            }
+            return Err(CheckError::Input(format!(
+                "{}:{}: `{}` is a preprocessor line of the renderer's own (not WGSL, nor naga_oil's #import/#ifdef family), which lobes cannot expand; give lobes the file as the renderer's preprocessor writes it (a pre-expanded file), or, where the line pulls in a module, write it as a naga_oil `#import` and stand in for that module with --stub MODULE=FILE; a switch the line tests is a --define",
+                s.name,
+                n + 1,
+                l.trim_end()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `--define` values as naga_oil's shader defs: no value or `true`/`false` a bool, else an
