@@ -137,6 +137,12 @@ pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
     (n >= PILOT_SAMPLES && fixed + n as f64 * per_sample <= budget).then_some(n)
 }
 
+/// Seconds as a user reads them: as typed for ordinary values, in exponent form for tiny or huge
+/// ones (`1e-300`, not 300 zeros).
+fn seconds(s: f64) -> String {
+    if (1e-3..1e7).contains(&s) { format!("{s}") } else { format!("{s:e}") }
+}
+
 /// Measures the check's time on `gpu` by pilot checks and picks the count for `budget` seconds.
 /// The pilots: one at [`PILOT_SAMPLES`] that warms the driver's pipelines (not used), one more
 /// there (the fixed part), then 2²⁰, 2²², … until the samples' share of the time is measurable
@@ -150,7 +156,8 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let base = pilots[1].clone();
     if base.seconds >= budget {
         return Err(CheckError::Input(format!(
-            "--budget {budget} s is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
+            "--budget {} s is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
+            seconds(budget),
             base.seconds,
             2.0 * base.seconds
         )));
@@ -169,7 +176,8 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let fixed = (base.seconds - per_sample * base.samples as f64).max(0.0);
     let samples = fit(budget, fixed, per_sample).ok_or_else(|| {
         CheckError::Input(format!(
-            "--budget {budget} s is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
+            "--budget {} s is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
+            seconds(budget),
             fixed + 2.0 * per_sample * PILOT_SAMPLES as f64 + 0.5
         ))
     })?;
