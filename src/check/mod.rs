@@ -420,17 +420,24 @@ fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, 
 /// The most samples of one dispatch of the histogram and weights passes.
 const CHUNK: u64 = 1 << 26;
 
-/// The histogram of `samples` samples: counts per bin, then per invalid reason, in dispatches
-/// of at most [`CHUNK`] samples.
-fn histogram(passes: &gpu::Passes, params: &gpu::Params, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
+/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
+/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
+/// numbers, counted on every sample, are bad input ([`gpu::too_many_draws`]).
+fn histogram(passes: &gpu::Passes, params: &gpu::Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
     let mut totals = vec![0u64; bins + 4];
+    let (mut over, mut most) = (0u64, 0u32);
     let mut first = 0;
     while first < samples {
         let n = CHUNK.min(samples - first) as u32;
-        for (t, c) in totals.iter_mut().zip(passes.histogram(params, first, n, bins + 4, None)?) {
+        let counted = passes.histogram(params, first, n, bins + 4, None)?;
+        for (t, c) in totals.iter_mut().zip(counted.counts) {
             *t += c as u64;
         }
+        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
         first += n as u64;
+    }
+    if over > 0 {
+        return Err(gpu::too_many_draws(sampler, most, over, samples));
     }
     let counted: u64 = totals.iter().sum();
     if counted != samples {
@@ -454,7 +461,7 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
         .map(|&(samples, seed)| {
             let params = params_of(sampler, &Settings { seed, ..settings.clone() });
             let started = std::time::Instant::now();
-            let counts = histogram(&passes, &params, samples, (rows * cols) as usize)?;
+            let counts = histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
             Ok((counts, started.elapsed().as_secs_f64()))
         })
         .collect()
@@ -477,7 +484,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let mut checks = Vec::new();
 
     let bins = (rows * cols) as usize;
-    let totals = histogram(&passes, &params, settings.samples, bins)?;
+    let totals = histogram(&passes, &params, sampler, settings.samples, bins)?;
 
     // The probe: uniforms away from the edges by 2ε, so that u ± ε stays in [0, 1].
     let margin = 2.0 * jacobian::EPS as f64;
@@ -625,12 +632,18 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     // a pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
     // expected counts the quadrature could not resolve give no verdict
     if integrals.bad_parts == 0 {
-        integrals.converged(settings.samples).map_err(CheckError::NoVerdict)?;
+        integrals.converged(settings.samples).map_err(|e| CheckError::NoVerdict(e + &half_vector_pole(sampler, settings, None).unwrap_or_default()))?;
     }
     let n = settings.samples as f64;
     let pdf_total: f64 = integrals.probabilities.iter().sum();
     // where the pdf is bad: its worst point on a fine grid (the WGSL pdf's, as the hard cases)
     let worst = if integrals.bad_parts > 0 { pdf_values::worst(&passes, &params, &sampler.domain, &sampler.conventions)? } else { None };
+    if integrals.bad_parts > 0
+        && let Some(pole) = half_vector_pole(sampler, settings, Some(worst.as_ref().map(|w| w.angles)))
+    {
+        let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&sampler.pdf_at_d(), false));
+        return Err(CheckError::NoVerdict(format!("{} returned NaN, ∞ or a negative value in {} of {} quadrature parts, {at}{pole}", sampler.pdf_at_d(), integrals.bad_parts, integrals.parts)));
+    }
     let worst_text = worst.as_ref().map(|w| w.describe(&sampler.pdf_at_d(), plane));
     checks.push(Check {
         passed: integrals.bad_parts == 0,
@@ -832,6 +845,29 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         invalid,
         expected: signed,
     })
+}
+
+/// Why a half-vector sampler's pdf may defeat the quadrature without a fault of its own, for a
+/// no-verdict message: with `--sample-returns half-vector` and reflections below the surface kept,
+/// the density of d = 2 (wi·h) h − wi is p(h) / (4 wi·h) with h = normalize(wi + d), which has an
+/// integrable pole at d = −wi wherever p(h) is not 0 for h ⊥ wi (NDF sampling: D(h) cos θh at
+/// θi > 0); no f32 quadrature resolves it, and the f32 pdf may be ∞ or NaN beside it. `bad_at`:
+/// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
+/// points), which must lie within 1° of −wi; None for an unconverged quadrature.
+fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<String> {
+    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || sampler.domain != Domain::Sphere {
+        return None;
+    }
+    let pole = crate::reference::reflect::spherical((180.0 - settings.incident_theta).to_radians(), (settings.incident_phi + 180.0).to_radians());
+    if let Some(Some((theta, phi))) = bad_at
+        && crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians()).dot(pole).clamp(-1.0, 1.0).acos() > 1f64.to_radians()
+    {
+        return None;
+    }
+    let (t, p) = (pole.z.clamp(-1.0, 1.0).acos().to_degrees(), pole.y.atan2(pole.x).to_degrees());
+    Some(format!(
+        "; with --sample-returns half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with --reflection-only (they are then rejections, and d = −wi is one of them)"
+    ))
 }
 
 /// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf

@@ -31,13 +31,13 @@ pub fn watch(first: &'static str) -> anyhow::Result<()> {
     std::thread::spawn(move || {
         for _ in signals.forever() {
             if REQUESTED.swap(true, Ordering::SeqCst) {
-                eprintln!("lobes: interrupted again: stopping now; the case in flight has no histogram.json");
+                crate::console::say(format_args!("lobes: interrupted again: stopping now; the case in flight has no histogram.json"));
                 if let Some(f) = BEFORE_EXIT.lock().unwrap_or_else(|p| p.into_inner()).take() {
                     f();
                 }
                 std::process::exit(super::EXIT_INTERRUPTED.into());
             }
-            eprintln!("lobes: interrupted: {first}");
+            crate::console::say(format_args!("lobes: interrupted: {first}"));
         }
     });
     Ok(())

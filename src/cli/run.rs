@@ -97,13 +97,13 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
             .tiling(&case.job)
             .map_err(|e| usage(format!("{}: case '{}': {e}", scene.case_location(i), case.name)))?;
         if tiling.tiles > 1 {
-            eprintln!(
+            crate::console::say(format_args!(
                 "lobes: note: case '{}': {} bins exceed one storage binding of this adapter; counting them in {} passes of {} bins",
                 case.name,
                 case.job.bins(),
                 tiling.tiles,
                 tiling.tile_bins
-            );
+            ));
         }
     }
     Ok(())
@@ -168,14 +168,14 @@ impl PlainProgress {
             bar.set_position(done);
             if on && last.elapsed() >= Self::EVERY {
                 last = Instant::now();
-                eprintln!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64());
+                crate::console::say(format_args!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64()));
             }
         }
     }
 
     fn finished(&self, i: usize, name: &str, verdict: &str, seconds: f64) {
         if self.on {
-            eprintln!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases);
+            crate::console::say(format_args!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases));
         }
     }
 }
@@ -203,7 +203,7 @@ pub(super) fn record_error(folder: &OutFolder, significance: f64, err: &anyhow::
         crate::report::summary::write(folder.path(), &summary, &[])
     });
     if let Err(e) = written {
-        eprintln!("lobes: error: {e:#}");
+        crate::console::say(format_args!("lobes: error: {e:#}"));
     }
 }
 
@@ -229,12 +229,12 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
     let stale = folder.clean(&names)?;
     if !stale.is_empty() {
-        eprintln!(
+        crate::console::say(format_args!(
             "lobes: note: removed the outputs of {} cases of an earlier run in {} that this run does not have ({})",
             stale.len(),
             args.out.display(),
             stale.join(", ")
-        );
+        ));
     }
     let n = scene.len();
     let level = sidak(args.significance, n);
@@ -249,7 +249,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         s.status = RunStatus::Interrupted;
         s.not_run = all.iter().filter(|n| !s.cases.iter().any(|c| &c.case == *n)).cloned().collect();
         if let Err(e) = crate::report::summary::write(&out, &s, &head) {
-            eprintln!("lobes: error: {e:#}");
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
     });
     let record = |f: &mut dyn FnMut(&mut RunSummary)| f(&mut summary.lock().unwrap_or_else(|p| p.into_inner()));
@@ -311,7 +311,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             }
             Err(e) if timed_out(&e) => {
                 // a failure of the case, with its reason; the device still runs its work
-                eprintln!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name());
+                crate::console::say(format_args!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name()));
                 lost = Some(format!("the GPU device is still running case '{}', which ran out of time", entry.name()));
                 let dash = || "-".to_string();
                 rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "FAIL".into(), dash(), dash()]);
@@ -320,9 +320,9 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
             }
             Err(e) => {
                 if lost.is_none() {
-                    eprintln!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
+                    crate::console::say(format_args!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name()));
                     if device_lost(&e) {
-                        eprintln!("lobes: error: the GPU device is unusable; the remaining cases do not run");
+                        crate::console::say(format_args!("lobes: error: the GPU device is unusable; the remaining cases do not run"));
                         lost = Some(format!("the GPU device was lost in case '{}'", entry.name()));
                     }
                 }
@@ -359,7 +359,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     let (errors, failed) = (summary.errors, summary.failed);
     if summary.status == RunStatus::Interrupted {
         if let Err(e) = &written {
-            eprintln!("lobes: error: {e:#}");
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
         let finished = n - summary.not_run.len();
         return Err(Interrupted(format!("interrupted after {finished} of {n} cases ({errors} could not run, {failed} failed)")).into());
