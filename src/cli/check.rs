@@ -283,7 +283,9 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         folder.clean_files(&CHECK_FILES)?;
     }
     // before the device opens: a signal while it does is seen at the first submission
-    interrupt::watch("stopping the check now (interrupt again to end at once)")?;
+    // the stop is seen within 50 ms of a wait on the GPU; 1.5 s after it, a process still
+    // held (by a thread in the driver) ends all the same
+    interrupt::watch("stopping the check now (interrupt again to end at once)", Some(Duration::from_millis(1500)))?;
     let gpu = Gpu::new()?;
     let _stop = gpu.stop_when(interrupt::requested);
     let settings = match args.budget_seconds() {

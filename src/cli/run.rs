@@ -240,7 +240,7 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     let level = sidak(args.significance, n);
     let heading = [format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
     let summary = Arc::new(Mutex::new(RunSummary { stale, ..RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level) }));
-    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now")?;
+    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now", None)?;
     // a second signal ends the process at once: it writes the summary first, the case in
     // flight and the rest as not run
     let (all, out, head, shared) = (names.iter().map(|s| s.to_string()).collect::<Vec<_>>(), args.out.clone(), heading.to_vec(), summary.clone());
