@@ -3,12 +3,15 @@
 //! hang, the time it must end in. Fixtures: tests/fixtures/samplers/. GPU tests: they need a
 //! wgpu adapter (lavapipe in CI); small sample counts and grids keep each to seconds.
 
+mod common;
+
+use common::{finish, text};
 use lobes::check::hard::HardRow;
 use lobes::check::{CheckError, Composition, Conventions, Domain, SampleReturns, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
@@ -23,10 +26,6 @@ fn path(name: &str) -> PathBuf {
 
 fn fixture(name: &str) -> PathBuf {
     path(&format!("tests/fixtures/samplers/{name}"))
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 /// A sampler of `files` with `composition` and `conventions`.
@@ -205,20 +204,6 @@ fn spawn_check(file: &Path, args: &[&str]) -> Child {
     Command::new(LOBES).arg("check").arg(file).args(args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap()
 }
 
-/// Waits for `child` at most `limit`; kills it (and fails) past that.
-fn finish(mut child: Child, limit: Duration) -> Output {
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().unwrap();
-            panic!("still running after {limit:?}:\n{}{}", text(&out.stdout), text(&out.stderr));
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.wait_with_output().unwrap()
-}
-
 const LOOPS: [&str; 8] = ["--sample", "s", "--pdf", "p", "--samples", "65536", "--bins", "8,16"];
 
 /// Issue 35 item 10: a sampler that loops only at u = (0, 0, 0, 0), which only the hard cases
@@ -227,7 +212,7 @@ const LOOPS: [&str; 8] = ["--sample", "s", "--pdf", "p", "--samples", "65536", "
 #[test]
 fn a_loop_only_the_hard_cases_reach_ends_at_the_timeout() {
     let started = Instant::now();
-    let out = finish(spawn_check(&fixture("loops_at_zero.wgsl"), &[&LOOPS[..], &["--timeout", "10"]].concat()), Duration::from_secs(60));
+    let (out, _) = finish(spawn_check(&fixture("loops_at_zero.wgsl"), &[&LOOPS[..], &["--timeout", "10"]].concat()), Duration::from_secs(60));
     let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
     assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
     let line = stdout.lines().find(|l| l.starts_with("timeout")).unwrap_or_else(|| panic!("no timeout row:\n{stdout}"));
@@ -245,7 +230,7 @@ fn sigint_ends_a_loop_only_the_hard_cases_reach_at_once() {
     std::thread::sleep(Duration::from_secs(12));
     assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
     let sent = Instant::now();
-    let out = finish(child, Duration::from_secs(30));
+    let (out, _) = finish(child, Duration::from_secs(30));
     assert_eq!(out.status.code(), Some(130), "{}{}", text(&out.stdout), text(&out.stderr));
     assert!(sent.elapsed() < Duration::from_millis(2500), "{:?} after the signal", sent.elapsed());
 }
