@@ -468,7 +468,7 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
         .map(|&(samples, seed)| {
             let params = params_of(sampler, &Settings { seed, ..settings.clone() });
             let started = std::time::Instant::now();
-            let counts = judge::histogram(&passes, &params, samples, (rows * cols) as usize)?;
+            let counts = judge::histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
             Ok((counts, started.elapsed().as_secs_f64()))
         })
         .collect()
@@ -527,6 +527,29 @@ fn report(run: &judge::Run, m: &judge::Measured, checks: Vec<Check>, adapter: St
         invalid: m.invalid(bins),
         expected,
     }
+}
+
+/// Why a half-vector sampler's pdf may defeat the quadrature without a fault of its own, for a
+/// no-verdict message: with `--sample-returns half-vector` and reflections below the surface kept,
+/// the density of d = 2 (wi·h) h − wi is p(h) / (4 wi·h) with h = normalize(wi + d), which has an
+/// integrable pole at d = −wi wherever p(h) is not 0 for h ⊥ wi (NDF sampling: D(h) cos θh at
+/// θi > 0); no f32 quadrature resolves it, and the f32 pdf may be ∞ or NaN beside it. `bad_at`:
+/// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
+/// points), which must lie within 1° of −wi; None for an unconverged quadrature.
+fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<String> {
+    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || sampler.domain != Domain::Sphere {
+        return None;
+    }
+    let pole = crate::reference::reflect::spherical((180.0 - settings.incident_theta).to_radians(), (settings.incident_phi + 180.0).to_radians());
+    if let Some(Some((theta, phi))) = bad_at
+        && crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians()).dot(pole).clamp(-1.0, 1.0).acos() > 1f64.to_radians()
+    {
+        return None;
+    }
+    let (t, p) = (pole.z.clamp(-1.0, 1.0).acos().to_degrees(), pole.y.atan2(pole.x).to_degrees());
+    Some(format!(
+        "; with --sample-returns half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with --reflection-only (they are then rejections, and d = −wi is one of them)"
+    ))
 }
 
 /// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf

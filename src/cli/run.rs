@@ -97,13 +97,13 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
             .tiling(&case.job)
             .map_err(|e| usage(format!("{}: case '{}': {e}", scene.case_location(i), case.name)))?;
         if tiling.tiles > 1 {
-            eprintln!(
+            crate::console::say(format_args!(
                 "lobes: note: case '{}': {} bins exceed one storage binding of this adapter; counting them in {} passes of {} bins",
                 case.name,
                 case.job.bins(),
                 tiling.tiles,
                 tiling.tile_bins
-            );
+            ));
         }
     }
     Ok(())
@@ -168,14 +168,14 @@ impl PlainProgress {
             bar.set_position(done);
             if on && last.elapsed() >= Self::EVERY {
                 last = Instant::now();
-                eprintln!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64());
+                crate::console::say(format_args!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64()));
             }
         }
     }
 
     fn finished(&self, i: usize, name: &str, verdict: &str, seconds: f64) {
         if self.on {
-            eprintln!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases);
+            crate::console::say(format_args!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases));
         }
     }
 }
@@ -203,7 +203,7 @@ pub(super) fn record_error(folder: &OutFolder, significance: f64, err: &anyhow::
         crate::report::summary::write(folder.path(), &summary, &[])
     });
     if let Err(e) = written {
-        eprintln!("lobes: error: {e:#}");
+        crate::console::say(format_args!("lobes: error: {e:#}"));
     }
 }
 
@@ -229,18 +229,18 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
     let names: Vec<String> = scene.entries().map(|(e, _)| e.name().to_string()).collect();
     let stale = folder.clean(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
     if !stale.is_empty() {
-        eprintln!(
+        crate::console::say(format_args!(
             "lobes: note: removed the outputs of {} cases of an earlier run in {} that this run does not have ({})",
             stale.len(),
             args.out.display(),
             stale.join(", ")
-        );
+        ));
     }
     let n = scene.len();
     let level = sidak(args.significance, n);
     let heading = vec![format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
     let summary = Arc::new(Mutex::new(RunSummary { stale, ..RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level) }));
-    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now")?;
+    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now", None)?;
     summary_on_exit(names, args.out.clone(), heading.clone(), summary.clone());
     let table = run_cases(args, &scene, &mut backend, level, &summary);
     let summary = summary.lock().unwrap_or_else(|p| p.into_inner()).clone();
@@ -261,7 +261,7 @@ fn summary_on_exit(all: Vec<String>, out: PathBuf, heading: Vec<String>, shared:
         s.status = RunStatus::Interrupted;
         s.not_run = all.iter().filter(|n| !s.cases.iter().any(|c| &c.case == *n)).cloned().collect();
         if let Err(e) = crate::report::summary::write(&out, &s, &heading) {
-            eprintln!("lobes: error: {e:#}");
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
     });
 }
@@ -334,7 +334,7 @@ fn run_cases(args: &RunArgs, scene: &Scene, backend: &mut Backend, level: f64, s
             }
             Err(e) if timed_out(&e) => {
                 // a failure of the case, with its reason; the device still runs its work
-                eprintln!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name());
+                crate::console::say(format_args!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name()));
                 lost = Some(format!("the GPU device is still running case '{}', which ran out of time", entry.name()));
                 table.push_dashes(&entry, "FAIL");
                 record(&mut |s| s.push(CaseSummary { failure: Some(format!("{e:#}")), error: None, ..CaseSummary::error(&entry, String::new()) }));
@@ -342,9 +342,9 @@ fn run_cases(args: &RunArgs, scene: &Scene, backend: &mut Backend, level: f64, s
             }
             Err(e) => {
                 if lost.is_none() {
-                    eprintln!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
+                    crate::console::say(format_args!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name()));
                     if device_lost(&e) {
-                        eprintln!("lobes: error: the GPU device is unusable; the remaining cases do not run");
+                        crate::console::say(format_args!("lobes: error: the GPU device is unusable; the remaining cases do not run"));
                         lost = Some(format!("the GPU device was lost in case '{}'", entry.name()));
                     }
                 }
@@ -392,7 +392,7 @@ fn verdict(summary: &RunSummary, n: usize, written: anyhow::Result<()>) -> anyho
     let (errors, failed) = (summary.errors, summary.failed);
     if summary.status == RunStatus::Interrupted {
         if let Err(e) = &written {
-            eprintln!("lobes: error: {e:#}");
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
         let finished = n - summary.not_run.len();
         return Err(Interrupted(format!("interrupted after {finished} of {n} cases ({errors} could not run, {failed} failed)")).into());

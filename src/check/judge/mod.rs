@@ -112,7 +112,7 @@ impl Measured {
 
 /// Measures `run`: the histogram, the probes, and the quadrature of the pdf.
 pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
-    let totals = histogram(&run.passes, &run.params, run.settings.samples, run.bins())?;
+    let totals = histogram(&run.passes, &run.params, run.sampler, run.settings.samples, run.bins())?;
     let probe_u = probe_uniforms(run.settings);
     let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, run.wi)).collect();
     let probes = run.passes.probe(&run.params, &items)?;
@@ -144,17 +144,24 @@ fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<Integrals, Check
     Ok(integrals)
 }
 
-/// The histogram of `samples` samples: counts per bin, then per invalid reason, in dispatches
-/// of at most [`CHUNK`] samples.
-pub(super) fn histogram(passes: &Passes, params: &Params, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
+/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
+/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
+/// numbers, counted on every sample, are bad input ([`super::gpu::too_many_draws`]).
+pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
     let mut totals = vec![0u64; bins + 4];
+    let (mut over, mut most) = (0u64, 0u32);
     let mut first = 0;
     while first < samples {
         let n = CHUNK.min(samples - first) as u32;
-        for (t, c) in totals.iter_mut().zip(passes.histogram(params, first, n, bins + 4, None)?) {
+        let counted = passes.histogram(params, first, n, bins + 4, None)?;
+        for (t, c) in totals.iter_mut().zip(counted.counts) {
             *t += c as u64;
         }
+        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
         first += n as u64;
+    }
+    if over > 0 {
+        return Err(super::gpu::too_many_draws(sampler, most, over, samples));
     }
     let counted: u64 = totals.iter().sum();
     if counted != samples {
@@ -167,7 +174,7 @@ pub(super) fn histogram(passes: &Passes, params: &Params, samples: u64, bins: us
 /// expected counts the quadrature could not resolve give no verdict.
 pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckError> {
     if m.integrals.bad_parts == 0 {
-        m.integrals.converged(run.settings.samples).map_err(CheckError::NoVerdict)?;
+        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(e + &super::half_vector_pole(run.sampler, run.settings, None).unwrap_or_default()))?;
     }
     Ok(())
 }

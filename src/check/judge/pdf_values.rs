@@ -92,6 +92,12 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     let (bad, parts) = (m.integrals.bad_parts, m.integrals.parts);
     let s = run.sampler;
     let worst = if bad > 0 { worst(&run.passes, &run.params, &s.domain, &s.conventions)? } else { None };
+    if bad > 0
+        && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
+    {
+        let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), false));
+        return Err(CheckError::NoVerdict(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}{pole}", run.pdf())));
+    }
     let worst = worst.map(|w| w.describe(&run.pdf(), run.plane()));
     let summary = if bad == 0 {
         format!("{} finite and ≥ 0 at every quadrature node ({parts} parts)", run.pdf())
