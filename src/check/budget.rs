@@ -158,6 +158,12 @@ pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
     (n >= PILOT_SAMPLES && fixed + n as f64 * per_sample <= budget).then_some(n)
 }
 
+/// Seconds as a user reads them: as typed for ordinary values, in exponent form for tiny or huge
+/// ones (`1e-300`, not 300 zeros).
+fn seconds(s: f64) -> String {
+    if (1e-3..1e7).contains(&s) { format!("{s}") } else { format!("{s:e}") }
+}
+
 /// Measures the check's time on `gpu` by pilot checks and picks the count for `budget` seconds,
 /// or for 1/[`TIMEOUT_MARGIN`] of `settings.timeout` where that is less (the pick's
 /// `budget_seconds` is then that part of the timeout): a count whose check is predicted to run
@@ -167,7 +173,11 @@ pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
 /// (half the fixed part, or an eighth of the budget), and the line through the last two.
 pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, profile: Option<Profile>) -> Result<BudgetPick, CheckError> {
     let (given, budget) = (budget, budget.min(settings.timeout.as_secs_f64() / TIMEOUT_MARGIN));
-    let named = if budget < given { format!("--budget {given} s, capped at 1/{TIMEOUT_MARGIN} of the timeout ({budget} s),") } else { format!("--budget {budget} s") };
+    let named = if budget < given {
+        format!("--budget {} s, capped at 1/{TIMEOUT_MARGIN} of the timeout ({} s),", seconds(given), seconds(budget))
+    } else {
+        format!("--budget {} s", seconds(budget))
+    };
     let run = |samples: u64| -> Result<Pilot, CheckError> {
         let r = check(gpu, sampler, &Settings { samples, ..settings.clone() })?;
         Ok(Pilot { samples, seconds: r.wall_seconds, gpu_seconds: r.gpu_seconds })

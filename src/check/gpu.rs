@@ -105,10 +105,12 @@ fn names(seed: &str) -> String {
     out
 }
 
-/// The type probe of a sample expression: a function whose `lobes_r` has the expression's type.
-pub(super) fn type_probe(sample: &str) -> String {
+/// The type probe of a call expression: a function `lobes_type_probe` whose `lobes_r` has the
+/// expression's type, over the names of `flag` (`--sample`: wi, u; `--pdf`/`--eval`: wi, d).
+pub(super) fn type_probe(flag: &str, expr: &str) -> String {
+    let second = if flag == "--sample" { "u: vec4<f32>" } else { "d: vec3<f32>" };
     format!(
-        "// the type of --sample\nfn lobes_type_probe(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) {{\n{}    let lobes_r = {sample};\n}}\n",
+        "// the type of {flag}\nfn lobes_type_probe(wi: vec3<f32>, {second}, params: array<vec4<f32>, 4>) {{\n{}    let lobes_r = {expr};\n}}\n",
         names("0u")
     )
 }
@@ -226,28 +228,65 @@ fn contract_glue(sampler: &UserSampler) -> String {
 /// The path of the generated module `lobes::user` in messages.
 const USER_MODULE: &str = "<lobes check glue>";
 
-/// What the sample expression returns (the contract's function: `Contract`), from naga's types
-/// of the expression in a probe function.
-pub(super) fn returned(code: &UserCode, sampler: &UserSampler) -> Result<Returned, CheckError> {
-    if is_name(&sampler.sample) {
-        return Ok(Returned::Contract);
-    }
+/// The type of a call expression of `flag` over the user's code (naga's type of it in a probe
+/// function); an expression that does not parse or validate is an error naming the flag.
+fn expression_type(code: &UserCode, flag: &str, expr: &str) -> Result<naga::TypeInner, CheckError> {
     let mut c = Composed::default();
     for p in &code.parts {
         c.push(&p.name, &p.text);
     }
-    c.push(GLUE, &type_probe(&sampler.sample));
-    let (module, info) = c.validate_with(naga::valid::Capabilities::all())?;
+    c.push(GLUE, &type_probe(flag, expr));
+    let (module, info) = c.validate_with(naga::valid::Capabilities::all()).map_err(|e| match e {
+        CheckError::Wgsl(m) => CheckError::Wgsl(format!("{flag} '{expr}': {m}")),
+        e => e,
+    })?;
     let (h, f) = module.functions.iter().find(|(_, f)| f.name.as_deref() == Some("lobes_type_probe")).ok_or_else(|| CheckError::Internal("no type probe".into()))?;
     let (e, _) = f.named_expressions.iter().find(|(_, n)| n.as_str() == "lobes_r").ok_or_else(|| CheckError::Internal("no lobes_r".into()))?;
-    let inner = info[h][*e].ty.inner_with(&module.types);
-    match inner {
-        naga::TypeInner::Vector { size: naga::VectorSize::Tri, scalar } if *scalar == naga::Scalar::F32 => Ok(Returned::Vec3),
-        naga::TypeInner::Vector { size: naga::VectorSize::Quad, scalar } if *scalar == naga::Scalar::F32 => Ok(Returned::Vec4),
+    Ok(info[h][*e].ty.inner_with(&module.types).clone())
+}
+
+/// The call expressions of --sample, --pdf and --eval: none empty, and each density one an f32.
+pub(super) fn check_expressions(code: &UserCode, sampler: &UserSampler) -> Result<(), CheckError> {
+    let calls = [("--sample", Some(sampler.sample.as_str())), ("--pdf", Some(sampler.pdf.as_str())), ("--eval", sampler.eval.as_deref())];
+    for (flag, call) in calls {
+        let Some(call) = call else { continue };
+        if call.trim().is_empty() {
+            return Err(CheckError::Input(format!(
+                "{flag} is empty; give a function name of the contract or a call expression over lobes' names, e.g. {}",
+                if flag == "--sample" { "'sample_ggx(wi, u.xy, p0)'" } else { "'ggx_pdf(wi, d, p0)'" }
+            )));
+        }
+        if flag == "--sample" || is_name(call) {
+            continue;
+        }
+        match expression_type(code, flag, call)? {
+            naga::TypeInner::Scalar(s) if s == naga::Scalar::F32 => {}
+            other => {
+                return Err(CheckError::Input(format!(
+                    "{flag} '{call}' returns {}; expected f32 (the {})",
+                    super::compose::describe_inner(&other),
+                    if flag == "--pdf" { "density at d" } else { "value f·|cos θ| at d" }
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// What the sample expression returns (the contract's function: `Contract`), from naga's types
+/// of the expression in a probe function.
+pub(super) fn returned(code: &UserCode, sampler: &UserSampler) -> Result<Returned, CheckError> {
+    check_expressions(code, sampler)?;
+    if is_name(&sampler.sample) {
+        return Ok(Returned::Contract);
+    }
+    match expression_type(code, "--sample", &sampler.sample)? {
+        naga::TypeInner::Vector { size: naga::VectorSize::Tri, scalar } if scalar == naga::Scalar::F32 => Ok(Returned::Vec3),
+        naga::TypeInner::Vector { size: naga::VectorSize::Quad, scalar } if scalar == naga::Scalar::F32 => Ok(Returned::Vec4),
         other => Err(CheckError::Input(format!(
             "--sample '{}' returns {}; a sample expression returns vec3<f32> (d) or vec4<f32> (d, pdf)",
             sampler.sample,
-            super::compose::describe_inner(other)
+            super::compose::describe_inner(&other)
         ))),
     }
 }
@@ -270,8 +309,8 @@ fn rand_body(name: &str, module: &naga::Module, f: &naga::Function) -> Result<St
 }
 
 /// The parts with the bodies of the --rand functions replaced by lobes' queue (lines kept). A
-/// function that `required` and is absent is an error naming the functions there.
-fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bool) -> Result<Vec<Source>, CheckError> {
+/// function that is absent is an error naming the functions there.
+fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String]) -> Result<Vec<Source>, CheckError> {
     if rand.is_empty() {
         return Ok(parts.to_vec());
     }
@@ -283,7 +322,7 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bo
     let mut bodies = Vec::new();
     for name in rand {
         let found = code.functions_named(&module, name);
-        if found.is_empty() && required {
+        if found.is_empty() {
             let known: Vec<String> = module
                 .functions
                 .iter()
@@ -298,8 +337,11 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String], required: bo
                 known.join(", ")
             )));
         }
+        // one function named twice (`rnd` and `rnd`, or `rand_f` and `package::utils::rand_f`) is one
         for h in found {
-            bodies.push((h, rand_body(name, &module, &module.functions[h])?));
+            if !bodies.iter().any(|(b, _)| *b == h) {
+                bodies.push((h, rand_body(name, &module, &module.functions[h])?));
+            }
         }
     }
     let text = super::modules::replace_bodies(&c.text, &module, &bodies)?;
@@ -335,26 +377,25 @@ pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Sour
     let returned = returned(&code, sampler)?;
     let rand = &sampler.composition.rand;
     if code.dialect == super::modules::Dialect::Wgsl {
-        let mut parts = replace_rand(&code.parts, &code, rand, true)?;
+        let mut parts = replace_rand(&code.parts, &code, rand)?;
         parts.push(Source { name: GLUE.into(), text: glue(sampler, returned, order, false) });
         return Ok(parts);
     }
-    // that each --rand function exists before compaction (after it, only the reached ones do)
-    replace_rand(&code.parts, &code, rand, true)?;
+    // the --rand bodies replaced in the tree as composed, where each function is found by its
+    // name there (before naga's writer renames any: `würfel` → `wrfel`); their calls of the
+    // queue reach the glue's `lobes_rand_take` in the one module below
+    let parts = replace_rand(&code.parts, &code, rand)?;
     let mut c = Composed::default();
-    c.push(&code.parts[0].name, &code.parts[0].text);
+    c.push(&parts[0].name, &parts[0].text);
     c.push(GLUE, &glue(sampler, returned, order, true));
     let (mut module, _) = c.validate_with(naga::valid::Capabilities::all())?;
-    naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
-    module.entry_points.clear();
-    let text = super::modules::write_wgsl(&module, naga::valid::Capabilities::all())?;
-    let parts = vec![Source { name: code.parts[0].name.clone(), text }];
-    // naga's writer writes a run of underscores as one (`package_utils__1rand_f` → `package_utils_1rand_f`)
-    let mut written = code.clone();
-    for o in &mut written.origins {
-        o.0 = o.0.split('_').filter(|w| !w.is_empty()).collect::<Vec<_>>().join("_");
-    }
-    replace_rand(&parts, &written, rand, false)
+    // compacted and written on a large stack, as parsed (a tree thousands of calls deep)
+    let text = crate::engine::gpu::stack::with_big_stack(move || {
+        naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
+        module.entry_points.clear();
+        super::modules::write_wgsl(&module, naga::valid::Capabilities::all())
+    })?;
+    Ok(vec![Source { name: code.parts[0].name.clone(), text }])
 }
 
 /// The user's code, the glue and lobes' passes as one module, validated by naga (errors at the

@@ -104,6 +104,9 @@ impl Composition {
                 _ => Err(format!("--stub '{s}': give MODULE=FILE, e.g. --stub package::bindings=tests/no_bindings.wesl")),
             })
             .collect::<Result<Vec<_>, String>>()?;
+        if let Some((m, _)) = stubs.iter().enumerate().find(|(i, (m, _))| stubs[..*i].iter().any(|(n, _)| n == m)).map(|(_, s)| s) {
+            return Err(format!("--stub {m}: given twice; one module has one stand-in"));
+        }
         let rand_order = rand_order.map(|o| Draw::parse_list(o).map_err(|e| format!("--rand-order: {e}"))).transpose()?;
         if rand_order.is_some() && rand.is_empty() {
             return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
@@ -249,7 +252,12 @@ pub(super) struct UserCode {
     pub files: Vec<String>,
     /// Where the declarations of a WESL tree came from (the wesl crate writes the tree anew).
     pub decls: Vec<super::compose::DeclOrigin>,
+    /// The functions naga's WGSL writer renamed in `parts` (`würfel` → `wrfel`, `rand_` → `rand`).
+    pub renamed: Renamed,
 }
+
+/// (the name naga's WGSL writer gave a function, its name in the module it wrote).
+pub(super) type Renamed = Vec<(String, String)>;
 
 impl UserCode {
     /// The functions named `name` (plain, or `module::path::name`) in `module`.
@@ -260,6 +268,7 @@ impl UserCode {
             .filter(|(_, f)| {
                 let Some(n) = f.name.as_deref() else { return false };
                 n == name
+                    || self.renamed.iter().any(|(written, original)| written == n && original == name)
                     || self.origins.iter().any(|(m, path, item)| m == n && (item == name || format!("{path}::{item}") == name))
             })
             .map(|(h, _)| h)
@@ -274,7 +283,7 @@ impl UserCode {
     /// name in the composed text. A module path matches an import's full path or its last
     /// segments. A name no imported module holds is an error naming the imported items.
     pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
-        if !expr.contains("::") {
+        if self.dialect == Dialect::Wgsl && !expr.contains("::") {
             return Ok(expr.to_string());
         }
         if self.dialect == Dialect::Wgsl {
@@ -312,7 +321,8 @@ impl UserCode {
             }
             let path = &expr[start..i];
             let Some((module, item)) = path.rsplit_once("::") else {
-                out.push_str(path);
+                let member = out.trim_end().ends_with('.');
+                out.push_str(self.imported(path, root_text).filter(|_| !member).unwrap_or(path));
                 continue;
             };
             let module = aliases.iter().find(|(a, _)| a == module).map_or(module, |(_, m)| m.as_str());
@@ -333,6 +343,19 @@ impl UserCode {
     }
 }
 
+impl UserCode {
+    /// The composed name of `name` where the sampler's file imports it by that name (naga_oil's
+    /// `#import a::b::{name}`, WESL's `import package::a::name;`): an expression names it as the
+    /// file does. `None` where no import line names it, or two modules hold an item of that name.
+    fn imported(&self, name: &str, root_text: &str) -> Option<&str> {
+        let word = |l: &str| l.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == name);
+        let imports = root_text.lines().map(str::trim_start).any(|l| (l.starts_with("#import ") || l.starts_with("import ")) && word(l));
+        let mut held = self.origins.iter().filter(|(_, _, item)| item == name).map(|(composed, _, _)| composed.as_str());
+        let first = held.next()?;
+        (imports && held.all(|c| c == first)).then_some(first)
+    }
+}
+
 /// The roots modules are looked up under: the given ones, else the first file's folder.
 fn roots(sources: &[Source], c: &Composition) -> Vec<PathBuf> {
     if !c.shader_roots.is_empty() {
@@ -347,8 +370,22 @@ fn show_roots(roots: &[PathBuf]) -> String {
 }
 
 /// Every file with one of `exts` under `dir` (hidden folders and `target` skipped), at most
-/// 20 000.
+/// 20 000. Each folder and file is taken once, by its device and inode: a symbolic link back up
+/// the tree (`loops/a -> .`) is not walked again, and a file reached by two links is one file.
 fn scan(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
+    scan_once(dir, exts, out, &mut std::collections::HashSet::new());
+}
+
+/// A file system object's identity: its device and inode.
+fn identity(p: &Path) -> Option<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    std::fs::metadata(p).ok().map(|m| (m.dev(), m.ino()))
+}
+
+fn scan_once(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>, seen: &mut std::collections::HashSet<(u64, u64)>) {
+    if !identity(dir).is_some_and(|id| seen.insert(id)) {
+        return;
+    }
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     let mut entries: Vec<_> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
     entries.sort();
@@ -359,9 +396,9 @@ fn scan(dir: &Path, exts: &[&str], out: &mut Vec<PathBuf>) {
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
         if p.is_dir() {
             if !name.starts_with('.') && name != "target" {
-                scan(&p, exts, out);
+                scan_once(&p, exts, out, seen);
             }
-        } else if exts.iter().any(|e| p.extension().and_then(|x| x.to_str()) == Some(e)) {
+        } else if exts.iter().any(|e| p.extension().and_then(|x| x.to_str()) == Some(e)) && identity(&p).is_some_and(|id| seen.insert(id)) {
             out.push(p);
         }
     }
@@ -380,11 +417,63 @@ fn line_col(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
-/// The user's files composed as their dialect composes them.
+/// What a composed tree was made from: the files given, the composition, and each file under
+/// the roots and each stub by its path, size and modification time.
+type TreeKey = (Vec<Source>, Composition, Vec<(PathBuf, u64, Option<std::time::SystemTime>)>);
+
+/// The trees this process composed (a check composes its sampler's tree for validation, for
+/// each --rand order probed and for the passes; a run composes each case's): naga_oil's
+/// composer is superlinear in a tree's depth (each module's header holds its imports' imports),
+/// so a tree is composed once per process, and again only when a file under its roots changed.
+static TREES: std::sync::Mutex<Vec<(TreeKey, UserCode)>> = std::sync::Mutex::new(Vec::new());
+
+/// The trees kept: a run's cases share a few.
+const TREES_KEPT: usize = 8;
+
+fn tree_key(sources: &[Source], c: &Composition) -> TreeKey {
+    let mut files = Vec::new();
+    for r in roots(sources, c) {
+        scan(&r, &["wgsl", "wesl"], &mut files);
+    }
+    files.extend(c.stubs.iter().map(|(_, f)| f.clone()));
+    let stamp = files
+        .into_iter()
+        .map(|f| {
+            let m = std::fs::metadata(&f).ok();
+            let len = m.as_ref().map_or(0, std::fs::Metadata::len);
+            let modified = m.and_then(|m| m.modified().ok());
+            (f, len, modified)
+        })
+        .collect();
+    (sources.to_vec(), c.clone(), stamp)
+}
+
+/// The user's files composed as their dialect composes them (a tree composed before in this
+/// process, from the same files, is taken from [`TREES`]).
 pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
+    if sources.is_empty() || (dialect(sources) == Dialect::Wgsl && c.defines.is_empty()) {
+        return compose_anew(sources, c);
+    }
+    let key = tree_key(sources, c);
+    let kept = TREES.lock().unwrap_or_else(|p| p.into_inner()).iter().find(|(k, _)| *k == key).map(|(_, code)| code.clone());
+    if let Some(code) = kept {
+        return Ok(code);
+    }
+    // on a large stack: naga_oil recurses once per module along a chain of imports
+    let code = crate::engine::gpu::stack::with_big_stack(|| compose_anew(sources, c))?;
+    let mut trees = TREES.lock().unwrap_or_else(|p| p.into_inner());
+    if trees.len() >= TREES_KEPT {
+        trees.remove(0);
+    }
+    trees.push((key, code.clone()));
+    Ok(code)
+}
+
+fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
+    foreign_directives(sources)?;
     let files = sources.iter().map(|s| s.name.clone()).collect();
     let mut d = dialect(sources);
     if d == Dialect::Wgsl && !c.defines.is_empty() {
@@ -396,14 +485,15 @@ pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCo
             if let Some((m, _)) = c.stubs.first() {
                 return Err(CheckError::Input(format!("--stub {m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
             }
-            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new() })
+            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new(), renamed: Vec::new() })
         }
-        Dialect::NagaOil => naga_oil_tree(sources, c).map(|(text, origins)| UserCode {
+        Dialect::NagaOil => naga_oil_tree(sources, c).map(|(text, origins, renamed)| UserCode {
             dialect: d,
             parts: vec![Source { name: format!("<{} with its modules, composed by naga_oil>", sources[0].name), text }],
             origins,
             files,
             decls: Vec::new(),
+            renamed,
         }),
         Dialect::Wesl => wesl_tree(sources, c).map(|(text, origins, decls)| UserCode {
             dialect: d,
@@ -411,14 +501,41 @@ pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCo
             origins,
             files,
             decls,
+            renamed: Vec::new(),
         }),
     }
+}
+
+/// The directives lobes composes: naga_oil's (WGSL and WESL have none at the start of a line).
+const DIRECTIVES: [&str; 9] = ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if", "#else", "#endif", "#elif", "#define"];
+
+/// A line of the user's files that starts with a preprocessor directive lobes does not know
+/// (a renderer's own, RedGPU's `#redgpu_include`): an error saying what it is and how to
+/// proceed, rather than WGSL's parse error at `#`.
+fn foreign_directives(sources: &[Source]) -> Result<(), CheckError> {
+    for s in sources {
+        for (n, line) in s.text.lines().enumerate() {
+            let l = line.trim_start();
+            let Some(word) = l.strip_prefix('#').map(|r| r.split(|c: char| !(c.is_alphanumeric() || c == '_')).next().unwrap_or("")) else { continue };
+            if word.is_empty() || DIRECTIVES.iter().any(|d| d[1..] == *word) {
+                continue;
+            }
+            return Err(CheckError::Input(format!(
+                "{}:{}: `{}` is a preprocessor line of the renderer's own (not WGSL, nor naga_oil's #import/#ifdef family), which lobes cannot expand; give lobes the file as the renderer's preprocessor writes it (a pre-expanded file), or, where the line pulls in a module, write it as a naga_oil `#import` and stand in for that module with --stub MODULE=FILE; a switch the line tests is a --define",
+                s.name,
+                n + 1,
+                l.trim_end()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `--define` values as naga_oil's shader defs: no value or `true`/`false` a bool, else an
 /// integer (`7`, `-1`; `7u` unsigned).
 fn shader_defs(c: &Composition) -> Result<std::collections::HashMap<String, naga_oil::compose::ShaderDefValue>, CheckError> {
     use naga_oil::compose::ShaderDefValue as V;
+    let digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
     c.defines
         .iter()
         .map(|(n, v)| {
@@ -428,6 +545,13 @@ fn shader_defs(c: &Composition) -> Result<std::collections::HashMap<String, naga
                 Some(s) => match (s.strip_suffix('u').map(str::parse::<u32>), s.parse::<i32>()) {
                     (Some(Ok(u)), _) => V::UInt(u),
                     (_, Ok(i)) => V::Int(i),
+                    // an integer, but not one naga_oil's i32 or u32 holds
+                    (Some(Err(_)), _) if s.strip_suffix('u').is_some_and(digits) => {
+                        return Err(CheckError::Input(format!("--define {n}={s}: {s} is out of the range of u32 (0 to {}u)", u32::MAX)));
+                    }
+                    (None, Err(_)) if digits(s.strip_prefix('-').unwrap_or(s)) => {
+                        return Err(CheckError::Input(format!("--define {n}={s}: {s} is out of the range of i32 ({} to {})", i32::MIN, i32::MAX)));
+                    }
                     _ => return Err(CheckError::Input(format!("--define {n}={s}: the value must be true, false or an integer (7, -1, 7u)"))),
                 },
             };
@@ -442,25 +566,24 @@ struct OilModule {
     source: Source,
     /// The file's `#import`s (module paths; an imported item's module is its prefix).
     imports: Vec<String>,
+    /// Whether it stands in for a module (`--stub`).
+    stub: bool,
+    /// Other files under the roots that declare the same `#define_import_path`.
+    also: Vec<String>,
 }
 
 fn oil_module(source: Source, as_name: Option<&str>) -> Option<OilModule> {
     let (name, imports, _) = naga_oil::compose::get_preprocessor_data(&source.text);
     let path = as_name.map(String::from).or(name)?;
-    Some(OilModule { path, imports: imports.into_iter().map(|i| i.import).collect(), source })
+    Some(OilModule { path, imports: imports.into_iter().map(|i| i.import).collect(), source, stub: as_name.is_some(), also: Vec::new() })
 }
 
-/// The tree of `sources[0]` composed by naga_oil, as WGSL text (the root's names as written, the
-/// imported ones decorated), and each decorated name's origin.
-fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>), CheckError> {
-    use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
-    let roots = roots(sources, c);
-    let defs = shader_defs(c)?;
-    // the modules: stubs first, then the files given, then every .wgsl under the roots
+/// The modules a naga_oil tree may import: stubs first, then the files given after the
+/// sampler's, then every .wgsl under the roots (a path already given by a stub or a file stays
+/// theirs; one declared by two files under the roots keeps both names, refused if imported).
+fn oil_modules(sources: &[Source], c: &Composition, roots: &[PathBuf]) -> Result<Vec<OilModule>, CheckError> {
     let mut modules: Vec<OilModule> = Vec::new();
-    let mut stubbed = Vec::new();
     for (m, s) in stubs(c)? {
-        stubbed.push(m.clone());
         modules.push(oil_module(s, Some(&m)).expect("a stub has a name"));
     }
     for s in &sources[1..] {
@@ -474,58 +597,136 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Ori
             }
         }
     }
+    let given = modules.len();
     let mut found = Vec::new();
-    for r in &roots {
+    for r in roots {
         if !r.is_dir() {
             return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
         }
         scan(r, &["wgsl"], &mut found);
     }
-    let root_path = std::fs::canonicalize(&sources[0].name).ok();
+    let skip: Vec<PathBuf> = sources.iter().filter_map(|s| std::fs::canonicalize(&s.name).ok()).collect();
+    let mut index: std::collections::HashMap<String, usize> = modules.iter().enumerate().map(|(i, m)| (m.path.clone(), i)).collect();
     for f in found {
-        if std::fs::canonicalize(&f).ok() == root_path {
+        if std::fs::canonicalize(&f).is_ok_and(|f| skip.contains(&f)) {
             continue;
         }
         let Ok(text) = std::fs::read_to_string(&f) else { continue };
-        if let Some(m) = oil_module(Source { name: f.display().to_string(), text }, None)
-            && !modules.iter().any(|x| x.path == m.path)
-        {
-            modules.push(m);
+        let Some(m) = oil_module(Source { name: f.display().to_string(), text }, None) else { continue };
+        match index.get(&m.path) {
+            Some(&i) if i >= given => modules[i].also.push(m.source.name),
+            Some(_) => {}
+            None => {
+                index.insert(m.path.clone(), modules.len());
+                modules.push(m);
+            }
         }
     }
+    Ok(modules)
+}
+
+/// The modules the root needs (indices of `modules`), each after those it imports; an import
+/// that no module declares, that two files declare, or that comes back to the root or to a
+/// module on the way, is an error naming it.
+fn oil_order(root: &OilModule, root_path: Option<&str>, modules: &[OilModule], roots: &[PathBuf]) -> Result<Vec<usize>, CheckError> {
+    let index: std::collections::HashMap<&str, usize> = modules.iter().enumerate().map(|(i, m)| (m.path.as_str(), i)).collect();
+    let mut order = Vec::new();
+    let mut done = vec![false; modules.len()];
+    let mut stack: Vec<String> = root_path.map(String::from).into_iter().collect();
+    // depth first, without recursion (a chain of thousands of modules): (module, next import)
+    let mut todo: Vec<(Option<usize>, usize)> = vec![(None, 0)];
+    while let Some((at, next)) = todo.pop() {
+        let from = at.map_or(root, |i| &modules[i]);
+        let Some(import) = from.imports.get(next) else {
+            if let Some(i) = at {
+                done[i] = true;
+                order.push(i);
+                stack.pop();
+            }
+            continue;
+        };
+        todo.push((at, next + 1));
+        let parent = import.rsplit_once("::").map(|(p, _)| p);
+        if root_path.is_some_and(|r| r == import || Some(r) == parent) {
+            return Err(CheckError::Input(format!(
+                "{}: imports form a cycle through the sampler's file: {} -> {} (the sampler's file, {})",
+                from.source.name,
+                stack.join(" -> "),
+                root_path.expect("a root path"),
+                root.source.name
+            )));
+        }
+        let Some(&i) = index.get(import.as_str()).or_else(|| parent.and_then(|p| index.get(p))) else {
+            return Err(unresolved(from, import, parent, modules, roots));
+        };
+        if done[i] {
+            continue;
+        }
+        if stack.contains(&modules[i].path) {
+            return Err(CheckError::Input(format!("{}: imports form a cycle: {} -> {}", modules[i].source.name, stack.join(" -> "), modules[i].path)));
+        }
+        if !modules[i].also.is_empty() {
+            return Err(CheckError::Input(format!(
+                "{}: `{}` is declared (#define_import_path {}) by more than one file under the shader roots: {} and {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with --stub {}=FILE",
+                from.source.name,
+                modules[i].path,
+                modules[i].path,
+                modules[i].source.name,
+                modules[i].also.join(" and "),
+                modules[i].path
+            )));
+        }
+        stack.push(modules[i].path.clone());
+        todo.push((Some(i), 0));
+    }
+    Ok(order)
+}
+
+/// The error of an import no module declares: at the import, with the roots and the closest
+/// module names.
+fn unresolved(from: &OilModule, import: &str, parent: Option<&str>, modules: &[OilModule], roots: &[PathBuf]) -> CheckError {
+    let at = from.source.text.find(import).map(|b| line_col(&from.source.text, b));
+    let at = at.map_or(from.source.name.clone(), |(l, c)| format!("{}:{l}:{c}", from.source.name));
+    let names: Vec<&str> = modules.iter().map(|m| m.path.as_str()).collect();
+    let close = crate::suggest::closest(import, names.iter().copied()).or_else(|| parent.and_then(|p| crate::suggest::closest(p, names.iter().copied())));
+    CheckError::Input(format!(
+        "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
+        show_roots(roots),
+        close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
+        some_names("modules found", &names, import),
+    ))
+}
+
+/// "modules found: a, b, c" for a few names; past 12 the 8 closest to `near` and how many more.
+fn some_names(what: &str, names: &[&str], near: &str) -> String {
+    if names.is_empty() {
+        return format!("{what}: none");
+    }
+    if names.len() <= 12 {
+        return format!("{what}: {}", names.join(", "));
+    }
+    let mut by: Vec<(f64, &str)> = names.iter().map(|n| (strsim::normalized_levenshtein(n, near), *n)).collect();
+    by.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(b.1)));
+    let shown: Vec<&str> = by.iter().take(8).map(|(_, n)| *n).collect();
+    format!("{} {what}, the closest: {} (and {} more)", names.len(), shown.join(", "), names.len() - shown.len())
+}
+
+/// The tree of `sources[0]` composed by naga_oil, as WGSL text (the root's names as written, the
+/// imported ones decorated), each decorated name's origin, and the names naga's writer changed.
+fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Origin>, Renamed), CheckError> {
+    use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType};
+    let roots = roots(sources, c);
+    let defs = shader_defs(c)?;
+    let modules = oil_modules(sources, c, &roots)?;
     let root = oil_module(sources[0].clone(), Some("")).expect("named");
-    // the modules the root needs, each after those it imports
-    let mut order: Vec<usize> = Vec::new();
-    fn visit(from: &OilModule, modules: &[OilModule], roots: &[PathBuf], order: &mut Vec<usize>, stack: &mut Vec<String>) -> Result<(), CheckError> {
-        for import in &from.imports {
-            let parent = import.rsplit_once("::").map(|(p, _)| p);
-            let Some(i) = modules.iter().position(|m| &m.path == import).or_else(|| modules.iter().position(|m| Some(m.path.as_str()) == parent)) else {
-                let at = from.source.text.find(import.as_str()).map(|b| line_col(&from.source.text, b));
-                let at = at.map_or(from.source.name.clone(), |(l, c)| format!("{}:{l}:{c}", from.source.name));
-                let names: Vec<&str> = modules.iter().map(|m| m.path.as_str()).collect();
-                let close = crate::suggest::closest(import, names.iter().copied())
-                    .or_else(|| parent.and_then(|p| crate::suggest::closest(p, names.iter().copied())));
-                return Err(CheckError::Input(format!(
-                    "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
-                    show_roots(roots),
-                    close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
-                    if names.is_empty() { "none".to_string() } else { names.join(", ") },
-                )));
-            };
-            if order.contains(&i) {
-                continue;
-            }
-            if stack.contains(&modules[i].path) {
-                return Err(CheckError::Input(format!("{}: imports form a cycle: {} -> {}", modules[i].source.name, stack.join(" -> "), modules[i].path)));
-            }
-            stack.push(modules[i].path.clone());
-            visit(&modules[i], modules, roots, order, stack)?;
-            stack.pop();
-            order.push(i);
-        }
-        Ok(())
+    let root_path = naga_oil::compose::get_preprocessor_data(&sources[0].text).0;
+    let order = oil_order(&root, root_path.as_deref(), &modules, &roots)?;
+    if let Some(m) = modules.iter().enumerate().find(|(i, m)| m.stub && !order.contains(i)).map(|(_, m)| m) {
+        return Err(CheckError::Input(format!(
+            "--stub {}: no import of {} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the #import names it)",
+            m.path, sources[0].name
+        )));
     }
-    visit(&root, &modules, &roots, &mut order, &mut Vec::new())?;
     let mut composer = Composer::default().with_capabilities(naga::valid::Capabilities::all());
     let oil_error = |e: naga_oil::compose::ComposerError, composer: &Composer, module: &str| {
         let text = e.emit_to_string(composer);
@@ -545,7 +746,7 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Ori
                 source: &m.source.text,
                 file_path: &m.source.name,
                 language: ShaderLanguage::Wgsl,
-                as_name: stubbed.contains(&m.path).then(|| m.path.clone()),
+                as_name: m.stub.then(|| m.path.clone()),
                 shader_defs: defs.clone(),
                 ..Default::default()
             })
@@ -562,7 +763,13 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Ori
             origins.push((name.clone(), path.clone(), name[..name.len() - suffix.len()].to_string()));
         }
     }
-    Ok((write_wgsl(&module, naga::valid::Capabilities::all())?, origins))
+    let (text, renamed) = write_wgsl_renamed(&module, naga::valid::Capabilities::all())?;
+    for o in &mut origins {
+        if let Some((written, _)) = renamed.iter().find(|(_, original)| *original == o.0) {
+            o.0 = written.clone();
+        }
+    }
+    Ok((text, origins, renamed))
 }
 
 /// `text` without terminal colour codes (`ESC [ … m`), which wesl's diagnostics hold.
@@ -600,6 +807,26 @@ pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities)
     Ok(undo_digit_suffix(&text))
 }
 
+/// [`write_wgsl`], and the functions whose names the writer changed (its namer keeps ASCII
+/// letters, digits and single underscores: `würfel` → `wrfel`, `rand_` → `rand`): the written
+/// text parsed again holds the functions in the module's order (the writer writes them in arena
+/// order, callees first, and the parser keeps that order), so each is paired with its handle's.
+pub(super) fn write_wgsl_renamed(module: &naga::Module, caps: naga::valid::Capabilities) -> Result<(String, Renamed), CheckError> {
+    let text = write_wgsl(module, caps)?;
+    let written = naga::front::wgsl::parse_str(&text).map_err(|e| CheckError::Internal(format!("the written WGSL does not parse: {}", e.message())))?;
+    if written.functions.len() != module.functions.len() {
+        return Err(CheckError::Internal(format!("naga's WGSL writer wrote {} functions of {}", written.functions.len(), module.functions.len())));
+    }
+    let renamed = written
+        .functions
+        .iter()
+        .zip(module.functions.iter())
+        .filter_map(|((_, w), (_, f))| Some((w.name.clone()?, f.name.clone()?)))
+        .filter(|(w, f)| w != f)
+        .collect();
+    Ok((text, renamed))
+}
+
 /// `name0_` → `name0` for every identifier that ends in a digit and one underscore.
 fn undo_digit_suffix(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
@@ -635,54 +862,140 @@ fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<WeslTree, CheckErro
     Err(CheckError::Input(format!("{}: WESL imports need lobes built with the feature \"wesl\" (the CLI has it)", sources[0].name)))
 }
 
-/// lobes' WESL resolver: `package::a::b` is `a/b.wesl` (or `.wgsl`) under the first shader root
-/// that has it, a stub where one is given.
+/// lobes' WESL resolver: `package::a::b` is `a/b.wesl` (or `.wgsl`) under the shader roots, a
+/// stub where one is given.
 #[cfg(feature = "wesl")]
 struct Roots {
     roots: Vec<PathBuf>,
     stubs: Vec<(String, Source)>,
     /// Module paths (`package::a::b`) of the files under the roots, for "closest" names.
     known: Vec<String>,
+    /// What resolving found (the wesl crate keeps the resolver; the tree's caller reads this).
+    seen: std::rc::Rc<std::cell::RefCell<Resolved>>,
+}
+
+/// What lobes' resolver saw of a WESL tree: the stubs used, and an input error of its own (a
+/// module reachable two ways, one that imports itself), which the wesl crate's error would hide.
+#[cfg(feature = "wesl")]
+#[derive(Default)]
+struct Resolved {
+    stubs_used: Vec<String>,
+    error: Option<String>,
+}
+
+#[cfg(feature = "wesl")]
+impl Resolved {
+    /// The resolver's own error, else a `--stub` that no import reached.
+    fn refusal(&self, c: &Composition, root: &str) -> Result<(), CheckError> {
+        if let Some(why) = &self.error {
+            return Err(CheckError::Input(why.clone()));
+        }
+        match c.stubs.iter().find(|(m, _)| !self.stubs_used.contains(m)) {
+            Some((m, _)) => Err(CheckError::Input(format!(
+                "--stub {m}: no import of {root} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the import names it: package::a::b)"
+            ))),
+            None => Ok(()),
+        }
+    }
 }
 
 #[cfg(feature = "wesl")]
 impl Roots {
-    fn file(&self, path: &wesl::ModulePath) -> Option<PathBuf> {
-        self.roots.iter().find_map(|r| {
+    /// The files that `path` names: `a/b.wesl` and `a/b.wgsl` under every root.
+    fn files(&self, path: &wesl::ModulePath) -> Vec<PathBuf> {
+        let mut out = Vec::new();
+        for r in &self.roots {
             let mut p = r.clone();
             p.extend(&path.components);
-            ["wesl", "wgsl"].iter().map(|e| p.with_extension(e)).find(|f| f.is_file())
-        })
+            out.extend(["wesl", "wgsl"].iter().map(|e| p.with_extension(e)).filter(|f| f.is_file()));
+        }
+        // one file under two roots (a root inside another) is one file
+        let mut ids = Vec::new();
+        out.retain(|f| match std::fs::canonicalize(f) {
+            Ok(c) if ids.contains(&c) => false,
+            Ok(c) => {
+                ids.push(c);
+                true
+            }
+            Err(_) => true,
+        });
+        out
     }
-    fn stub(&self, path: &wesl::ModulePath) -> Option<&Source> {
+    fn file(&self, path: &wesl::ModulePath) -> Option<PathBuf> {
+        self.files(path).into_iter().next()
+    }
+    fn stub(&self, path: &wesl::ModulePath) -> Option<&(String, Source)> {
         let shown = path.to_string();
-        self.stubs.iter().find(|(m, _)| *m == shown || format!("package::{m}") == shown).map(|(_, s)| s)
+        self.stubs.iter().find(|(m, _)| *m == shown || format!("package::{m}") == shown)
     }
+    /// An error of the resolver's own, kept for the tree's caller (and a short one for wesl).
+    fn refuse(&self, path: &wesl::ModulePath, why: String) -> wesl::ResolveError {
+        self.seen.borrow_mut().error.get_or_insert(why);
+        wesl::ResolveError::ModuleNotFound(path.clone(), "see above".into())
+    }
+}
+
+/// The first `import` statement of a WESL text that names its own module `path`
+/// (`package::a::b`, or through `super::`): its line and text.
+#[cfg(feature = "wesl")]
+fn self_import(text: &str, path: &wesl::ModulePath) -> Option<(usize, String)> {
+    let own = path.to_string();
+    let parent = path.components[..path.components.len().saturating_sub(1)].join("::");
+    text.lines().enumerate().find_map(|(n, line)| {
+        let stmt = line.trim().strip_prefix("import ")?.trim_end().trim_end_matches(';').trim();
+        // the module the statement imports from: before `::{`, else all but the last segment
+        let module = match stmt.split_once("::{") {
+            Some((m, _)) => m,
+            None => stmt.rsplit_once("::")?.0,
+        };
+        let module = match module.strip_prefix("super::") {
+            Some(rest) if !parent.is_empty() => format!("package::{parent}::{rest}"),
+            Some(rest) => format!("package::{rest}"),
+            None => module.to_string(),
+        };
+        (module == own).then(|| (n + 1, line.trim().to_string()))
+    })
 }
 
 #[cfg(feature = "wesl")]
 impl wesl::Resolver for Roots {
     fn resolve_source<'a>(&'a self, path: &wesl::ModulePath) -> Result<std::borrow::Cow<'a, str>, wesl::ResolveError> {
-        if let Some(s) = self.stub(path) {
+        if let Some((m, s)) = self.stub(path) {
+            self.seen.borrow_mut().stubs_used.push(m.clone());
             return Ok(s.text.as_str().into());
         }
-        let not_found = |why: String| wesl::ResolveError::ModuleNotFound(path.clone(), why);
-        let Some(f) = self.file(path) else {
-            let shown = path.to_string();
+        let shown = path.to_string();
+        let files = self.files(path);
+        let Some(f) = files.first() else {
             let close = crate::suggest::closest(&shown, self.known.iter().map(String::as_str));
-            return Err(not_found(format!(
-                "unresolved import: no file {}.wesl or .wgsl under the shader roots ({}){}; modules found: {}. Add its folder with --shader-root, or stand in for it with --stub {shown}=FILE",
+            let known: Vec<&str> = self.known.iter().map(String::as_str).collect();
+            return Err(wesl::ResolveError::ModuleNotFound(path.clone(), format!(
+                "unresolved import: no file {}.wesl or .wgsl under the shader roots ({}){}; {}. Add its folder with --shader-root, or stand in for it with --stub {shown}=FILE",
                 path.components.join("/"),
                 show_roots(&self.roots),
                 close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
-                if self.known.is_empty() { "none".to_string() } else { self.known.join(", ") },
+                some_names("modules found", &known, &shown),
             )));
         };
-        std::fs::read_to_string(&f).map(Into::into).map_err(|e| not_found(format!("{}: {e}", f.display())))
+        if files.len() > 1 {
+            let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
+            return Err(self.refuse(path, format!(
+                "the module {shown} is reachable two ways: {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with --stub {shown}=FILE",
+                names.join(" and ")
+            )));
+        }
+        let text = std::fs::read_to_string(f).map_err(|e| wesl::ResolveError::ModuleNotFound(path.clone(), format!("{}: {e}", f.display())))?;
+        if let Some((line, stmt)) = self_import(&text, path) {
+            return Err(self.refuse(path, format!(
+                "{}:{line}: the module {shown} imports itself (`{stmt}`); a module names its own declarations without an import: remove the line",
+                f.display()
+            )));
+        }
+        Ok(text.into())
     }
     fn display_name(&self, path: &wesl::ModulePath) -> Option<String> {
         match self.stub(path) {
-            Some(s) => Some(s.name.clone()),
+            Some((_, s)) => Some(s.name.clone()),
             None => self.file(path).map(|f| f.display().to_string()),
         }
     }
@@ -714,32 +1027,15 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
             file.strip_prefix(&r).ok().map(|rel| (r.clone(), rel.with_extension("")))
         })
         .ok_or_else(|| CheckError::Input(format!("{}: not under any shader root ({}); WESL's `package::` paths start at a root", sources[0].name, show_roots(&roots))))?;
-    let mut known = Vec::new();
-    for r in &roots {
-        let mut files = Vec::new();
-        scan(r, &["wesl", "wgsl"], &mut files);
-        for f in files {
-            if let Ok(rel) = f.strip_prefix(r) {
-                let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
-                known.push(format!("package::{}", comps.join("::")));
-            }
-        }
-    }
+    let known = wesl_known(&roots);
     let components: Vec<String> = rel.iter().map(|c| c.to_string_lossy().into_owned()).collect();
     let root_path = wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components };
     let _ = base;
     let root_path_shown = root_path.to_string();
-    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known: known.clone() };
-    let resolver_files = Roots { roots: roots.clone(), stubs: Vec::new(), known };
-    let mut features = wesl::Features::default();
-    for (n, v) in &c.defines {
-        let on = match v.as_deref() {
-            None | Some("true") => true,
-            Some("false") => false,
-            Some(other) => return Err(CheckError::Input(format!("--define {n}={other}: WESL's @if features are true or false"))),
-        };
-        features.flags.insert(n.clone(), on.into());
-    }
+    let seen = std::rc::Rc::new(std::cell::RefCell::new(Resolved::default()));
+    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known: known.clone(), seen: seen.clone() };
+    let resolver_files = Roots { roots: roots.clone(), stubs: Vec::new(), known, seen: seen.clone() };
+    let features = wesl_features(c)?;
     let options = wesl::CompileOptions {
         imports: true,
         condcomp: true,
@@ -753,7 +1049,9 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
     };
     let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
     compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
-    let result = compiler.compile(&root_path).map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
+    let result = compiler.compile(&root_path);
+    seen.borrow().refusal(c, &sources[0].name)?;
+    let result = result.map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
     let mut origins = Vec::new();
     use wesl::syntax::GlobalDeclaration as G;
     let ident = |decl: &G| match decl {
@@ -783,23 +1081,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         from = at + written.len();
         let first = text[..at].matches('\n').count() as u32 + 1;
         let lines = (first, first + written.trim_end().matches('\n').count() as u32);
-        let map = result.sourcemap.as_ref();
-        let (file, module, item, source) = match map.and_then(|m| m.get_decl(&name)) {
-            Some((path, item)) if path.to_string() != root_path_shown => {
-                let m = map.expect("a source map holds the declaration");
-                let file = m.get_display_name(path).map(str::to_string).or_else(|| resolver_files.file(path).map(|f| f.display().to_string()));
-                let Some(file) = file else { continue };
-                let source = match m.get_source(path) {
-                    Some(s) => s.to_string(),
-                    None => match std::fs::read_to_string(&file) {
-                        Ok(s) => s,
-                        Err(_) => continue,
-                    },
-                };
-                (file, path.to_string(), item.to_string(), source)
-            }
-            _ => (sources[0].name.clone(), root_path_shown.clone(), name.clone(), sources[0].text.clone()),
-        };
+        let Some((file, module, item, source)) = declared_in(result.sourcemap.as_ref(), &name, &root_path_shown, &resolver_files, &sources[0]) else { continue };
         // the declaration's text in its file: its span there, or (a span that does not hold its
         // name) from the line that declares it to the next declaration
         let span = decl.span();
@@ -815,6 +1097,57 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         decls.push(super::compose::DeclOrigin { lines, file, module, name: item, text: original, at, renames: renames.clone() });
     }
     Ok((text, origins, decls))
+}
+
+/// Where the declaration `name` of a composed WESL tree comes from: (its file, module path,
+/// name there, the file's text); the root's own declarations are the sampler's file's.
+#[cfg(feature = "wesl")]
+fn declared_in(map: Option<&wesl::BasicSourceMap>, name: &str, root_path: &str, roots: &Roots, root: &Source) -> Option<(String, String, String, String)> {
+    use wesl::SourceMap;
+    match map.and_then(|m| m.get_decl(name)) {
+        Some((path, item)) if path.to_string() != root_path => {
+            let m = map.expect("a source map holds the declaration");
+            let file = m.get_display_name(path).map(str::to_string).or_else(|| roots.file(path).map(|f| f.display().to_string()))?;
+            let source = match m.get_source(path) {
+                Some(s) => s.to_string(),
+                None => std::fs::read_to_string(&file).ok()?,
+            };
+            Some((file, path.to_string(), item.to_string(), source))
+        }
+        _ => Some((root.name.clone(), root_path.to_string(), name.to_string(), root.text.clone())),
+    }
+}
+
+/// The module paths (`package::a::b`) of the WESL and WGSL files under the roots.
+#[cfg(feature = "wesl")]
+fn wesl_known(roots: &[PathBuf]) -> Vec<String> {
+    let mut known = Vec::new();
+    for r in roots {
+        let mut files = Vec::new();
+        scan(r, &["wesl", "wgsl"], &mut files);
+        for f in files {
+            if let Ok(rel) = f.strip_prefix(r) {
+                let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
+                known.push(format!("package::{}", comps.join("::")));
+            }
+        }
+    }
+    known
+}
+
+/// `--define` values as WESL's `@if` features: true or false.
+#[cfg(feature = "wesl")]
+fn wesl_features(c: &Composition) -> Result<wesl::Features, CheckError> {
+    let mut features = wesl::Features::default();
+    for (n, v) in &c.defines {
+        let on = match v.as_deref() {
+            None | Some("true") => true,
+            Some("false") => false,
+            Some(other) => return Err(CheckError::Input(format!("--define {n}={other}: WESL's @if features are true or false"))),
+        };
+        features.flags.insert(n.clone(), on.into());
+    }
+    Ok(features)
 }
 
 /// Where the declaration of `name` starts in a WGSL/WESL text (a line `fn NAME(`, `const NAME`,

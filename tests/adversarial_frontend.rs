@@ -1,0 +1,533 @@
+//! The adversarial cases of issue 35 that live in composition (the front end: shader roots,
+//! imports, `--rand`, call expressions, flags), each its own test with the exit code it must
+//! give and, for the ones that hung, the time it must finish in; and property-based tests of what
+//! parses user text (call expressions, `--define`, `--stub`, `--rand`, module paths): no panic,
+//! and every rejection is bad input naming the input.
+//! Most cases are refused before any GPU work; the ones that pass run a small check (a wgpu
+//! adapter: lavapipe in CI).
+
+use lobes::check::{CheckError, Composition, Domain, Source, UserSampler};
+use proptest::prelude::*;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
+const OIL: &str = "tests/fixtures/repository/naga_oil";
+const WESL: &str = "tests/fixtures/repository/wesl";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("adversarial-frontend-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(path: &Path, text: &str) {
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(path, text).unwrap();
+}
+
+fn lobes(args: &[&str]) -> Output {
+    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
+    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
+    out
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Exit 2, no panic, and stderr naming every string of `want`; the stderr.
+fn bad_input(out: &Output, want: &[&str]) -> String {
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "want exit 2: {e}");
+    assert!(!e.contains("panicked"), "{e}");
+    for w in want {
+        assert!(e.contains(w), "stderr lacks {w:?}: {e}");
+    }
+    e
+}
+
+/// A copy of a fixture tree in `dir`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let t = to.join(p.file_name().unwrap());
+        if p.is_dir() {
+            copy_tree(&p, &t)
+        } else {
+            std::fs::copy(&p, &t).unwrap();
+        }
+    }
+}
+
+/// The naga_oil fixture's check, in `dir` (a copy of the tree), with `extra` flags.
+fn oil_check(dir: &Path, extra: &[&str]) -> Output {
+    let file = dir.join("shaders/sampling/diffuse.wgsl");
+    let roots = dir.join("shaders");
+    let stub = format!("common::view={}", dir.join("stubs/view.wgsl").display());
+    let mut args = vec!["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub];
+    args.extend(["--sample", "sample_diffuse(wi)", "--pdf", "diffuse_pdf(d)", "--rand", "rand", "--samples", "65536"]);
+    args.extend(extra);
+    lobes(&args)
+}
+
+/// Item 1: an old copy of `common::maths` (PI = 3, so the diffuse pdf integrates to 1.047) that
+/// declares the same `#define_import_path` and sorts first: an error naming both files, not
+/// whichever the scan met first.
+#[test]
+fn two_files_declaring_one_naga_oil_module_path_are_refused_naming_both() {
+    let dir = scratch("oil-twice");
+    copy_tree(&root().join(OIL), &dir);
+    let stale = dir.join("shaders/archive/maths_2023.wgsl");
+    write(&stale, "#define_import_path common::maths\n\nconst PI: f32 = 3.0;\nconst TAU: f32 = 6.0;\n");
+    let out = oil_check(&dir, &[]);
+    let maths = dir.join("shaders/common/maths.wgsl");
+    bad_input(&out, &["common::maths", stale.to_str().unwrap(), maths.to_str().unwrap()]);
+}
+
+/// Item 1, WESL: `package::utils` as both `utils.wesl` and `utils.wgsl` of a root, or under two
+/// roots: refused naming both files.
+#[test]
+fn a_wesl_module_reachable_two_ways_is_refused_naming_both() {
+    let dir = scratch("wesl-twice");
+    copy_tree(&root().join(WESL), &dir);
+    let utils = dir.join("shaders/utils.wesl");
+    let copy = dir.join("shaders/utils.wgsl");
+    std::fs::copy(&utils, &copy).unwrap();
+    let file = dir.join("shaders/sampling/ggx.wesl");
+    let roots = dir.join("shaders");
+    let stub = format!("package::bindings={}", dir.join("stubs/bindings.wesl").display());
+    let args = |extra: &[&str]| {
+        let mut a = vec!["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub];
+        a.extend(["--sample", "sample_ggx_vndf(wi, p0, rng)", "--sample-returns", "half-vector", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--params", "0.5"]);
+        a.extend(extra);
+        lobes(&a)
+    };
+    bad_input(&args(&[]), &["package::utils", utils.to_str().unwrap(), copy.to_str().unwrap()]);
+    // the same under a second root
+    std::fs::remove_file(&copy).unwrap();
+    let other = dir.join("other");
+    std::fs::copy(&utils, other.join("utils.wesl")).unwrap_or_else(|_| {
+        std::fs::create_dir_all(&other).unwrap();
+        std::fs::copy(&utils, other.join("utils.wesl")).unwrap()
+    });
+    let second = other.join("utils.wesl");
+    bad_input(&args(&["--shader-root", other.to_str().unwrap()]), &["package::utils", utils.to_str().unwrap(), second.to_str().unwrap()]);
+}
+
+/// `n` naga_oil modules in a chain (`chain::m0` imports `chain::m1`, …), and a sampler that
+/// imports the first: a cosine lobe whose constant comes through every module.
+fn chain(dir: &Path, n: usize) -> PathBuf {
+    for i in 0..n {
+        let body = if i + 1 < n {
+            format!("#define_import_path chain::m{i}\n#import chain::m{}::{{c{}}}\n\nfn c{i}() -> f32 {{ return c{}(); }}\n", i + 1, i + 1, i + 1)
+        } else {
+            format!("#define_import_path chain::m{i}\n\nfn c{i}() -> f32 {{ return 0.31830988618379067; }}\n")
+        };
+        write(&dir.join(format!("shaders/chain/m{i}.wgsl")), &body);
+    }
+    let file = dir.join("shaders/sampler.wgsl");
+    write(
+        &file,
+        "#import chain::m0::{c0}\n\n\
+         fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
+         \x20   let z = sqrt(u.x);\n\
+         \x20   let r = sqrt(max(0.0, 1.0 - z * z));\n\
+         \x20   let phi = 6.283185307179586 * u.y;\n\
+         \x20   return vec4<f32>(r * cos(phi), r * sin(phi), z, z * c0());\n\
+         }\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return max(d.z, 0.0) * c0(); }\n",
+    );
+    file
+}
+
+/// Seconds to compose (and validate) the chain of `n` modules through the library.
+fn compose_seconds(n: usize) -> f64 {
+    let dir = scratch(&format!("chain-{n}"));
+    let file = chain(&dir, n);
+    let c = Composition::default().shader_root(dir.join("shaders"));
+    let start = Instant::now();
+    UserSampler::from_repository(&[file], "s", "p", None, Domain::Sphere, c).unwrap_or_else(|e| panic!("{e}"));
+    start.elapsed().as_secs_f64()
+}
+
+/// Item 11: composition is near-linear in the modules: a chain 4 times as long takes well under
+/// 16 times as long (it took 32 times: N^2.5), and a chain of 1000 composes in seconds.
+/// Open: naga_oil's `Composer` builds each module's header from its imports' headers, which hold
+/// their own imports' (`add_import` recurses, `add_composable_data` scans each header's whole
+/// IR): a chain of N costs ~N³ inside naga_oil (measured 250: 0.29 s, 1000: 26 s). Passing needs
+/// lobes' own naga_oil composer; until then lobes composes a tree once per process (`TREES`).
+#[test]
+#[ignore = "issue 35 item 11 is open: naga_oil's composer is cubic in an import chain's depth"]
+fn a_chain_of_modules_composes_in_near_linear_time() {
+    let short = compose_seconds(250);
+    let long = compose_seconds(1000);
+    println!("250 modules: {short:.2} s, 1000 modules: {long:.2} s");
+    assert!(long < 10.0 && long < 10.0 * short.max(0.05), "250 modules: {short:.2} s, 1000 modules: {long:.2} s");
+}
+
+/// Item 11 through the CLI: the chain of 1000 modules is checked (and passes) within a bound that
+/// the quadratic composition (35 s) broke. (Composed once per process it passes alone here in
+/// about 25 s; in parallel with other tests it does not: open, as above.)
+#[test]
+#[ignore = "issue 35 item 11 is open: naga_oil's composer is cubic in an import chain's depth"]
+fn a_chain_of_1000_modules_is_checked_in_time() {
+    let dir = scratch("chain-cli");
+    let file = chain(&dir, 1000);
+    let roots = dir.join("shaders");
+    let start = Instant::now();
+    let out = lobes(&["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "s", "--pdf", "p", "--samples", "65536"]);
+    let took = start.elapsed();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(took < Duration::from_secs(30), "took {took:?}");
+}
+
+/// Item 12: `loops/a -> .` and `loops/b -> .` under the shader root: each folder is read once, and
+/// the check of the naga_oil fixture is refused or passes in seconds, never walks 2^40 paths.
+#[test]
+fn a_symlink_loop_under_a_shader_root_is_walked_once() {
+    let dir = scratch("symlink-loop");
+    copy_tree(&root().join(OIL), &dir);
+    let loops = dir.join("shaders/loops");
+    std::fs::create_dir_all(&loops).unwrap();
+    std::os::unix::fs::symlink(".", loops.join("a")).unwrap();
+    std::os::unix::fs::symlink(".", loops.join("b")).unwrap();
+    std::os::unix::fs::symlink("..", loops.join("up")).unwrap();
+    let c = Composition::default()
+        .shader_root(dir.join("shaders"))
+        .stub("common::view", dir.join("stubs/view.wgsl"))
+        .rand("rand");
+    let start = Instant::now();
+    let sampler = UserSampler::from_repository(&[dir.join("shaders/sampling/diffuse.wgsl")], "sample_diffuse(wi)", "diffuse_pdf(d)", None, Domain::Sphere, c);
+    let took = start.elapsed();
+    sampler.unwrap_or_else(|e| panic!("{e}"));
+    assert!(took < Duration::from_secs(5), "took {took:?}");
+}
+
+/// Item 13: one function named twice by `--rand` (the same name, or its name and its qualified
+/// path) was a panic (exit 101); now it is one function, and the check runs.
+#[test]
+fn one_rand_function_named_twice_is_one_function() {
+    let dir = scratch("rand-twice");
+    copy_tree(&root().join(OIL), &dir);
+    for extra in [&["--rand", "rand"][..], &["--rand", "common::random::rand"][..]] {
+        let out = oil_check(&dir, extra);
+        assert_eq!(out.status.code(), Some(0), "{extra:?}: {}", text(&out.stderr));
+    }
+}
+
+/// Item 13 in a scene: `rand = ["rand", "rand"]` through `lobes run` is not a panic.
+#[test]
+fn one_rand_function_named_twice_in_a_scene_is_one_function() {
+    let dir = scratch("rand-twice-scene");
+    copy_tree(&root().join(OIL), &dir);
+    let scene = "[[case]]\nname = \"oil\"\nsamples = 65536\n\n[case.sampler]\nwgsl = [\"shaders/sampling/diffuse.wgsl\"]\nshader_root = [\"shaders\"]\n\
+                 stub = { \"common::view\" = \"stubs/view.wgsl\" }\nsample = \"sample_diffuse(wi)\"\npdf = \"diffuse_pdf(d)\"\nrand = [\"rand\", \"rand\"]\n";
+    let path = dir.join("scene.toml");
+    write(&path, scene);
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", path.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+}
+
+/// A plain WGSL sampler (uniform sphere) that draws its two numbers from `name()`, through the
+/// naga_oil composer (a `#define_import_path`) so that naga's WGSL writer writes it back.
+fn named_rand(dir: &Path, name: &str) -> PathBuf {
+    let file = dir.join("shaders/sampler.wgsl");
+    write(
+        &file,
+        &format!(
+            "#define_import_path sampling::unicode\n\n\
+             var<private> state: u32 = 9u;\n\
+             fn {name}() -> f32 {{ state = state * 747796405u + 2891336453u; return f32(state >> 8u) / 16777216.0; }}\n\
+             fn s(wi: vec3<f32>) -> vec3<f32> {{\n\
+             \x20   let z = 1.0 - 2.0 * {name}();\n\
+             \x20   let phi = 6.283185307179586 * {name}();\n\
+             \x20   let r = sqrt(max(0.0, 1.0 - z * z));\n\
+             \x20   return vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
+             }}\n"
+        ),
+    );
+    file
+}
+
+/// Item 15: `--rand würfel` (WGSL allows Unicode identifiers) and `--rand rand_` (naga's writer
+/// drops the trailing underscore) are found in the composed module, and the check passes.
+#[test]
+fn rand_functions_renamed_by_the_wgsl_writer_are_found() {
+    for name in ["würfel", "rand_", "r2"] {
+        let dir = scratch(&format!("rand-name-{}", name.len()));
+        let file = named_rand(&dir, name);
+        let roots = dir.join("shaders");
+        let out = lobes(&[
+            "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "s(wi)", "--pdf", "0.07957747154594767",
+            "--rand", name, "--samples", "65536",
+        ]);
+        assert_eq!(out.status.code(), Some(0), "--rand {name}: {}", text(&out.stderr));
+    }
+}
+
+/// Item 16: a naga_oil module that imports the sampler's own file is a cycle through the root,
+/// named as one.
+#[test]
+fn a_naga_oil_cycle_through_the_root_is_named_as_a_cycle() {
+    let dir = scratch("oil-cycle");
+    let file = dir.join("shaders/sampling/diff_back.wgsl");
+    write(&file, "#define_import_path sampling::diff_back\n#import sampling::helper::{h}\n\nfn p(d: vec3<f32>) -> f32 { return h(); }\nfn k() -> f32 { return 1.0; }\n");
+    write(&dir.join("shaders/sampling/helper.wgsl"), "#define_import_path sampling::helper\n#import sampling::diff_back::{k}\n\nfn h() -> f32 { return k(); }\n");
+    let roots = dir.join("shaders");
+    let out = lobes(&["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "vec3<f32>(0.0, 0.0, 1.0)", "--pdf", "p(d)"]);
+    let e = bad_input(&out, &["cycle", "sampling::diff_back -> sampling::helper -> sampling::diff_back"]);
+    assert!(!e.contains("no file under the shader roots"), "{e}");
+}
+
+/// Item 16: a WESL module that imports itself: a message naming the cycle.
+#[test]
+fn a_wesl_module_importing_itself_is_named_as_a_cycle() {
+    let dir = scratch("wesl-cycle");
+    let file = dir.join("shaders/sampling/s.wesl");
+    write(&file, "import package::sampling::helper::helper;\n\nfn p(d: vec3<f32>) -> f32 { return helper(); }\n");
+    write(&dir.join("shaders/sampling/helper.wesl"), "import package::sampling::helper::one;\n\nfn one() -> f32 { return 1.0; }\nfn helper() -> f32 { return one(); }\n");
+    let roots = dir.join("shaders");
+    let out = lobes(&["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "vec3<f32>(0.0, 0.0, 1.0)", "--pdf", "p(d)"]);
+    bad_input(&out, &["package::sampling::helper", "imports itself"]);
+}
+
+/// A plain uniform-sphere sampler with helper functions for the call-expression cases.
+fn plain(dir: &Path) -> PathBuf {
+    let file = dir.join("plain.wgsl");
+    write(
+        &file,
+        "fn s(wi: vec3<f32>, u: vec4<f32>) -> vec3<f32> {\n\
+         \x20   let z = 1.0 - 2.0 * u.x;\n\
+         \x20   let r = sqrt(max(0.0, 1.0 - z * z));\n\
+         \x20   return vec3<f32>(r * cos(6.2831853 * u.y), r * sin(6.2831853 * u.y), z);\n\
+         }\n\
+         fn p(d: vec3<f32>) -> f32 { return 0.07957747; }\n\
+         fn v(d: vec3<f32>) -> vec3<f32> { return d; }\n",
+    );
+    file
+}
+
+/// Item 16: a `--pdf` / `--eval` expression of the wrong type, an empty one, and a call with the
+/// wrong number of arguments: a message in the flag's terms, not naga's internals.
+#[test]
+fn density_expressions_of_the_wrong_type_or_empty_are_named_in_the_flags_terms() {
+    let dir = scratch("density-types");
+    let file = plain(&dir);
+    let check = |pdf: &str, eval: Option<&str>| {
+        let mut a = vec!["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", pdf];
+        if let Some(e) = eval {
+            a.extend(["--eval", e]);
+        }
+        lobes(&a)
+    };
+    for out in [bad_input(&check("v(d)", None), &["--pdf 'v(d)' returns vec3<f32>; expected f32"]), bad_input(&check("p(d)", Some("v(d)")), &["--eval 'v(d)' returns vec3<f32>; expected f32"])] {
+        assert!(!out.contains("Handle") && !out.contains("Some(["), "{out}");
+    }
+    bad_input(&check("", None), &["--pdf is empty"]);
+    bad_input(&check("  ", None), &["--pdf is empty"]);
+    let e = bad_input(&check("p(d, d)", None), &["--pdf 'p(d, d)'"]);
+    assert!(!e.contains("Some(["), "{e}");
+    bad_input(&lobes(&["check", file.to_str().unwrap(), "--sample", "", "--pdf", "p(d)"]), &["--sample is empty"]);
+}
+
+/// Item 16: `--define N=99999999999` is out of i32's range (said so); `X=false` vs `#ifdef X`
+/// behaves as docs/testing-your-own-sampler.md says (naga_oil's rule: `#ifdef` asks whether X is
+/// defined at all).
+#[test]
+fn define_values_out_of_range_are_named() {
+    let dir = scratch("define-range");
+    copy_tree(&root().join(OIL), &dir);
+    bad_input(&oil_check(&dir, &["--define", "N=99999999999"]), &["--define N=99999999999", "out of the range of i32"]);
+    bad_input(&oil_check(&dir, &["--define", "N=99999999999u"]), &["--define N=99999999999u", "out of the range of u32"]);
+    let docs = std::fs::read_to_string(root().join("docs/testing-your-own-sampler.md")).unwrap();
+    assert!(docs.contains("`--define X=false`") && docs.contains("`#ifdef X`"), "the docs say what X=false does to #ifdef X");
+}
+
+/// Item 16: `--budget 1e-300` is refused with a short message (no 300 zeros).
+#[test]
+fn a_tiny_budget_gets_a_short_message() {
+    let dir = scratch("budget");
+    let file = plain(&dir);
+    let out = lobes(&["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "p(d)", "--budget", "1e-300"]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(e.len() < 600 && !e.contains("00000000"), "{e}");
+}
+
+/// Item 16: a `--stub` no import uses, and one module stubbed twice: exit 2 naming it.
+#[test]
+fn unused_or_repeated_stubs_are_refused_naming_them() {
+    let dir = scratch("stubs");
+    copy_tree(&root().join(OIL), &dir);
+    let other = format!("common::lights={}", dir.join("stubs/view.wgsl").display());
+    bad_input(&oil_check(&dir, &["--stub", &other]), &["--stub common::lights", "no import"]);
+    let again = format!("common::view={}", dir.join("stubs/view.wgsl").display());
+    bad_input(&oil_check(&dir, &["--stub", &again]), &["--stub common::view", "twice"]);
+    // WESL: a stub of a module nothing imports
+    let wesl = scratch("stubs-wesl");
+    copy_tree(&root().join(WESL), &wesl);
+    let file = wesl.join("shaders/sampling/ggx.wesl");
+    let roots = wesl.join("shaders");
+    let stub = format!("package::bindings={}", wesl.join("stubs/bindings.wesl").display());
+    let unused = format!("package::lights={}", wesl.join("stubs/bindings.wesl").display());
+    let out = lobes(&[
+        "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--stub", &unused,
+        "--sample", "sample_ggx_vndf(wi, p0, rng)", "--sample-returns", "half-vector", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--params", "0.5",
+    ]);
+    bad_input(&out, &["--stub package::lights", "no import"]);
+}
+
+/// Whether `e` is bad input naming `what` (or a WGSL error at a file:line:column).
+fn names_input(e: &CheckError, what: &str) -> bool {
+    match e {
+        CheckError::Input(m) => m.contains(what) || what.trim().is_empty(),
+        CheckError::Wgsl(m) => m.contains(':'),
+        _ => false,
+    }
+}
+
+const SPHERE: &str = "fn s(wi: vec3<f32>, u: vec4<f32>) -> vec3<f32> { let z = 1.0 - 2.0 * u.x; let r = sqrt(max(0.0, 1.0 - z * z)); return vec3<f32>(r * cos(6.28 * u.y), r * sin(6.28 * u.y), z); }\n\
+                      fn p(d: vec3<f32>) -> f32 { return 0.0795; }\nfn rnd() -> f32 { return 0.5; }\n";
+
+fn sphere() -> Vec<Source> {
+    vec![Source { name: "sphere.wgsl".into(), text: SPHERE.into() }]
+}
+
+/// Text a user might type as an expression: lobes' names, operators, calls, qualified paths,
+/// stray punctuation and Unicode.
+fn expression() -> impl Strategy<Value = String> {
+    let token = prop_oneof![
+        Just("wi".to_string()), Just("d".to_string()), Just("u".to_string()), Just("p0".to_string()), Just("params".to_string()),
+        Just("rng".to_string()), Just("s(wi, u)".to_string()), Just("p(d)".to_string()), Just("(".to_string()), Just(")".to_string()),
+        Just(",".to_string()), Just("+".to_string()), Just("*".to_string()), Just("::".to_string()), Just("a::b::c".to_string()),
+        Just("1.0".to_string()), Just("99999999999".to_string()), Just(".xyz".to_string()), Just("{".to_string()), Just(";".to_string()),
+        Just("é".to_string()), Just("lobes_x".to_string()), Just(" ".to_string()), "[a-z_]{1,6}", "[ -~]{0,4}",
+    ];
+    prop::collection::vec(token, 0..8).prop_map(|t| t.concat())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Call expressions: no panic; a rejection is bad input (Input, or a WGSL error at a place).
+    #[test]
+    fn call_expressions_never_panic(sample in expression(), pdf in expression()) {
+        match UserSampler::from_sources(sphere(), &sample, &pdf, None, Domain::Sphere) {
+            Ok(_) => {}
+            Err(e) => prop_assert!(names_input(&e, ""), "{sample:?} / {pdf:?}: {e:?}"),
+        }
+    }
+
+    /// `--define`, `--stub`, `--rand` and `--rand-order` as typed: no panic; a rejection names
+    /// the flag.
+    #[test]
+    fn flags_never_panic(define in "[ -~é]{0,12}", stub in "[ -~é]{0,12}", rand in "[ -~é]{0,8}", order in "[ -~]{0,12}") {
+        let flags = Composition::from_flags(&[], std::slice::from_ref(&define), std::slice::from_ref(&stub), std::slice::from_ref(&rand), Some(&order), Default::default());
+        if let Err(e) = flags {
+            prop_assert!(["--define", "--stub", "--rand"].iter().any(|f| e.contains(f)), "{e}");
+        }
+    }
+
+    /// Module paths and `--rand` names through composition: no panic, bad input naming them.
+    #[test]
+    fn module_paths_and_rand_names_never_panic(path in "[a-z:_é ]{0,16}", rand in "[a-zé_0-9:]{1,12}") {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("adversarial-frontend-proptest-paths");
+        let file = dir.join("sphere.wgsl");
+        write(&file, &format!("#import {path}\n{SPHERE}"));
+        let c = Composition::default().rand(&rand).shader_root(&dir);
+        if let Err(e) = UserSampler::from_repository(&[file], "s(wi, u)", "p(d)", None, Domain::Sphere, c) {
+            prop_assert!(names_input(&e, ""), "{path:?} / {rand:?}: {e:?}");
+        }
+        let file = dir.join("plain/sphere.wgsl");
+        write(&file, SPHERE);
+        let c = Composition::default().rand(&rand).rand(&rand);
+        if let Err(e) = UserSampler::from_repository(&[file], "s(wi, u)", "p(d)", None, Domain::Sphere, c) {
+            prop_assert!(names_input(&e, &rand), "{rand:?}: {e:?}");
+        }
+    }
+}
+
+/// Issue 34 §2: a call expression names what the sampler's file imports as the file names it
+/// (`PI` of `#import common::maths::{PI, TAU}`), not only by a qualified path: the cosine pdf
+/// written with it passes, and with `TAU` (half the density) fails.
+#[test]
+fn a_call_expression_names_an_imported_item_as_the_file_does() {
+    let dir = scratch("imported-names");
+    copy_tree(&root().join(OIL), &dir);
+    let with_pdf = |pdf: &str| {
+        let file = dir.join("shaders/sampling/diffuse.wgsl");
+        let roots = dir.join("shaders");
+        let stub = format!("common::view={}", dir.join("stubs/view.wgsl").display());
+        lobes(&[
+            "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--sample", "sample_diffuse(wi)",
+            "--pdf", pdf, "--rand", "rand", "--samples", "262144",
+        ])
+    };
+    let out = with_pdf("select(0.0, d.z / PI, d.z > 0.0)");
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let out = with_pdf("select(0.0, d.z / TAU, d.z > 0.0)");
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+}
+
+/// Issue 34 §2: `--rand rand_f` where `rand_f` lives in a module whose path has underscores
+/// (Bevy's `bevy_pbr::render_utils`, mangled `…_1rand_f` by the wesl crate): found, and the GGX
+/// sampler passes.
+#[test]
+fn a_rand_function_of_a_module_with_underscores_in_its_path_is_found() {
+    let dir = scratch("wesl-underscores");
+    copy_tree(&root().join(WESL), &dir);
+    let moved = dir.join("shaders/bevy_pbr/render_utils.wesl");
+    std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
+    std::fs::rename(dir.join("shaders/utils.wesl"), &moved).unwrap();
+    let file = dir.join("shaders/sampling/ggx.wesl");
+    let source = std::fs::read_to_string(&file).unwrap();
+    let edited = source.replace("import package::utils::rand_vec2f;", "import package::bevy_pbr::render_utils::rand_vec2f;");
+    assert_ne!(edited, source);
+    std::fs::write(&file, edited).unwrap();
+    let roots = dir.join("shaders");
+    let stub = format!("package::bindings={}", dir.join("stubs/bindings.wesl").display());
+    let out = lobes(&[
+        "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--sample", "sample_ggx_vndf(wi, p0, rng)",
+        "--sample-returns", "half-vector", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--rand", "rand_f", "--params", "0.5", "--incident-theta", "40",
+        "--samples", "262144",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("random draws x,y"), "{}", text(&out.stdout));
+}
+
+/// Issue 34 §2: a renderer's own preprocessor line (RedGPU's `#redgpu_include`) is named, with
+/// what to do, not a WGSL parse error at `#`.
+#[test]
+fn a_custom_preprocessor_line_is_named_with_what_to_do() {
+    let dir = scratch("custom-directive");
+    let file = dir.join("ibl.wgsl");
+    write(&file, &format!("#redgpu_include SYSTEM_UNIFORM\n{SPHERE}"));
+    let out = lobes(&["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "p(d)"]);
+    bad_input(&out, &[&format!("{}:1: `#redgpu_include SYSTEM_UNIFORM`", file.display()), "pre-expanded", "--stub", "--define"]);
+}
+
+/// Issue 34 §2: an unresolved import among many modules lists the closest few, not all of them.
+#[test]
+fn an_unresolved_import_among_many_modules_lists_the_closest_few() {
+    let dir = scratch("many-modules");
+    for i in 0..40 {
+        write(&dir.join(format!("shaders/pbr/m{i}.wgsl")), &format!("#define_import_path pbr::module_{i}\nfn f{i}() -> f32 {{ return 1.0; }}\n"));
+    }
+    write(&dir.join("shaders/pbr/lighting.wgsl"), "#define_import_path pbr::lighting\nfn light() -> f32 { return 1.0; }\n");
+    let file = dir.join("shaders/sampler.wgsl");
+    write(&file, &format!("#import pbr::lightning::light\n{SPHERE}fn lit(d: vec3<f32>) -> f32 {{ return light() * 0.0795; }}\n"));
+    let roots = dir.join("shaders");
+    let out = lobes(&["check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "lit(d)"]);
+    let e = bad_input(&out, &["closest: `pbr::lighting`", "41 modules found"]);
+    let listed = e.matches("pbr::module_").count();
+    assert!(listed <= 8, "{listed} module names listed: {e}");
+}
