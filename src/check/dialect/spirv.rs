@@ -41,7 +41,11 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Source, CheckError> {
     let words: Vec<u8> = if bytes[..4] == MAGIC.to_be_bytes() { bytes.chunks(4).flat_map(|w| [w[3], w[2], w[1], w[0]]).collect() } else { bytes.to_vec() };
     let options = naga::front::spv::Options { adjust_coordinate_space: false, strict_capabilities: false, block_ctx_dump_prefix: None };
     let mut module = crate::engine::gpu::stack::with_big_stack(|| naga::front::spv::parse_u8_slice(&words, &options))
-        .map_err(|e| CheckError::Input(format!("{name}: naga's SPIR-V front end cannot read it: {e}")))?;
+        .map_err(|e| {
+            // naga 30 reads no OpLine where glslang's -g puts them (wgpu issue 4532)
+            let hint = if e.to_string().contains("instruction Line") { "; compile without -g (OpName, the names lobes needs, is written without it)" } else { "" };
+            CheckError::Input(format!("{name}: naga's SPIR-V front end cannot read it: {e}{hint}"))
+        })?;
     // a function whose parameters are pointers (glslang and DXC pass every parameter so) is
     // renamed NAME_pointers, and NAME becomes a wrapper that takes values (`by_value`)
     let by_pointer = |f: &naga::Function, types: &naga::UniqueArena<naga::Type>| {
