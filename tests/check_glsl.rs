@@ -1,5 +1,5 @@
 //! `lobes check` of GLSL and SPIR-V samplers (issue 34 §1), in the shapes GLSL path tracers
-//! write them (tests/fixtures/glsl): `#include` of a file in another folder (relative to the
+//! write them (tests/fixtures/repository/glsl): `#include` of a file in another folder (relative to the
 //! including file) and of one under `--shader-root`, a `float rand()` that steps a global
 //! `uint seed`, call expressions over the GLSL functions' own names. The correct sampler passes,
 //! the one whose pdf keeps a sin θ fails the checks that catch it; an error in an included file is
@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
-const GLSL: &str = "tests/fixtures/glsl";
+const GLSL: &str = "tests/fixtures/repository/glsl";
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -64,11 +64,11 @@ fn ggx_args<'a>(file: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     a
 }
 
-const SHADER_ROOT: [&str; 2] = ["--shader-root", "tests/fixtures/glsl/common"];
+const SHADER_ROOT: [&str; 2] = ["--shader-root", "tests/fixtures/repository/glsl/common"];
 
 #[test]
 fn a_glsl_sampler_with_includes_and_a_global_seed_passes() {
-    let out = lobes(&ggx_args("tests/fixtures/glsl/shaders/ggx.glsl", &SHADER_ROOT));
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/ggx.glsl", &SHADER_ROOT));
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let v = verdicts(&out);
     assert!(v.len() == 6 && v.iter().all(|(_, p)| *p), "{v:?}");
@@ -76,7 +76,7 @@ fn a_glsl_sampler_with_includes_and_a_global_seed_passes() {
 
 #[test]
 fn a_glsl_pdf_missing_the_sin_theta_jacobian_fails() {
-    let out = lobes(&ggx_args("tests/fixtures/glsl/shaders/broken_sin_theta.glsl", &SHADER_ROOT));
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/broken_sin_theta.glsl", &SHADER_ROOT));
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let f = failed(&out);
     // the sampler reports the same wrong pdf: consistency holds, the map's density does not
@@ -87,7 +87,7 @@ fn a_glsl_pdf_missing_the_sin_theta_jacobian_fails() {
 /// naming the paths searched and the flag that adds a folder.
 #[test]
 fn an_include_that_no_root_holds_is_named_at_its_line() {
-    let out = lobes(&ggx_args("tests/fixtures/glsl/shaders/ggx.glsl", &[]));
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/ggx.glsl", &[]));
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     let e = stderr(&out);
     let line = std::fs::read_to_string(root().join(GLSL).join("shaders/ggx.glsl")).unwrap().lines().position(|l| l.contains("#include \"constants.glsl\"")).unwrap() + 1;
@@ -154,10 +154,10 @@ fn spirv_from_glslang_is_checked_by_the_functions_debug_names() {
     let tool = glslang();
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-glsl-spirv");
     std::fs::create_dir_all(&dir).unwrap();
-    for (file, code, fails) in [("tests/fixtures/glsl/shaders/ggx.glsl", 0, false), ("tests/fixtures/glsl/shaders/broken_sin_theta.glsl", 1, true)] {
+    for (file, code, fails) in [("tests/fixtures/repository/glsl/shaders/ggx.glsl", 0, false), ("tests/fixtures/repository/glsl/shaders/broken_sin_theta.glsl", 1, true)] {
         let spv = dir.join(format!("{}.spv", Path::new(file).file_stem().unwrap().to_str().unwrap()));
         let comp = with_main(file, &spv);
-        let compiled = Command::new(tool).args(["-V", "-Itests/fixtures/glsl/shaders", "-Itests/fixtures/glsl/common", comp.to_str().unwrap(), "-o", spv.to_str().unwrap()]).current_dir(root()).output().unwrap();
+        let compiled = Command::new(tool).args(["-V", "-Itests/fixtures/repository/glsl/shaders", "-Itests/fixtures/repository/glsl/common", comp.to_str().unwrap(), "-o", spv.to_str().unwrap()]).current_dir(root()).output().unwrap();
         assert!(compiled.status.success(), "{}", String::from_utf8_lossy(&compiled.stdout));
         let out = lobes(&ggx_args(spv.to_str().unwrap(), &[]));
         assert_eq!(out.status.code(), Some(code), "{}", stderr(&out));

@@ -241,7 +241,7 @@ mod translation_tests {
     /// with the GLSL functions under their own names.
     #[test]
     fn the_fixture_translates_to_wgsl_that_parses() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/glsl");
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/repository/glsl");
         let sources = vec![Source::read(&dir.join("shaders/ggx.glsl")).unwrap()];
         let c = Composition::default().shader_root(dir.join("common"));
         let t = translate(&sources, &c).unwrap();
@@ -251,5 +251,23 @@ mod translation_tests {
         for f in ["fn rand(", "fn GgxD(", "fn GgxReflectionPdf(", "fn SampleGgxH(", "fn SampleGgxReflection("] {
             assert!(t.text.contains(f), "{f}\n{}", t.text);
         }
+    }
+}
+
+#[cfg(test)]
+mod name_tests {
+    use super::*;
+
+    /// A GLSL function named as a WGSL built-in and an overloaded one: written under other
+    /// names, which call expressions reach by the GLSL names (an overload is refused).
+    #[test]
+    fn names_wgsl_cannot_spell_are_mapped() {
+        let text = "#version 450\nfloat saturate(float x) { return clamp(x, 0.0, 1.0); }\nfloat sqr(float x) { return x * x; }\nvec3 sqr(vec3 x) { return x * x; }\n";
+        let t = translate(&[Source { name: "n.glsl".into(), text: text.into() }], &Composition::default()).unwrap();
+        naga::front::wgsl::parse_str(&t.text).unwrap();
+        let call = super::super::call_names("--pdf", "saturate(p0) * d.z", &t.origins).unwrap();
+        assert!(call.starts_with("saturate_(") && t.text.contains("fn saturate_("), "{call}\n{}", t.text);
+        let e = super::super::call_names("--pdf", "sqr(p0)", &t.origins).unwrap_err().to_string();
+        assert!(e.contains("`sqr` is overloaded"), "{e}");
     }
 }
