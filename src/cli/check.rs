@@ -4,7 +4,7 @@ use super::{NumberList, OutputArgs, emit, emit_json, interrupt, parse_azimuth, p
 use crate::report::check::CHECK_FILES;
 use crate::report::folder::{Access, OutFolder};
 use crate::report::table;
-use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Settings, UserSampler};
+use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Setting, Settings, UserSampler};
 use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -161,8 +161,22 @@ fn input(e: CheckError) -> anyhow::Error {
     match e {
         CheckError::Gpu(GpuError::Stopped(_)) => super::Interrupted(e.to_string()).into(),
         CheckError::Gpu(GpuError::TimedOut { .. }) => super::ChecksFailed(e.to_string()).into(),
+        CheckError::Setting { setting, message } => usage(format!("--{}: {message}", flag(setting))),
         e if e.is_input() => usage(e.to_string()),
         e => e.into(),
+    }
+}
+
+/// The flag that sets `setting`.
+pub(super) fn flag(setting: Setting) -> &'static str {
+    match setting {
+        Setting::Params => "params",
+        Setting::IncidentTheta => "incident-theta",
+        Setting::IncidentPhi => "incident-phi",
+        Setting::Samples => "samples",
+        Setting::Timeout => "timeout",
+        Setting::Bins => "bins",
+        Setting::Significance => "significance",
     }
 }
 
