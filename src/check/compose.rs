@@ -19,8 +19,13 @@ pub struct Source {
 impl Source {
     /// Reads a WGSL file, naming it by its path.
     pub fn read(path: &std::path::Path) -> Result<Self, CheckError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| CheckError::Input(format!("{}: cannot read the WGSL file: {e}", path.display())))?;
+        if super::dialect::spirv::is_spirv(path) {
+            return super::dialect::spirv::read(path);
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| match std::fs::read(path) {
+            Ok(b) if super::dialect::spirv::has_magic(&b) => CheckError::Input(format!("{}: a SPIR-V module: name it FILE.spv", path.display())),
+            _ => CheckError::Input(format!("{}: cannot read the shader file: {e}", path.display())),
+        })?;
         Ok(Self { name: path.display().to_string(), text })
     }
 }

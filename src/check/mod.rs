@@ -38,6 +38,7 @@ pub mod budget;
 mod builtin;
 pub mod compose;
 pub mod conventions;
+pub mod dialect;
 mod gpu;
 pub mod hard;
 pub mod modules;

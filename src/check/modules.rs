@@ -203,6 +203,10 @@ pub enum Dialect {
     NagaOil,
     /// WESL's `import package::…;`.
     Wesl,
+    /// GLSL, translated by naga ([`super::dialect::glsl`]).
+    Glsl,
+    /// A SPIR-V module, translated by naga ([`super::dialect::spirv`]).
+    Spirv,
 }
 
 impl Dialect {
@@ -211,6 +215,8 @@ impl Dialect {
             Dialect::Wgsl => "WGSL",
             Dialect::NagaOil => "naga_oil",
             Dialect::Wesl => "WESL",
+            Dialect::Glsl => "GLSL",
+            Dialect::Spirv => "SPIR-V",
         }
     }
 }
@@ -218,6 +224,9 @@ impl Dialect {
 /// The dialect of the files, from their text: a naga_oil directive at the start of a line, a WESL
 /// `import …;` statement (or a `.wesl` file), else plain WGSL.
 pub fn dialect(sources: &[Source]) -> Dialect {
+    if let Some(d) = super::dialect::sniff(sources) {
+        return d;
+    }
     let directive = |l: &str| {
         let l = l.trim_start();
         ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if ", "#else", "#endif"].iter().any(|d| l.starts_with(d))
@@ -283,6 +292,9 @@ impl UserCode {
     /// name in the composed text. A module path matches an import's full path or its last
     /// segments. A name no imported module holds is an error naming the imported items.
     pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
+        if matches!(self.dialect, Dialect::Glsl | Dialect::Spirv) {
+            return super::dialect::call_names(flag, expr, &self.origins);
+        }
         if self.dialect == Dialect::Wgsl && !expr.contains("::") {
             return Ok(expr.to_string());
         }
@@ -503,6 +515,7 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
             decls,
             renamed: Vec::new(),
         }),
+        Dialect::Glsl | Dialect::Spirv => super::dialect::compose(d, sources, c),
     }
 }
 

@@ -40,7 +40,8 @@ pub enum ProfileChoice {
 
 #[derive(Debug, Args)]
 pub struct CheckArgs {
-    /// The WGSL files that define the sampler, in order.
+    /// The files that define the sampler, in order: WGSL, WESL, naga_oil, GLSL (one translation
+    /// unit, with its #includes) or one SPIR-V module (.spv).
     #[arg(required = true, value_name = "FILE.wgsl")]
     pub files: Vec<PathBuf>,
     /// The sampling function: fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>,

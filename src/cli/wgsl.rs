@@ -1,6 +1,7 @@
-//! `lobes wgsl MODULE...`: lobes' WGSL for a renderer, in one of three forms: plain WGSL with
+//! `lobes wgsl MODULE...`: lobes' WGSL for a renderer, in one of four forms: plain WGSL with
 //! every name prefixed ([`embed::wgsl_with`]), naga_oil modules (`--naga-oil`,
-//! [`Module::naga_oil_source`]) or the WESL package (`--wesl`, [`Module::wesl_source`]); on stdout,
+//! [`Module::naga_oil_source`]), the WESL package (`--wesl`, [`Module::wesl_source`]) or GLSL 450
+//! (`--glsl`, [`embed::glsl`]); on stdout,
 //! or one file per module in `--out-dir`.
 
 use super::{emit, usage};
@@ -25,6 +26,10 @@ pub struct WgslArgs {
     /// `wesl` crate): one `NAME.wesl` per module, so it needs --out-dir.
     #[arg(long, requires = "out_dir")]
     pub wesl: bool,
+    /// The modules as GLSL 450 (naga's GLSL back end), for `#include` in a `#version 450` shader:
+    /// the plain WGSL's functions and names (`lobes_`), one text (with --out-dir: lobes.glsl).
+    #[arg(long, conflicts_with_all = ["naga_oil", "wesl"])]
+    pub glsl: bool,
     /// Write one file per module into DIR (created if missing): NAME.wgsl (plain or naga_oil)
     /// or NAME.wesl, and NAME/internal.wgsl or .wesl for a naga_oil or WESL module's internal
     /// helpers; the plain files do not overlap, so include each once, in any order.
@@ -45,20 +50,24 @@ enum Form {
     Plain,
     NagaOil,
     Wesl,
+    Glsl,
 }
 
 pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
     let modules = parse(&args.modules)?;
     let resolved = embed::resolve(&modules);
     let bindings = bindings(args, &resolved)?;
-    let form = match (args.naga_oil, args.wesl) {
-        (true, _) => Form::NagaOil,
-        (_, true) => Form::Wesl,
+    let form = match (args.naga_oil, args.wesl, args.glsl) {
+        (true, _, _) => Form::NagaOil,
+        (_, true, _) => Form::Wesl,
+        (_, _, true) => Form::Glsl,
         _ => Form::Plain,
     };
+    let glsl = || embed::glsl(&modules, bindings).context("writing lobes' WGSL as GLSL");
     let Some(dir) = &args.out_dir else {
         return emit(&match form {
             Form::Plain => embed::wgsl_with(&modules, bindings),
+            Form::Glsl => glsl()?,
             _ => embed::naga_oil_modules(&modules)
                 .into_iter()
                 .map(|m| format!("// ==== naga_oil module {} ====\n{}\n", m.import_path, naga_oil_text(&m, bindings).trim_end()))
@@ -67,6 +76,7 @@ pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
     };
     let files: Vec<(String, String)> = match form {
         Form::Plain => resolved.iter().map(|&m| (format!("{}.wgsl", m.name()), plain_file(m, bindings))).collect(),
+        Form::Glsl => vec![("lobes.glsl".to_string(), glsl()?)],
         Form::NagaOil => embed::naga_oil_modules(&modules).into_iter().map(|m| (m.file_name("wgsl"), naga_oil_text(&m, bindings))).collect(),
         Form::Wesl => embed::wesl_files(&modules)
             .into_iter()

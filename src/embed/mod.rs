@@ -62,6 +62,10 @@
 //! per unit solid angle of ωr; BRDF values without Fresnel.
 
 mod discrete;
+#[cfg(feature = "glsl")]
+mod glsl;
+#[cfg(feature = "glsl")]
+pub use glsl::glsl;
 mod namespace;
 // the text rules; besides `with_bindings` they are build.rs's (and the unit tests')
 #[allow(dead_code)]

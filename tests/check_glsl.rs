@@ -1,0 +1,205 @@
+//! `lobes check` of GLSL and SPIR-V samplers (issue 34 §1), in the shapes GLSL path tracers
+//! write them (tests/fixtures/repository/glsl): `#include` of a file in another folder (relative to the
+//! including file) and of one under `--shader-root`, a `float rand()` that steps a global
+//! `uint seed`, call expressions over the GLSL functions' own names. The correct sampler passes,
+//! the one whose pdf keeps a sin θ fails the checks that catch it; an error in an included file is
+//! reported at that file and line; SPIR-V compiled from the same GLSL is checked by its debug
+//! names; `lobes wgsl --glsl` writes GLSL that naga's GLSL front end and glslang compile.
+//! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one. glslangValidator
+//! (Debian's `glslang-tools`, installed by .ci/install) is required, not optional.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
+const GLSL: &str = "tests/fixtures/repository/glsl";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn lobes(args: &[&str]) -> Output {
+    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
+    out
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The report's (name, passed) per check.
+fn verdicts(out: &Output) -> Vec<(String, bool)> {
+    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report on stdout");
+    v["checks"].as_array().expect("checks").iter().map(|c| (c["name"].as_str().unwrap_or("?").to_string(), c["passed"].as_bool().unwrap())).collect()
+}
+
+fn failed(out: &Output) -> Vec<String> {
+    verdicts(out).into_iter().filter(|(_, p)| !p).map(|(n, _)| n).collect()
+}
+
+/// The GGX reflection sampler's command: α = 0.5 at θi 40°, the GLSL functions called by their
+/// names, the renderer's `rand()` replaced by lobes' uniforms.
+fn ggx_args<'a>(file: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec![
+        "check",
+        file,
+        "--sample",
+        "SampleGgxReflection(wi, p0)",
+        "--pdf",
+        "GgxReflectionPdf(wi, d, p0)",
+        "--rand",
+        "rand",
+        "--params",
+        "0.5",
+        "--incident-theta",
+        "40",
+        "--samples",
+        "262144",
+        "--json",
+    ];
+    a.extend_from_slice(extra);
+    a
+}
+
+const SHADER_ROOT: [&str; 2] = ["--shader-root", "tests/fixtures/repository/glsl/common"];
+
+#[test]
+fn a_glsl_sampler_with_includes_and_a_global_seed_passes() {
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/ggx.glsl", &SHADER_ROOT));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let v = verdicts(&out);
+    assert!(v.len() == 6 && v.iter().all(|(_, p)| *p), "{v:?}");
+}
+
+#[test]
+fn a_glsl_pdf_missing_the_sin_theta_jacobian_fails() {
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/broken_sin_theta.glsl", &SHADER_ROOT));
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let f = failed(&out);
+    // the sampler reports the same wrong pdf: consistency holds, the map's density does not
+    assert!(f.contains(&"jacobian".to_string()) && f.contains(&"normalization".to_string()) && !f.contains(&"pdf_consistency".to_string()), "{f:?}");
+}
+
+/// An include found neither beside the including file nor under a root: exit 2 at its line,
+/// naming the paths searched and the flag that adds a folder.
+#[test]
+fn an_include_that_no_root_holds_is_named_at_its_line() {
+    let out = lobes(&ggx_args("tests/fixtures/repository/glsl/shaders/ggx.glsl", &[]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    let line = std::fs::read_to_string(root().join(GLSL).join("shaders/ggx.glsl")).unwrap().lines().position(|l| l.contains("#include \"constants.glsl\"")).unwrap() + 1;
+    assert!(e.contains(&format!("shaders/ggx.glsl:{line}:")) && e.contains("#include \"constants.glsl\": no such file") && e.contains("--shader-root"), "{e}");
+}
+
+/// A copy of the fixture tree in a fresh folder, with `edit` applied to one file.
+fn copy_tree(name: &str, file: &str, edit: impl Fn(&str) -> String) -> PathBuf {
+    fn copy(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).unwrap();
+        for e in std::fs::read_dir(from).unwrap() {
+            let p = e.unwrap().path();
+            let t = to.join(p.file_name().unwrap());
+            if p.is_dir() { copy(&p, &t) } else { std::fs::copy(&p, &t).unwrap(); }
+        }
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("check-glsl-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy(&root().join(GLSL), &dir);
+    let f = dir.join(file);
+    let text = std::fs::read_to_string(&f).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text, "the edit changed {file}");
+    std::fs::write(&f, edited).unwrap();
+    dir
+}
+
+/// A type error in a file the sampler includes (from another folder) is reported at that
+/// file's own line, after the includes: not at a line of the expanded text.
+#[test]
+fn an_error_in_an_included_file_is_at_that_file_and_line() {
+    let dir = copy_tree("included-error", "common/random.glsl", |t| t.replace("return float(w >> 8u) / 16777216.0;", "return float(w >> 8u) / SCALE;"));
+    let random = dir.join("common/random.glsl");
+    let line = std::fs::read_to_string(&random).unwrap().lines().position(|l| l.contains("/ SCALE;")).unwrap() + 1;
+    let sampler = dir.join("shaders/ggx.glsl");
+    let root_dir = dir.join("common");
+    let out = lobes(&ggx_args(sampler.to_str().unwrap(), &["--shader-root", root_dir.to_str().unwrap()]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(e.contains(&format!("common/random.glsl:{line}:")), "not at random.glsl:{line}: {e}");
+    assert!(e.contains("return float(w >> 8u) / SCALE;") && e.contains("SCALE"), "the line as the file has it: {e}");
+}
+
+/// glslangValidator, which these tests need (Debian's `glslang-tools`, .ci/install).
+fn glslang() -> &'static str {
+    let ok = Command::new("glslangValidator").arg("--version").output().is_ok_and(|o| o.status.success());
+    assert!(ok, "glslangValidator is not installed: these tests need Debian's package glslang-tools (apt-get install glslang-tools; .ci/install installs it)");
+    "glslangValidator"
+}
+
+/// The sampler with a compute entry point that calls it, for a compiler that needs one.
+fn with_main(file: &str, out: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(root().join(file)).unwrap();
+    let comp = out.with_extension("comp");
+    std::fs::write(&comp, format!("{text}\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 0) buffer Out {{ vec4 o; }};\nvoid main() {{ o = SampleGgxReflection(vec3(0.0, 0.0, 1.0), 0.5) + vec4(GgxReflectionPdf(vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, 1.0), 0.5)); }}\n")).unwrap();
+    comp
+}
+
+/// SPIR-V as glslang compiles a GLSL renderer's shader (every parameter passed as a pointer,
+/// functions named `SampleGgxReflection(vf3;f1;`), checked by the functions' debug names: the
+/// correct sampler passes, the one without the sin θ Jacobian fails as its GLSL does.
+#[test]
+fn spirv_from_glslang_is_checked_by_the_functions_debug_names() {
+    let tool = glslang();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-glsl-spirv");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, code, fails) in [("tests/fixtures/repository/glsl/shaders/ggx.glsl", 0, false), ("tests/fixtures/repository/glsl/shaders/broken_sin_theta.glsl", 1, true)] {
+        let spv = dir.join(format!("{}.spv", Path::new(file).file_stem().unwrap().to_str().unwrap()));
+        let comp = with_main(file, &spv);
+        let compiled = Command::new(tool).args(["-V", "-Itests/fixtures/repository/glsl/shaders", "-Itests/fixtures/repository/glsl/common", comp.to_str().unwrap(), "-o", spv.to_str().unwrap()]).current_dir(root()).output().unwrap();
+        assert!(compiled.status.success(), "{}", String::from_utf8_lossy(&compiled.stdout));
+        let out = lobes(&ggx_args(spv.to_str().unwrap(), &[]));
+        assert_eq!(out.status.code(), Some(code), "{}", stderr(&out));
+        let f = failed(&out);
+        assert_eq!(f.contains(&"jacobian".to_string()), fails, "{f:?}");
+    }
+}
+
+/// SPIR-V written by naga's own SPIR-V back end from the GLSL (no external tool): the same
+/// verdict.
+#[test]
+fn spirv_from_naga_passes() {
+    let read = |f: &str| std::fs::read_to_string(root().join(GLSL).join(f)).unwrap();
+    let sampler: String = read("shaders/ggx.glsl").lines().filter(|l| !l.starts_with("#include")).map(|l| format!("{l}\n")).collect();
+    let sampler = sampler.replacen("#extension GL_GOOGLE_include_directive : require\n", &format!("{}{}", read("common/random.glsl"), read("common/constants.glsl")), 1);
+    let text = format!("{sampler}\nvoid main() {{}}\n");
+    let module = naga::front::glsl::Frontend::default().parse(&naga::front::glsl::Options::from(naga::ShaderStage::Compute), &text).unwrap_or_else(|e| panic!("{e:?}"));
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default()).validate(&module).unwrap();
+    let options = naga::back::spv::Options { flags: naga::back::spv::WriterFlags::DEBUG, ..Default::default() };
+    let words = naga::back::spv::write_vec(&module, &info, &options, None).unwrap();
+    let spv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-glsl-naga.spv");
+    std::fs::write(&spv, words.iter().flat_map(|w| w.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+    let out = lobes(&ggx_args(spv.to_str().unwrap(), &[]));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(verdicts(&out).iter().all(|(_, p)| *p));
+}
+
+/// `lobes wgsl --glsl`: GLSL 450 that naga's GLSL front end and glslang both compile, holding
+/// lobes' functions under their names.
+#[test]
+fn lobes_wgsl_glsl_compiles_in_naga_and_in_glslang() {
+    let tool = glslang();
+    let out = lobes(&["wgsl", "ggx", "beckmann", "ward", "dielectric", "discrete", "--glsl"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let glsl = String::from_utf8(out.stdout).unwrap();
+    let shader = format!("#version 450\n{glsl}\nlayout(local_size_x = 1) in;\nvoid main() {{}}\n");
+    let module = naga::front::glsl::Frontend::default().parse(&naga::front::glsl::Options::from(naga::ShaderStage::Compute), &shader).unwrap_or_else(|e| panic!("{e:?}\n{shader}"));
+    for f in ["lobes_ggx_d", "lobes_beckmann_d", "lobes_ward_sample"] {
+        assert!(module.functions.iter().any(|(_, x)| x.name.as_deref() == Some(f)), "{f}");
+    }
+    let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join("lobes-wgsl-glsl.comp");
+    std::fs::write(&file, &shader).unwrap();
+    let compiled = Command::new(tool).args(["-V", file.to_str().unwrap(), "-o"]).arg(file.with_extension("spv")).output().unwrap();
+    assert!(compiled.status.success(), "glslang: {}", String::from_utf8_lossy(&compiled.stdout));
+}
