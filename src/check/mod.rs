@@ -556,7 +556,8 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     });
 
     // The Jacobian.
-    let jac = jacobian::judge(&probes, &probe_u, &at, &kappa, CONDITIONING_ULPS, plane);
+    let jump = map_jump(&passes, &params, &probes, &probe_u, plane)?;
+    let jac = jacobian::judge(&probes, &probe_u, &at, &kappa, CONDITIONING_ULPS, plane, jump);
     let unresolved = match jac.skipped_unresolved {
         0 => String::new(),
         k => format!(
@@ -583,6 +584,16 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         ),
         _ => format!("; systematic test not applicable: {} samples resolved to {:.1}%", jac.resolved, 100.0 * jacobian::RESOLVED),
     };
+    let jumps = match jac.jump {
+        Some(j) => format!(
+            "; the map u ↦ d jumps along u.{} (at {:.4}, on {} of {} lines scanned): a choice made with that uniform and reused, so several u land on one d and pdf · |J| ≥ 1 there, judged as an event's (off only below 1)",
+            ["x", "y"][j.axis as usize],
+            j.at,
+            j.lines,
+            j.scanned
+        ),
+        None => String::new(),
+    };
     let summary = if jac.applicable {
         format!(
             "pdf · |J| has median {:.4} and worst {:.4} (allowed ±{:.1}% there); {:.2}% of {} samples off by more than {:.0}% + the f32 resolution of |J| and of the pdf (limit {:.0}%){}{systematic}{unresolved}{not_unit}",
@@ -597,7 +608,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
                 0 => String::new(),
                 k => format!("; {k} of them chose an event with u.z or u.w, judged by pdf · |J| / share ({} above 1)", jac.above_events),
             }
-        )
+        ) + &jumps
     } else {
         format!(
             "not applicable: only {} of {} samples comparable ({} move with u.z or u.w, {} not smooth, {} unresolved in f32, {} invalid)",
@@ -617,7 +628,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         Some(cpu) => cpu,
         None => &gpu_integrand,
     };
-    let mut integrals = quadrature::integrate(pdf_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
+    let (mut integrals, leaves) = quadrature::integrate_leaves(pdf_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
     if cpu_integrand.is_some() && sampler.eval.is_some() {
         // eval has no f64 twin: its integral stays the GPU's
         integrals.eval = quadrature::integrate(&gpu_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?.eval;
@@ -656,14 +667,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         integrals.probabilities.iter().zip(&integrals.dropped).map(|(p, d)| n * (p + d)).collect()
     };
     let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
-    // The mass the pdf leaves to invalid samples, 1 − ∫pdf, is known no better than the
-    // quadrature of ∫pdf (its error estimate and the f32 rounding of the sum; `invalid_expectation`
-    // says what the invalid cell makes of it), and no better than the f32 pdf itself: each node's
-    // value is uncertain by CONDITIONING_ULPS × the pdf's conditioning there, whose pdf-weighted
-    // mean the probes, drawn from the sampler, estimate
-    let valid_kappa: Vec<f64> = probes.iter().zip(&kappa).filter(|(p, _)| p[0][3] > 0.0 && p[0][3].is_finite()).map(|(_, k)| *k).collect();
-    let mean_kappa = valid_kappa.iter().sum::<f64>() / valid_kappa.len().max(1) as f64;
-    let resolution = integrals.error_estimate + 2e-6 * pdf_total + CONDITIONING_ULPS * mean_kappa.min(1.0) * pdf_total;
+    let resolution = integral_resolution(&integrals, pdf_total, cpu_integrand.is_none().then_some((&passes, &params, &leaves[..])))?;
     let observed_invalid = totals[bins..].iter().sum::<u64>() as f64 / n;
     let expected_invalid = invalid_expectation(settings.samples, totals[bins..].iter().sum(), pdf_total, resolution);
     // Normalisation: ∫pdf over the domain is the probability of a valid sample, which the
@@ -832,6 +836,36 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
         invalid,
         expected: signed,
     })
+}
+
+/// A jump of the sample map along u.x or u.y ([`jacobian::find_jump`]) on the lines through the
+/// first [`jacobian::JUMP_LINES`] probes with a valid sample.
+fn map_jump(passes: &gpu::Passes, params: &gpu::Params, probes: &[[[f32; 4]; 7]], probe_u: &[[f32; 4]], plane: bool) -> Result<Option<jacobian::Jump>, CheckError> {
+    let valid: Vec<[f32; 4]> = probes
+        .iter()
+        .zip(probe_u)
+        .filter(|(p, _)| p[0][3] > 0.0 && p[0].iter().all(|x| x.is_finite()))
+        .map(|(_, u)| *u)
+        .take(jacobian::JUMP_LINES)
+        .collect();
+    jacobian::find_jump(&valid, plane, &|us| passes.map(params, us))
+}
+
+/// The resolution of ∫pdf: the mass the pdf leaves to invalid samples, 1 − ∫pdf, is known no
+/// better than the quadrature (its error estimate, the f32 rounding of the sum;
+/// [`invalid_expectation`] says what the invalid cell makes of it), and, for the WGSL pdf on the
+/// GPU (`gpu`: its passes, parameters and the quadrature's parts), no better than the f32 pdf
+/// moves the integral: [`quadrature::sensitivity`] measures how far ∫pdf moves on the same parts
+/// when the pdf's inputs move by an ulp. Not CONDITIONING_ULPS × the pdf's mean conditioning: that
+/// bounds each node's error at its worst, while the integral sums the errors with their signs (a
+/// Phong lobe at n = 1000: 5·10⁻⁴ bounded, 10⁻⁴ moved, and a pdf normalised with (n + 2)/2π,
+/// 10⁻³ too large, passed within the bound).
+fn integral_resolution(integrals: &quadrature::Integrals, pdf_total: f64, gpu: Option<(&gpu::Passes, &gpu::Params, &[quadrature::Leaf])>) -> Result<f64, CheckError> {
+    let moved = match gpu {
+        Some((passes, params, leaves)) => quadrature::f32_sensitivity(passes, params, leaves)?,
+        None => 0.0,
+    };
+    Ok(integrals.error_estimate + 2e-6 * pdf_total + moved)
 }
 
 /// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf
