@@ -18,6 +18,11 @@
 //! levels deep, up to [`RETRIES`] times, and keep the new values; where a bin is still beyond it
 //! ([`Integrals::converged`] says so) `lobes check` draws no verdict (exit 3).
 //!
+//! **Jumps and poles.** Agreement is not trusted where the pdf's support has an edge (the pdf 0
+//! at some of a part's nodes, corners and sides' midpoints, > 0 at others): such a part is split
+//! [`EDGE_DEPTH`] levels past [`MAX_DEPTH`] while its jump holds more than the tolerance, and a
+//! part at a pole is integrated in s = √a ([`Rect`]), where a pdf ∝ 1/sin θ is smooth.
+//!
 //! Sphere bins are integrated over (a, φ) with a = 1 − |cos θ| per hemisphere (see
 //! `lobes_domain_point`), so that parts next to a pole keep their f32 resolution, and with φ
 //! measured from the axis nearest the part (`rect_f32`), so that an edge on an axis (the seam
@@ -124,8 +129,15 @@ impl Integrals {
     }
 }
 
+/// The first coordinate of a part ([`Rect`]): a = 1 − |cos θ| (on the plane, x), or s = √a.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Radial {
+    A,
+    RootA,
+}
+
 /// A rectangle of the quadrature's coordinates: `r` = (a0, a1, b0, b1) in hemisphere `h` (its
-/// sign; 0 on the plane), its first coordinate a = 1 − |cos θ|, or, where `root`, s = √a: a part
+/// sign; 0 on the plane), its first coordinate a = 1 − |cos θ|, or, [`Radial::RootA`], s = √a: a part
 /// at a pole is integrated in s (dω = da dφ = 2s ds dφ), which turns an integrable singularity
 /// a^(−1/2) there — a pdf ∝ 1/sin θ (uniform in θ, as a lat-long map draws its rows) or
 /// ∝ 1/√(1 − cos θ) — into a smooth integrand, where Gauss–Legendre in a converged to a value
@@ -134,7 +146,7 @@ impl Integrals {
 pub(super) struct Rect {
     pub r: [f64; 4],
     pub h: f32,
-    pub root: bool,
+    pub radial: Radial,
 }
 
 #[derive(Clone, Copy)]
@@ -143,8 +155,8 @@ struct Part {
     b: (f64, f64),
     /// hemisphere sign on the sphere, 0 on the plane
     h: f32,
-    /// `a` is s = √(1 − |cos θ|) ([`Rect`])
-    root: bool,
+    /// what `a` is ([`Rect`])
+    radial: Radial,
     bin: u32,
     depth: u32,
     /// the parent's 5 × 5 estimates (pdf, eval), none for a bin's initial parts
@@ -159,7 +171,7 @@ impl Part {
         [q((self.a.0, am), (self.b.0, bm)), q((am, self.a.1), (self.b.0, bm)), q((self.a.0, am), (bm, self.b.1)), q((am, self.a.1), (bm, self.b.1))]
     }
     fn rect(&self) -> Rect {
-        Rect { r: [self.a.0, self.a.1, self.b.0, self.b.1], h: self.h, root: self.root }
+        Rect { r: [self.a.0, self.a.1, self.b.0, self.b.1], h: self.h, radial: self.radial }
     }
 }
 
@@ -190,7 +202,7 @@ pub(super) trait Integrand {
 /// rather than of φ (f32(π) is 8.7·10⁻⁸ past π).
 /// The third number is 1 where the first coordinate is s = √a ([`Rect`]).
 fn rect_f32(rect: &Rect) -> ([f32; 4], [f32; 3]) {
-    let (r, h, root) = (&rect.r, rect.h, f32::from(u8::from(rect.root)));
+    let (r, h, root) = (&rect.r, rect.h, if rect.radial == Radial::RootA { 1.0 } else { 0.0 });
     if h == 0.0 {
         return (r.map(|x| x as f32), [0.0, 0.0, root]);
     }
@@ -235,7 +247,7 @@ impl CpuPdf<'_> {
         let (mut zero, mut positive, mut smallest) = (false, false, f64::INFINITY);
         for (x, y) in points {
             let s = c[0] + hw[0] * x;
-            let a = if rect.root { s * s } else { s };
+            let a = if rect.radial == Radial::RootA { s * s } else { s };
             let p = (self.pdf)(self.point(a, c[1] + hw[1] * y, rect.h));
             zero |= p == 0.0;
             if p > 0.0 && p.is_finite() {
@@ -243,12 +255,12 @@ impl CpuPdf<'_> {
                 smallest = smallest.min(p);
             }
         }
-        let area = 4.0 * hw[0] * hw[1] * if rect.root { 2.0 * r[1] } else { 1.0 };
+        let area = 4.0 * hw[0] * hw[1] * if rect.radial == Radial::RootA { 2.0 * r[1] } else { 1.0 };
         (zero && positive).then_some(smallest * area)
     }
     fn rule(&self, rect: &Rect, rule: &GaussLegendre) -> f64 {
         let r = &rect.r;
-        if rect.root {
+        if rect.radial == Radial::RootA {
             return rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |s, b| 2.0 * s * (self.pdf)(self.point(s * s, b, rect.h)));
         }
         rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |a, b| (self.pdf)(self.point(a, b, rect.h)))
@@ -315,10 +327,10 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
                 for i in 0..m {
                     let a = (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da);
                     // a part at a pole in s = √a ([`Rect`])
-                    let root = h != 0.0 && a.0 == 0.0;
-                    let a = if root { (0.0, a.1.sqrt()) } else { a };
+                    let radial = if h != 0.0 && a.0 == 0.0 { Radial::RootA } else { Radial::A };
+                    let a = if radial == Radial::RootA { (0.0, a.1.sqrt()) } else { a };
                     for j in 0..m {
-                        parts.push(Part { a, b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db), h, root, bin, depth: 0, coarse: None });
+                        parts.push(Part { a, b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db), h, radial, bin, depth: 0, coarse: None });
                     }
                 }
             }
@@ -489,7 +501,7 @@ pub(super) fn edge_strips(f: &dyn Integrand, rows: u32, cols: u32, width: f64, s
                 let m = ((z.dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
                 let da = (z.a.1 - z.a.0) / m as f64;
                 for i in 0..m {
-                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, root: false, bin, depth: 0, coarse: None });
+                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, radial: Radial::A, bin, depth: 0, coarse: None });
                 }
             }
         }
@@ -710,7 +722,7 @@ fn graded_parts() -> Vec<Part> {
         for band in edges.windows(2) {
             for j in 0..AZIMUTH_PARTS {
                 let b = (-std::f64::consts::PI + j as f64 * dphi, -std::f64::consts::PI + (j + 1) as f64 * dphi);
-                parts.push(Part { a: (band[0], band[1]), b, h, root: false, bin: 0, depth: 0, coarse: None });
+                parts.push(Part { a: (band[0], band[1]), b, h, radial: Radial::A, bin: 0, depth: 0, coarse: None });
             }
         }
     }
