@@ -623,7 +623,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let gpu_integrand = (&passes, &params);
     let wi64 = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
     let reference_pdf = settings.reference.as_ref().map(|r| move |d: glam::DVec3| (r.0)(wi64, d));
-    let cpu_integrand = reference_pdf.as_ref().map(|pdf| quadrature::CpuPdf { pdf, plane });
+    let cpu_integrand = reference_pdf.as_ref().map(|pdf| quadrature::CpuPdf { pdf, plane, jumps: quadrature::Jumps::Locate });
     let pdf_integrand: &dyn quadrature::Integrand = match &cpu_integrand {
         Some(cpu) => cpu,
         None => &gpu_integrand,

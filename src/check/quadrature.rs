@@ -46,6 +46,16 @@ pub const MAX_DEPTH: u32 = 8;
 /// Levels past the deepest split for a part where the pdf's support has an edge (the jump is
 /// located to 2⁻ᴰ of the part: bisection of the edge, a quarter at a time).
 pub const EDGE_DEPTH: u32 = 4;
+
+/// Whether [`refine`] locates the edges of the pdf's support ([`EDGE_DEPTH`]) or trusts the
+/// rules' agreement there: a sampler's pdf is judged against counts, and a jump it has is located;
+/// the whole-sphere integrals of [`WgslIntegrand`] and [`sphere_integral_f64`] hold kinks
+/// (max(0, ω·h)), not jumps, which their own graded parts resolve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Jumps {
+    Locate,
+    Trust,
+}
 /// The initial split of a bin per axis is at most this.
 pub const MAX_INITIAL_SPLIT: u32 = 16;
 /// Parts evaluated in one round at most; beyond it, parts are accepted unrefined and counted.
@@ -226,6 +236,8 @@ impl Integrand for (&Passes<'_>, &Params) {
 pub(super) struct CpuPdf<'a> {
     pub pdf: &'a (dyn Fn(glam::DVec3) -> f64 + Send + Sync),
     pub plane: bool,
+    /// Whether its parts' support edges are looked for (`None` from [`CpuPdf::edge`] otherwise).
+    pub jumps: Jumps,
 }
 
 impl CpuPdf<'_> {
@@ -240,6 +252,9 @@ impl CpuPdf<'_> {
     /// `lobes_support_edge` in f64: the pdf at both rules' nodes, the corners and the sides'
     /// midpoints.
     fn edge(&self, rect: &Rect, rules: [&GaussLegendre; 2]) -> Option<f64> {
+        if self.jumps == Jumps::Trust {
+            return None;
+        }
         let r = &rect.r;
         let (c, hw) = ([0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3])], [0.5 * (r[1] - r[0]), 0.5 * (r[3] - r[2])]);
         let mut points: Vec<(f64, f64)> = rules.iter().flat_map(|g| g.nodes().iter().flat_map(|&(x, _)| g.nodes().iter().map(move |&(y, _)| (x, y)))).collect();
@@ -363,7 +378,7 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
 /// [`integrate`], with the parts its integrals are the sum of ([`Leaf`]).
 pub(super) fn integrate_leaves(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<(Integrals, Vec<Leaf>), CheckError> {
     let bins = (rows * cols) as usize;
-    let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH)?;
+    let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH, Jumps::Locate)?;
     let mut rounds = out.rounds;
     let n = samples.max(1) as f64;
     let unseen = |i: usize, p: f64| observed.is_some_and(|o| o[i] > 0) && p <= 0.0;
@@ -401,7 +416,7 @@ pub(super) fn integrate_leaves(f: &dyn Integrand, domain: &Domain, rows: u32, co
             break;
         }
         let parts = initial_parts(domain, rows, cols, width / factor as f64, cap, Some(&over));
-        let (again, a) = refine(f, parts, bins, samples, MAX_DEPTH + 2 * retry)?;
+        let (again, a) = refine(f, parts, bins, samples, MAX_DEPTH + 2 * retry, Jumps::Locate)?;
         for i in (0..bins).filter(|&i| over[i]) {
             out.probabilities[i] = again.probabilities[i];
             out.eval[i] = again.eval[i];
@@ -509,7 +524,7 @@ pub(super) fn edge_strips(f: &dyn Integrand, rows: u32, cols: u32, width: f64, s
     if parts.is_empty() {
         return Ok(vec![0.0; bins]);
     }
-    Ok(refine(f, parts, bins, samples, MAX_DEPTH)?.0.probabilities)
+    Ok(refine(f, parts, bins, samples, MAX_DEPTH, Jumps::Locate)?.0.probabilities)
 }
 
 /// The counts and expected counts the χ² judges: where an off-axis column edge is closer to the
@@ -591,7 +606,7 @@ pub(super) struct Leaf {
 
 /// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says
 /// down to `max_depth`; with each bin's error estimate and its parts accepted unconverged.
-fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, max_depth: u32) -> Result<(Integrals, Bins), CheckError> {
+fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, max_depth: u32, jumps: Jumps) -> Result<(Integrals, Bins), CheckError> {
     let n = samples.max(1) as f64;
     let rounding = f.rounding();
     let tolerance = |v: f64, n: f64| tolerance(v, n, rounding);
@@ -611,7 +626,7 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, 
         // [`EDGE_DEPTH`] levels past `max_depth`, whatever its rules say: across a jump the two
         // rules (and a part and its quarters) can agree on a wrong value, and a corner of the
         // support can lie beyond every node (a uniform cap of 0.05 rad: ∫pdf 0.99967)
-        let edged = |k: usize, depth: u32| depth < max_depth + EDGE_DEPTH && edges[k].is_some_and(|scale| scale > tolerance(scale, n));
+        let edged = |k: usize, depth: u32| jumps == Jumps::Locate && depth < max_depth + EDGE_DEPTH && edges[k].is_some_and(|scale| scale > tolerance(scale, n));
         let mut next = Vec::new();
         let mut accept = |out: &mut Integrals, part: &Part, pdf: f64, eval: f64, err: f64, converged: bool| {
             out.probabilities[part.bin as usize] += pdf;
@@ -730,7 +745,7 @@ fn graded_parts() -> Vec<Part> {
 }
 
 fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
-    let (i, _) = refine(f, graded_parts(), 1, SPHERE_SAMPLES, MAX_DEPTH)?;
+    let (i, _) = refine(f, graded_parts(), 1, SPHERE_SAMPLES, MAX_DEPTH, Jumps::Trust)?;
     Ok(SphereIntegral { value: i.probabilities[0], error_estimate: i.error_estimate, unconverged_parts: i.unconverged_parts, bad_parts: i.bad_parts, parts: i.parts })
 }
 
@@ -743,7 +758,7 @@ fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
 /// assert!((i.value - std::f64::consts::PI).abs() < 1e-12);
 /// ```
 pub fn sphere_integral_f64(f: &(dyn Fn(glam::DVec3) -> f64 + Send + Sync)) -> SphereIntegral {
-    sphere_integral(&CpuPdf { pdf: f, plane: false }).expect("the CPU rules do not fail")
+    sphere_integral(&CpuPdf { pdf: f, plane: false, jumps: Jumps::Trust }).expect("the CPU rules do not fail")
 }
 
 /// A WGSL function `fn name(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`
