@@ -8,7 +8,7 @@
 //! (`tests/layout.rs` checks that no two import each other):
 //!
 //! - [`atomic`]: the one way lobes writes a file (the outputs, and the GPU engine's pipeline
-//!   cache).
+//!   cache); [`console`]: the one way it writes a line on stderr.
 //! - [`reference`](mod@reference): the f64 math, one module per lobe, each the twin of a WGSL
 //!   file in `shaders/`.
 //! - [`stats`]: binning, expected counts by quadrature, the χ² test, weighted sums.
@@ -35,6 +35,8 @@
 
 #[cfg(feature = "check")]
 pub mod atomic;
+#[cfg(feature = "check")]
+pub mod console;
 #[cfg(feature = "check")]
 pub mod folder_names;
 #[cfg(feature = "check")]

@@ -20,7 +20,8 @@ fn main() -> ExitCode {
     let cli = match lobes::cli::Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if e.use_stderr() => {
-            eprint!("lobes: {}", e.render());
+            // clap's rendering ends with its newline
+            lobes::console::say(format_args!("lobes: {}", e.render().to_string().trim_end()));
             return ExitCode::from(lobes::cli::EXIT_USAGE);
         }
         Err(e) => e.exit(),
@@ -32,9 +33,9 @@ fn main() -> ExitCode {
         Err(err) => {
             let code = lobes::cli::exit_code(&err);
             if code == lobes::cli::EXIT_INTERRUPTED {
-                eprintln!("lobes: {err:#}");
+                lobes::console::say(format_args!("lobes: {err:#}"));
             } else {
-                eprintln!("lobes: error: {err:#}");
+                lobes::console::say(format_args!("lobes: error: {err:#}"));
             }
             ExitCode::from(code)
         }

@@ -7,9 +7,12 @@
 //! GPU tests (all but the sweep's and the samples' checks): they need a wgpu adapter (lavapipe
 //! in CI) and fail without one. Each runs within seconds: short timeouts, small sample counts.
 
+mod common;
+
+use common::{finish, text};
 use lobes::report::output::RunSummary;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
@@ -23,10 +26,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 /// A sphere sampler whose sample function loops "forever": on a real GPU it never returns; on
@@ -59,20 +58,6 @@ fn spawn_check(file: &Path, extra: &[&str]) -> Child {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap()
-}
-
-/// Waits for `child` at most `limit`; kills it (and fails) past that.
-fn finish(mut child: Child, limit: Duration) -> (Output, Duration) {
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let out = child.wait_with_output().unwrap();
-            panic!("still running after {limit:?}:\n{}{}", text(&out.stdout), text(&out.stderr));
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    (child.wait_with_output().unwrap(), start.elapsed())
 }
 
 fn signal(child: &Child, name: &str) {

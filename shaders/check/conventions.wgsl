@@ -24,9 +24,12 @@ fn lobes_measure(value: f32, d: vec3<f32>) -> f32 {
     return value;
 }
 
-// Whether d is outside what a reflection-only sampler may return (d.z ≤ 0, or NaN).
+// Whether d is outside what a reflection-only sampler may return: a finite d with d.z ≤ 0. A d
+// that is NaN or infinite is not a direction under the surface but a bug, and stays one (read
+// from the bits, as user_passes.wgsl's lobes_finite3: NaN compares false under fast-math too).
 fn lobes_below(d: vec3<f32>) -> bool {
-    return LOBES_REFLECTION_ONLY && !(d.z > 0.0);
+    let b = bitcast<vec3<u32>>(d) & vec3<u32>(0x7f800000u);
+    return LOBES_REFLECTION_ONLY && all(b != vec3<u32>(0x7f800000u)) && d.z <= 0.0;
 }
 
 fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32> {

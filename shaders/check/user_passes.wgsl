@@ -17,7 +17,7 @@
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
-// lobes_check.slabs slabs of rows * cols + 4 cells, one per invocation of lobes_histogram_slabs
+// lobes_check.slabs slabs of lobes_cells() cells, one per invocation of lobes_histogram_slabs
 @group(0) @binding(4) var<storage, read_write> lobes_slabs: array<u32>;
 
 // x > 0 and finite, read from the bits (not relying on NaN comparing false, which fast-math
@@ -501,28 +501,46 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
     return row * lobes_check.cols + col;
 }
 
+// The cells of the histogram: the bins, the 4 reasons, then the two draw counters of the
+// --rand queue: the samples that drew more than the four uniforms it holds, and the most draws
+// one sample took (src/check/gpu.rs: Counted). Counted on every sample, not on a probe: a lobe
+// of a mixture that draws a fifth number in 0.2 % of its samples is found at any seed.
+fn lobes_cells() -> u32 {
+    return lobes_check.rows * lobes_check.cols + 6u;
+}
+const LOBES_OVER_DRAWN: u32 = 4u;
+const LOBES_MOST_DRAWS: u32 = 5u;
+
 // Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
 // keeps each dispatch under 2^32 samples and adds into 64-bit totals), one storage atomic per
 // sample: on GPUs. On CPU adapters lobes_histogram_slabs and lobes_reduce_slabs instead
-// (src/engine/gpu/counting.rs chooses).
+// (src/engine/gpu/counting.rs chooses). A sample that drew more than four numbers (rare, and
+// then an error) adds to the draw counters.
 @compute @workgroup_size(64)
 fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let first = (gid.x + gid.y * nwg.x * 64u) * lobes_check.samples_per_thread;
     let wi = lobes_check.wi.xyz;
+    let bins = lobes_check.rows * lobes_check.cols;
     for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
         let local = first + k;
         if (local < lobes_check.count) {
             let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
             atomicAdd(&lobes_counts[lobes_cell(s)], 1u);
+            let n = lobes_user_draws();
+            if (n > 4u) {
+                atomicAdd(&lobes_counts[bins + LOBES_OVER_DRAWN], 1u);
+                atomicMax(&lobes_counts[bins + LOBES_MOST_DRAWS], n);
+            }
         }
     }
 }
 
 // The histogram in per-invocation slabs (CPU adapters: llvmpipe serialises the lanes' atomics on
 // shared counters; src/engine/gpu/counting.rs): invocation g of lobes_check.slabs counts samples
-// base + g, base + g + slabs, ... of the dispatch into its own slab with plain adds, which no other
-// invocation touches; lobes_reduce_slabs then adds the slabs into lobes_counts. A slab entry counts
-// some of one dispatch's samples (under 2^32), so none wraps.
+// base + g, base + g + slabs, ... of the dispatch into its own slab of lobes_cells() cells with
+// plain adds (the most draws with max), which no other invocation touches; lobes_reduce_slabs then
+// adds the slabs into lobes_counts. A slab entry counts some of one dispatch's samples (under
+// 2^32), so none wraps.
 @compute @workgroup_size(8)
 fn lobes_histogram_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = gid.x + gid.y * nwg.x * 8u;
@@ -530,26 +548,35 @@ fn lobes_histogram_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     if (g >= slabs) {
         return;
     }
-    let first = g * (lobes_check.rows * lobes_check.cols + 4u);
+    let first = g * lobes_cells();
+    let draws = first + lobes_check.rows * lobes_check.cols;
     let wi = lobes_check.wi.xyz;
     for (var local = g; local < lobes_check.count; local += slabs) {
         let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
         let w = first + lobes_cell(s);
         lobes_slabs[w] = lobes_slabs[w] + 1u;
+        let n = lobes_user_draws();
+        if (n > 4u) {
+            lobes_slabs[draws + LOBES_OVER_DRAWN] += 1u;
+            lobes_slabs[draws + LOBES_MOST_DRAWS] = max(lobes_slabs[draws + LOBES_MOST_DRAWS], n);
+        }
     }
 }
 
-// lobes_counts[cell] = the sum of the slabs' counts of `cell`, one invocation per cell.
+// lobes_counts[cell] = the sum of the slabs' counts of `cell` (the most draws: their largest),
+// one invocation per cell.
 @compute @workgroup_size(64)
 fn lobes_reduce_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let cell = gid.x + gid.y * nwg.x * 64u;
-    let cells = lobes_check.rows * lobes_check.cols + 4u;
+    let cells = lobes_cells();
     if (cell >= cells) {
         return;
     }
+    let most = cell == lobes_check.rows * lobes_check.cols + LOBES_MOST_DRAWS;
     var c = 0u;
     for (var s = 0u; s < lobes_check.slabs; s++) {
-        c += lobes_slabs[s * cells + cell];
+        let v = lobes_slabs[s * cells + cell];
+        c = select(c + v, max(c, v), most);
     }
     atomicStore(&lobes_counts[cell], c);
 }

@@ -74,6 +74,27 @@ impl Budget {
     }
 }
 
+/// The check at a picked count is predicted to take at most 1/`TIMEOUT_MARGIN` of its timeout:
+/// the prediction is a line through two pilots on a machine whose load may change, and a
+/// correct sampler cut off by its timeout reads as one that hangs (a `timeout` FAIL).
+pub const TIMEOUT_MARGIN: f64 = 2.0;
+
+/// The timeout of a check whose count a `budget` of seconds picks: `given` where the user gave
+/// one (the count is then picked for at most 1/[`TIMEOUT_MARGIN`] of it, [`pick`]), else the
+/// default, raised to [`TIMEOUT_MARGIN`] × the budget where that is more (`--budget 1000`
+/// alone runs its 1000 s check under a 2000 s timeout, not the default 600 s).
+///
+/// ```
+/// use lobes::check::budget::timeout_for;
+/// use std::time::Duration;
+/// assert_eq!(timeout_for(1000.0, None), Duration::from_secs(2000));
+/// assert_eq!(timeout_for(20.0, None), lobes::check::DEFAULT_TIMEOUT);
+/// assert_eq!(timeout_for(40.0, Some(Duration::from_secs(10))), Duration::from_secs(10));
+/// ```
+pub fn timeout_for(budget: f64, given: Option<std::time::Duration>) -> std::time::Duration {
+    given.unwrap_or_else(|| super::DEFAULT_TIMEOUT.max(std::time::Duration::from_secs_f64((TIMEOUT_MARGIN * budget).min(super::MAX_TIMEOUT_SECONDS))))
+}
+
 /// The first pilot count, and the granularity of a picked count.
 pub const PILOT_SAMPLES: u64 = 1 << 16;
 
@@ -137,11 +158,16 @@ pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
     (n >= PILOT_SAMPLES && fixed + n as f64 * per_sample <= budget).then_some(n)
 }
 
-/// Measures the check's time on `gpu` by pilot checks and picks the count for `budget` seconds.
+/// Measures the check's time on `gpu` by pilot checks and picks the count for `budget` seconds,
+/// or for 1/[`TIMEOUT_MARGIN`] of `settings.timeout` where that is less (the pick's
+/// `budget_seconds` is then that part of the timeout): a count whose check is predicted to run
+/// past its timeout is never picked.
 /// The pilots: one at [`PILOT_SAMPLES`] that warms the driver's pipelines (not used), one more
 /// there (the fixed part), then 2²⁰, 2²², … until the samples' share of the time is measurable
 /// (half the fixed part, or an eighth of the budget), and the line through the last two.
 pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, profile: Option<Profile>) -> Result<BudgetPick, CheckError> {
+    let (given, budget) = (budget, budget.min(settings.timeout.as_secs_f64() / TIMEOUT_MARGIN));
+    let named = if budget < given { format!("--budget {given} s, capped at 1/{TIMEOUT_MARGIN} of the timeout ({budget} s),") } else { format!("--budget {budget} s") };
     let run = |samples: u64| -> Result<Pilot, CheckError> {
         let r = check(gpu, sampler, &Settings { samples, ..settings.clone() })?;
         Ok(Pilot { samples, seconds: r.wall_seconds, gpu_seconds: r.gpu_seconds })
@@ -150,7 +176,7 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let base = pilots[1].clone();
     if base.seconds >= budget {
         return Err(CheckError::Input(format!(
-            "--budget {budget} s is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
+            "{named} is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
             base.seconds,
             2.0 * base.seconds
         )));
@@ -169,7 +195,7 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let fixed = (base.seconds - per_sample * base.samples as f64).max(0.0);
     let samples = fit(budget, fixed, per_sample).ok_or_else(|| {
         CheckError::Input(format!(
-            "--budget {budget} s is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
+            "{named} is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
             fixed + 2.0 * per_sample * PILOT_SAMPLES as f64 + 0.5
         ))
     })?;

@@ -61,6 +61,36 @@ pub(super) enum Returned {
     Vec4,
 }
 
+/// The cells after the bins and reasons: the --rand draw counters (user_passes.wgsl,
+/// `lobes_cells`).
+const DRAW_CELLS: usize = 2;
+
+/// What the histogram pass counted in one dispatch.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct Counted {
+    /// Per cell: the bins, then the 4 reasons.
+    pub counts: Vec<u32>,
+    /// Samples that drew more than the four numbers of the --rand queue, and the most draws one
+    /// of them took (0 where none did).
+    pub over_drawn: u32,
+    pub most_draws: u32,
+}
+
+impl Counted {
+    fn new(words: &[u32], cells: usize) -> Self {
+        Self { counts: words[..cells].to_vec(), over_drawn: words[cells], most_draws: words[cells + 1] }
+    }
+}
+
+/// The error of a sampler of which `over` of `of` samples drew more than the queue's four
+/// uniforms, one of them `most`.
+pub(super) fn too_many_draws(sampler: &UserSampler, most: u32, over: u64, of: u64) -> CheckError {
+    CheckError::Input(format!(
+        "--rand {}: one sample drew {most} random numbers, and {over} of {of} samples drew more than four; lobes hands out four (u.x, u.y, u.z, u.w). A sampler checked with --rand draws at most four per sample",
+        sampler.composition.rand.join(", ")
+    ))
+}
+
 /// The path of the generated glue in messages: errors in a call expression point here.
 pub(super) const GLUE: &str = "<lobes check glue>";
 
@@ -88,24 +118,28 @@ pub(super) fn type_probe(sample: &str) -> String {
 /// --rand (`lobes_rand_take`, in the order `order` of u's components) and the seeding of `rng`.
 pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], reach: bool) -> String {
     let half = sampler.composition.sample_returns == super::SampleReturns::HalfVector;
-    let sample = match returned {
-        Returned::Contract => format!("    return {}(wi, u, params);\n", sampler.sample),
-        r => {
-            let mut s = format!("{}    // --sample\n    let lobes_r = {};\n", names("lobes_rng_seed(u)"), sampler.sample);
-            s += if half {
-                "    let lobes_h = lobes_r.xyz;\n    let lobes_d = 2.0 * dot(wi, lobes_h) * lobes_h - wi;\n"
-            } else {
-                "    let lobes_d = lobes_r.xyz;\n"
-            };
-            s += match (r, half) {
-                // the pdf of h over that of d: the reflection's Jacobian |dω_h/dω_d| = 1 / (4 |wi·h|)
-                // (Walter et al. 2007, eq. 14)
-                (Returned::Vec4, true) => "    return vec4<f32>(lobes_d, lobes_r.w / (4.0 * abs(dot(wi, lobes_h))));\n",
-                (Returned::Vec4, false) => "    return vec4<f32>(lobes_d, lobes_r.w);\n",
-                _ => "    return vec4<f32>(lobes_d, lobes_glue_pdf(wi, lobes_d, params));\n",
-            };
-            s
-        }
+    let mut sample = match returned {
+        Returned::Contract => format!("    let lobes_r = {}(wi, u, params);\n", sampler.sample),
+        _ => format!("{}    // --sample\n    let lobes_r = {};\n", names("lobes_rng_seed(u)"), sampler.sample),
+    };
+    sample += if half {
+        // A half vector facing away from wi (wi·h ≤ 0, h = (0, 0, 0) among them) is rejected before
+        // reflecting, as renderers do: there the reflection's density 1 / (4 wi·h) has no finite
+        // value (Walter et al. 2007, eq. 14, |dω_h/dω_d| = 1 / (4 |wi·h|)); a NaN h stays NaN.
+        "    let lobes_h = lobes_r.xyz;\n\
+         \x20   let lobes_wh = dot(wi, lobes_h);\n\
+         \x20   let lobes_d = 2.0 * lobes_wh * lobes_h - wi;\n\
+         \x20   if (lobes_wh <= 0.0) {\n\
+         \x20       return vec4<f32>(lobes_d, 0.0);\n\
+         \x20   }\n"
+    } else {
+        "    let lobes_d = lobes_r.xyz;\n"
+    };
+    sample += match (returned, half) {
+        // the pdf of h over that of d: the reflection's Jacobian
+        (Returned::Contract | Returned::Vec4, true) => "    return vec4<f32>(lobes_d, lobes_r.w / (4.0 * lobes_wh));\n",
+        (Returned::Contract | Returned::Vec4, false) => "    return vec4<f32>(lobes_d, lobes_r.w);\n",
+        (Returned::Vec3, _) => "    return vec4<f32>(lobes_d, lobes_glue_pdf(wi, lobes_d, params));\n",
     };
     let density = |flag: &str, call: Option<&str>| match call {
         None => "    return 0.0;\n".to_string(),
@@ -131,14 +165,17 @@ pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], r
          var<private> lobes_rand_next: u32;\n\
          const LOBES_RAND_ORDER = array<u32, 4>({o0}u, {o1}u, {o2}u, {o3}u);\n\
          // The next n uniforms of the queue u[LOBES_RAND_ORDER[0]], u[LOBES_RAND_ORDER[1]], …: the\n\
-         // bodies of the user's --rand functions. Past the fourth it gives 0, and the host refuses a\n\
-         // sampler that draws more (lobes_user_draws).\n\
+         // bodies of the user's --rand functions. Past the fourth it hands out a hash of u and the\n\
+         // draw's index (never 0 for ever: a loop that redraws until it gets a nonzero number ends),\n\
+         // and the host refuses a sampler that draws more (lobes_user_draws).\n\
          fn lobes_rand_take(n: u32) -> vec4<f32> {{\n\
          \x20   var r = vec4<f32>(0.0);\n\
          \x20   for (var k = 0u; k < n; k++) {{\n\
          \x20       let i = lobes_rand_next + k;\n\
          \x20       if (i < 4u) {{\n\
          \x20           r[k] = lobes_rand_u[LOBES_RAND_ORDER[i]];\n\
+         \x20       }} else {{\n\
+         \x20           r[k] = f32(lobes_pcg(i ^ lobes_rng_seed(lobes_rand_u)) >> 8u) / 16777216.0;\n\
          \x20       }}\n\
          \x20   }}\n\
          \x20   lobes_rand_next += n;\n\
@@ -367,6 +404,20 @@ pub(super) fn reserved(name: &str) -> bool {
     RNG_NAMES.contains(&name) || name.starts_with("lobes_") || name.starts_with("LOBES_") || name.starts_with("Lobes")
 }
 
+impl Drop for Passes<'_> {
+    /// On an abandoned device (a pass ran past the deadline or was stopped, and may still be
+    /// running) the module and pipelines are leaked, not destroyed: a driver destroys a pipeline
+    /// under the lock its queue holds while it runs a shader (lavapipe), so dropping one would
+    /// hold the process as long as the shader runs, forever for a sampler that loops (as
+    /// [`Gpu`]'s own drop keeps the device).
+    fn drop(&mut self) {
+        if self.gpu.abandoned().is_some() {
+            std::mem::forget(std::mem::take(self.pipelines.get_mut()));
+            std::mem::forget(self.module.clone());
+        }
+    }
+}
+
 impl<'g> Passes<'g> {
     pub fn new(gpu: &'g Gpu, composed: &Composed) -> Result<Self, CheckError> {
         // `composed` is already validated with its errors mapped to the user's files
@@ -459,19 +510,21 @@ impl<'g> Passes<'g> {
         Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons;
-    /// in per-invocation slabs on a CPU adapter, else in storage atomics
-    /// ([`Counting::choose`]; `force` asks for one, as tests do).
-    pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize, force: Option<Strategy>) -> Result<Vec<u32>, CheckError> {
+    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons
+    /// (`cells` in all), and the --rand draws past the queue's four; in per-invocation slabs on a
+    /// CPU adapter, else in storage atomics ([`Counting::choose`]; `force` asks for one, as
+    /// tests do).
+    pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize, force: Option<Strategy>) -> Result<Counted, CheckError> {
         let gpu = self.gpu;
         let p = Params { base: split(first), count, ..*params };
-        let slabs = match Counting::choose(gpu.info.device_type, &gpu.limits, cells as u32, force) {
+        let all = cells + DRAW_CELLS;
+        let slabs = match Counting::choose(gpu.info.device_type, &gpu.limits, all as u32, force) {
             Counting::Slabs { slabs } => slabs,
             _ => {
                 let spt = 64u32;
                 let p = Params { samples_per_thread: spt, slabs: 0, ..p };
-                let bytes = self.run("lobes_histogram", &p, &[], count.div_ceil(spt), cells as u64 * 4, true)?;
-                return Ok(bytemuck::cast_slice(&bytes).to_vec());
+                let bytes = self.run("lobes_histogram", &p, &[], count.div_ceil(spt), all as u64 * 4, true)?;
+                return Ok(Counted::new(bytemuck::cast_slice(&bytes), cells));
             }
         };
         let p = Params { slabs, ..p };
@@ -480,7 +533,7 @@ impl<'g> Passes<'g> {
             contents: bytemuck::bytes_of(&p),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bytes = cells as u64 * 4;
+        let bytes = all as u64 * 4;
         let counts = gpu.buffer("check counts", bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
         let slab_buffer = gpu.buffer("check slabs", slabs as u64 * bytes, wgpu::BufferUsages::STORAGE);
         let (sample, reduce) = (self.pipeline("lobes_histogram_slabs")?, self.pipeline("lobes_reduce_slabs")?);
@@ -491,11 +544,11 @@ impl<'g> Passes<'g> {
         let (sample_bind, reduce_bind) = (bind(&sample, &[(0, &uniform), (4, &slab_buffer)]), bind(&reduce, &[(0, &uniform), (3, &counts), (4, &slab_buffer)]));
         let passes = [
             Pass { label: "lobes_histogram_slabs", bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &sample, groups: (slabs / SLAB_WORKGROUP) as u64 }] },
-            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (cells as u32).div_ceil(WG) as u64 }] },
+            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (all as u32).div_ceil(WG) as u64 }] },
         ];
         let seconds = gpu.dispatch(&passes)?;
         self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));
-        Ok(bytemuck::cast_slice(&gpu.read(&counts, bytes)?).to_vec())
+        Ok(Counted::new(bytemuck::cast_slice(&gpu.read(&counts, bytes)?), cells))
     }
 
     /// The pipeline of `entry`, made at its first use.
@@ -548,8 +601,8 @@ impl<'g> Passes<'g> {
 /// report: `--rand-order` as given, else what lobes' probe finds at 256 uniforms, with the queue
 /// in call order: a draw along which the sample stays put over a run of its values (a share in
 /// [0, 1), as the Jacobian check measures events on u.z and u.w) chooses an event and goes to
-/// u.z, then u.w; the others move the direction and go to u.x, then u.y. More than four draws in
-/// one sample is an error naming the count.
+/// u.z, then u.w; the others move the direction and go to u.x, then u.y. (More than four draws
+/// in one sample the histogram refuses, counted on every sample.)
 pub(super) fn rand_order(passes: &Passes, params: &Params, sampler: &UserSampler, seed: u64) -> Result<([u32; 4], String), CheckError> {
     let wi = [params.wi[0], params.wi[1], params.wi[2]];
     let margin = 2.0 * super::jacobian::EPS as f64;
@@ -557,13 +610,10 @@ pub(super) fn rand_order(passes: &Passes, params: &Params, sampler: &UserSampler
         .map(|i| (crate::reference::rng::uniforms(seed ^ 0x5851_f42d_4c95_7f2d, i).map(|x| (margin + (1.0 - 2.0 * margin) * x) as f32), wi))
         .collect();
     let out = passes.draws(params, &items)?;
-    let most = out.iter().map(|o| o[0][0] as u32).max().unwrap_or(0);
+    // the order of the queue's four; draws past them are counted on every sample of the
+    // histogram, and refused there (`too_many_draws`)
+    let most = out.iter().map(|o| o[0][0] as u32).max().unwrap_or(0).min(4);
     let names = sampler.composition.rand.join(", ");
-    if most > 4 {
-        return Err(CheckError::Input(format!(
-            "--rand {names}: one sample drew {most} random numbers; lobes hands out four (u.x, u.y, u.z, u.w). A sampler checked with --rand draws at most four per sample"
-        )));
-    }
     if most == 0 {
         return Err(CheckError::Input(format!(
             "--rand {names}: no sample called {} (256 probed); name the functions the sampler draws its random numbers from",
@@ -693,13 +743,13 @@ mod tests {
         let params = Params { wi: [0.0, 0.0, 1.0, 0.0], seed: [7, 0], rows, cols, ..Zeroable::zeroed() };
         let cells = (rows * cols + 4) as usize;
         for (first, count) in [(0u64, 1_000_003u32), (5_000_000_000, 77)] {
-            let atomics = passes.histogram(&params, first, count, cells, Some(Strategy::Atomics)).unwrap();
-            let slabs = passes.histogram(&params, first, count, cells, Some(Strategy::Slabs)).unwrap();
+            let atomics = passes.histogram(&params, first, count, cells, Some(Strategy::Atomics)).unwrap().counts;
+            let slabs = passes.histogram(&params, first, count, cells, Some(Strategy::Slabs)).unwrap().counts;
             assert_eq!(atomics.iter().map(|&c| c as u64).sum::<u64>(), count as u64);
             assert!(atomics == slabs, "slabs and atomics counted samples {first}.. differently");
         }
         // about 1 % each outside the domain and with pdf 0 (10 000 ± 100)
-        let counts = passes.histogram(&params, 0, 1_000_003, cells, Some(Strategy::Slabs)).unwrap();
+        let counts = passes.histogram(&params, 0, 1_000_003, cells, Some(Strategy::Slabs)).unwrap().counts;
         let (outside, zero) = (counts[cells - 4 + 1], counts[cells - 4 + 3]);
         assert!((9_500..10_500).contains(&outside) && (9_500..10_500).contains(&zero), "{outside} {zero}");
     }

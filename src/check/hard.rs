@@ -1,8 +1,9 @@
 //! The user's sampler at the inputs where samplers break: every component of u at 0, 2⁻²⁴, ½,
 //! 1 − 2⁻²⁴ and 1 (625 combinations), from normal, oblique, grazing and below-the-surface
-//! incidence. A sample must be either rejected (reported pdf exactly 0) or valid: a finite point
-//! (a unit direction on the sphere, inside the bounds on the plane) with a finite reported pdf
-//! > 0 and a finite pdf(d) ≥ 0. NaN, ∞ or a negative pdf is never acceptable.
+//! incidence. A sample must be either rejected (reported pdf exactly 0 at a finite point) or
+//! valid: a finite point (a unit direction on the sphere, inside the bounds on the plane) with a
+//! finite reported pdf > 0 and a finite pdf(d) ≥ 0. NaN, ∞ or a negative pdf is never
+//! acceptable, nor a NaN or infinite point, whatever pdf comes with it.
 
 use serde::{Deserialize, Serialize};
 
@@ -40,7 +41,8 @@ pub struct HardRow {
     pub rejected: u32,
     /// Reported pdf NaN, ∞ or negative.
     pub bad_pdf: u32,
-    /// pdf > 0 but the point is not finite, not a unit direction, or outside the bounds.
+    /// The point not finite (whatever the pdf), or with pdf > 0 not a unit direction or outside
+    /// the bounds.
     pub bad_point: u32,
     /// pdf(d) of a valid sample NaN, ∞ or negative.
     pub bad_pdf_function: u32,
@@ -88,7 +90,8 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
     };
     for (p, u) in probes.iter().zip(u) {
         let (d, pdf) = (p[0], p[0][3]);
-        let in_domain = d[..3].iter().all(|x| x.is_finite())
+        let finite = d[..3].iter().all(|x| x.is_finite());
+        let in_domain = finite
             && match bounds {
                 Some([x0, y0, x1, y1]) => (x0..=x1).contains(&(d[0] as f64)) && (y0..=y1).contains(&(d[1] as f64)),
                 None => is_unit(p[6][2]),
@@ -97,7 +100,7 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
         let failed = if !pdf.is_finite() || pdf < 0.0 {
             r.bad_pdf += 1;
             true
-        } else if pdf == 0.0 {
+        } else if pdf == 0.0 && finite {
             r.rejected += 1;
             false
         } else if !in_domain {

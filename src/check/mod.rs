@@ -42,7 +42,7 @@ mod gpu;
 pub mod hard;
 pub mod modules;
 pub mod jacobian;
-mod pdf_values;
+mod judge;
 pub mod power;
 pub mod quadrature;
 pub mod report;
@@ -55,9 +55,7 @@ pub use modules::{Composition, Dialect, Draw, SampleReturns};
 pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
-use crate::reference::rng;
-use crate::stats::family;
-use report::{AlbedoFigures, Chi2Figures, ConsistencyFigures, NormalizationFigures, PdfValuesFigures, REPORT_VERSION, WeightFigures};
+use report::REPORT_VERSION;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -75,6 +73,10 @@ pub enum CheckError {
     Device(String),
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// A setting of [`Settings`] out of its range, named by its [`Setting`] (the command line
+    /// says its flag, a scene its key).
+    #[error("{}: {message}", setting.key())]
+    Setting { setting: Setting, message: String },
     /// A fault of lobes itself.
     #[error("internal error in lobes check: {0}")]
     Internal(String),
@@ -88,7 +90,34 @@ pub enum CheckError {
 impl CheckError {
     /// Whether the error is the user's input (exit code 2) rather than a failure to run (1).
     pub fn is_input(&self) -> bool {
-        matches!(self, CheckError::Input(_) | CheckError::Wgsl(_))
+        matches!(self, CheckError::Input(_) | CheckError::Wgsl(_) | CheckError::Setting { .. })
+    }
+}
+
+/// A field of [`Settings`], as errors name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    Params,
+    IncidentTheta,
+    IncidentPhi,
+    Samples,
+    Timeout,
+    Bins,
+    Significance,
+}
+
+impl Setting {
+    /// Its name as a field and as a scene's key: `incident_theta`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Setting::Params => "params",
+            Setting::IncidentTheta => "incident_theta",
+            Setting::IncidentPhi => "incident_phi",
+            Setting::Samples => "samples",
+            Setting::Timeout => "timeout",
+            Setting::Bins => "bins",
+            Setting::Significance => "significance",
+        }
     }
 }
 
@@ -315,36 +344,43 @@ impl Settings {
             Domain::Plane { .. } => (64, 64),
         })
     }
-    /// Bad input, named by its command-line flag: more than 16 params, an incident θ outside
+    /// Bad input, named by its [`Setting`]: more than 16 params, an incident θ outside
     /// [0, 180], no samples, an empty or too large grid, a significance outside (0, 1).
+    ///
+    /// ```
+    /// use lobes::check::{CheckError, Setting, Settings};
+    /// let e = Settings { incident_theta: 200.0, ..Settings::default() }.validate().unwrap_err();
+    /// assert!(matches!(e, CheckError::Setting { setting: Setting::IncidentTheta, .. }));
+    /// assert_eq!(e.to_string(), "incident_theta: 200 is outside [0, 180] degrees");
+    /// ```
     pub fn validate(&self) -> Result<(), CheckError> {
-        let bad = |flag: &str, what: String| Err(CheckError::Input(format!("{flag}: {what}")));
+        let bad = |setting, message: String| Err(CheckError::Setting { setting, message });
         if self.params.len() > MAX_PARAMS {
-            return bad("--params", format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
+            return bad(Setting::Params, format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
         }
         if let Some(p) = self.params.iter().find(|p| !p.is_finite()) {
-            return bad("--params", format!("{p} is not a finite number"));
+            return bad(Setting::Params, format!("{p} is not a finite number"));
         }
         if !(self.incident_theta.is_finite() && (0.0..=180.0).contains(&self.incident_theta)) {
-            return bad("--incident-theta", format!("{} is outside [0, 180] degrees", self.incident_theta));
+            return bad(Setting::IncidentTheta, format!("{} is outside [0, 180] degrees", self.incident_theta));
         }
         if !self.incident_phi.is_finite() {
-            return bad("--incident-phi", format!("{} is not finite", self.incident_phi));
+            return bad(Setting::IncidentPhi, format!("{} is not finite", self.incident_phi));
         }
         if !(1..=crate::engine::job::MAX_SAMPLES).contains(&self.samples) {
-            return bad("--samples", format!("{} is not allowed; give a whole number from 1 to 2^40 ({})", self.samples, crate::engine::job::MAX_SAMPLES));
+            return bad(Setting::Samples, format!("{} is not allowed; give a whole number from 1 to 2^40 ({})", self.samples, crate::engine::job::MAX_SAMPLES));
         }
         let t = self.timeout.as_secs_f64();
         if !(t > 0.0 && t <= MAX_TIMEOUT_SECONDS) {
-            return bad("--timeout", format!("{t} s is not allowed; give seconds > 0, at most {MAX_TIMEOUT_SECONDS:e}"));
+            return bad(Setting::Timeout, format!("{t} s is not allowed; give seconds > 0, at most {MAX_TIMEOUT_SECONDS:e}"));
         }
         if let Some((r, c)) = self.bins
             && (r == 0 || c == 0 || r as u64 * c as u64 > 1 << 24)
         {
-            return bad("--bins", format!("{r},{c}: rows and cols must be ≥ 1 with at most 2^24 bins"));
+            return bad(Setting::Bins, format!("{r},{c}: rows and cols must be ≥ 1 with at most 2^24 bins"));
         }
         if !(self.significance > 0.0 && self.significance < 1.0) {
-            return bad("--significance", format!("{} is outside (0, 1)", self.significance));
+            return bad(Setting::Significance, format!("{} is outside (0, 1)", self.significance));
         }
         Ok(())
     }
@@ -352,7 +388,7 @@ impl Settings {
 
 /// The incident direction at θ, φ in degrees (lobes' frame; the same numbers in a y-up frame,
 /// `conventions::Frame`).
-fn incident(theta: f64, phi: f64) -> [f32; 3] {
+pub(crate) fn incident(theta: f64, phi: f64) -> [f32; 3] {
     let w = crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians());
     [w.x as f32, w.y as f32, w.z as f32]
 }
@@ -417,28 +453,6 @@ fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, 
     Ok((passes, draws))
 }
 
-/// The most samples of one dispatch of the histogram and weights passes.
-const CHUNK: u64 = 1 << 26;
-
-/// The histogram of `samples` samples: counts per bin, then per invalid reason, in dispatches
-/// of at most [`CHUNK`] samples.
-fn histogram(passes: &gpu::Passes, params: &gpu::Params, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
-    let mut totals = vec![0u64; bins + 4];
-    let mut first = 0;
-    while first < samples {
-        let n = CHUNK.min(samples - first) as u32;
-        for (t, c) in totals.iter_mut().zip(passes.histogram(params, first, n, bins + 4, None)?) {
-            *t += c as u64;
-        }
-        first += n as u64;
-    }
-    let counted: u64 = totals.iter().sum();
-    if counted != samples {
-        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
-    }
-    Ok(totals)
-}
-
 /// The histograms alone (none of the other checks) of `sampler` at each (samples, seed) of
 /// `runs`, the passes composed once: counts per bin then per reason of [`REASONS`], and the
 /// wall seconds of each histogram. For measurements over many seeds and counts (`lobes
@@ -454,13 +468,13 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
         .map(|&(samples, seed)| {
             let params = params_of(sampler, &Settings { seed, ..settings.clone() });
             let started = std::time::Instant::now();
-            let counts = histogram(&passes, &params, samples, (rows * cols) as usize)?;
+            let counts = judge::histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
             Ok((counts, started.elapsed().as_secs_f64()))
         })
         .collect()
 }
 
-/// Runs every check of `sampler` on `gpu`.
+/// Runs every check of `sampler` on `gpu`: measures once ([`judge::measure`]), then judges.
 pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
     let started = std::time::Instant::now();
     settings.validate()?;
@@ -469,403 +483,73 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     if !matches!(sampler.domain, Domain::Plane { .. }) {
         sampler.conventions.check_incident(settings.incident_theta)?;
     }
-    let (rows, cols) = settings.grid(&sampler.domain);
-    let wi = incident(settings.incident_theta, settings.incident_phi);
-    let params = params_of(sampler, settings);
-    let (passes, draws) = compose_passes(gpu, sampler, settings, &params)?;
-    let plane = matches!(sampler.domain, Domain::Plane { .. });
-    let mut checks = Vec::new();
-
-    let bins = (rows * cols) as usize;
-    let totals = histogram(&passes, &params, settings.samples, bins)?;
-
-    // The probe: uniforms away from the edges by 2ε, so that u ± ε stays in [0, 1].
-    let margin = 2.0 * jacobian::EPS as f64;
-    let probe_u: Vec<[f32; 4]> = (0..settings.probe_samples as u64)
-        .map(|i| rng::uniforms(settings.seed ^ 0x9e37_79b9_7f4a_7c15, i).map(|x| (margin + (1.0 - 2.0 * margin) * x) as f32))
-        .collect();
-    let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, wi)).collect();
-    let probes = passes.probe(&params, &items)?;
-
-    // The pdf's f32 conditioning at each probe's d (0 where the pdf is not finite and > 0),
-    // and the map around each probe at the Jacobian's steps.
-    let points: Vec<[f32; 3]> = probes.iter().map(|p| [p[0][0], p[0][1], p[0][2]]).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();
-    let kappa: Vec<f64> = passes.conditioning(&params, &points)?.iter().map(|v| v[1] as f64).collect();
-    let around: Vec<[f32; 4]> = probe_u.iter().flat_map(|u| jacobian::around(*u)).collect();
-    let at: Vec<[[f32; 4]; jacobian::AROUND]> =
-        passes.map(&params, &around)?.chunks(jacobian::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
-
-    // pdf consistency: the reported pdf against the pdf function, at valid samples, each within
-    // the limit widened by the pdf's conditioning there.
-    let mut consistency = ConsistencyFigures {
-        compared: 0,
-        max_relative_difference: 0.0,
-        pdf_function_not_finite: 0,
-        worst_u: [0.0; 4],
-        limit: PDF_CONSISTENCY_LIMIT,
-        worst_limit: PDF_CONSISTENCY_LIMIT,
-        widened: 0,
-        over_limit: 0,
-    };
-    let mut p_max: f64 = 0.0;
-    let mut worst = 0.0;
-    for ((p, u), k) in probes.iter().zip(&probe_u).zip(&kappa) {
-        let (rep, fun) = (p[0][3] as f64, p[6][0] as f64);
-        if rep > 0.0 && rep.is_finite() && p[0][..3].iter().all(|x| x.is_finite()) {
-            consistency.compared += 1;
-            if !fun.is_finite() {
-                // the worst of all: the first such sample is the one shown
-                if consistency.pdf_function_not_finite == 0 {
-                    consistency.worst_u = *u;
-                }
-                consistency.pdf_function_not_finite += 1;
-            } else {
-                let diff = (rep - fun).abs() / rep.max(fun);
-                let limit = PDF_CONSISTENCY_LIMIT + CONDITIONING_ULPS * k;
-                consistency.max_relative_difference = consistency.max_relative_difference.max(diff);
-                consistency.widened += u64::from(diff > PDF_CONSISTENCY_LIMIT && diff <= limit);
-                consistency.over_limit += u64::from(diff > limit);
-                if diff / limit > worst {
-                    worst = diff / limit;
-                    consistency.worst_limit = limit;
-                    if consistency.pdf_function_not_finite == 0 {
-                        consistency.worst_u = *u;
-                    }
-                }
-            }
-            p_max = p_max.max(rep);
-        }
+    let run = judge::Run::new(gpu, sampler, settings)?;
+    let m = judge::measure(&run)?;
+    judge::require_converged(&run, &m)?;
+    let mut checks = vec![
+        judge::pdf_consistency::check(&run, &m),
+        judge::jacobian::check(&run, &m),
+        judge::pdf_values::check(&run, &m)?,
+        judge::normalization::check(&run, &m),
+        judge::chi2::check(&run, &m)?,
+    ];
+    if sampler.eval.is_some() {
+        checks.extend(judge::weights::check(&run, &m)?);
     }
-    let consistent = consistency.over_limit == 0 && consistency.pdf_function_not_finite == 0;
-    let not_finite = match consistency.pdf_function_not_finite {
-        0 => String::new(),
-        k => format!("; {} NaN or ∞ at {k} of them", sampler.pdf_at_d()),
-    };
-    let widened = match (consistency.widened, consistency.over_limit) {
-        (0, 0) => String::new(),
-        (w, 0) => format!("; {w} beyond {PDF_CONSISTENCY_LIMIT:.0e} but within the pdf's f32 conditioning there"),
-        (_, o) => format!("; {o} beyond the limit widened by the pdf's f32 conditioning (worst: {:.2e} allowed there)", consistency.worst_limit),
-    };
-    checks.push(Check {
-        passed: consistent,
-        summary: format!(
-            "the pdf the sampler reports and {} differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning) over {} samples{widened}{not_finite}",
-            sampler.pdf_at_d(), consistency.max_relative_difference, consistency.compared
-        ),
-        figures: Figures::PdfConsistency(consistency),
-    });
+    checks.push(judge::hard_cases::check(&run)?);
+    Ok(report(&run, &m, checks, gpu.adapter_name(), started))
+}
 
-    // The Jacobian.
-    let jump = map_jump(&passes, &params, &probes, &probe_u, plane)?;
-    let jac = jacobian::judge(&probes, &probe_u, &at, &kappa, CONDITIONING_ULPS, plane, jump);
-    let unresolved = match jac.skipped_unresolved {
-        0 => String::new(),
-        k => format!(
-            "; {k} samples skipped where no three steps agree on |J| to {:.0}% (d moves by only a few f32 ulps there: an f32 staircase, e.g. sin θ = √(1 − cos²θ) near a pole)",
-            100.0 * jacobian::UNRESOLVED
-        ),
-    };
-    // the length of d at the worst probe: a map onto non-unit vectors has the wrong |J| on the
-    // sphere, and the cause is then the length, not the density
-    let worst_length = probes.iter().zip(&probe_u).find(|(_, u)| **u == jac.worst_u).map(|(p, _)| p[6][2]);
-    let not_unit = match worst_length {
-        Some(l) if !plane && !jac.passed && !hard::is_unit(l) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
-        _ => String::new(),
-    };
-    let systematic = match jac.median_deviation {
-        Some(m) if jac.resolved >= jacobian::MIN_COMPARED => format!(
-            "; systematically: {} of {} samples resolved to {:.1}% off by more than {:.1}% + their f32 resolution (at most {:.0} may be: half, plus chance), median |pdf · |J| − 1| {:.1e}",
-            jac.systematic_off,
-            jac.resolved,
-            100.0 * jacobian::RESOLVED,
-            100.0 * jac.systematic_tolerance,
-            jac.systematic_limit.floor(),
-            m
-        ),
-        _ => format!("; systematic test not applicable: {} samples resolved to {:.1}%", jac.resolved, 100.0 * jacobian::RESOLVED),
-    };
-    let jumps = match jac.jump {
-        Some(j) => format!(
-            "; the map u ↦ d jumps along u.{} (at {:.4}, on {} of {} lines scanned): a choice made with that uniform and reused, so several u land on one d and pdf · |J| ≥ 1 there, judged as an event's (off only below 1)",
-            ["x", "y"][j.axis as usize],
-            j.at,
-            j.lines,
-            j.scanned
-        ),
-        None => String::new(),
-    };
-    let summary = if jac.applicable {
-        format!(
-            "pdf · |J| has median {:.4} and worst {:.4} (allowed ±{:.1}% there); {:.2}% of {} samples off by more than {:.0}% + the f32 resolution of |J| and of the pdf (limit {:.0}%){}{systematic}{unresolved}{not_unit}",
-            jac.median_ratio.unwrap_or(f64::NAN),
-            jac.worst_ratio,
-            100.0 * jac.worst_limit,
-            100.0 * jac.share_off,
-            jac.compared,
-            100.0 * jac.tolerance,
-            100.0 * jacobian::MAX_SHARE_OFF,
-            match jac.compared_events {
-                0 => String::new(),
-                k => format!("; {k} of them chose an event with u.z or u.w, judged by pdf · |J| / share ({} above 1)", jac.above_events),
-            }
-        ) + &jumps
-    } else {
-        format!(
-            "not applicable: only {} of {} samples comparable ({} move with u.z or u.w, {} not smooth, {} unresolved in f32, {} invalid)",
-            jac.compared, jac.probed, jac.skipped_selection, jac.skipped_not_smooth, jac.skipped_unresolved, jac.skipped_invalid
-        )
-    };
-    checks.push(Check { passed: jac.passed, summary, figures: Figures::Jacobian(jac) });
-
-    // The expected histogram.
-    let width = quadrature::initial_width(p_max, plane);
-    // what integrates the pdf: the WGSL pdf on the GPU, or the f64 reference on the CPU
-    let gpu_integrand = (&passes, &params);
-    let wi64 = glam::DVec3::new(wi[0] as f64, wi[1] as f64, wi[2] as f64);
-    let reference_pdf = settings.reference.as_ref().map(|r| move |d: glam::DVec3| (r.0)(wi64, d));
-    let cpu_integrand = reference_pdf.as_ref().map(|pdf| quadrature::CpuPdf { pdf, plane, jumps: quadrature::Jumps::Locate });
-    let pdf_integrand: &dyn quadrature::Integrand = match &cpu_integrand {
-        Some(cpu) => cpu,
-        None => &gpu_integrand,
-    };
-    let (mut integrals, leaves) = quadrature::integrate_leaves(pdf_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?;
-    if cpu_integrand.is_some() && sampler.eval.is_some() {
-        // eval has no f64 twin: its integral stays the GPU's
-        integrals.eval = quadrature::integrate(&gpu_integrand, &sampler.domain, rows, cols, width, settings.samples, Some(&totals[..bins]))?.eval;
-    }
-    // a pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
-    // expected counts the quadrature could not resolve give no verdict
-    if integrals.bad_parts == 0 {
-        integrals.converged(settings.samples).map_err(CheckError::NoVerdict)?;
-    }
-    let n = settings.samples as f64;
-    let pdf_total: f64 = integrals.probabilities.iter().sum();
-    // where the pdf is bad: its worst point on a fine grid (the WGSL pdf's, as the hard cases)
-    let worst = if integrals.bad_parts > 0 { pdf_values::worst(&passes, &params, &sampler.domain, &sampler.conventions)? } else { None };
-    let worst_text = worst.as_ref().map(|w| w.describe(&sampler.pdf_at_d(), plane));
-    checks.push(Check {
-        passed: integrals.bad_parts == 0,
-        summary: if integrals.bad_parts == 0 {
-            format!("{} finite and ≥ 0 at every quadrature node ({} parts)", sampler.pdf_at_d(), integrals.parts)
-        } else {
-            format!(
-                "{} returned NaN, ∞ or a negative value in {} of {} quadrature parts; {}",
-                sampler.pdf_at_d(),
-                integrals.bad_parts,
-                integrals.parts,
-                worst_text.clone().unwrap_or_else(|| "no such value on a fine grid of the domain: it lies between the grid's points".into())
-            )
-        },
-        figures: Figures::PdfValues(PdfValuesFigures { bad_parts: integrals.bad_parts, parts: integrals.parts, worst: worst_text }),
-    });
-    let expected: Vec<f64> = integrals.probabilities.iter().map(|p| n * p).collect();
+/// The report of `checks` over the measurement `m` of `run`.
+fn report(run: &judge::Run, m: &judge::Measured, checks: Vec<Check>, adapter: String, started: std::time::Instant) -> Report {
+    let bins = run.bins();
     // what the report holds and the pictures draw: the pdf's signed integral, below 0 where the
     // pdf is (the χ² leaves those parts out, and `pdf_values` fails)
-    let signed: Vec<f64> = if integrals.dropped.is_empty() {
-        expected.clone()
+    let n = run.samples();
+    let expected = if m.integrals.dropped.is_empty() {
+        judge::chi2::expected(run, m)
     } else {
-        integrals.probabilities.iter().zip(&integrals.dropped).map(|(p, d)| n * (p + d)).collect()
+        m.integrals.probabilities.iter().zip(&m.integrals.dropped).map(|(p, d)| n * (p + d)).collect()
     };
-    let invalid: [u64; 4] = totals[bins..].try_into().expect("four reasons");
-    let resolution = integral_resolution(&integrals, pdf_total, cpu_integrand.is_none().then_some((&passes, &params, &leaves[..])))?;
-    let observed_invalid = totals[bins..].iter().sum::<u64>() as f64 / n;
-    let expected_invalid = invalid_expectation(settings.samples, totals[bins..].iter().sum(), pdf_total, resolution);
-    // Normalisation: ∫pdf over the domain is the probability of a valid sample, which the
-    // histogram measures as the valid fraction f (standard error √(f(1 − f)/N)).
-    let valid = 1.0 - observed_invalid;
-    let norm_tolerance = 2.0 * resolution + 4.0 * (valid * (1.0 - valid) / n).sqrt();
-    let norm = NormalizationFigures { pdf_integral: pdf_total, valid_fraction: valid, resolution, tolerance: norm_tolerance };
-    checks.push(Check {
-        passed: (pdf_total - valid).abs() <= norm_tolerance,
-        summary: format!(
-            "∫{} over the domain = {pdf_total:.6} against the valid fraction {valid:.6} of the samples (tolerance {norm_tolerance:.1e})",
-            sampler.pdf_at_d()
-        ),
-        figures: Figures::Normalization(norm),
-    });
-    // column edges off the axes that f32 binning cannot place as finely as the lobe needs: their
-    // two bins judged as one cell
-    let (judged_counts, judged_expected, joined) = if plane {
-        (totals[..bins].to_vec(), expected.clone(), 0)
-    } else {
-        let strips = quadrature::edge_strips(pdf_integrand, rows, cols, width, settings.samples, &integrals.probabilities)?;
-        quadrature::join_unresolved_edges(&totals[..bins], &expected, &strips, rows, cols, settings.samples)
-    };
-    let grid = if plane { family::Grid::plane(rows, cols) } else { family::Grid::sphere(rows, cols) };
-    let chi2 = family::judge(grid, (&judged_counts, &judged_expected), (&[invalid.iter().sum()], &[expected_invalid]), settings.significance);
-    let family_p = chi2.family_p_value.unwrap_or(chi2.p_value);
-    let summary = format!(
-        "{}{}χ² = {:.1} on {} dof, p = {:.3e}; over {} grids and marginals (Holm) p = {:.3e} (significance {}){}{}; ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ{}",
-        chi2.untested.map_or(String::new(), |u| format!("{}; ", u.describe())),
-        family::caught(&chi2).map_or(String::new(), |c| format!("{c}; ")),
-        chi2.statistic,
-        chi2.dof,
-        chi2.p_value,
-        chi2.family.len(),
-        family_p,
-        settings.significance,
-        report::invalid_dominates(&invalid, expected_invalid, chi2.statistic).map_or(String::new(), |m| format!("; {m}")),
-        report::borderline(family_p, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}")),
-        pdf_total,
-        chi2.in_impossible_cells,
-        integrals.max_error_sigma,
-        if joined > 0 {
-            format!("; {joined} column edges off the axes lie closer to the lobe than f32 binning places them (±{:.0e} rad): the bins beside each judged as one", quadrature::EDGE_RESOLUTION)
-        } else {
-            String::new()
-        }
-    );
-    let passed = chi2.passed;
-    let figures = Chi2Figures { chi2, pdf_integral: pdf_total, invalid, expected_invalid, quadrature: integrals.clone(), joined_edges: joined as u64 };
-    checks.push(Check { passed, summary, figures: Figures::Chi2(figures) });
-
-    // Weights and albedo, with an eval.
-    if sampler.eval.is_some() {
-        let (mut sw, mut sw2, mut max_err, mut sum_err, mut judged) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-        let mut first = 0;
-        while first < settings.samples {
-            let n = CHUNK.min(settings.samples - first) as u32;
-            for [v, e] in passes.weights(&params, first, n)? {
-                sw += v[0] as f64;
-                sw2 += v[1] as f64;
-                max_err = max_err.max(v[2] as f64);
-                sum_err += e[0] as f64;
-                judged = judged.max(e[1] as f64);
-            }
-            first += n as u64;
-        }
-        let limit = crate::stats::weighted::WEIGHT_ERROR_LIMIT as f64;
-        let wf = WeightFigures { max_weight_error: max_err, limit, max_over_allowance: judged };
-        let widened = if max_err > limit && judged <= 1.0 { " (beyond it only within the pdf's f32 conditioning there)" } else { "" };
-        checks.push(Check {
-            passed: judged <= 1.0,
-            summary: format!(
-                "eval/pdf from the sampler and eval/{} differ by at most {max_err:.2e} (limit {limit:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning){widened}",
-                sampler.pdf_at_d()
-            ),
-            figures: Figures::Weights(wf),
-        });
-        let mean = sw / n;
-        let var = (sw2 / n - mean * mean).max(0.0);
-        let se = (var / n).sqrt();
-        let quad: f64 = integrals.eval.iter().sum();
-        // ∫eval is known to the quadrature's resolution, taken relative as that of ∫pdf (its
-        // error estimate, the f32 rounding of the sum and the pdf's conditioning), twice as
-        // `normalization` allows; the
-        // mean weight is biased by the f32 error of the weights, which the mean of
-        // |w − eval/pdf(d)| over the samples within the weights' allowance measures (a larger
-        // error is the sampler's, and counts 0), and by its own f32 sums (2·10⁻⁶)
-        let quad_err = resolution / pdf_total.max(f64::MIN_POSITIVE) * quad.abs();
-        let weight_err = sum_err / n + 2e-6 * mean.abs();
-        let allowance = 2.0 * quad_err + weight_err;
-        let excess = ((mean - quad).abs() - allowance).max(0.0) * (mean - quad).signum();
-        let z = if excess == 0.0 { 0.0 } else { excess / se.max(f64::MIN_POSITIVE) };
-        let p = libm::erfc(z.abs() / std::f64::consts::SQRT_2);
-        let af = AlbedoFigures {
-            mean_weight: mean,
-            std_error: se,
-            quadrature: quad,
-            quadrature_error: quad_err,
-            weight_error: weight_err,
-            allowance,
-            z,
-            p_value: p,
-            significance: settings.significance,
-        };
-        checks.push(Check {
-            passed: p >= settings.significance,
-            summary: format!(
-                "mean weight {mean:.6} ± {se:.1e} against ∫eval = {quad:.6} (f32 allowance {allowance:.1e}: quadrature, weights): z = {z:.2}, p = {p:.3e}{}",
-                report::borderline(p, settings.significance, settings.seed).map_or(String::new(), |m| format!("; {m}"))
-            ),
-            figures: Figures::Albedo(af),
-        });
-    }
-
-    // Hard cases.
-    let us = hard::uniforms(&sampler.conventions.hard_u_values());
-    let thetas: Vec<f64> = if plane { vec![settings.incident_theta] } else { sampler.conventions.hard_thetas() };
-    let items: Vec<([f32; 4], [f32; 3])> =
-        thetas.iter().flat_map(|&t| us.iter().map(move |u| (*u, incident(t, settings.incident_phi)))).collect();
-    let probes = passes.probe(&params, &items)?;
-    let bounds = match sampler.domain {
-        Domain::Plane { bounds } => Some(bounds),
-        Domain::Sphere => None,
-    };
-    let table: Vec<hard::HardRow> =
-        thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
-    let failing_rows: Vec<&hard::HardRow> = table.iter().filter(|r| !r.passed).collect();
-    let failing: Vec<String> = match failing_rows.first() {
-        None => Vec::new(),
-        Some(first) => {
-            let angles: Vec<String> = failing_rows.iter().map(|r| format!("{}°", r.incident_theta)).collect();
-            vec![format!(
-                "θi {}; the first at θi {}°, u = {:?}: {}",
-                angles.join(", "),
-                first.incident_theta,
-                first.first_failure.unwrap_or_default(),
-                first.first_failure_got.as_deref().unwrap_or("")
-            )]
-        }
-    };
-    checks.push(Check {
-        passed: failing.is_empty(),
-        summary: if failing.is_empty() {
-            let ones = if sampler.conventions.u_open { "" } else { ", 1" };
-            format!("{} inputs at u ∈ {{0, 2⁻²⁴, ½, 1 − 2⁻²⁴{ones}}}⁴ × {} incident angles: every sample valid or rejected with pdf 0", items.len(), thetas.len())
-        } else {
-            format!("NaN, ∞, a negative pdf or a bad point at {}", failing.join(", "))
-        },
-        figures: Figures::HardCases(table),
-    });
-
-    let passed = checks.iter().all(|c| c.passed);
-    Ok(Report {
+    Report {
         format_version: REPORT_VERSION,
-        passed,
+        passed: checks.iter().all(|c| c.passed),
         checks,
-        sampler: describe(sampler) + &draws,
-        domain: sampler.domain,
-        samples: settings.samples,
-        rows,
-        cols,
-        adapter: gpu.adapter_name(),
-        gpu_seconds: passes.gpu_seconds(),
+        sampler: describe(run.sampler) + &run.draws,
+        domain: run.sampler.domain,
+        samples: run.settings.samples,
+        rows: run.rows,
+        cols: run.cols,
+        adapter,
+        gpu_seconds: run.passes.gpu_seconds(),
         wall_seconds: started.elapsed().as_secs_f64(),
-        counts: totals[..bins].to_vec(),
-        invalid,
-        expected: signed,
-    })
+        counts: m.counts(bins).to_vec(),
+        invalid: m.invalid(bins),
+        expected,
+    }
 }
 
-/// A jump of the sample map along u.x or u.y ([`jacobian::find_jump`]) on the lines through the
-/// first [`jacobian::JUMP_LINES`] probes with a valid sample.
-fn map_jump(passes: &gpu::Passes, params: &gpu::Params, probes: &[[[f32; 4]; 7]], probe_u: &[[f32; 4]], plane: bool) -> Result<Option<jacobian::Jump>, CheckError> {
-    let valid: Vec<[f32; 4]> = probes
-        .iter()
-        .zip(probe_u)
-        .filter(|(p, _)| p[0][3] > 0.0 && p[0].iter().all(|x| x.is_finite()))
-        .map(|(_, u)| *u)
-        .take(jacobian::JUMP_LINES)
-        .collect();
-    jacobian::find_jump(&valid, plane, &|us| passes.map(params, us))
-}
-
-/// The resolution of ∫pdf: the mass the pdf leaves to invalid samples, 1 − ∫pdf, is known no
-/// better than the quadrature (its error estimate, the f32 rounding of the sum;
-/// [`invalid_expectation`] says what the invalid cell makes of it), and, for the WGSL pdf on the
-/// GPU (`gpu`: its passes, parameters and the quadrature's parts), no better than the f32 pdf
-/// moves the integral: [`quadrature::sensitivity`] measures how far ∫pdf moves on the same parts
-/// when the pdf's inputs move by an ulp. Not CONDITIONING_ULPS × the pdf's mean conditioning: that
-/// bounds each node's error at its worst, while the integral sums the errors with their signs (a
-/// Phong lobe at n = 1000: 5·10⁻⁴ bounded, 10⁻⁴ moved, and a pdf normalised with (n + 2)/2π,
-/// 10⁻³ too large, passed within the bound).
-fn integral_resolution(integrals: &quadrature::Integrals, pdf_total: f64, gpu: Option<(&gpu::Passes, &gpu::Params, &[quadrature::Leaf])>) -> Result<f64, CheckError> {
-    let moved = match gpu {
-        Some((passes, params, leaves)) => quadrature::f32_sensitivity(passes, params, leaves)?,
-        None => 0.0,
-    };
-    Ok(integrals.error_estimate + 2e-6 * pdf_total + moved)
+/// Why a half-vector sampler's pdf may defeat the quadrature without a fault of its own, for a
+/// no-verdict message: with `--sample-returns half-vector` and reflections below the surface kept,
+/// the density of d = 2 (wi·h) h − wi is p(h) / (4 wi·h) with h = normalize(wi + d), which has an
+/// integrable pole at d = −wi wherever p(h) is not 0 for h ⊥ wi (NDF sampling: D(h) cos θh at
+/// θi > 0); no f32 quadrature resolves it, and the f32 pdf may be ∞ or NaN beside it. `bad_at`:
+/// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
+/// points), which must lie within 1° of −wi; None for an unconverged quadrature.
+fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<String> {
+    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || sampler.domain != Domain::Sphere {
+        return None;
+    }
+    let pole = crate::reference::reflect::spherical((180.0 - settings.incident_theta).to_radians(), (settings.incident_phi + 180.0).to_radians());
+    if let Some(Some((theta, phi))) = bad_at
+        && crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians()).dot(pole).clamp(-1.0, 1.0).acos() > 1f64.to_radians()
+    {
+        return None;
+    }
+    let (t, p) = (pole.z.clamp(-1.0, 1.0).acos().to_degrees(), pole.y.atan2(pole.x).to_degrees());
+    Some(format!(
+        "; with --sample-returns half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with --reflection-only (they are then rejections, and d = −wi is one of them)"
+    ))
 }
 
 /// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf

@@ -4,7 +4,7 @@ use super::{NumberList, OutputArgs, emit, emit_json, interrupt, parse_azimuth, p
 use crate::report::check::CHECK_FILES;
 use crate::report::folder::{Access, OutFolder};
 use crate::report::table;
-use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Settings, UserSampler};
+use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Setting, Settings, UserSampler};
 use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -160,8 +160,22 @@ fn input(e: CheckError) -> anyhow::Error {
     match e {
         CheckError::Gpu(GpuError::Stopped(_)) => super::Interrupted(e.to_string()).into(),
         CheckError::Gpu(GpuError::TimedOut { .. }) => super::ChecksFailed(e.to_string()).into(),
+        CheckError::Setting { setting, message } => usage(format!("--{}: {message}", flag(setting))),
         e if e.is_input() => usage(e.to_string()),
         e => e.into(),
+    }
+}
+
+/// The flag that sets `setting`.
+pub(super) fn flag(setting: Setting) -> &'static str {
+    match setting {
+        Setting::Params => "params",
+        Setting::IncidentTheta => "incident-theta",
+        Setting::IncidentPhi => "incident-phi",
+        Setting::Samples => "samples",
+        Setting::Timeout => "timeout",
+        Setting::Bins => "bins",
+        Setting::Significance => "significance",
     }
 }
 
@@ -194,6 +208,18 @@ impl CheckArgs {
             .map_err(input)
     }
 
+    /// The time budget of `--budget` or `--profile`, if either is given.
+    fn budget_seconds(&self) -> Option<f64> {
+        self.budget.or(self.profile().map(|p| p.seconds()))
+    }
+
+    fn profile(&self) -> Option<check::budget::Profile> {
+        self.profile.map(|p| match p {
+            ProfileChoice::Ci => check::budget::Profile::Ci,
+            ProfileChoice::Thorough => check::budget::Profile::Thorough,
+        })
+    }
+
     fn settings(&self) -> anyhow::Result<Settings> {
         let bins = match &self.bins {
             None => None,
@@ -211,7 +237,10 @@ impl CheckArgs {
             bins,
             seed: self.seed,
             significance: self.significance,
-            timeout: self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
+            timeout: match self.budget_seconds() {
+                Some(budget) => check::budget::timeout_for(budget, self.timeout.map(Duration::from_secs_f64)),
+                None => self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
+            },
             ..Settings::default()
         })
     }
@@ -253,7 +282,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
             if let Some(folder) = &existing
                 && let Err(clean) = folder.clean_files(&CHECK_FILES)
             {
-                eprintln!("lobes: error: {clean:#}");
+                crate::console::say(format_args!("lobes: error: {clean:#}"));
             }
             return Err(e);
         }
@@ -268,22 +297,25 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         folder.clean_files(&CHECK_FILES)?;
     }
     // before the device opens: a signal while it does is seen at the first submission
-    interrupt::watch("stopping the check now (interrupt again to end at once)")?;
+    // the stop is seen within 50 ms of a wait on the GPU; 1.5 s after it, a process still
+    // held (by a thread in the driver) ends all the same
+    interrupt::watch("stopping the check now (interrupt again to end at once)", Some(Duration::from_millis(1500)))?;
     let gpu = Gpu::new()?;
     let _stop = gpu.stop_when(interrupt::requested);
-    let profile = args.profile.map(|p| match p {
-        ProfileChoice::Ci => check::budget::Profile::Ci,
-        ProfileChoice::Thorough => check::budget::Profile::Thorough,
-    });
-    let settings = match args.budget.or(profile.map(|p| p.seconds())) {
+    let settings = match args.budget_seconds() {
         None => settings,
         Some(budget) => {
-            let pick = check::budget::pick(&gpu, &sampler, &settings, budget, profile).map_err(input)?;
+            let pick = check::budget::pick(&gpu, &sampler, &settings, budget, args.profile()).map_err(input)?;
+            let capped = if pick.budget_seconds < budget {
+                format!(" (the budget {budget} s capped at 1/{} of --timeout {} s)", check::budget::TIMEOUT_MARGIN, settings.timeout.as_secs_f64())
+            } else {
+                String::new()
+            };
             // the reason on stdout before the table; with --json (one object on stdout) on stderr
             if args.output.json {
-                eprintln!("lobes: {}", pick.explain());
+                crate::console::say(format_args!("lobes: {}{capped}", pick.explain()));
             } else {
-                emit(&format!("{}\n", pick.explain()))?;
+                emit(&format!("{}{capped}\n", pick.explain()))?;
             }
             Settings { samples: pick.samples, ..settings }
         }

@@ -47,7 +47,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     };
     let (adapter, backend) = (&merged.adapter, &merged.backend);
     for mixture in &merged.mixtures {
-        eprintln!("lobes: warning: {mixture}; their counts add exactly, but the sum is not bit-identical to a run on any one of them");
+        crate::console::say(format_args!("lobes: warning: {mixture}; their counts add exactly, but the sum is not bit-identical to a run on any one of them"));
     }
     let n = merged.scene.cases.len();
     let level = sidak(args.significance, n);
@@ -71,7 +71,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
                 summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
             }
             Err(e) => {
-                eprintln!("lobes: error: case '{}': {e:#}; no histogram.json was written for it", case.name);
+                crate::console::say(format_args!("lobes: error: case '{}': {e:#}; no histogram.json was written for it", case.name));
                 let dash = || "-".to_string();
                 rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
                 summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::error(&Entry::Lobe(case), format!("{e:#}")) });

@@ -229,10 +229,15 @@ impl FileArgs {
     }
 }
 
-/// Writes `text` to stdout; a failed write (closed pipe, full disk) is a runtime error.
+/// Writes `text` to stdout. A reader that has gone (a closed pipe: `lobes check … | head -2`)
+/// wants no more: the text is dropped and the command ends with its verdict's exit code; any
+/// other failed write (a full disk) is a runtime error.
 pub fn emit(text: &str) -> anyhow::Result<()> {
     let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes()).and_then(|()| out.flush()).map_err(|e| anyhow::anyhow!("writing to stdout: {e}"))
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(anyhow::anyhow!("writing to stdout: {e}")),
+        _ => Ok(()),
+    }
 }
 
 /// Writes `value` to stdout as one compact JSON object and a newline. Non-finite numbers

@@ -97,13 +97,13 @@ fn check_fits(backend: &Backend, scene: &Scene) -> anyhow::Result<()> {
             .tiling(&case.job)
             .map_err(|e| usage(format!("{}: case '{}': {e}", scene.case_location(i), case.name)))?;
         if tiling.tiles > 1 {
-            eprintln!(
+            crate::console::say(format_args!(
                 "lobes: note: case '{}': {} bins exceed one storage binding of this adapter; counting them in {} passes of {} bins",
                 case.name,
                 case.job.bins(),
                 tiling.tiles,
                 tiling.tile_bins
-            );
+            ));
         }
     }
     Ok(())
@@ -168,14 +168,14 @@ impl PlainProgress {
             bar.set_position(done);
             if on && last.elapsed() >= Self::EVERY {
                 last = Instant::now();
-                eprintln!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64());
+                crate::console::say(format_args!("lobes: [{}/{cases}] {name}: {done} of {samples} samples, {:.0} s", i + 1, start.elapsed().as_secs_f64()));
             }
         }
     }
 
     fn finished(&self, i: usize, name: &str, verdict: &str, seconds: f64) {
         if self.on {
-            eprintln!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases);
+            crate::console::say(format_args!("lobes: [{}/{}] {name}: {verdict} ({seconds:.2} s)", i + 1, self.cases));
         }
     }
 }
@@ -203,7 +203,7 @@ pub(super) fn record_error(folder: &OutFolder, significance: f64, err: &anyhow::
         crate::report::summary::write(folder.path(), &summary, &[])
     });
     if let Err(e) = written {
-        eprintln!("lobes: error: {e:#}");
+        crate::console::say(format_args!("lobes: error: {e:#}"));
     }
 }
 
@@ -226,140 +226,173 @@ pub fn run(args: &RunArgs) -> anyhow::Result<()> {
         Some(folder) => folder,
         None => args.files.claim(&args.out, Access::Owner)?,
     };
-    let names: Vec<&str> = scene.entries().map(|(e, _)| e.name()).collect();
-    let stale = folder.clean(&names)?;
+    let names: Vec<String> = scene.entries().map(|(e, _)| e.name().to_string()).collect();
+    let stale = folder.clean(&names.iter().map(String::as_str).collect::<Vec<_>>())?;
     if !stale.is_empty() {
-        eprintln!(
+        crate::console::say(format_args!(
             "lobes: note: removed the outputs of {} cases of an earlier run in {} that this run does not have ({})",
             stale.len(),
             args.out.display(),
             stale.join(", ")
-        );
+        ));
     }
     let n = scene.len();
     let level = sidak(args.significance, n);
-    let heading = [format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
+    let heading = vec![format!("adapter: {}", backend.adapter()), format!("significance {} (Šidák over {n} cases: {level:.3e} each)", args.significance)];
     let summary = Arc::new(Mutex::new(RunSummary { stale, ..RunSummary::new(backend.adapter(), backend.name().into(), args.significance, level) }));
-    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now")?;
-    // a second signal ends the process at once: it writes the summary first, the case in
-    // flight and the rest as not run
-    let (all, out, head, shared) = (names.iter().map(|s| s.to_string()).collect::<Vec<_>>(), args.out.clone(), heading.to_vec(), summary.clone());
+    interrupt::watch("stopping after the case in flight (a case of your own sampler stops at once); interrupt again to stop now", None)?;
+    summary_on_exit(names, args.out.clone(), heading.clone(), summary.clone());
+    let table = run_cases(args, &scene, &mut backend, level, &summary);
+    let summary = summary.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    let written = crate::report::summary::write(&args.out, &summary, &heading);
+    if args.output.json {
+        emit_json(&summary)?;
+    } else {
+        emit(&table.text(args, &heading, &summary, n))?;
+    }
+    verdict(&summary, n, written)
+}
+
+/// A second signal ends the process at once: it writes the summary first, the case in flight
+/// and the rest as not run.
+fn summary_on_exit(all: Vec<String>, out: PathBuf, heading: Vec<String>, shared: Arc<Mutex<RunSummary>>) {
     interrupt::before_exit(move || {
         let mut s = shared.lock().unwrap_or_else(|p| p.into_inner()).clone();
         s.status = RunStatus::Interrupted;
         s.not_run = all.iter().filter(|n| !s.cases.iter().any(|c| &c.case == *n)).cloned().collect();
-        if let Err(e) = crate::report::summary::write(&out, &s, &head) {
-            eprintln!("lobes: error: {e:#}");
+        if let Err(e) = crate::report::summary::write(&out, &s, &heading) {
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
     });
+}
+
+/// The table's rows, and which footnotes they need.
+#[derive(Default)]
+struct Table {
+    rows: Vec<[String; 9]>,
+    /// Rows timed by the wall clock (no timestamp queries, or the CPU engine), and rows of a
+    /// user's sampler.
+    wall_rows: bool,
+    user_rows: bool,
+}
+
+impl Table {
+    /// The row of a case that has no result: its name, samples and the word.
+    fn push_dashes(&mut self, entry: &Entry, word: &str) {
+        let dash = || "-".to_string();
+        self.rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), word.into(), dash(), dash()]);
+    }
+
+    fn text(&self, args: &RunArgs, heading: &[String], summary: &RunSummary, n: usize) -> String {
+        let mut text = format!("{}\n\n", heading.join("\n"));
+        text += &output::format_table(&self.rows);
+        if self.wall_rows {
+            text += if args.cpu { "\n* wall time of the CPU engine (--cpu)\n" } else { "\n* wall time: the adapter has no timestamp queries\n" };
+        }
+        if self.user_rows {
+            text += "\n† a WGSL sampler of your own: wall time of all its checks (lobes check); FAIL names the checks that failed\n";
+        }
+        if self.rows.iter().any(|r| r[1].ends_with(output::BUDGET_MARK)) {
+            text += &format!("\n{} the count the case's budget picked: pilot checks measured its time on this adapter (histogram.json: user_sampler.budget)\n", output::BUDGET_MARK);
+        }
+        if !summary.not_run.is_empty() {
+            text += &format!("\ninterrupted: {} of {n} cases not run ({})\n", summary.not_run.len(), summary.not_run.join(", "));
+        }
+        text + &format!("\noutputs in {} (index.html, summary.json, junit.xml)\n", args.out.display())
+    }
+}
+
+/// Every case of `scene` in turn. A case that cannot run (a write that fails, a lost device) is
+/// reported and the others still run; a stop asked for by SIGINT/SIGTERM ends the run after the
+/// case in flight.
+fn run_cases(args: &RunArgs, scene: &Scene, backend: &mut Backend, level: f64, summary: &Mutex<RunSummary>) -> Table {
     let record = |f: &mut dyn FnMut(&mut RunSummary)| f(&mut summary.lock().unwrap_or_else(|p| p.into_inner()));
-    let mut rows = Vec::new();
-    let (mut wall_rows, mut user_rows) = (false, false);
-    let plain = PlainProgress::new(n);
+    let mut table = Table::default();
+    let plain = PlainProgress::new(scene.len());
     // The case in which the device was lost: no further case runs on it.
     let mut lost: Option<String> = None;
-    // A case that cannot run (a write that fails, a lost device) is reported and the others
-    // still run; a stop asked for by SIGINT/SIGTERM ends the run after the case in flight.
     for (i, (entry, at)) in scene.entries().enumerate() {
         if interrupt::requested() {
-            record(&mut |s| {
-                s.status = RunStatus::Interrupted;
-                s.not_run.push(entry.name().to_string());
-            });
+            record(&mut |s| s.not_run_now(entry.name()));
             continue;
         }
         let t = Instant::now();
-        let outcome = match (&lost, entry) {
-            (Some(why), _) => Err(anyhow::anyhow!("not run: {why}")),
-            (None, Entry::Lobe(case)) => {
-                let bar = progress_bar(case.samples, &case.name);
-                let outcome = run_and_write(&mut backend, case, level, &args.out, args.files.style(), &mut plain.samples(i, &case.name, case.samples, &bar));
-                bar.finish_and_clear();
-                outcome.map(|result| {
-                    wall_rows |= result.gpu_seconds.is_none();
-                    (output::table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) })
-                })
-            }
-            (None, Entry::User(case)) => {
-                user_rows = true;
-                let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
-                bar.enable_steady_tick(Duration::from_millis(200));
-                // a user's sampler may never return: a signal stops it at once
-                let _stop = match &backend {
-                    Backend::Gpu(engine) => Some(engine.gpu.stop_when(interrupt::requested)),
-                    Backend::Cpu => None,
-                };
-                let outcome = run_user_and_write(&backend, case, level, &args.out, args.files.style());
-                bar.finish_and_clear();
-                outcome
-            }
+        let outcome = match &lost {
+            Some(why) => Err(anyhow::anyhow!("not run: {why}")),
+            None => run_entry(args, backend, &entry, level, &plain, i, &mut table),
         };
         let verdict = match outcome {
             Ok((row, case_summary)) => {
-                let verdict = if case_summary.passed { "pass" } else { "FAIL" };
-                rows.push(row);
+                table.rows.push(row);
                 record(&mut |s| s.push(case_summary.clone()));
-                verdict
+                if case_summary.passed { "pass" } else { "FAIL" }
             }
             Err(e) if stopped(&e) => {
                 // the case in flight stopped by SIGINT/SIGTERM did not finish: it is not run
-                record(&mut |s| {
-                    s.status = RunStatus::Interrupted;
-                    s.not_run.push(entry.name().to_string());
-                });
+                record(&mut |s| s.not_run_now(entry.name()));
                 continue;
             }
             Err(e) if timed_out(&e) => {
                 // a failure of the case, with its reason; the device still runs its work
-                eprintln!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name());
+                crate::console::say(format_args!("lobes: case '{}' ({at}) FAILED: {e:#}; the remaining cases do not run on this GPU device", entry.name()));
                 lost = Some(format!("the GPU device is still running case '{}', which ran out of time", entry.name()));
-                let dash = || "-".to_string();
-                rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "FAIL".into(), dash(), dash()]);
+                table.push_dashes(&entry, "FAIL");
                 record(&mut |s| s.push(CaseSummary { failure: Some(format!("{e:#}")), error: None, ..CaseSummary::error(&entry, String::new()) }));
                 "FAIL"
             }
             Err(e) => {
                 if lost.is_none() {
-                    eprintln!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name());
+                    crate::console::say(format_args!("lobes: error: case '{}' ({at}): {e:#}; no histogram.json was written for it", entry.name()));
                     if device_lost(&e) {
-                        eprintln!("lobes: error: the GPU device is unusable; the remaining cases do not run");
+                        crate::console::say(format_args!("lobes: error: the GPU device is unusable; the remaining cases do not run"));
                         lost = Some(format!("the GPU device was lost in case '{}'", entry.name()));
                     }
                 }
-                let dash = || "-".to_string();
-                rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
+                table.push_dashes(&entry, "ERROR");
                 record(&mut |s| s.push(CaseSummary::error(&entry, format!("{e:#}"))));
                 "ERROR"
             }
         };
         plain.finished(i, entry.name(), verdict, t.elapsed().as_secs_f64());
     }
-    let summary = summary.lock().unwrap_or_else(|p| p.into_inner()).clone();
-    let written = crate::report::summary::write(&args.out, &summary, &heading);
-    if args.output.json {
-        emit_json(&summary)?;
-    } else {
-        let mut text = format!("{}\n\n", heading.join("\n"));
-        text += &output::format_table(&rows);
-        if wall_rows {
-            text += if args.cpu { "\n* wall time of the CPU engine (--cpu)\n" } else { "\n* wall time: the adapter has no timestamp queries\n" };
+    table
+}
+
+/// One case: a lobe's on the engine, a user's sampler through `lobes check`; its table row and
+/// summary.
+fn run_entry(args: &RunArgs, backend: &mut Backend, entry: &Entry, level: f64, plain: &PlainProgress, i: usize, table: &mut Table) -> anyhow::Result<([String; 9], CaseSummary)> {
+    match entry {
+        Entry::Lobe(case) => {
+            let bar = progress_bar(case.samples, &case.name);
+            let outcome = run_and_write(backend, case, level, &args.out, args.files.style(), &mut plain.samples(i, &case.name, case.samples, &bar));
+            bar.finish_and_clear();
+            outcome.map(|result| {
+                table.wall_rows |= result.gpu_seconds.is_none();
+                (output::table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) })
+            })
         }
-        if user_rows {
-            text += "\n† a WGSL sampler of your own: wall time of all its checks (lobes check); FAIL names the checks that failed\n";
+        Entry::User(case) => {
+            table.user_rows = true;
+            let bar = ProgressBar::new_spinner().with_message(format!("{}: lobes check", case.name));
+            bar.enable_steady_tick(Duration::from_millis(200));
+            // a user's sampler may never return: a signal stops it at once
+            let _stop = match &*backend {
+                Backend::Gpu(engine) => Some(engine.gpu.stop_when(interrupt::requested)),
+                Backend::Cpu => None,
+            };
+            let outcome = run_user_and_write(backend, case, level, &args.out, args.files.style());
+            bar.finish_and_clear();
+            outcome
         }
-        if rows.iter().any(|r| r[1].ends_with(output::BUDGET_MARK)) {
-            text += &format!("\n{} the count the case's budget picked: pilot checks measured its time on this adapter (histogram.json: user_sampler.budget)\n", output::BUDGET_MARK);
-        }
-        if !summary.not_run.is_empty() {
-            text += &format!("\ninterrupted: {} of {n} cases not run ({})\n", summary.not_run.len(), summary.not_run.join(", "));
-        }
-        text += &format!("\noutputs in {} (index.html, summary.json, junit.xml)\n", args.out.display());
-        emit(&text)?;
     }
+}
+
+/// The run's exit: interrupted (130), cases failed (1), cases that could not run.
+fn verdict(summary: &RunSummary, n: usize, written: anyhow::Result<()>) -> anyhow::Result<()> {
     let (errors, failed) = (summary.errors, summary.failed);
     if summary.status == RunStatus::Interrupted {
         if let Err(e) = &written {
-            eprintln!("lobes: error: {e:#}");
+            crate::console::say(format_args!("lobes: error: {e:#}"));
         }
         let finished = n - summary.not_run.len();
         return Err(Interrupted(format!("interrupted after {finished} of {n} cases ({errors} could not run, {failed} failed)")).into());

@@ -29,7 +29,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     // The module depends on the adapter's device type and limits (its counting, the workgroup
     // storage, the storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
-    let engine = GpuEngine::open().map_err(|e| eprintln!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits")).ok();
+    let engine = GpuEngine::open().map_err(|e| crate::console::say(format_args!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits"))).ok();
     let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
     for entry in entries {
         let m = match entry {

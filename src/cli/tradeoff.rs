@@ -125,8 +125,8 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
     }
     let mut engine = GpuEngine::open()?;
     let adapter = engine.gpu.adapter_name();
-    eprintln!("adapter: {adapter}");
-    let mut log = |s: &str| eprintln!("{s}");
+    crate::console::say(format_args!("adapter: {adapter}"));
+    let mut log = |s: &str| crate::console::say(s);
     let sweep_settings = SweepSettings {
         samplers,
         precisions,
@@ -184,7 +184,7 @@ pub fn run(args: &TradeoffArgs) -> anyhow::Result<()> {
     };
     if let Some(out) = &args.out {
         report::write(out, &r)?;
-        eprintln!("wrote {0}/tradeoff.md, {0}/tradeoff.png, {0}/tradeoff.json", out.display());
+        crate::console::say(format_args!("wrote {0}/tradeoff.md, {0}/tradeoff.png, {0}/tradeoff.json", out.display()));
     }
     if args.output.json {
         emit_json(&r)

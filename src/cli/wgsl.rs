@@ -86,7 +86,7 @@ pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
     }
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     let plural = if files.len() == 1 { "" } else { "s" };
-    eprintln!("wrote {} file{plural} to {}: {}", files.len(), dir.display(), names.join(", "));
+    crate::console::say(format_args!("wrote {} file{plural} to {}: {}", files.len(), dir.display(), names.join(", ")));
     Ok(())
 }
 

@@ -263,26 +263,21 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
         heatmap::write_png_scaled(&Heatmap { title, values, scale: *scale, marked_key, ..base }, *mapping, &dir.join(file))
     })?;
 
-    // the marginals: sums over the columns of each drawn row, and over the drawn rows of each column
+    let axes = [(row_label, (drawn.start..=drawn.end).map(row_edge).collect()), (col_label, (0..=cols).map(col_edge).collect())];
+    write_marginals(dir, c.caption, axes, (&measured, &expected), cols)
+}
+
+/// The marginals of the drawn cells (`cols` a row): sums over the columns of each row, and over
+/// the rows of each column, against the axes' labels and edges.
+fn write_marginals(dir: &Path, caption: &str, axes: [(&'static str, Vec<f64>); 2], (measured, expected): (&[f64], &[f64]), cols: usize) -> anyhow::Result<()> {
     let row_sums = |v: &[f64]| -> Vec<f64> { v.chunks(cols).map(|row| row.iter().sum()).collect() };
     let col_sums = |v: &[f64]| -> Vec<f64> { (0..cols).map(|k| v.iter().skip(k).step_by(cols).sum()).collect() };
+    let [(row_label, row_edges), (col_label, col_edges)] = axes;
     let panels = [
-        Panel {
-            title: format!("over {row_label}"),
-            x_label: row_label,
-            edges: (drawn.start..=drawn.end).map(row_edge).collect(),
-            measured: row_sums(&measured),
-            expected: row_sums(&expected),
-        },
-        Panel {
-            title: format!("over {col_label}"),
-            x_label: col_label,
-            edges: (0..=cols).map(col_edge).collect(),
-            measured: col_sums(&measured),
-            expected: col_sums(&expected),
-        },
+        Panel { title: format!("over {row_label}"), x_label: row_label, edges: row_edges, measured: row_sums(measured), expected: row_sums(expected) },
+        Panel { title: format!("over {col_label}"), x_label: col_label, edges: col_edges, measured: col_sums(measured), expected: col_sums(expected) },
     ];
-    marginals::write_png(&dir.join(MARGINALS_PNG), c.caption, &panels)
+    marginals::write_png(&dir.join(MARGINALS_PNG), caption, &panels)
 }
 
 #[cfg(test)]

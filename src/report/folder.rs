@@ -102,7 +102,7 @@ impl OutFolder {
                         path.display()
                     )));
                 }
-                eprintln!("lobes: waiting for --out {}, in use by another lobes ({holder})", path.display());
+                crate::console::say(format_args!("lobes: waiting for --out {}, in use by another lobes ({holder})", path.display()));
                 match access {
                     Access::Owner => file.lock().map_err(cannot)?,
                     Access::Shard => file.lock_shared().map_err(cannot)?,

@@ -471,6 +471,12 @@ impl RunSummary {
         self.errors += usize::from(case.error.is_some());
         self.cases.push(case);
     }
+
+    /// A case not run: the run was interrupted before or during it.
+    pub fn not_run_now(&mut self, case: &str) {
+        self.status = RunStatus::Interrupted;
+        self.not_run.push(case.to_string());
+    }
 }
 
 /// One case of a [`RunSummary`].

@@ -619,7 +619,6 @@ fn validate_table(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, room: u64
 fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Point, common: Common) -> Result<Case, SceneError> {
     let c = spanned.get_ref();
     let Common { name, samples, seed } = common;
-    const LOBES: [&str; 4] = ["ward", "beckmann", "ggx", "discrete"];
     let lobes_allowed = "use ward, beckmann, ggx or discrete";
     let Some(lobe_v) = &c.lobe else {
         return Err(ctx.err(
@@ -629,106 +628,17 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
     };
     let lobe_name = string(ctx, lobe_v, "lobe", lobes_allowed)?;
     let method = point.get("method").map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
-
     if lobe_name == "discrete" {
-        let method = match method {
-            None => DEFAULT_DISCRETE_METHOD,
-            Some(("cdf", _)) => DiscreteMethod::Cdf,
-            Some(("alias", _)) => DiscreteMethod::Alias,
-            Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias{}", did_you_mean(other, ["cdf", "alias"])))),
-        };
-        reject_keys(ctx, &roughness_keys(point), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
-        reject_keys(
-            ctx,
-            &[("incident_theta", point.get("incident_theta")), ("incident_phi", point.get("incident_phi")), ("bins", point.get("bins")), ("scatter", point.get("scatter"))],
-            "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
-        )?;
-        reject_keys(ctx, &effect_keys(c, point), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
-        let Some(w) = &c.weights else {
-            return Err(ctx.err(lobe_v.span(), "a discrete case needs weights = [w0, w1, ...]: finite numbers ≥ 0, not all zero"));
-        };
-        let items = &w.get_ref().0;
-        if items.len() as u64 > MAX_BINS {
-            return Err(ctx.err(w.span(), format!("weights has {} items; at most 2^24 (16777216)", items.len())));
-        }
-        let values = items
-            .iter()
-            .enumerate()
-            .map(|(i, v)| number(ctx, v, &format!("weights[{i}]"), |x| x >= 0.0, "weights must be finite numbers ≥ 0"))
-            .collect::<Result<Vec<f64>, _>>()?;
-        let dist = Distribution::new(&values).map_err(|e| {
-            let span = match e {
-                WeightsError::Invalid { index, .. } => items.get(index).map_or(w.span(), |v| v.span()),
-                _ => w.span(),
-            };
-            ctx.err(span, format!("weights: {e}"))
-        })?;
-        return Ok(Case { name, job: Job::Discrete { dist, method }, samples, seed, incident_deg: (0.0, 0.0), effects: None });
+        let job = discrete_job(ctx, c, point, lobe_v, method)?;
+        return Ok(Case { name, job, samples, seed, incident_deg: (0.0, 0.0), effects: None });
     }
-
-    let kind = match lobe_name {
-        "ward" => LobeKind::Ward,
-        "beckmann" => LobeKind::Beckmann,
-        "ggx" => LobeKind::Ggx,
-        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; {lobes_allowed}{}", did_you_mean(other, LOBES)))),
-    };
-    let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
-    let method = match method.map_or(DEFAULT_METHOD.name(), |m| m.0) {
-        "ndf" => Method::Ndf,
-        "vndf" => Method::Vndf,
-        "bounded" => Method::Bounded,
-        other => {
-            let hint = did_you_mean(other, ["ndf", "vndf", "bounded"]);
-            return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\"){hint}")));
-        }
-    };
-    if !kind.supports(method) {
-        return Err(ctx.err(
-            method_span,
-            format!("{} has no '{}' sampler; ward: ndf; beckmann: ndf, vndf; ggx: ndf, vndf, bounded", kind.name(), method.name()),
-        ));
-    }
+    let (kind, method, method_span) = lobe_method(ctx, lobe_name, lobe_v, method)?;
     if let Some(w) = &c.weights {
         return Err(ctx.err(w.span(), "weights only apply to lobe = \"discrete\"; remove them"));
     }
-    let rough = "roughness must be a finite number > 0";
-    let positive = |v: &Val, key| {
-        let a = number(ctx, v, key, |x| x > 0.0, rough)?;
-        if a < MIN_ALPHA {
-            return Err(ctx.err(
-                v.span(),
-                format!("{key} = {a:e} is below the smallest roughness lobes judges, {MIN_ALPHA:e}: the f64 reference cannot resolve a narrower lobe, so its histogram could not be judged; give {key} ≥ {MIN_ALPHA:e}"),
-            ));
-        }
-        Ok(a)
-    };
-    let (ax, ay) = match (point.get("alpha"), point.get("alpha_x"), point.get("alpha_y")) {
-        (Some(a), None, None) => {
-            let a = positive(a, "alpha")?;
-            (a, a)
-        }
-        (None, Some(x), Some(y)) => (positive(x, "alpha_x")?, positive(y, "alpha_y")?),
-        (Some(_), Some(v), _) | (Some(_), None, Some(v)) => {
-            return Err(ctx.err(v.span(), "give either alpha or both alpha_x and alpha_y, not both"));
-        }
-        (None, Some(v), None) => return Err(ctx.err(v.span(), "alpha_x needs alpha_y too (or give alpha alone)")),
-        (None, None, Some(v)) => return Err(ctx.err(v.span(), "alpha_y needs alpha_x too (or give alpha alone)")),
-        (None, None, None) => {
-            return Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})")));
-        }
-    };
+    let (ax, ay) = roughness(ctx, point, lobe_v, &name)?;
     let scatter = scatter(ctx, c, point, kind, method, lobe_v, &method_span)?;
-    let theta = match (point.get("incident_theta"), scatter) {
-        (Some(t), Scatter::Reflect) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90")?,
-        (Some(t), Scatter::Dielectric { .. }) => number(
-            ctx,
-            t,
-            "incident_theta",
-            |x| (0.0..180.0).contains(&x),
-            "incident_theta is in degrees from the normal, 0 ≤ θ < 180 for scatter = \"dielectric\" (θ > 90: light from inside)",
-        )?,
-        (None, _) => DEFAULT_INCIDENT_THETA,
-    };
+    let theta = incident_theta(ctx, point, scatter)?;
     let phi = incident_phi(ctx, point)?;
     let grid = match point.get("bins") {
         Some(v) => bins(ctx, v)?,
@@ -751,6 +661,110 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
         return Err(ctx.err(span, format!("samples = {samples}{given} is too many for a weighted case; at most 2^32 (4294967296)")));
     }
     Ok(Case { name, job: Job::Lobe { lobe, incident, grid, scatter }, samples, seed, incident_deg: (theta, phi), effects })
+}
+
+/// A discrete case's job: its weights and method, with no key of a lobe's.
+fn discrete_job(ctx: &Ctx, c: &RawCase, point: &Point, lobe_v: &Val, method: Option<(&str, Range<usize>)>) -> Result<Job, SceneError> {
+    let method = match method {
+        None => DEFAULT_DISCRETE_METHOD,
+        Some(("cdf", _)) => DiscreteMethod::Cdf,
+        Some(("alias", _)) => DiscreteMethod::Alias,
+        Some((other, span)) => return Err(ctx.err(span, format!("method '{other}' is not a discrete method; use cdf or alias{}", did_you_mean(other, ["cdf", "alias"])))),
+    };
+    reject_keys(ctx, &roughness_keys(point), "does not apply to lobe = \"discrete\" (a discrete distribution has no roughness); remove it")?;
+    reject_keys(
+        ctx,
+        &[("incident_theta", point.get("incident_theta")), ("incident_phi", point.get("incident_phi")), ("bins", point.get("bins")), ("scatter", point.get("scatter"))],
+        "does not apply to lobe = \"discrete\" (a discrete histogram has one bin per weight); remove it",
+    )?;
+    reject_keys(ctx, &effect_keys(c, point), "does not apply to lobe = \"discrete\" (effects are for ward, beckmann and ggx); remove it")?;
+    let Some(w) = &c.weights else {
+        return Err(ctx.err(lobe_v.span(), "a discrete case needs weights = [w0, w1, ...]: finite numbers ≥ 0, not all zero"));
+    };
+    let items = &w.get_ref().0;
+    if items.len() as u64 > MAX_BINS {
+        return Err(ctx.err(w.span(), format!("weights has {} items; at most 2^24 (16777216)", items.len())));
+    }
+    let values = items
+        .iter()
+        .enumerate()
+        .map(|(i, v)| number(ctx, v, &format!("weights[{i}]"), |x| x >= 0.0, "weights must be finite numbers ≥ 0"))
+        .collect::<Result<Vec<f64>, _>>()?;
+    let dist = Distribution::new(&values).map_err(|e| {
+        let span = match e {
+            WeightsError::Invalid { index, .. } => items.get(index).map_or(w.span(), |v| v.span()),
+            _ => w.span(),
+        };
+        ctx.err(span, format!("weights: {e}"))
+    })?;
+    Ok(Job::Discrete { dist, method })
+}
+
+/// A lobe case's lobe and method (the default method unless given), and where the method was
+/// said (the lobe's span when it was not).
+fn lobe_method(ctx: &Ctx, lobe_name: &str, lobe_v: &Val, method: Option<(&str, Range<usize>)>) -> Result<(LobeKind, Method, Range<usize>), SceneError> {
+    const LOBES: [&str; 4] = ["ward", "beckmann", "ggx", "discrete"];
+    let kind = match lobe_name {
+        "ward" => LobeKind::Ward,
+        "beckmann" => LobeKind::Beckmann,
+        "ggx" => LobeKind::Ggx,
+        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; use ward, beckmann, ggx or discrete{}", did_you_mean(other, LOBES)))),
+    };
+    let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
+    let method = match method.map_or(DEFAULT_METHOD.name(), |m| m.0) {
+        "ndf" => Method::Ndf,
+        "vndf" => Method::Vndf,
+        "bounded" => Method::Bounded,
+        other => {
+            let hint = did_you_mean(other, ["ndf", "vndf", "bounded"]);
+            return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\"){hint}")));
+        }
+    };
+    if !kind.supports(method) {
+        return Err(ctx.err(
+            method_span,
+            format!("{} has no '{}' sampler; ward: ndf; beckmann: ndf, vndf; ggx: ndf, vndf, bounded", kind.name(), method.name()),
+        ));
+    }
+    Ok((kind, method, method_span))
+}
+
+/// (αx, αy) from `alpha`, or from `alpha_x` and `alpha_y`, each ≥ [`MIN_ALPHA`].
+fn roughness(ctx: &Ctx, point: &Point, lobe_v: &Val, name: &str) -> Result<(f64, f64), SceneError> {
+    let rough = "roughness must be a finite number > 0";
+    let positive = |v: &Val, key| {
+        let a = number(ctx, v, key, |x| x > 0.0, rough)?;
+        if a < MIN_ALPHA {
+            return Err(ctx.err(
+                v.span(),
+                format!("{key} = {a:e} is below the smallest roughness lobes judges, {MIN_ALPHA:e}: the f64 reference cannot resolve a narrower lobe, so its histogram could not be judged; give {key} ≥ {MIN_ALPHA:e}"),
+            ));
+        }
+        Ok(a)
+    };
+    match (point.get("alpha"), point.get("alpha_x"), point.get("alpha_y")) {
+        (Some(a), None, None) => positive(a, "alpha").map(|a| (a, a)),
+        (None, Some(x), Some(y)) => Ok((positive(x, "alpha_x")?, positive(y, "alpha_y")?)),
+        (Some(_), Some(v), _) | (Some(_), None, Some(v)) => Err(ctx.err(v.span(), "give either alpha or both alpha_x and alpha_y, not both")),
+        (None, Some(v), None) => Err(ctx.err(v.span(), "alpha_x needs alpha_y too (or give alpha alone)")),
+        (None, None, Some(v)) => Err(ctx.err(v.span(), "alpha_y needs alpha_x too (or give alpha alone)")),
+        (None, None, None) => Err(ctx.err(lobe_v.span(), format!("case '{name}' needs a roughness: alpha = A, or alpha_x = AX and alpha_y = AY ({rough})"))),
+    }
+}
+
+/// `incident_theta` in degrees: below 90 for a reflection, below 180 for a dielectric.
+fn incident_theta(ctx: &Ctx, point: &Point, scatter: Scatter) -> Result<f64, SceneError> {
+    match (point.get("incident_theta"), scatter) {
+        (Some(t), Scatter::Reflect) => number(ctx, t, "incident_theta", |x| (0.0..90.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ < 90"),
+        (Some(t), Scatter::Dielectric { .. }) => number(
+            ctx,
+            t,
+            "incident_theta",
+            |x| (0.0..180.0).contains(&x),
+            "incident_theta is in degrees from the normal, 0 ≤ θ < 180 for scatter = \"dielectric\" (θ > 90: light from inside)",
+        ),
+        (None, _) => Ok(DEFAULT_INCIDENT_THETA),
+    }
 }
 
 /// `scatter` of a lobe case (reflect unless given) with a dielectric's `eta`: only for a

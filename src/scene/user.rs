@@ -233,7 +233,7 @@ fn budget(ctx: &Ctx, d: &Defaults, point: &Point, v: &Val) -> Result<Option<Budg
 }
 
 /// One case of a user's sampler at one point of its sweeps.
-pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, (timeout, budget_v): (Option<&Val>, Option<&Val>)) -> Result<UserCase, SceneError> {
+pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampler: &Arc<UserSampler>, (timeout_v, budget_v): (Option<&Val>, Option<&Val>)) -> Result<UserCase, SceneError> {
     let defaults = Settings::default();
     let incident_theta = match point.get("incident_theta") {
         Some(t) => {
@@ -256,7 +256,7 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
         (None, Some(g)) => Some(*g),
         (None, None) => None,
     };
-    let timeout = match timeout {
+    let timeout = match timeout_v {
         Some(t) => {
             let allowed = format!("timeout is the seconds the case's checks may take, a number > 0 and at most {MAX_TIMEOUT_SECONDS:e} (default {})", DEFAULT_TIMEOUT.as_secs());
             std::time::Duration::from_secs_f64(number(ctx, t, "timeout", |x| x > 0.0 && x <= MAX_TIMEOUT_SECONDS, &allowed)?)
@@ -267,6 +267,7 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
         Some(v) => budget(ctx, d, point, v)?,
         None => None,
     };
+    let timeout = budget.map_or(timeout, |b| crate::check::budget::timeout_for(b.seconds, timeout_v.is_some().then_some(timeout)));
     let Common { name, samples, seed } = common;
     let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, timeout, ..defaults };
     Ok(UserCase { name, sampler: sampler.clone(), settings, budget })

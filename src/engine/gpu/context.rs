@@ -216,7 +216,7 @@ impl Drop for Gpu {
             return;
         }
         if let Some(Err(e)) = self.pipeline_cache.as_ref().map(DiskCache::save) {
-            eprintln!("lobes: note: pipeline cache not saved ({e}); set {}=off to stop using it", pipeline_cache::DISABLE_VAR);
+            crate::console::say(format_args!("lobes: note: pipeline cache not saved ({e}); set {}=off to stop using it", pipeline_cache::DISABLE_VAR));
         }
     }
 }

@@ -1,12 +1,14 @@
-//! Where the pdf is NaN, ∞ or negative: when `pdf_values` finds bad quadrature parts, the pdf is
-//! evaluated on a fine grid of the domain (the centres of 256 × 512 cells in (cos θ, φ) on the
+//! `pdf_values`: the pdf never NaN, ∞ or negative at the quadrature's nodes. Where it is, the
+//! pdf is evaluated on a fine grid of the domain (the centres of 256 × 512 cells in (cos θ, φ) on the
 //! sphere, 256 × 256 of the box on the plane) and the worst point named: NaN first, then ±∞,
 //! then the most negative value.
 
-use super::conventions::Conventions;
-use super::gpu::{Params, Passes};
-use super::hard::show;
-use super::{CheckError, Domain};
+use super::{Measured, Run};
+use crate::check::conventions::Conventions;
+use crate::check::gpu::{Params, Passes};
+use crate::check::hard::show;
+use crate::check::report::{Check, Figures, PdfValuesFigures};
+use crate::check::{CheckError, Domain};
 
 /// The grid's rows and columns on the sphere (on the plane: rows × rows).
 const ROWS: u32 = 256;
@@ -55,7 +57,7 @@ fn badness(v: f32) -> Option<(u8, f32)> {
 }
 
 /// The worst point of the grid, if any is bad.
-pub(super) fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conventions) -> Result<Option<Worst>, CheckError> {
+fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conventions) -> Result<Option<Worst>, CheckError> {
     let points: Vec<[f32; 4]> = match *domain {
         Domain::Sphere => (0..ROWS * COLS)
             .map(|k| {
@@ -83,6 +85,27 @@ pub(super) fn worst(passes: &Passes, params: &Params, domain: &Domain, conventio
         let d = [d[0] as f64, d[1] as f64, d[2] as f64];
         Worst { d: if matches!(domain, Domain::Plane { .. }) { d } else { conventions.to_user(d) }, angles: angles(d), value }
     }))
+}
+
+/// `pdf_values`: the pdf finite and ≥ 0 at every quadrature node; where not, its worst point.
+pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
+    let (bad, parts) = (m.integrals.bad_parts, m.integrals.parts);
+    let s = run.sampler;
+    let worst = if bad > 0 { worst(&run.passes, &run.params, &s.domain, &s.conventions)? } else { None };
+    if bad > 0
+        && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
+    {
+        let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), false));
+        return Err(CheckError::NoVerdict(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}{pole}", run.pdf())));
+    }
+    let worst = worst.map(|w| w.describe(&run.pdf(), run.plane()));
+    let summary = if bad == 0 {
+        format!("{} finite and ≥ 0 at every quadrature node ({parts} parts)", run.pdf())
+    } else {
+        let at = worst.clone().unwrap_or_else(|| "no such value on a fine grid of the domain: it lies between the grid's points".into());
+        format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts; {at}", run.pdf())
+    };
+    Ok(Check { passed: bad == 0, summary, figures: Figures::PdfValues(PdfValuesFigures { bad_parts: bad, parts, worst }) })
 }
 
 #[cfg(test)]

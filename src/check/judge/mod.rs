@@ -1,0 +1,197 @@
+//! The judge: one measurement of a sampler, then a list of small checks over it.
+//!
+//! [`Run`] holds what every check reads: the composed passes, their parameters and the grid.
+//! [`Measured`] is the one measurement all checks share (the histogram, the probes with the
+//! pdf's f32 conditioning and the map around them, the quadrature of the pdf). Each check is a
+//! function of its own module, `check(&Run, &Measured) -> Check`, in the order
+//! [`super::check`] lists them.
+
+pub mod chi2;
+pub mod hard_cases;
+pub mod jacobian;
+pub mod normalization;
+pub mod pdf_consistency;
+pub mod pdf_values;
+pub mod weights;
+
+use super::gpu::{Params, Passes};
+use super::quadrature::{self, Integrals, Integrand};
+use super::{CheckError, Domain, Settings, UserSampler, jacobian as map};
+use crate::engine::gpu::Gpu;
+use crate::reference::rng;
+
+/// The most samples of one dispatch of the histogram and weights passes.
+pub(super) const CHUNK: u64 = 1 << 26;
+
+/// One check of one sampler at one setting: the composed passes and their parameters.
+pub(crate) struct Run<'a, 'g> {
+    pub sampler: &'a UserSampler,
+    pub settings: &'a Settings,
+    pub passes: Passes<'g>,
+    pub params: Params,
+    /// The note on the order of the user's --rand draws, for the report.
+    pub draws: String,
+    /// The incident direction in f32, as the passes see it.
+    pub wi: [f32; 3],
+    pub rows: u32,
+    pub cols: u32,
+}
+
+impl<'a, 'g> Run<'a, 'g> {
+    pub fn new(gpu: &'g Gpu, sampler: &'a UserSampler, settings: &'a Settings) -> Result<Self, CheckError> {
+        let (rows, cols) = settings.grid(&sampler.domain);
+        let params = super::params_of(sampler, settings);
+        let (passes, draws) = super::compose_passes(gpu, sampler, settings, &params)?;
+        let wi = super::incident(settings.incident_theta, settings.incident_phi);
+        Ok(Self { sampler, settings, passes, params, draws, wi, rows, cols })
+    }
+    pub fn bins(&self) -> usize {
+        (self.rows * self.cols) as usize
+    }
+    pub fn plane(&self) -> bool {
+        matches!(self.sampler.domain, Domain::Plane { .. })
+    }
+    pub fn samples(&self) -> f64 {
+        self.settings.samples as f64
+    }
+    /// The pdf as the user named it at a sample's d, for messages.
+    pub fn pdf(&self) -> String {
+        self.sampler.pdf_at_d()
+    }
+    /// What integrates the pdf, handed to `f`: the f64 reference on the CPU where the settings
+    /// give one, else the WGSL pdf on the GPU.
+    pub fn with_integrand<R>(&self, f: impl FnOnce(&dyn Integrand) -> R) -> R {
+        let wi = glam::DVec3::new(self.wi[0] as f64, self.wi[1] as f64, self.wi[2] as f64);
+        match &self.settings.reference {
+            Some(r) => {
+                let pdf = move |d: glam::DVec3| (r.0)(wi, d);
+                f(&quadrature::CpuPdf { pdf: &pdf, plane: self.plane(), jumps: quadrature::Jumps::Locate })
+            }
+            None => f(&(&self.passes, &self.params)),
+        }
+    }
+}
+
+/// The probe of one sample as the probe pass writes it (`lobes_probe`,
+/// shaders/check/user_passes.wgsl).
+pub(crate) type Probe = [[f32; 4]; 7];
+
+/// Everything the checks judge, measured once.
+pub(crate) struct Measured {
+    /// Counts per bin, then per invalid reason ([`super::REASONS`]).
+    pub totals: Vec<u64>,
+    /// The probed uniforms and what the probe pass found at each.
+    pub probe_u: Vec<[f32; 4]>,
+    pub probes: Vec<Probe>,
+    /// The pdf's f32 conditioning at each probe's d (0 where the pdf is not finite and > 0).
+    pub kappa: Vec<f64>,
+    /// The map at the Jacobian's steps around each probe.
+    pub at: Vec<[[f32; 4]; map::AROUND]>,
+    /// The quadrature of the pdf (and eval) over the grid.
+    pub integrals: Integrals,
+    /// The quadrature's first part width, from the largest reported pdf.
+    pub width: f64,
+    /// How far ∫pdf moves on the quadrature's parts when the WGSL pdf's inputs move by an ulp
+    /// ([`quadrature::sensitivity`]; 0 for an f64 reference).
+    pub f32_moved: f64,
+    /// A jump of the sample map along u.x or u.y ([`map::find_jump`]).
+    pub jump: Option<map::Jump>,
+}
+
+impl Measured {
+    pub fn counts(&self, bins: usize) -> &[u64] {
+        &self.totals[..bins]
+    }
+    pub fn invalid(&self, bins: usize) -> [u64; 4] {
+        self.totals[bins..].try_into().expect("four reasons")
+    }
+    /// ∫pdf over the domain.
+    pub fn pdf_total(&self) -> f64 {
+        self.integrals.probabilities.iter().sum()
+    }
+    /// Whether a probe's reported sample is valid: a finite point with a pdf > 0.
+    pub fn valid(p: &Probe) -> bool {
+        p[0][3] > 0.0 && p[0][3].is_finite() && p[0][..3].iter().all(|x| x.is_finite())
+    }
+}
+
+/// Measures `run`: the histogram, the probes, and the quadrature of the pdf.
+pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
+    let totals = histogram(&run.passes, &run.params, run.sampler, run.settings.samples, run.bins())?;
+    let probe_u = probe_uniforms(run.settings);
+    let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, run.wi)).collect();
+    let probes = run.passes.probe(&run.params, &items)?;
+    let points: Vec<[f32; 3]> = probes.iter().map(|p| [p[0][0], p[0][1], p[0][2]]).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();
+    let kappa: Vec<f64> = run.passes.conditioning(&run.params, &points)?.iter().map(|v| v[1] as f64).collect();
+    let around: Vec<[f32; 4]> = probe_u.iter().flat_map(|u| map::around(*u)).collect();
+    let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
+    let p_max = probes.iter().filter(|p| Measured::valid(p)).map(|p| p[0][3] as f64).fold(0.0, f64::max);
+    let width = quadrature::initial_width(p_max, run.plane());
+    let (integrals, f32_moved) = integrate(run, &totals[..run.bins()], width)?;
+    let jump = map_jump(run, &probes, &probe_u)?;
+    Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
+}
+
+/// A jump of the sample map along u.x or u.y ([`map::find_jump`]) on the lines through the first
+/// [`map::JUMP_LINES`] probes with a valid sample.
+fn map_jump(run: &Run, probes: &[Probe], probe_u: &[[f32; 4]]) -> Result<Option<map::Jump>, CheckError> {
+    let valid: Vec<[f32; 4]> = probes.iter().zip(probe_u).filter(|(p, _)| Measured::valid(p)).map(|(_, u)| *u).take(map::JUMP_LINES).collect();
+    map::find_jump(&valid, run.plane(), &|us| run.passes.map(&run.params, us))
+}
+
+/// The probe's uniforms: away from the edges by 2ε, so that u ± ε stays in [0, 1].
+fn probe_uniforms(settings: &Settings) -> Vec<[f32; 4]> {
+    let margin = 2.0 * map::EPS as f64;
+    (0..settings.probe_samples as u64)
+        .map(|i| rng::uniforms(settings.seed ^ 0x9e37_79b9_7f4a_7c15, i).map(|x| (margin + (1.0 - 2.0 * margin) * x) as f32))
+        .collect()
+}
+
+/// The quadrature of the pdf per bin (and of eval, which has no f64 twin: always the GPU's), and
+/// how far the WGSL pdf's f32 evaluation moves ∫pdf ([`quadrature::f32_sensitivity`]; 0 for an
+/// f64 reference).
+fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64), CheckError> {
+    let (domain, rows, cols, samples) = (&run.sampler.domain, run.rows, run.cols, run.settings.samples);
+    let (mut integrals, leaves) = run.with_integrand(|f| quadrature::integrate_leaves(f, domain, rows, cols, width, samples, Some(observed)))?;
+    if run.settings.reference.is_some() && run.sampler.eval.is_some() {
+        integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(observed))?.eval;
+    }
+    let moved = if run.settings.reference.is_some() { 0.0 } else { quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? };
+    Ok((integrals, moved))
+}
+
+/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
+/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
+/// numbers, counted on every sample, are bad input ([`super::gpu::too_many_draws`]).
+pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
+    let mut totals = vec![0u64; bins + 4];
+    let (mut over, mut most) = (0u64, 0u32);
+    let mut first = 0;
+    while first < samples {
+        let n = CHUNK.min(samples - first) as u32;
+        let counted = passes.histogram(params, first, n, bins + 4, None)?;
+        for (t, c) in totals.iter_mut().zip(counted.counts) {
+            *t += c as u64;
+        }
+        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
+        first += n as u64;
+    }
+    if over > 0 {
+        return Err(super::gpu::too_many_draws(sampler, most, over, samples));
+    }
+    let counted: u64 = totals.iter().sum();
+    if counted != samples {
+        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
+    }
+    Ok(totals)
+}
+
+/// A pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
+/// expected counts the quadrature could not resolve give no verdict.
+pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckError> {
+    if m.integrals.bad_parts == 0 {
+        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(e + &super::half_vector_pole(run.sampler, run.settings, None).unwrap_or_default()))?;
+    }
+    Ok(())
+}
+

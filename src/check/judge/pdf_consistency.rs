@@ -1,0 +1,67 @@
+//! `pdf_consistency`: the pdf the sampler reports against the pdf function at the same d, at
+//! the valid probes, each within [`PDF_CONSISTENCY_LIMIT`] widened by [`CONDITIONING_ULPS`] ×
+//! the pdf's f32 conditioning there.
+
+use super::{Measured, Run};
+use crate::check::report::{Check, ConsistencyFigures, Figures};
+use crate::check::{CONDITIONING_ULPS, PDF_CONSISTENCY_LIMIT};
+
+pub(crate) fn check(run: &Run, m: &Measured) -> Check {
+    let c = figures(m);
+    Check { passed: c.over_limit == 0 && c.pdf_function_not_finite == 0, summary: summary(&c, &run.pdf()), figures: Figures::PdfConsistency(c) }
+}
+
+fn figures(m: &Measured) -> ConsistencyFigures {
+    let mut c = ConsistencyFigures {
+        compared: 0,
+        max_relative_difference: 0.0,
+        pdf_function_not_finite: 0,
+        worst_u: [0.0; 4],
+        limit: PDF_CONSISTENCY_LIMIT,
+        worst_limit: PDF_CONSISTENCY_LIMIT,
+        widened: 0,
+        over_limit: 0,
+    };
+    let mut worst = 0.0;
+    for ((p, u), k) in m.probes.iter().zip(&m.probe_u).zip(&m.kappa).filter(|((p, _), _)| Measured::valid(p)) {
+        let (rep, fun) = (p[0][3] as f64, p[6][0] as f64);
+        c.compared += 1;
+        if !fun.is_finite() {
+            // the worst of all: the first such sample is the one shown
+            if c.pdf_function_not_finite == 0 {
+                c.worst_u = *u;
+            }
+            c.pdf_function_not_finite += 1;
+            continue;
+        }
+        let diff = (rep - fun).abs() / rep.max(fun);
+        let limit = PDF_CONSISTENCY_LIMIT + CONDITIONING_ULPS * k;
+        c.max_relative_difference = c.max_relative_difference.max(diff);
+        c.widened += u64::from(diff > PDF_CONSISTENCY_LIMIT && diff <= limit);
+        c.over_limit += u64::from(diff > limit);
+        if diff / limit > worst {
+            worst = diff / limit;
+            c.worst_limit = limit;
+            if c.pdf_function_not_finite == 0 {
+                c.worst_u = *u;
+            }
+        }
+    }
+    c
+}
+
+fn summary(c: &ConsistencyFigures, pdf: &str) -> String {
+    let not_finite = match c.pdf_function_not_finite {
+        0 => String::new(),
+        k => format!("; {pdf} NaN or ∞ at {k} of them"),
+    };
+    let widened = match (c.widened, c.over_limit) {
+        (0, 0) => String::new(),
+        (w, 0) => format!("; {w} beyond {PDF_CONSISTENCY_LIMIT:.0e} but within the pdf's f32 conditioning there"),
+        (_, o) => format!("; {o} beyond the limit widened by the pdf's f32 conditioning (worst: {:.2e} allowed there)", c.worst_limit),
+    };
+    format!(
+        "the pdf the sampler reports and {pdf} differ by at most {:.2e} (limit {PDF_CONSISTENCY_LIMIT:.0e} + {CONDITIONING_ULPS} × the pdf's f32 conditioning) over {} samples{widened}{not_finite}",
+        c.max_relative_difference, c.compared
+    )
+}
