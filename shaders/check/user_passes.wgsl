@@ -60,21 +60,30 @@ const LOBES_GL_W = array<f32, 8>(0.236926885056189, 0.478628670499367, 0.5688888
 
 // (∫ pdf, ∫ eval) over the rectangle of centre c and half-widths hw in hemisphere h and quadrant
 // `quadrant` (lobes_domain_point) by the tensor
-// rule of nodes first .. first + n of LOBES_GL_*, without the area factor ha hb.
-fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, quadrant: u32, wi: vec3<f32>) -> vec2<f32> {
+// rule of nodes first .. first + n of LOBES_GL_*, without the area factor ha hb. Where `root`,
+// the first coordinate is s = √a (a part at a pole, src/check/quadrature.rs: Rect): the node's
+// a is s², its weight times da/ds = 2s.
+fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, quadrant: u32, root: bool, wi: vec3<f32>, seen: ptr<function, vec3<f32>>) -> vec2<f32> {
     var sum = vec2<f32>(0.0);
     for (var j = first; j < first + n; j++) {
         for (var k = first; k < first + n; k++) {
-            let d = lobes_domain_point(c.x + hw.x * LOBES_GL_X[j], c.y + hw.y * LOBES_GL_X[k], h, quadrant);
-            let w = LOBES_GL_W[j] * LOBES_GL_W[k];
-            sum += w * vec2<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d));
+            var a = c.x + hw.x * LOBES_GL_X[j];
+            var w = LOBES_GL_W[j] * LOBES_GL_W[k];
+            if (root) {
+                w *= 2.0 * a;
+                a *= a;
+            }
+            let d = lobes_domain_point(a, c.y + hw.y * LOBES_GL_X[k], h, quadrant);
+            let p = lobes_user_pdf(wi, d);
+            lobes_seen(seen, p);
+            sum += w * vec2<f32>(p, lobes_user_eval(wi, d));
         }
     }
     return sum;
 }
 
-// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign and quadrant in
-// lobes_in[count + i].xy (b measured from the quadrant's axis, lobes_domain_point),
+// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign, quadrant and root flag in
+// lobes_in[count + i].xyz (b measured from the quadrant's axis, lobes_domain_point),
 // integrated with the 5 × 5 and the 3 × 3 tensor
 // Gauss–Legendre rules: (∫ pdf by 5 × 5, by 3 × 3, ∫ eval by 5 × 5, by 3 × 3). A pdf that is
 // NaN, infinite or negative at a node is returned as such: the host reports it.
@@ -87,12 +96,55 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     let r = lobes_in[i];
     let h = lobes_in[lobes_check.count + i].x;
     let quadrant = u32(lobes_in[lobes_check.count + i].y);
+    let root = lobes_in[lobes_check.count + i].z != 0.0;
     let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
     let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
     let wi = lobes_check.wi.xyz;
-    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, wi);
-    let r3 = lobes_rule(5u, 3u, c, hw, h, quadrant, wi);
+    var seen = vec3<f32>(0.0, 0.0, 3.4e38);
+    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, root, wi, &seen);
+    let r3 = lobes_rule(5u, 3u, c, hw, h, quadrant, root, wi, &seen);
     lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (hw.x * hw.y);
+    lobes_out[lobes_check.count + i] = lobes_support_edge(seen, c, hw, h, quadrant, root, wi);
+}
+
+// What the pdf's values at a rectangle's points say of its support: (any 0, any > 0, the
+// smallest value > 0) so far, updated with the value p (z starts at the largest f32).
+fn lobes_seen(seen: ptr<function, vec3<f32>>, p: f32) {
+    if (p == 0.0) {
+        (*seen).x = 1.0;
+    }
+    if (lobes_positive(p)) {
+        (*seen).y = 1.0;
+        (*seen).z = min((*seen).z, p);
+    }
+}
+
+// Whether the pdf's support has an edge in the rectangle (lobes_integrate_rects), from `seen` at
+// its 5 × 5 and 3 × 3 nodes and here at its four corners and the midpoints of its sides: (1 where
+// the pdf is 0 at some of them and > 0 at others, else 0; the smallest value > 0 times the
+// rectangle's area (in a, or in s with da/ds = 2s at the larger s): the scale of the jump's
+// mass there, 0, 0). The Gauss–Legendre nodes stay 4.7 % of the width inside: a support's corner
+// beyond them is seen by the corners, taken 10⁻³ of the width inside, off the domain's own edges
+// (a pole, the horizon, where a pdf is often 0 by its convention, d.z ≤ 0).
+fn lobes_support_edge(seen_nodes: vec3<f32>, c: vec2<f32>, hw: vec2<f32>, h: f32, quadrant: u32, root: bool, wi: vec3<f32>) -> vec4<f32> {
+    var seen = seen_nodes;
+    for (var j = 0; j < 3; j++) {
+        for (var k = 0; k < 3; k++) {
+            if (j == 1 && k == 1) {
+                continue;
+            }
+            var a = c.x + 0.999 * hw.x * f32(j - 1);
+            if (root) {
+                a *= a;
+            }
+            lobes_seen(&seen, lobes_user_pdf(wi, lobes_domain_point(a, c.y + 0.999 * hw.y * f32(k - 1), h, quadrant)));
+        }
+    }
+    var area = 4.0 * hw.x * hw.y;
+    if (root) {
+        area *= 2.0 * (c.x + hw.x);
+    }
+    return vec4<f32>(seen.x * seen.y, seen.z * area, 0.0, 0.0);
 }
 
 // Whether sample s is valid and lands on d0: within 1e-6 relative, the tolerance of "moves d"
@@ -141,15 +193,19 @@ fn lobes_transition(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>, t_in:
 // The share of t ∈ [0, 1) for which sample(u with component `axis` = t) is valid and lands on
 // d0 = sample(u): 1 where d does not depend on that component, the probability of the event the
 // sampler chose at u where it chooses one with it, and −1 where d moves with it (the run of t
-// around u[axis] that lands on d0 is shorter than LOBES_MIN_SHARE). A coarse scan at t = j/256
-// and at u[axis] itself, each change between neighbouring nodes bisected; a run narrower than
-// 2⁻⁸ between two nodes is not seen unless it holds u[axis] (at most 2⁻⁸ of share misread).
+// around u[axis] that lands on d0 is shorter than LOBES_MIN_SHARE, or d is not constant along
+// it). A coarse scan at t = j/256 and at u[axis] itself, each change between neighbouring nodes
+// bisected; a run narrower than 2⁻⁸ between two nodes is not seen unless it holds u[axis] (at
+// most 2⁻⁸ of share misread).
 fn lobes_share(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>) -> f32 {
     let t0 = u[axis];
     let step = 1.0 / f32(LOBES_SCAN);
     var share = 0.0;
-    // the run of nodes landing on d0 that holds t0, and where the current run began (−1: none)
+    // the run of nodes landing on d0 that holds t0 (its length and ends), and where the current
+    // run began (−1: none)
     var own = 0.0;
+    var own_lo = t0;
+    var own_hi = t0;
     var start = -1.0;
     // whether any node missed d0 (else the share is exactly 1, whatever the sums round to)
     var missed = false;
@@ -183,6 +239,8 @@ fn lobes_share(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>) -> f32 {
             share += t - a;
             if (start <= t0 && t0 <= t) {
                 own = t - start;
+                own_lo = start;
+                own_hi = t;
             }
             start = -1.0;
         } else if (sb) {
@@ -201,11 +259,24 @@ fn lobes_share(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>) -> f32 {
     }
     if (sa && start <= t0) {
         own = 1.0 - start;
+        own_lo = start;
+        own_hi = 1.0;
     }
     if (!missed) {
         return 1.0;
     }
     if (own < LOBES_MIN_SHARE) {
+        return -1.0;
+    }
+    // An event leaves d exactly as it is across its run; a draw that moves d by less than 10⁻⁶
+    // per 2⁻¹² (a narrow lobe's azimuth, a small jitter) makes a run of the same length, along
+    // which d moves by up to 10⁻⁶: look at d nine tenths of the way to the run's farther end
+    // (at least 2⁻¹⁴ from t0), where such a draw has moved it by far more than an ulp.
+    var far = own_hi - 0.1 * (own_hi - t0);
+    if (t0 - own_lo > own_hi - t0) {
+        far = own_lo + 0.1 * (t0 - own_lo);
+    }
+    if (any(lobes_user_sample(wi, lobes_at(u, axis, min(far, 1.0 - 1.0 / 16777216.0))).xyz != d0)) {
         return -1.0;
     }
     return share;

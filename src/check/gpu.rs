@@ -506,17 +506,21 @@ impl<'g> Passes<'g> {
         Ok(gpu.read(&out, out_bytes)?)
     }
 
-    /// Per rectangle (a0, a1, b0, b1) in hemisphere h and quadrant k, `(rect, [h, k])` (b measured
-    /// from the axis k quarter turns from +x, `lobes_domain_point`): (∫pdf 5×5, ∫pdf 3×3, ∫eval
-    /// 5×5, ∫eval 3×3).
-    pub fn integrate(&self, params: &Params, rects: &[([f32; 4], [f32; 2])]) -> Result<Vec<[f32; 4]>, CheckError> {
+    /// Per rectangle (a0, a1, b0, b1) in hemisphere h and quadrant k, `(rect, [h, k, root])` (b
+    /// measured from the axis k quarter turns from +x, `lobes_domain_point`; root 1 where the
+    /// first coordinate is s = √a, `quadrature::Rect`): (∫pdf 5×5, ∫pdf 3×3, ∫eval 5×5, ∫eval
+    /// 3×3), and whether the pdf's support has an edge there with its scale (1 or 0, the smallest
+    /// pdf > 0 seen times the area, 0, 0; `lobes_support_edge`).
+    pub fn integrate(&self, params: &Params, rects: &[([f32; 4], [f32; 3])]) -> Result<Vec<[[f32; 4]; 2]>, CheckError> {
         let mut out = Vec::with_capacity(rects.len());
         let per_call = 1 << 20;
         for chunk in rects.chunks(per_call) {
-            let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], 0.0, 0.0])).collect();
+            let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], r.1[2], 0.0])).collect();
             let p = Params { count: chunk.len() as u32, ..*params };
-            let bytes = self.run("lobes_integrate_rects", &p, &input, chunk.len() as u32, chunk.len() as u64 * 16, false)?;
-            out.extend_from_slice(bytemuck::cast_slice(&bytes));
+            let bytes = self.run("lobes_integrate_rects", &p, &input, chunk.len() as u32, chunk.len() as u64 * 32, false)?;
+            let values: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+            let (rules, edges) = values.split_at(chunk.len());
+            out.extend(rules.iter().zip(edges).map(|(r, e)| [*r, *e]));
         }
         Ok(out)
     }
@@ -673,8 +677,10 @@ pub(super) fn rand_order(passes: &Passes, params: &Params, sampler: &UserSampler
     }
     let events = kinds.iter().filter(|&&e| e).count();
     if events == 0 || events > 2 || kinds.len() - events > 2 {
-        let c = Draw::components(&[]);
-        return Ok((c, format!("; random draws {} in call order", Draw::list(&c, most as usize))));
+        // each draw named by what the probe found, not by the component it takes: a third
+        // continuous draw takes u.z, and is no event for that
+        let names: Vec<&str> = kinds.iter().zip(["x", "y", "z", "w"]).map(|(&e, c)| if e { "event" } else { c }).collect();
+        return Ok((Draw::components(&[]), format!("; random draws {} in call order", names.join(","))));
     }
     let mut smooth = [Draw::X, Draw::Y].into_iter();
     let order: Vec<Draw> = kinds.iter().map(|&e| if e { Draw::Event } else { smooth.next().expect("at most two") }).collect();

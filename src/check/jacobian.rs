@@ -145,7 +145,109 @@ pub struct JacobianCheck {
     /// chance (only with at least [`MIN_COMPARED`] resolved samples).
     #[serde(default)]
     pub systematic: bool,
+    /// A jump of the map along u.x or u.y ([`find_jump`]): several pieces of u may land on one d,
+    /// and every probe is judged as an event's, off only below 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jump: Option<Jump>,
     pub passed: bool,
+}
+
+/// Where the sample map jumps along u.x or u.y: a sampler choosing a lobe with u.x itself and
+/// reusing it (pbrt's uRemapped: u.x < w picks lobe A with u.x/w, else lobe B with
+/// (u.x − w)/(1 − w)). The map is then not one-to-one: at d the pdf is the sum of the densities
+/// of every piece landing there, of which the probe's own piece, 1/|J|, is one, so pdf · |J| ≥ 1
+/// and only a ratio below 1 is off (as for an event chosen with u.z).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq, schemars::JsonSchema)]
+pub struct Jump {
+    /// 0 for u.x, 1 for u.y.
+    pub axis: u8,
+    /// The u of the first jump found along that axis (to 2⁻¹⁶).
+    pub at: f64,
+    /// Scanned lines (a probe's u with one component swept over [2ε, 1 − 2ε]) with a jump, and
+    /// all scanned lines.
+    pub lines: u64,
+    pub scanned: u64,
+}
+
+/// Lines scanned for a jump ([`find_jump`]) at most, and nodes per line (then per refinement).
+pub const JUMP_LINES: usize = 32;
+const JUMP_NODES: usize = 256;
+const JUMP_REFINE: usize = 16;
+/// A step of d is a jump where, refined twice by [`JUMP_REFINE`] (to 2⁻¹⁶ of u), one sub-step
+/// still holds this share of it (a smooth map's steps shrink by 256) and it exceeds
+/// [`JUMP_MIN`].
+const JUMP_SHARE: f64 = 0.5;
+const JUMP_MIN: f64 = 1e-3;
+
+/// The nodes t₀ … t_k evenly over [lo, hi] on the line through `u` along `axis`.
+fn line(u: [f32; 4], axis: usize, lo: f64, hi: f64, k: usize) -> Vec<[f32; 4]> {
+    (0..=k)
+        .map(|j| {
+            let mut v = u;
+            v[axis] = (lo + (hi - lo) * j as f64 / k as f64) as f32;
+            v
+        })
+        .collect()
+}
+
+/// The largest step of d between consecutive valid nodes of `at` (the map at [`line`]'s nodes),
+/// with its index.
+fn largest_step(at: &[[f32; 4]], plane: bool) -> Option<(usize, f64)> {
+    let valid = |v: &[f32; 4]| v.iter().all(|x| x.is_finite()) && v[3] > 0.0;
+    at.windows(2)
+        .enumerate()
+        .filter(|(_, w)| valid(&w[0]) && valid(&w[1]))
+        .map(|(j, w)| {
+            let mut e = sub(v3(w[1]), v3(w[0]));
+            if plane {
+                e[2] = 0.0;
+            }
+            (j, norm(e))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Whether the sample map jumps along u.x or u.y: on the lines through the first [`JUMP_LINES`]
+/// of `probes` (u with a valid sample) along each axis, the largest step of d over
+/// [`JUMP_NODES`] nodes, refined twice around its largest sub-step; `map` evaluates the sampler
+/// at uniforms (the check's map pass). A smooth map's largest sub-step shrinks with the step; a
+/// jump's stays.
+pub fn find_jump(probes: &[[f32; 4]], plane: bool, map: &dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::CheckError>) -> Result<Option<Jump>, super::CheckError> {
+    let margin = 2.0 * EPS as f64;
+    for axis in 0..2 {
+        // (u, the interval [lo, hi] of the largest step, that step) per line
+        let mut lines: Vec<([f32; 4], f64, f64, f64)> = Vec::new();
+        let nodes: Vec<[f32; 4]> = probes.iter().flat_map(|u| line(*u, axis, margin, 1.0 - margin, JUMP_NODES)).collect();
+        let at = map(&nodes)?;
+        for (u, at) in probes.iter().zip(at.chunks(JUMP_NODES + 1)) {
+            if let Some((j, step)) = largest_step(at, plane) {
+                let h = (1.0 - 2.0 * margin) / JUMP_NODES as f64;
+                lines.push((*u, margin + j as f64 * h, margin + (j + 1) as f64 * h, step));
+            }
+        }
+        let scanned = lines.len() as u64;
+        let mut current: Vec<([f32; 4], f64, f64, f64)> = lines.clone();
+        for _ in 0..2 {
+            let nodes: Vec<[f32; 4]> = current.iter().flat_map(|(u, lo, hi, _)| line(*u, axis, *lo, *hi, JUMP_REFINE)).collect();
+            let at = map(&nodes)?;
+            current = current
+                .iter()
+                .zip(at.chunks(JUMP_REFINE + 1))
+                .map(|(&(u, lo, hi, _), at)| match largest_step(at, plane) {
+                    Some((j, step)) => {
+                        let h = (hi - lo) / JUMP_REFINE as f64;
+                        (u, lo + j as f64 * h, lo + (j + 1) as f64 * h, step)
+                    }
+                    None => (u, lo, hi, 0.0),
+                })
+                .collect();
+        }
+        let jumps: Vec<f64> = lines.iter().zip(&current).filter(|(l, c)| c.3 > JUMP_MIN && c.3 >= JUMP_SHARE * l.3).map(|(_, c)| 0.5 * (c.1 + c.2)).collect();
+        if let Some(&at) = jumps.first() {
+            return Ok(Some(Jump { axis: axis as u8, at, lines: jumps.len() as u64, scanned }));
+        }
+    }
+    Ok(None)
 }
 
 fn v3(v: [f32; 4]) -> [f64; 3] {
@@ -283,7 +385,8 @@ fn local(probe: &[[f32; 4]; 7], u: [f32; 4], at: &[[f32; 4]; AROUND], plane: boo
 /// Compares the pdf function at each probed sample with share / |J|: `u` are the probed
 /// uniforms, `at` the map at [`around`] each of them, `conditioning` the pdf's f32 conditioning
 /// at each probe's d (0 where unknown) and `ulps` its multiple allowed.
-pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]], conditioning: &[f64], ulps: f64, plane: bool) -> JacobianCheck {
+/// With `jump` (the map is not one-to-one, [`find_jump`]) every probe is judged as an event's.
+pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]], conditioning: &[f64], ulps: f64, plane: bool, jump: Option<Jump>) -> JacobianCheck {
     let mut c = JacobianCheck {
         probed: probes.len() as u64,
         compared: 0,
@@ -308,6 +411,7 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
         systematic_tolerance: SYSTEMATIC_TOLERANCE,
         systematic_limit: 0.0,
         systematic: false,
+        jump,
         passed: true,
     };
     let mut ratios = Vec::new();
@@ -324,7 +428,7 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
                 ratios.push(ratio);
                 c.largest_step = c.largest_step.max(h);
                 let limit = TOLERANCE + 2.0 * error + ulps * kappa;
-                let event = share < 1.0;
+                let event = share < 1.0 || jump.is_some();
                 let deviation = if event { (1.0 - ratio).max(0.0) } else { (ratio - 1.0).abs() };
                 let allowance = limit - TOLERANCE;
                 if !event && allowance <= RESOLVED {
@@ -379,7 +483,7 @@ mod tests {
         let n = MIN_COMPARED as usize;
         let u = [0.3, 0.6, 0.0, 0.0];
         let at = around(u).map(|v| [v[0], v[1], 0.0, pdf]);
-        judge(&vec![probe(pdf, shares); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true)
+        judge(&vec![probe(pdf, shares); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, None)
     }
 
     /// The probe of `map` at `u` with pdf `pdf` (shares 1), and the map around it.
@@ -397,7 +501,7 @@ mod tests {
 
     fn judge_all(p: [[f32; 4]; 7], u: [f32; 4], at: [[f32; 4]; AROUND]) -> JacobianCheck {
         let n = MIN_COMPARED as usize;
-        judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true)
+        judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, None)
     }
 
     /// The probe u of the two tests below.
@@ -463,7 +567,7 @@ mod tests {
                 us.push(u);
                 ats.push(at);
             }
-            judge(&probes, &us, &ats, &vec![0.0; 400], 4.0, true)
+            judge(&probes, &us, &ats, &vec![0.0; 400], 4.0, true, None)
         };
         let c = judged(5e-3);
         assert!(c.share_off == 0.0 && c.resolved == 400 && c.systematic && !c.passed, "{c:?}");
@@ -504,6 +608,34 @@ mod tests {
             assert!(!low.passed && (low.worst_ratio - 0.5).abs() < 1e-6, "{low:?}");
             let high = judged(0.5, shares);
             assert!(high.passed && high.off == 0 && high.above_events == MIN_COMPARED && high.worst_ratio == 1.0, "{high:?}");
+        }
+    }
+
+    /// A lobe choice made with u.x and reused (pbrt's uRemapped) on the plane: u.x < ½ maps
+    /// (2u.x, u.y), else (2u.x − 1, u.y), onto the unit square, two pieces over one d. The jump at
+    /// u.x = ½ is found on every line along u.x, at ½, and not along u.y; the identity map has
+    /// none, nor has a steep smooth one (x = u.x⁸).
+    #[test]
+    fn a_jump_along_u_x_is_found() {
+        let lines: Vec<[f32; 4]> = (0..JUMP_LINES).map(|i| [0.5, (i as f32 + 0.5) / JUMP_LINES as f32, 0.0, 0.0]).collect();
+        let found = |f: fn([f32; 4]) -> [f32; 4]| find_jump(&lines, true, &|us| Ok(us.iter().map(|u| f(*u)).collect())).unwrap();
+        let jump = found(|u| [if u[0] < 0.5 { 2.0 * u[0] } else { 2.0 * u[0] - 1.0 }, u[1], 0.0, 0.5]).expect("a jump");
+        assert!(jump.axis == 0 && (jump.at - 0.5).abs() < 1e-4 && jump.lines == JUMP_LINES as u64 && jump.scanned == JUMP_LINES as u64, "{jump:?}");
+        assert_eq!(found(|u| [u[0], u[1], 0.0, 1.0]), None);
+        assert_eq!(found(|u| [u[0].powi(8), u[1], 0.0, 1.0]), None);
+    }
+
+    /// With the jump, a probe whose pdf is twice its own piece's density (the other piece lands on
+    /// the same d) is not off; one whose pdf is half that density is.
+    #[test]
+    fn a_non_injective_map_is_judged_one_sided() {
+        let n = MIN_COMPARED as usize;
+        let u = [0.3, 0.6, 0.0, 0.0];
+        let jump = Some(Jump { axis: 0, at: 0.5, lines: 32, scanned: 32 });
+        for (pdf, passes) in [(2.0f32, true), (0.5, false)] {
+            let at = around(u).map(|v| [v[0], v[1], 0.0, pdf]);
+            let c = judge(&vec![probe(pdf, [1.0, 1.0]); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, jump);
+            assert_eq!(c.passed, passes, "pdf {pdf}: {c:?}");
         }
     }
 

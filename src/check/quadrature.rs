@@ -18,6 +18,11 @@
 //! levels deep, up to [`RETRIES`] times, and keep the new values; where a bin is still beyond it
 //! ([`Integrals::converged`] says so) `lobes check` draws no verdict (exit 3).
 //!
+//! **Jumps and poles.** Agreement is not trusted where the pdf's support has an edge (the pdf 0
+//! at some of a part's nodes, corners and sides' midpoints, > 0 at others): such a part is split
+//! [`EDGE_DEPTH`] levels past [`MAX_DEPTH`] while its jump holds more than the tolerance, and a
+//! part at a pole is integrated in s = √a ([`Rect`]), where a pdf ∝ 1/sin θ is smooth.
+//!
 //! Sphere bins are integrated over (a, φ) with a = 1 − |cos θ| per hemisphere (see
 //! `lobes_domain_point`), so that parts next to a pole keep their f32 resolution, and with φ
 //! measured from the axis nearest the part (`rect_f32`), so that an edge on an axis (the seam
@@ -38,6 +43,19 @@ use serde::{Deserialize, Serialize};
 
 /// Deepest split of a part (a quarter per level).
 pub const MAX_DEPTH: u32 = 8;
+/// Levels past the deepest split for a part where the pdf's support has an edge (the jump is
+/// located to 2⁻ᴰ of the part: bisection of the edge, a quarter at a time).
+pub const EDGE_DEPTH: u32 = 4;
+
+/// Whether [`refine`] locates the edges of the pdf's support ([`EDGE_DEPTH`]) or trusts the
+/// rules' agreement there: a sampler's pdf is judged against counts, and a jump it has is located;
+/// the whole-sphere integrals of [`WgslIntegrand`] and [`sphere_integral_f64`] hold kinks
+/// (max(0, ω·h)), not jumps, which their own graded parts resolve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Jumps {
+    Locate,
+    Trust,
+}
 /// The initial split of a bin per axis is at most this.
 pub const MAX_INITIAL_SPLIT: u32 = 16;
 /// Parts evaluated in one round at most; beyond it, parts are accepted unrefined and counted.
@@ -83,6 +101,21 @@ pub struct Integrals {
 }
 
 impl Integrals {
+    /// Nothing integrated yet over `bins` bins.
+    fn zero(bins: usize) -> Self {
+        Self {
+            probabilities: vec![0.0; bins],
+            eval: vec![0.0; bins],
+            error_estimate: 0.0,
+            max_error_sigma: 0.0,
+            unconverged_parts: 0,
+            bad_parts: 0,
+            dropped: vec![0.0; bins],
+            parts: 0,
+            rounds: 0,
+        }
+    }
+
     /// `Err` with what is wrong where a bin's error estimate is beyond [`MAX_QUADRATURE_SIGMA`] of
     /// its count's standard deviation at `samples` (after the retries of [`integrate`]): expected
     /// counts that uncertain give no verdict, neither a pass nor a fail.
@@ -106,12 +139,34 @@ impl Integrals {
     }
 }
 
+/// The first coordinate of a part ([`Rect`]): a = 1 − |cos θ| (on the plane, x), or s = √a.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Radial {
+    A,
+    RootA,
+}
+
+/// A rectangle of the quadrature's coordinates: `r` = (a0, a1, b0, b1) in hemisphere `h` (its
+/// sign; 0 on the plane), its first coordinate a = 1 − |cos θ|, or, [`Radial::RootA`], s = √a: a part
+/// at a pole is integrated in s (dω = da dφ = 2s ds dφ), which turns an integrable singularity
+/// a^(−1/2) there — a pdf ∝ 1/sin θ (uniform in θ, as a lat-long map draws its rows) or
+/// ∝ 1/√(1 − cos θ) — into a smooth integrand, where Gauss–Legendre in a converged to a value
+/// 3·10⁻⁴ short (a smooth pdf stays smooth in s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Rect {
+    pub r: [f64; 4],
+    pub h: f32,
+    pub radial: Radial,
+}
+
 #[derive(Clone, Copy)]
 struct Part {
     a: (f64, f64),
     b: (f64, f64),
     /// hemisphere sign on the sphere, 0 on the plane
     h: f32,
+    /// what `a` is ([`Rect`])
+    radial: Radial,
     bin: u32,
     depth: u32,
     /// the parent's 5 × 5 estimates (pdf, eval), none for a bin's initial parts
@@ -125,8 +180,8 @@ impl Part {
         let q = |a, b| Part { a, b, depth: self.depth + 1, coarse: Some(coarse), ..*self };
         [q((self.a.0, am), (self.b.0, bm)), q((am, self.a.1), (self.b.0, bm)), q((self.a.0, am), (bm, self.b.1)), q((am, self.a.1), (bm, self.b.1))]
     }
-    fn rect(&self) -> ([f64; 4], f32) {
-        ([self.a.0, self.a.1, self.b.0, self.b.1], self.h)
+    fn rect(&self) -> Rect {
+        Rect { r: [self.a.0, self.a.1, self.b.0, self.b.1], h: self.h, radial: self.radial }
     }
 }
 
@@ -142,10 +197,12 @@ fn tolerance(value: f64, n: f64, rounding: f64) -> f64 {
 pub const GPU_ROUNDING: f64 = 2e-6;
 pub const CPU_ROUNDING: f64 = 1e-13;
 
-/// What integrates the parts: per (a0, a1, b0, b1, hemisphere) the 5 × 5 and 3 × 3 rules of the
-/// pdf and of eval, and the relative rounding of those sums.
+/// What integrates the parts: per [`Rect`] the 5 × 5 and 3 × 3 rules of the pdf and of eval, and
+/// where the pdf's support has an edge in it (0 at some of the rules' nodes, its corners and the
+/// midpoints of its sides, > 0 at others), the scale of the jump's mass there (the smallest value
+/// > 0 seen times the area); and the relative rounding of those sums.
 pub(super) trait Integrand {
-    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError>;
+    fn rules(&self, rects: &[Rect]) -> Result<Vec<([f64; 4], Option<f64>)>, CheckError>;
     fn rounding(&self) -> f64;
 }
 
@@ -153,20 +210,22 @@ pub(super) trait Integrand {
 /// nearest its centre, k quarter turns from +x, with k (`lobes_domain_point`): an edge on an axis
 /// then stays exactly on it, and one off the axes is within an ulp of the offset (≤ 4.7·10⁻⁸ rad)
 /// rather than of φ (f32(π) is 8.7·10⁻⁸ past π).
-fn rect_f32(r: &[f64; 4], h: f32) -> ([f32; 4], [f32; 2]) {
+/// The third number is 1 where the first coordinate is s = √a ([`Rect`]).
+fn rect_f32(rect: &Rect) -> ([f32; 4], [f32; 3]) {
+    let (r, h, root) = (&rect.r, rect.h, if rect.radial == Radial::RootA { 1.0 } else { 0.0 });
     if h == 0.0 {
-        return (r.map(|x| x as f32), [0.0, 0.0]);
+        return (r.map(|x| x as f32), [0.0, 0.0, root]);
     }
     let quarter = std::f64::consts::FRAC_PI_2;
     let k = (0.5 * (r[2] + r[3]) / quarter).round();
     let b = |x: f64| (x - k * quarter) as f32;
-    ([r[0] as f32, r[1] as f32, b(r[2]), b(r[3])], [h, (k as i64).rem_euclid(4) as f32])
+    ([r[0] as f32, r[1] as f32, b(r[2]), b(r[3])], [h, (k as i64).rem_euclid(4) as f32, root])
 }
 
 impl Integrand for (&Passes<'_>, &Params) {
-    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError> {
-        let rects32: Vec<([f32; 4], [f32; 2])> = rects.iter().map(|(r, h)| rect_f32(r, *h)).collect();
-        Ok(self.0.integrate(self.1, &rects32)?.into_iter().map(|v| v.map(f64::from)).collect())
+    fn rules(&self, rects: &[Rect]) -> Result<Vec<([f64; 4], Option<f64>)>, CheckError> {
+        let rects32: Vec<([f32; 4], [f32; 3])> = rects.iter().map(rect_f32).collect();
+        Ok(self.0.integrate(self.1, &rects32)?.into_iter().map(|[v, e]| (v.map(f64::from), (e[0] != 0.0).then_some(e[1] as f64))).collect())
     }
     fn rounding(&self) -> f64 {
         GPU_ROUNDING
@@ -177,6 +236,8 @@ impl Integrand for (&Passes<'_>, &Params) {
 pub(super) struct CpuPdf<'a> {
     pub pdf: &'a (dyn Fn(glam::DVec3) -> f64 + Send + Sync),
     pub plane: bool,
+    /// Whether its parts' support edges are looked for (`None` from [`CpuPdf::edge`] otherwise).
+    pub jumps: Jumps,
 }
 
 impl CpuPdf<'_> {
@@ -188,17 +249,45 @@ impl CpuPdf<'_> {
         let s = (a * (2.0 - a)).max(0.0).sqrt();
         glam::DVec3::new(s * b.cos(), s * b.sin(), h as f64 * (1.0 - a))
     }
-    fn rule(&self, r: &[f64; 4], h: f32, rule: &GaussLegendre) -> f64 {
-        rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |a, b| (self.pdf)(self.point(a, b, h)))
+    /// `lobes_support_edge` in f64: the pdf at both rules' nodes, the corners and the sides'
+    /// midpoints.
+    fn edge(&self, rect: &Rect, rules: [&GaussLegendre; 2]) -> Option<f64> {
+        if self.jumps == Jumps::Trust {
+            return None;
+        }
+        let r = &rect.r;
+        let (c, hw) = ([0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3])], [0.5 * (r[1] - r[0]), 0.5 * (r[3] - r[2])]);
+        let mut points: Vec<(f64, f64)> = rules.iter().flat_map(|g| g.nodes().iter().flat_map(|&(x, _)| g.nodes().iter().map(move |&(y, _)| (x, y)))).collect();
+        points.extend([-0.999, 0.0, 0.999].iter().flat_map(|&x| [-0.999, 0.0, 0.999].map(|y| (x, y))).filter(|&(x, y)| (x, y) != (0.0, 0.0)));
+        let (mut zero, mut positive, mut smallest) = (false, false, f64::INFINITY);
+        for (x, y) in points {
+            let s = c[0] + hw[0] * x;
+            let a = if rect.radial == Radial::RootA { s * s } else { s };
+            let p = (self.pdf)(self.point(a, c[1] + hw[1] * y, rect.h));
+            zero |= p == 0.0;
+            if p > 0.0 && p.is_finite() {
+                positive = true;
+                smallest = smallest.min(p);
+            }
+        }
+        let area = 4.0 * hw[0] * hw[1] * if rect.radial == Radial::RootA { 2.0 * r[1] } else { 1.0 };
+        (zero && positive).then_some(smallest * area)
+    }
+    fn rule(&self, rect: &Rect, rule: &GaussLegendre) -> f64 {
+        let r = &rect.r;
+        if rect.radial == Radial::RootA {
+            return rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |s, b| 2.0 * s * (self.pdf)(self.point(s * s, b, rect.h)));
+        }
+        rule.integrate_2d((r[0], r[1]), (r[2], r[3]), |a, b| (self.pdf)(self.point(a, b, rect.h)))
     }
 }
 
 impl Integrand for CpuPdf<'_> {
-    fn rules(&self, rects: &[([f64; 4], f32)]) -> Result<Vec<[f64; 4]>, CheckError> {
+    fn rules(&self, rects: &[Rect]) -> Result<Vec<([f64; 4], Option<f64>)>, CheckError> {
         use rayon::prelude::*;
         // the pair of rules the GPU pass and the f64 quadrature of stats::expected use
         let (g5, g3) = (GaussLegendre::new(5), GaussLegendre::new(3));
-        Ok(rects.par_iter().map(|(r, h)| [self.rule(r, *h, &g5), self.rule(r, *h, &g3), 0.0, 0.0]).collect())
+        Ok(rects.par_iter().map(|r| ([self.rule(r, &g5), self.rule(r, &g3), 0.0, 0.0], self.edge(r, [&g5, &g3]))).collect())
     }
     fn rounding(&self) -> f64 {
         CPU_ROUNDING
@@ -251,15 +340,12 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
             for (a, b, h, m) in pieces {
                 let (da, db) = ((a.1 - a.0) / m as f64, (b.1 - b.0) / m as f64);
                 for i in 0..m {
+                    let a = (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da);
+                    // a part at a pole in s = √a ([`Rect`])
+                    let radial = if h != 0.0 && a.0 == 0.0 { Radial::RootA } else { Radial::A };
+                    let a = if radial == Radial::RootA { (0.0, a.1.sqrt()) } else { a };
                     for j in 0..m {
-                        parts.push(Part {
-                            a: (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da),
-                            b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db),
-                            h,
-                            bin,
-                            depth: 0,
-                            coarse: None,
-                        });
+                        parts.push(Part { a, b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db), h, radial, bin, depth: 0, coarse: None });
                     }
                 }
             }
@@ -286,8 +372,13 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
 /// sampler that puts samples where its pdf does not fails as before.
 /// [`Integrals::converged`] says whether any bin is left beyond the limit.
 pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<Integrals, CheckError> {
+    Ok(integrate_leaves(f, domain, rows, cols, width, samples, observed)?.0)
+}
+
+/// [`integrate`], with the parts its integrals are the sum of ([`Leaf`]).
+pub(super) fn integrate_leaves(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<(Integrals, Vec<Leaf>), CheckError> {
     let bins = (rows * cols) as usize;
-    let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH)?;
+    let (mut out, mut b) = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, samples, MAX_DEPTH, Jumps::Locate)?;
     let mut rounds = out.rounds;
     let n = samples.max(1) as f64;
     let unseen = |i: usize, p: f64| observed.is_some_and(|o| o[i] > 0) && p <= 0.0;
@@ -325,7 +416,7 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
             break;
         }
         let parts = initial_parts(domain, rows, cols, width / factor as f64, cap, Some(&over));
-        let (again, a) = refine(f, parts, bins, samples, MAX_DEPTH + 2 * retry)?;
+        let (again, a) = refine(f, parts, bins, samples, MAX_DEPTH + 2 * retry, Jumps::Locate)?;
         for i in (0..bins).filter(|&i| over[i]) {
             out.probabilities[i] = again.probabilities[i];
             out.eval[i] = again.eval[i];
@@ -334,6 +425,8 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
             b.unconverged[i] = a.unconverged[i];
             out.dropped[i] = again.dropped[i];
         }
+        b.leaves.retain(|l| !over[l.bin as usize]);
+        b.leaves.extend(a.leaves.into_iter().filter(|l| over[l.bin as usize]));
         out.parts += again.parts;
         out.bad_parts = out.bad_parts.max(again.bad_parts);
         rounds += again.rounds;
@@ -345,7 +438,25 @@ pub(super) fn integrate(f: &dyn Integrand, domain: &Domain, rows: u32, cols: u32
     out.unconverged_parts = b.unconverged.iter().sum();
     out.error_estimate = b.linear.iter().sum();
     out.max_error_sigma = b.error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max);
-    Ok(out)
+    Ok((out, b.leaves))
+}
+
+/// How far the integral over `leaves` moves when the pdf is evaluated by each integrand of
+/// `perturbed` (the same pdf at inputs a few ulps off) instead of the one that gave the leaves'
+/// values: the largest |Σ (perturbed − value)| over the leaves where both are finite and ≥ 0. On a
+/// fixed partition the quadrature's own error cancels, and what is left is what the f32
+/// evaluation of the pdf does to the integral, coherent errors (a reflected axis a rounding
+/// longer than 1, a constant rounded in a subexpression) included, incoherent ones averaged as
+/// the integral averages them.
+pub(super) fn sensitivity(perturbed: &[&dyn Integrand], leaves: &[Leaf]) -> Result<f64, CheckError> {
+    let rects: Vec<Rect> = leaves.iter().map(|l| l.rect).collect();
+    let mut worst: f64 = 0.0;
+    for f in perturbed {
+        let values: Vec<[f64; 4]> = f.rules(&rects)?.into_iter().map(|(v, _)| v).collect();
+        let shift: f64 = leaves.iter().zip(&values).filter(|(l, v)| v[0].is_finite() && v[0] >= 0.0 && l.value.is_finite() && l.value >= 0.0).map(|(l, v)| v[0] - l.value).sum();
+        worst = worst.max(shift.abs());
+    }
+    Ok(worst)
 }
 
 /// How far from a column edge off the axes `lobes check`'s f32 binning may put it (radians): the
@@ -405,7 +516,7 @@ pub(super) fn edge_strips(f: &dyn Integrand, rows: u32, cols: u32, width: f64, s
                 let m = ((z.dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
                 let da = (z.a.1 - z.a.0) / m as f64;
                 for i in 0..m {
-                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, bin, depth: 0, coarse: None });
+                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, radial: Radial::A, bin, depth: 0, coarse: None });
                 }
             }
         }
@@ -413,7 +524,7 @@ pub(super) fn edge_strips(f: &dyn Integrand, rows: u32, cols: u32, width: f64, s
     if parts.is_empty() {
         return Ok(vec![0.0; bins]);
     }
-    Ok(refine(f, parts, bins, samples, MAX_DEPTH)?.0.probabilities)
+    Ok(refine(f, parts, bins, samples, MAX_DEPTH, Jumps::Locate)?.0.probabilities)
 }
 
 /// The counts and expected counts the χ² judges: where an off-axis column edge is closer to the
@@ -480,35 +591,42 @@ struct Bins {
     error: Vec<f64>,
     linear: Vec<f64>,
     unconverged: Vec<u64>,
+    leaves: Vec<Leaf>,
+}
+
+/// A part whose 5 × 5 value was summed into its bin's integral (an accepted initial part, or each
+/// of the four quarters accepted together), with that value: the fixed partition on which
+/// [`sensitivity`] integrates a perturbed pdf.
+#[derive(Clone, Copy)]
+pub(super) struct Leaf {
+    rect: Rect,
+    bin: u32,
+    value: f64,
 }
 
 /// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says
 /// down to `max_depth`; with each bin's error estimate and its parts accepted unconverged.
-fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, max_depth: u32) -> Result<(Integrals, Bins), CheckError> {
+fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, max_depth: u32, jumps: Jumps) -> Result<(Integrals, Bins), CheckError> {
     let n = samples.max(1) as f64;
     let rounding = f.rounding();
     let tolerance = |v: f64, n: f64| tolerance(v, n, rounding);
-    let mut out = Integrals {
-        probabilities: vec![0.0; bins],
-        eval: vec![0.0; bins],
-        error_estimate: 0.0,
-        max_error_sigma: 0.0,
-        unconverged_parts: 0,
-        bad_parts: 0,
-        dropped: vec![0.0; bins],
-        parts: 0,
-        rounds: 0,
-    };
+    let mut out = Integrals::zero(bins);
     // per bin: the errors of parts accepted unconverged, summed, and of converged parts, squared
     let mut bin_error = vec![0.0; bins];
     let mut bin_converged_sq = vec![0.0; bins];
     let mut bin_linear = vec![0.0; bins];
     let mut bin_unconverged = vec![0u64; bins];
+    let mut leaves = Vec::new();
     while !pending.is_empty() {
         out.rounds += 1;
         out.parts += pending.len() as u64;
-        let rects: Vec<([f64; 4], f32)> = pending.iter().map(Part::rect).collect();
-        let values = f.rules(&rects)?;
+        let rects: Vec<Rect> = pending.iter().map(Part::rect).collect();
+        let (values, edges): (Vec<[f64; 4]>, Vec<Option<f64>>) = f.rules(&rects)?.into_iter().unzip();
+        // a part where the support has an edge holding more than the tolerance is split on to
+        // [`EDGE_DEPTH`] levels past `max_depth`, whatever its rules say: across a jump the two
+        // rules (and a part and its quarters) can agree on a wrong value, and a corner of the
+        // support can lie beyond every node (a uniform cap of 0.05 rad: ∫pdf 0.99967)
+        let edged = |k: usize, depth: u32| jumps == Jumps::Locate && depth < max_depth + EDGE_DEPTH && edges[k].is_some_and(|scale| scale > tolerance(scale, n));
         let mut next = Vec::new();
         let mut accept = |out: &mut Integrals, part: &Part, pdf: f64, eval: f64, err: f64, converged: bool| {
             out.probabilities[part.bin as usize] += pdf;
@@ -533,10 +651,11 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, 
                     if bad(&v) {
                         out.bad_parts += 1;
                         out.dropped[part.bin as usize] += finite(v[0]);
-                    } else if ((p5 - p3).abs() <= tolerance(p5, n) && (e5 - e3).abs() <= tolerance(e5, n)) || !room(next.len()) {
+                    } else if (!edged(i, part.depth) && (p5 - p3).abs() <= tolerance(p5, n) && (e5 - e3).abs() <= tolerance(e5, n)) || !room(next.len()) {
                         let converged = (p5 - p3).abs() <= tolerance(p5, n);
                         bin_unconverged[part.bin as usize] += u64::from(!converged);
                         accept(&mut out, &part, p5, e5, (p5 - p3).abs(), converged);
+                        leaves.push(Leaf { rect: part.rect(), bin: part.bin, value: p5 });
                     } else {
                         next.extend(part.quarters((p5, e5)));
                     }
@@ -554,9 +673,11 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, 
                     let fine: f64 = group.iter().map(|v| v[0]).sum();
                     let fine_e: f64 = group.iter().map(|v| v[2]).sum();
                     let agree = (fine - cp).abs() <= tolerance(fine, n) && (fine_e - ce).abs() <= tolerance(fine_e, n);
-                    if agree || part.depth >= max_depth || !room(next.len() + 12) {
+                    let edge = (i..i + 4).any(|k| edged(k, part.depth));
+                    if (agree && !edge) || (part.depth >= max_depth && !edge) || !room(next.len() + 12) {
                         bin_unconverged[part.bin as usize] += u64::from(!agree);
                         accept(&mut out, &part, fine, fine_e, (fine - cp).abs(), agree);
+                        leaves.extend(pending[i..i + 4].iter().zip(group).map(|(q, v)| Leaf { rect: q.rect(), bin: q.bin, value: v[0] }));
                     } else {
                         for (k, q) in pending[i..i + 4].iter().enumerate() {
                             next.extend(q.quarters((group[k][0], group[k][2])));
@@ -574,7 +695,7 @@ fn refine(f: &dyn Integrand, mut pending: Vec<Part>, bins: usize, samples: u64, 
         *e += sq.sqrt();
     }
     out.max_error_sigma = bin_error.iter().zip(&out.probabilities).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max);
-    Ok((out, Bins { error: bin_error, linear: bin_linear, unconverged: bin_unconverged }))
+    Ok((out, Bins { error: bin_error, linear: bin_linear, unconverged: bin_unconverged, leaves }))
 }
 
 /// ∫ f(d) dω over the unit sphere ([`WgslIntegrand::integrate`], [`sphere_integral_f64`]).
@@ -616,7 +737,7 @@ fn graded_parts() -> Vec<Part> {
         for band in edges.windows(2) {
             for j in 0..AZIMUTH_PARTS {
                 let b = (-std::f64::consts::PI + j as f64 * dphi, -std::f64::consts::PI + (j + 1) as f64 * dphi);
-                parts.push(Part { a: (band[0], band[1]), b, h, bin: 0, depth: 0, coarse: None });
+                parts.push(Part { a: (band[0], band[1]), b, h, radial: Radial::A, bin: 0, depth: 0, coarse: None });
             }
         }
     }
@@ -624,7 +745,7 @@ fn graded_parts() -> Vec<Part> {
 }
 
 fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
-    let (i, _) = refine(f, graded_parts(), 1, SPHERE_SAMPLES, MAX_DEPTH)?;
+    let (i, _) = refine(f, graded_parts(), 1, SPHERE_SAMPLES, MAX_DEPTH, Jumps::Trust)?;
     Ok(SphereIntegral { value: i.probabilities[0], error_estimate: i.error_estimate, unconverged_parts: i.unconverged_parts, bad_parts: i.bad_parts, parts: i.parts })
 }
 
@@ -637,7 +758,7 @@ fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
 /// assert!((i.value - std::f64::consts::PI).abs() < 1e-12);
 /// ```
 pub fn sphere_integral_f64(f: &(dyn Fn(glam::DVec3) -> f64 + Send + Sync)) -> SphereIntegral {
-    sphere_integral(&CpuPdf { pdf: f, plane: false }).expect("the CPU rules do not fail")
+    sphere_integral(&CpuPdf { pdf: f, plane: false, jumps: Jumps::Trust }).expect("the CPU rules do not fail")
 }
 
 /// A WGSL function `fn name(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`
@@ -687,4 +808,48 @@ impl<'g> WgslIntegrand<'g> {
         p.wi = [wi.x as f32, wi.y as f32, wi.z as f32, 0.0];
         sphere_integral(&(&self.passes, &p))
     }
+}
+
+/// `x` one ulp farther from 0 (`outward`) or nearer to it; 0 and non-finite values as they are.
+fn ulp_step(x: f32, outward: bool) -> f32 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    f32::from_bits(if outward { x.to_bits() + 1 } else { x.to_bits() - 1 })
+}
+
+/// The check's parameters with the pdf's inputs moved by an ulp, for [`sensitivity`]: wi a
+/// rounding longer (every component outward), wi turned by about an ulp (x and y outward, z
+/// inward), and where the user's numbers hold a non-integer (a roughness, an asymmetry g), those
+/// one ulp outward and one inward. Integers (an exponent, a mode flag) stay as they are: an ulp
+/// would turn a flag into another pdf, and an exponent's ulp moves nothing a rounding does not.
+pub(super) fn perturbed_params(p: &Params) -> Vec<Params> {
+    let turn = |signs: [bool; 3]| {
+        let mut q = *p;
+        for (c, outward) in signs.into_iter().enumerate() {
+            q.wi[c] = ulp_step(p.wi[c], outward);
+        }
+        q
+    };
+    let mut out = vec![turn([true; 3]), turn([true, true, false])];
+    if p.user.iter().flatten().any(|x| x.fract() != 0.0) {
+        for outward in [true, false] {
+            let mut q = *p;
+            for x in q.user.iter_mut().flatten() {
+                if x.fract() != 0.0 {
+                    *x = ulp_step(*x, outward);
+                }
+            }
+            out.push(q);
+        }
+    }
+    out
+}
+
+/// [`sensitivity`] of the WGSL pdf on the GPU at `params` ([`perturbed_params`]).
+pub(super) fn f32_sensitivity(passes: &Passes, params: &Params, leaves: &[Leaf]) -> Result<f64, CheckError> {
+    let perturbed = perturbed_params(params);
+    let integrands: Vec<(&Passes, &Params)> = perturbed.iter().map(|q| (passes, q)).collect();
+    let dynamic: Vec<&dyn Integrand> = integrands.iter().map(|i| i as &dyn Integrand).collect();
+    sensitivity(&dynamic, leaves)
 }

@@ -8,7 +8,7 @@ use crate::check::report::{Check, Figures};
 use crate::check::CONDITIONING_ULPS;
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Check {
-    let jac = map::judge(&m.probes, &m.probe_u, &m.at, &m.kappa, CONDITIONING_ULPS, run.plane());
+    let jac = map::judge(&m.probes, &m.probe_u, &m.at, &m.kappa, CONDITIONING_ULPS, run.plane(), m.jump);
     let summary = if jac.applicable { applicable(&jac, &not_unit(run, m, &jac)) } else { not_applicable(&jac) };
     Check { passed: jac.passed, summary, figures: Figures::Jacobian(jac) }
 }
@@ -39,7 +39,21 @@ fn applicable(jac: &JacobianCheck, not_unit: &str) -> String {
         100.0 * map::MAX_SHARE_OFF,
         systematic(jac),
         unresolved(jac),
-    )
+    ) + &jump(jac)
+}
+
+/// A jump of the map ([`map::Jump`]): why every probe was judged as an event's.
+fn jump(jac: &JacobianCheck) -> String {
+    match jac.jump {
+        Some(j) => format!(
+            "; the map u ↦ d jumps along u.{} (at {:.4}, on {} of {} lines scanned): a choice made with that uniform and reused, so several u land on one d and pdf · |J| ≥ 1 there, judged as an event's (off only below 1)",
+            ["x", "y"][j.axis as usize],
+            j.at,
+            j.lines,
+            j.scanned
+        ),
+        None => String::new(),
+    }
 }
 
 fn systematic(jac: &JacobianCheck) -> String {

@@ -65,7 +65,7 @@ impl<'a, 'g> Run<'a, 'g> {
         match &self.settings.reference {
             Some(r) => {
                 let pdf = move |d: glam::DVec3| (r.0)(wi, d);
-                f(&quadrature::CpuPdf { pdf: &pdf, plane: self.plane() })
+                f(&quadrature::CpuPdf { pdf: &pdf, plane: self.plane(), jumps: quadrature::Jumps::Locate })
             }
             None => f(&(&self.passes, &self.params)),
         }
@@ -91,6 +91,11 @@ pub(crate) struct Measured {
     pub integrals: Integrals,
     /// The quadrature's first part width, from the largest reported pdf.
     pub width: f64,
+    /// How far ∫pdf moves on the quadrature's parts when the WGSL pdf's inputs move by an ulp
+    /// ([`quadrature::sensitivity`]; 0 for an f64 reference).
+    pub f32_moved: f64,
+    /// A jump of the sample map along u.x or u.y ([`map::find_jump`]).
+    pub jump: Option<map::Jump>,
 }
 
 impl Measured {
@@ -122,8 +127,16 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
     let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
     let p_max = probes.iter().filter(|p| Measured::valid(p)).map(|p| p[0][3] as f64).fold(0.0, f64::max);
     let width = quadrature::initial_width(p_max, run.plane());
-    let integrals = integrate(run, &totals[..run.bins()], width)?;
-    Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width })
+    let (integrals, f32_moved) = integrate(run, &totals[..run.bins()], width)?;
+    let jump = map_jump(run, &probes, &probe_u)?;
+    Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
+}
+
+/// A jump of the sample map along u.x or u.y ([`map::find_jump`]) on the lines through the first
+/// [`map::JUMP_LINES`] probes with a valid sample.
+fn map_jump(run: &Run, probes: &[Probe], probe_u: &[[f32; 4]]) -> Result<Option<map::Jump>, CheckError> {
+    let valid: Vec<[f32; 4]> = probes.iter().zip(probe_u).filter(|(p, _)| Measured::valid(p)).map(|(_, u)| *u).take(map::JUMP_LINES).collect();
+    map::find_jump(&valid, run.plane(), &|us| run.passes.map(&run.params, us))
 }
 
 /// The probe's uniforms: away from the edges by 2ε, so that u ± ε stays in [0, 1].
@@ -134,14 +147,17 @@ fn probe_uniforms(settings: &Settings) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// The quadrature of the pdf per bin (and of eval, which has no f64 twin: always the GPU's).
-fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<Integrals, CheckError> {
+/// The quadrature of the pdf per bin (and of eval, which has no f64 twin: always the GPU's), and
+/// how far the WGSL pdf's f32 evaluation moves ∫pdf ([`quadrature::f32_sensitivity`]; 0 for an
+/// f64 reference).
+fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64), CheckError> {
     let (domain, rows, cols, samples) = (&run.sampler.domain, run.rows, run.cols, run.settings.samples);
-    let mut integrals = run.with_integrand(|f| quadrature::integrate(f, domain, rows, cols, width, samples, Some(observed)))?;
+    let (mut integrals, leaves) = run.with_integrand(|f| quadrature::integrate_leaves(f, domain, rows, cols, width, samples, Some(observed)))?;
     if run.settings.reference.is_some() && run.sampler.eval.is_some() {
         integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(observed))?.eval;
     }
-    Ok(integrals)
+    let moved = if run.settings.reference.is_some() { 0.0 } else { quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? };
+    Ok((integrals, moved))
 }
 
 /// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
