@@ -49,7 +49,7 @@ pub(super) fn compose(dialect: Dialect, sources: &[Source], c: &Composition) -> 
         }
     };
     let name = format!("<{} translated to WGSL by naga's {} front end>", files.join(", "), dialect.name());
-    Ok(UserCode { dialect, parts: vec![Source { name, text }], origins, files, decls: Vec::new() })
+    Ok(UserCode { dialect, parts: vec![Source { name, text }], origins, files, decls: Vec::new(), renamed: Vec::new() })
 }
 
 /// A module read from another language, as WGSL: its text and where renamed functions came from.
