@@ -8,6 +8,8 @@
 
 use lobes::check::{CheckError, Composition, Domain, Source, UserSampler};
 use proptest::prelude::*;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
@@ -53,20 +55,6 @@ fn bad_input(out: &Output, want: &[&str]) -> String {
     e
 }
 
-/// A copy of a fixture tree in `dir`.
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let p = e.unwrap().path();
-        let t = to.join(p.file_name().unwrap());
-        if p.is_dir() {
-            copy_tree(&p, &t)
-        } else {
-            std::fs::copy(&p, &t).unwrap();
-        }
-    }
-}
-
 /// The naga_oil fixture's check, in `dir` (a copy of the tree), with `extra` flags.
 fn oil_check(dir: &Path, extra: &[&str]) -> Output {
     let file = dir.join("shaders/sampling/diffuse.wgsl");
@@ -84,7 +72,7 @@ fn oil_check(dir: &Path, extra: &[&str]) -> Output {
 #[test]
 fn two_files_declaring_one_naga_oil_module_path_are_refused_naming_both() {
     let dir = scratch("oil-twice");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     let stale = dir.join("shaders/archive/maths_2023.wgsl");
     write(&stale, "#define_import_path common::maths\n\nconst PI: f32 = 3.0;\nconst TAU: f32 = 6.0;\n");
     let out = oil_check(&dir, &[]);
@@ -97,7 +85,7 @@ fn two_files_declaring_one_naga_oil_module_path_are_refused_naming_both() {
 #[test]
 fn a_wesl_module_reachable_two_ways_is_refused_naming_both() {
     let dir = scratch("wesl-twice");
-    copy_tree(&root().join(WESL), &dir);
+    common::copy_dir(&root().join(WESL), &dir);
     let utils = dir.join("shaders/utils.wesl");
     let copy = dir.join("shaders/utils.wgsl");
     std::fs::copy(&utils, &copy).unwrap();
@@ -127,7 +115,7 @@ fn a_wesl_module_reachable_two_ways_is_refused_naming_both() {
 #[test]
 fn a_symlink_loop_under_a_shader_root_is_walked_once() {
     let dir = scratch("symlink-loop");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     let loops = dir.join("shaders/loops");
     std::fs::create_dir_all(&loops).unwrap();
     std::os::unix::fs::symlink(".", loops.join("a")).unwrap();
@@ -149,7 +137,7 @@ fn a_symlink_loop_under_a_shader_root_is_walked_once() {
 #[test]
 fn one_rand_function_named_twice_is_one_function() {
     let dir = scratch("rand-twice");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     for extra in [&["--rand", "rand"][..], &["--rand", "common::random::rand"][..]] {
         let out = oil_check(&dir, extra);
         assert_eq!(out.status.code(), Some(0), "{extra:?}: {}", text(&out.stderr));
@@ -160,7 +148,7 @@ fn one_rand_function_named_twice_is_one_function() {
 #[test]
 fn one_rand_function_named_twice_in_a_scene_is_one_function() {
     let dir = scratch("rand-twice-scene");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     let scene = "[[case]]\nname = \"oil\"\nsamples = 65536\n\n[case.sampler]\nwgsl = [\"shaders/sampling/diffuse.wgsl\"]\nshader_root = [\"shaders\"]\n\
                  stub = { \"common::view\" = \"stubs/view.wgsl\" }\nsample = \"sample_diffuse(wi)\"\npdf = \"diffuse_pdf(d)\"\nrand = [\"rand\", \"rand\"]\n";
     let path = dir.join("scene.toml");
@@ -278,7 +266,7 @@ fn density_expressions_of_the_wrong_type_or_empty_are_named_in_the_flags_terms()
 #[test]
 fn define_values_out_of_range_are_named() {
     let dir = scratch("define-range");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     bad_input(&oil_check(&dir, &["--define", "N=99999999999"]), &["--define N=99999999999", "out of the range of i32"]);
     bad_input(&oil_check(&dir, &["--define", "N=99999999999u"]), &["--define N=99999999999u", "out of the range of u32"]);
     let docs = std::fs::read_to_string(root().join("docs/testing-your-own-sampler.md")).unwrap();
@@ -300,14 +288,14 @@ fn a_tiny_budget_gets_a_short_message() {
 #[test]
 fn unused_or_repeated_stubs_are_refused_naming_them() {
     let dir = scratch("stubs");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     let other = format!("common::lights={}", dir.join("stubs/view.wgsl").display());
     bad_input(&oil_check(&dir, &["--stub", &other]), &["--stub common::lights", "no import"]);
     let again = format!("common::view={}", dir.join("stubs/view.wgsl").display());
     bad_input(&oil_check(&dir, &["--stub", &again]), &["--stub common::view", "twice"]);
     // WESL: a stub of a module nothing imports
     let wesl = scratch("stubs-wesl");
-    copy_tree(&root().join(WESL), &wesl);
+    common::copy_dir(&root().join(WESL), &wesl);
     let file = wesl.join("shaders/sampling/ggx.wesl");
     let roots = wesl.join("shaders");
     let stub = format!("package::bindings={}", wesl.join("stubs/bindings.wesl").display());
@@ -395,7 +383,7 @@ proptest! {
 #[test]
 fn a_call_expression_names_an_imported_item_as_the_file_does() {
     let dir = scratch("imported-names");
-    copy_tree(&root().join(OIL), &dir);
+    common::copy_dir(&root().join(OIL), &dir);
     let with_pdf = |pdf: &str| {
         let file = dir.join("shaders/sampling/diffuse.wgsl");
         let roots = dir.join("shaders");
@@ -417,7 +405,7 @@ fn a_call_expression_names_an_imported_item_as_the_file_does() {
 #[test]
 fn a_rand_function_of_a_module_with_underscores_in_its_path_is_found() {
     let dir = scratch("wesl-underscores");
-    copy_tree(&root().join(WESL), &dir);
+    common::copy_dir(&root().join(WESL), &dir);
     let moved = dir.join("shaders/bevy_pbr/render_utils.wesl");
     std::fs::create_dir_all(moved.parent().unwrap()).unwrap();
     std::fs::rename(dir.join("shaders/utils.wesl"), &moved).unwrap();

@@ -9,6 +9,8 @@
 //! (Debian's `glslang-tools`, installed by .ci/install) is required, not optional.
 
 use serde_json::Value;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -96,23 +98,7 @@ fn an_include_that_no_root_holds_is_named_at_its_line() {
 
 /// A copy of the fixture tree in a fresh folder, with `edit` applied to one file.
 fn copy_tree(name: &str, file: &str, edit: impl Fn(&str) -> String) -> PathBuf {
-    fn copy(from: &Path, to: &Path) {
-        std::fs::create_dir_all(to).unwrap();
-        for e in std::fs::read_dir(from).unwrap() {
-            let p = e.unwrap().path();
-            let t = to.join(p.file_name().unwrap());
-            if p.is_dir() { copy(&p, &t) } else { std::fs::copy(&p, &t).unwrap(); }
-        }
-    }
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("check-glsl-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    copy(&root().join(GLSL), &dir);
-    let f = dir.join(file);
-    let text = std::fs::read_to_string(&f).unwrap();
-    let edited = edit(&text);
-    assert_ne!(edited, text, "the edit changed {file}");
-    std::fs::write(&f, edited).unwrap();
-    dir
+    common::edited_copy(&format!("check-glsl-{name}"), &root().join(GLSL), file, edit)
 }
 
 /// A type error in a file the sampler includes (from another folder) is reported at that

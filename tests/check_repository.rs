@@ -6,6 +6,8 @@
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
 use serde_json::Value;
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -186,23 +188,7 @@ fn qualified_names_in_call_expressions_resolve_or_are_refused() {
 
 /// A copy of a fixture tree in a fresh folder, with `edit` applied to one file.
 fn copy_tree(name: &str, from: &str, file: &str, edit: impl Fn(&str) -> String) -> PathBuf {
-    fn copy(from: &Path, to: &Path) {
-        std::fs::create_dir_all(to).unwrap();
-        for e in std::fs::read_dir(from).unwrap() {
-            let p = e.unwrap().path();
-            let t = to.join(p.file_name().unwrap());
-            if p.is_dir() { copy(&p, &t) } else { std::fs::copy(&p, &t).unwrap(); }
-        }
-    }
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("check-repository-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    copy(&root().join(from), &dir);
-    let f = dir.join(file);
-    let text = std::fs::read_to_string(&f).unwrap();
-    let edited = edit(&text);
-    assert_ne!(edited, text, "the edit changed {file}");
-    std::fs::write(&f, edited).unwrap();
-    dir
+    common::edited_copy(&format!("check-repository-{name}"), &root().join(from), file, edit)
 }
 
 #[test]

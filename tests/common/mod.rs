@@ -1,6 +1,8 @@
-//! Helpers of the tests that drive the `lobes` binary as CI does (tests/hangs.rs,
-//! tests/adversarial_runtime.rs).
+//! Helpers of the tests that drive the `lobes` binary as CI does, and copies of fixture trees.
+//! (Each test file that says `mod common;` compiles its own copy, using some of them.)
+#![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
 use std::process::{Child, Output};
 use std::time::{Duration, Instant};
 
@@ -21,4 +23,28 @@ pub fn finish(mut child: Child, limit: Duration) -> (Output, Duration) {
         std::thread::sleep(Duration::from_millis(20));
     }
     (child.wait_with_output().unwrap(), start.elapsed())
+}
+
+/// Copies the folder `from` (its files and subfolders) into `to`.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let p = e.unwrap().path();
+        let t = to.join(p.file_name().unwrap());
+        if p.is_dir() { copy_dir(&p, &t) } else { std::fs::copy(&p, &t).unwrap(); }
+    }
+}
+
+/// A copy of the fixture tree `from` in a fresh scratch folder `name`, with `edit` applied to its
+/// `file` (which the edit must change).
+pub fn edited_copy(name: &str, from: &Path, file: &str, edit: impl Fn(&str) -> String) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(from, &dir);
+    let f = dir.join(file);
+    let text = std::fs::read_to_string(&f).unwrap();
+    let edited = edit(&text);
+    assert_ne!(edited, text, "the edit changed {file}");
+    std::fs::write(&f, edited).unwrap();
+    dir
 }
