@@ -485,9 +485,12 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
-    foreign_directives(sources)?;
     let files = sources.iter().map(|s| s.name.clone()).collect();
     let mut d = dialect(sources);
+    if !matches!(d, Dialect::Glsl | Dialect::Spirv) {
+        // GLSL's own directives (#version, #include, #extension) are its front end's
+        foreign_directives(sources)?;
+    }
     if d == Dialect::Wgsl && !c.defines.is_empty() {
         // shader defs of plain files are naga_oil's (#ifdef); with none in the files they are unused
         d = Dialect::NagaOil;
