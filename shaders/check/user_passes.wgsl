@@ -1,8 +1,8 @@
 #define_import_path lobes::check
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::check_params::lobes_check
-#import lobes::bins::lobes_axis_column
-#import lobes::user::{LOBES_DOMAIN_PLANE, lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
+#import lobes::domain::{LOBES_DOMAIN_OUTSIDE, lobes_domain_point, lobes_domain_coordinates, lobes_domain_cell}
+#import lobes::user::{lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
 
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
 // functions through three wrappers of `lobes::user`, the module that the composing host
@@ -10,8 +10,9 @@
 //   fn lobes_user_sample(wi: vec3<f32>, u: vec4<f32>) -> vec4<f32>   // (d, pdf the sampler reports)
 //   fn lobes_user_pdf(wi: vec3<f32>, d: vec3<f32>) -> f32
 //   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
-// and `const LOBES_DOMAIN_PLANE: bool`, and fn lobes_user_draws() -> u32, the draws the last
-// sample took from the queue of the user's --rand functions. Every name here starts with `lobes_` so that it cannot
+// and fn lobes_user_draws() -> u32, the draws the last sample took from the queue of the user's
+// --rand functions. `lobes::domain` (domain_sphere.wgsl or domain_plane.wgsl, as the sampler's
+// domain says) maps quadrature coordinates to points and points to bins. Every name here starts with `lobes_` so that it cannot
 // collide with the user's own.
 
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
@@ -25,29 +26,6 @@
 fn lobes_positive(x: f32) -> bool {
     let bits = bitcast<u32>(x);
     return (bits & 0x7f800000u) != 0x7f800000u && x > 0.0;
-}
-
-// The point of the domain at coordinates (a, b) of a rectangle in hemisphere `h` (±1) and
-// quadrant `k`: on the sphere, a = 1 − |cos θ| (the distance from the nearer pole, exact in f32
-// where a peak sits at a pole) and b = φ − k π/2, φ measured from the axis nearest the rectangle
-// (the host chooses k), so the direction is (s cos φ, s sin φ, h (1 − a)) with s = √(a (2 − a)),
-// (cos φ, sin φ) being (cos b, sin b) turned by k quarter turns, which is exact; and the
-// solid-angle element is da dφ: a rectangle's integral needs no Jacobian. So an edge on an axis
-// is exactly where the binning puts it (f32(π) is 8.7·10⁻⁸ past π: with φ itself in f32 the two
-// columns of the seam overlapped by twice that, 2.5 % of a grazing lobe of α 10⁻⁴ counted twice),
-// and one off the axes within an ulp of b (≤ 4.7·10⁻⁸ rad) rather than of φ (2.4·10⁻⁷ near ±π).
-// On the plane, the point (a, b).
-fn lobes_domain_point(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
-    if (LOBES_DOMAIN_PLANE) {
-        return vec3<f32>(a, b, 0.0);
-    }
-    let s = sqrt(max(0.0, a * (2.0 - a)));
-    let e = vec2<f32>(cos(b), sin(b));
-    var t = e;
-    t = select(t, vec2<f32>(-e.y, e.x), k == 1u);
-    t = select(t, -e, k == 2u);
-    t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
-    return vec3<f32>(s * t.x, s * t.y, h * (1.0 - a));
 }
 
 // 5- and 3-point Gauss–Legendre nodes and weights on [−1, 1] (Abramowitz & Stegun 25.4.30),
@@ -150,12 +128,9 @@ fn lobes_support_edge(seen_nodes: vec3<f32>, c: vec2<f32>, hw: vec2<f32>, h: f32
 // Whether sample s is valid and lands on d0: within 1e-6 relative, the tolerance of "moves d"
 // in src/check/jacobian.rs (a sampler that chooses an event gives the same bits throughout it).
 fn lobes_same(s: vec4<f32>, d0: vec3<f32>) -> bool {
-    var diff = s.xyz - d0;
-    var scale = max(length(d0), 1.0);
-    if (LOBES_DOMAIN_PLANE) {
-        diff.z = 0.0;
-        scale = max(length(d0.xy), 1.0);
-    }
+    let p0 = lobes_domain_coordinates(d0);
+    let diff = lobes_domain_coordinates(s.xyz) - p0;
+    let scale = max(length(p0), 1.0);
     return lobes_positive(s.w) && length(diff) <= 1e-6 * scale;
 }
 
@@ -282,12 +257,28 @@ fn lobes_share(wi: vec3<f32>, u: vec4<f32>, axis: u32, d0: vec3<f32>) -> f32 {
     return share;
 }
 
-// The sample map around item i of lobes_in = (u, wi): per item 7 vec4s,
-//   0: sample(u) as (d, reported pdf)
-//   1, 2: sample(u ± eps in u.x); 3, 4: sample(u ± eps in u.y)
-//   5: (share of u.z, share of u.w, 0, 0): lobes_share along each
-//   6: (pdf(d), eval(d), |d|, 0) at d of 0
-// The host differentiates in f64 (src/check/jacobian.rs) and classifies (src/check/hard.rs).
+// One probed sample and the map around it (Probe in src/check/probe.rs, whose layout a test
+// holds to this one).
+struct LobesProbe {
+    // sample(u): (d, the pdf the sampler reported)
+    sample: vec4<f32>,
+    // sample(u ± eps along u.x), then along u.y: +x, −x, +y, −y
+    neighbours: array<vec4<f32>, 4>,
+    // lobes_share along u.z and along u.w at d
+    share_z: f32,
+    share_w: f32,
+    // the pdf and eval functions at d, and |d|
+    pdf: f32,
+    eval: f32,
+    length: f32,
+    _pad: array<f32, 3>,
+}
+
+// The probes, one per item (the probe pass's output buffer).
+@group(0) @binding(5) var<storage, read_write> lobes_probes: array<LobesProbe>;
+
+// The sample map around item i of lobes_in = (u, wi): a LobesProbe. The host differentiates in
+// f64 (src/check/jacobian.rs) and classifies (src/check/hard.rs).
 @compute @workgroup_size(64)
 fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
@@ -298,18 +289,15 @@ fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     let wi = lobes_in[2u * i + 1u].xyz;
     let e = lobes_check.eps;
     let s = lobes_user_sample(wi, u);
-    let o = 7u * i;
-    lobes_out[o] = s;
     let px = lobes_user_sample(wi, u + vec4<f32>(e, 0.0, 0.0, 0.0));
     let mx = lobes_user_sample(wi, u - vec4<f32>(e, 0.0, 0.0, 0.0));
     let py = lobes_user_sample(wi, u + vec4<f32>(0.0, e, 0.0, 0.0));
     let my = lobes_user_sample(wi, u - vec4<f32>(0.0, e, 0.0, 0.0));
-    lobes_out[o + 1u] = px;
-    lobes_out[o + 2u] = mx;
-    lobes_out[o + 3u] = py;
-    lobes_out[o + 4u] = my;
-    lobes_out[o + 5u] = vec4<f32>(lobes_share(wi, u, 2u, s.xyz), lobes_share(wi, u, 3u, s.xyz), 0.0, 0.0);
-    lobes_out[o + 6u] = vec4<f32>(lobes_user_pdf(wi, s.xyz), lobes_user_eval(wi, s.xyz), length(s.xyz), 0.0);
+    let share_z = lobes_share(wi, u, 2u, s.xyz);
+    let share_w = lobes_share(wi, u, 3u, s.xyz);
+    let neighbours = array<vec4<f32>, 4>(px, mx, py, my);
+    let pad = array<f32, 3>(0.0, 0.0, 0.0);
+    lobes_probes[i] = LobesProbe(s, neighbours, share_z, share_w, lobes_user_pdf(wi, s.xyz), lobes_user_eval(wi, s.xyz), length(s.xyz), pad);
 }
 
 // (pdf(d), eval(d), 0, 0) at the points d = lobes_in[i].xyz, for the incident direction of the
@@ -453,10 +441,8 @@ fn lobes_finite3(d: vec3<f32>) -> bool {
 }
 
 // The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1 (a rejection,
-// pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`). Bins as lobes bins
-// directions (shaders/lib/histogram.wgsl's bin_of, src/stats/histogram.rs): rows uniform in cos θ
-// over [−1, 1], columns in φ over [−π, π), φ = π wrapping to column 0, the column exact on the
-// axes' edges (shaders/lib/bins.wgsl); on the plane, rows in y and columns in x over the bounds.
+// pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`); the bin is the domain's
+// (lobes_domain_cell).
 fn lobes_cell(s: vec4<f32>) -> u32 {
     let bins = lobes_check.rows * lobes_check.cols;
     if (!lobes_finite3(s.xyz)) {
@@ -467,29 +453,9 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
     if (s.w == 0.0) {
         return bins + LOBES_ZERO_PDF - 1u;
     }
-    var row = 0u;
-    var col = 0u;
-    if (LOBES_DOMAIN_PLANE) {
-        let lo = lobes_check.bounds.xy;
-        let hi = lobes_check.bounds.zw;
-        if (any(s.xy < lo) || any(s.xy > hi)) {
-            return bins + LOBES_OUTSIDE_DOMAIN - 1u;
-        }
-        let t = (s.xy - lo) / (hi - lo);
-        col = min(u32(t.x * f32(lobes_check.cols)), lobes_check.cols - 1u);
-        row = min(u32(t.y * f32(lobes_check.rows)), lobes_check.rows - 1u);
-    } else {
-        if (abs(length(s.xyz) - 1.0) > 1e-3) {
-            return bins + LOBES_OUTSIDE_DOMAIN - 1u;
-        }
-        let z = clamp(s.z, -1.0, 1.0);
-        row = min(u32((z + 1.0) * 0.5 * f32(lobes_check.rows)), lobes_check.rows - 1u);
-        var t = 0.5;
-        if (s.x != 0.0 || s.y != 0.0) {
-            t = (atan2(s.y, s.x) + 3.14159265358979) * (0.5 / 3.14159265358979);
-        }
-        // the column made exact on the axes' edges (the φ = ±π seam above all), as lobes run's
-        col = lobes_axis_column(u32(max(t, 0.0) * f32(lobes_check.cols)), lobes_check.cols, s.x, s.y);
+    let cell = lobes_domain_cell(s.xyz);
+    if (cell == LOBES_DOMAIN_OUTSIDE) {
+        return bins + LOBES_OUTSIDE_DOMAIN - 1u;
     }
     let bits = bitcast<u32>(s.w);
     if ((bits & 0x7f800000u) == 0x7f800000u) {
@@ -498,7 +464,7 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
     if (!(s.w > 0.0)) {
         return bins + LOBES_ZERO_PDF - 1u;
     }
-    return row * lobes_check.cols + col;
+    return cell;
 }
 
 // The cells of the histogram: the bins, the 4 reasons, then the two draw counters of the

@@ -113,14 +113,14 @@ impl Conventions {
     }
 
     /// Conventions that mean nothing for 2-D points: all but `--u-open` apply to directions.
-    pub fn validate(&self, plane: bool) -> Result<(), CheckError> {
+    pub fn validate(&self, domain: super::Domain) -> Result<(), CheckError> {
         let directional = [
             ("--incident upper", self.incident == Incident::Upper),
             ("--reflection-only", self.reflection_only),
             ("--measure projected", self.measure == Measure::Projected),
             ("--frame y-up", self.frame == Frame::YUp),
         ];
-        match directional.iter().find(|(_, set)| plane && *set) {
+        match directional.iter().find(|(_, set)| !domain.directions() && *set) {
             Some((flag, _)) => Err(CheckError::Input(format!("{flag}: only with --domain sphere (a point of the plane has no normal); remove it"))),
             None => Ok(()),
         }
@@ -232,8 +232,9 @@ mod tests {
     #[test]
     fn directional_conventions_are_refused_on_the_plane() {
         let c = Conventions { measure: Measure::Projected, ..Conventions::default() };
-        assert!(c.validate(false).is_ok());
-        assert!(c.validate(true).unwrap_err().to_string().starts_with("--measure projected"));
-        assert!(Conventions { u_open: true, ..Conventions::default() }.validate(true).is_ok());
+        let plane = crate::stats::domain::Domain::UNIT_SQUARE;
+        assert!(c.validate(crate::stats::domain::Domain::Sphere).is_ok());
+        assert!(c.validate(plane).unwrap_err().to_string().starts_with("--measure projected"));
+        assert!(Conventions { u_open: true, ..Conventions::default() }.validate(plane).is_ok());
     }
 }

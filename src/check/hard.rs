@@ -5,6 +5,7 @@
 //! finite reported pdf > 0 and a finite pdf(d) ≥ 0. NaN, ∞ or a negative pdf is never
 //! acceptable, nor a NaN or infinite point, whatever pdf comes with it.
 
+use super::probe::Probe;
 use serde::{Deserialize, Serialize};
 
 /// The values every component of u takes.
@@ -68,14 +69,13 @@ pub fn show(x: f32) -> String {
 }
 
 /// What a probed sample got: its point, length, reported pdf and pdf(d).
-fn got(p: &[[f32; 4]; 7]) -> String {
-    let d = p[0];
-    format!("d = ({}, {}, {}), |d| = {}, pdf = {}, pdf(d) = {}", show(d[0]), show(d[1]), show(d[2]), show(p[6][2]), show(d[3]), show(p[6][0]))
+fn got(p: &Probe) -> String {
+    let d = p.d();
+    format!("d = ({}, {}, {}), |d| = {}, pdf = {}, pdf(d) = {}", show(d[0]), show(d[1]), show(d[2]), show(p.length), show(p.reported_pdf()), show(p.pdf))
 }
 
-/// Classifies the probed samples of one row (`probe[0]` = (d, reported pdf), `probe[6]` =
-/// (pdf(d), eval(d), |d|)).
-pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds: Option<[f64; 4]>) -> HardRow {
+/// Classifies the probed samples of one row.
+pub fn row(incident_theta: f64, probes: &[Probe], u: &[[f32; 4]], bounds: Option<[f64; 4]>) -> HardRow {
     let mut r = HardRow {
         incident_theta,
         samples: probes.len() as u32,
@@ -89,14 +89,14 @@ pub fn row(incident_theta: f64, probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], bounds
         passed: true,
     };
     for (p, u) in probes.iter().zip(u) {
-        let (d, pdf) = (p[0], p[0][3]);
+        let (d, pdf) = (p.d(), p.reported_pdf());
         let finite = d[..3].iter().all(|x| x.is_finite());
         let in_domain = finite
             && match bounds {
                 Some([x0, y0, x1, y1]) => (x0..=x1).contains(&(d[0] as f64)) && (y0..=y1).contains(&(d[1] as f64)),
-                None => is_unit(p[6][2]),
+                None => is_unit(p.length),
             };
-        let fn_pdf = p[6][0];
+        let fn_pdf = p.pdf;
         let failed = if !pdf.is_finite() || pdf < 0.0 {
             r.bad_pdf += 1;
             true

@@ -35,6 +35,8 @@
 //! ∫p equal to the valid fraction (`normalization`), p ≥ each event's density leaves no room for a
 //! p too large where the events do not overlap.
 
+use super::Domain;
+use super::probe::Probe;
 use serde::{Deserialize, Serialize};
 
 /// The smallest finite-difference step in u (2⁻¹²), and the probe's margin from the edges of
@@ -192,18 +194,12 @@ fn line(u: [f32; 4], axis: usize, lo: f64, hi: f64, k: usize) -> Vec<[f32; 4]> {
 
 /// The largest step of d between consecutive valid nodes of `at` (the map at [`line`]'s nodes),
 /// with its index.
-fn largest_step(at: &[[f32; 4]], plane: bool) -> Option<(usize, f64)> {
+fn largest_step(at: &[[f32; 4]], domain: Domain) -> Option<(usize, f64)> {
     let valid = |v: &[f32; 4]| v.iter().all(|x| x.is_finite()) && v[3] > 0.0;
     at.windows(2)
         .enumerate()
         .filter(|(_, w)| valid(&w[0]) && valid(&w[1]))
-        .map(|(j, w)| {
-            let mut e = sub(v3(w[1]), v3(w[0]));
-            if plane {
-                e[2] = 0.0;
-            }
-            (j, norm(e))
-        })
+        .map(|(j, w)| (j, norm(sub(domain.point(v3(w[1])), domain.point(v3(w[0]))))))
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
@@ -212,7 +208,7 @@ fn largest_step(at: &[[f32; 4]], plane: bool) -> Option<(usize, f64)> {
 /// [`JUMP_NODES`] nodes, refined twice around its largest sub-step; `map` evaluates the sampler
 /// at uniforms (the check's map pass). A smooth map's largest sub-step shrinks with the step; a
 /// jump's stays.
-pub fn find_jump(probes: &[[f32; 4]], plane: bool, map: &dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::CheckError>) -> Result<Option<Jump>, super::CheckError> {
+pub fn find_jump(probes: &[[f32; 4]], domain: Domain, map: &dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::CheckError>) -> Result<Option<Jump>, super::CheckError> {
     let margin = 2.0 * EPS as f64;
     for axis in 0..2 {
         // (u, the interval [lo, hi] of the largest step, that step) per line
@@ -220,7 +216,7 @@ pub fn find_jump(probes: &[[f32; 4]], plane: bool, map: &dyn Fn(&[[f32; 4]]) -> 
         let nodes: Vec<[f32; 4]> = probes.iter().flat_map(|u| line(*u, axis, margin, 1.0 - margin, JUMP_NODES)).collect();
         let at = map(&nodes)?;
         for (u, at) in probes.iter().zip(at.chunks(JUMP_NODES + 1)) {
-            if let Some((j, step)) = largest_step(at, plane) {
+            if let Some((j, step)) = largest_step(at, domain) {
                 let h = (1.0 - 2.0 * margin) / JUMP_NODES as f64;
                 lines.push((*u, margin + j as f64 * h, margin + (j + 1) as f64 * h, step));
             }
@@ -233,7 +229,7 @@ pub fn find_jump(probes: &[[f32; 4]], plane: bool, map: &dyn Fn(&[[f32; 4]]) -> 
             current = current
                 .iter()
                 .zip(at.chunks(JUMP_REFINE + 1))
-                .map(|(&(u, lo, hi, _), at)| match largest_step(at, plane) {
+                .map(|(&(u, lo, hi, _), at)| match largest_step(at, domain) {
                     Some((j, step)) => {
                         let h = (hi - lo) / JUMP_REFINE as f64;
                         (u, lo + j as f64 * h, lo + (j + 1) as f64 * h, step)
@@ -296,15 +292,9 @@ struct Derivative {
 
 /// The derivative of the map along `axis` at `u` from the samples `at` of [`around`]`(u)`
 /// (this axis's 2 · STEPS), or `None` where no two consecutive steps are smooth.
-fn derivative(u: [f32; 4], axis: usize, d0: [f64; 3], at: &[[f32; 4]], plane: bool) -> Option<Derivative> {
-    let point = |v: [f32; 4]| {
-        let mut p = v3(v);
-        if plane {
-            p[2] = 0.0;
-        }
-        p
-    };
-    let d0 = if plane { [d0[0], d0[1], 0.0] } else { d0 };
+fn derivative(u: [f32; 4], axis: usize, d0: [f64; 3], at: &[[f32; 4]], domain: Domain) -> Option<Derivative> {
+    let point = |v: [f32; 4]| domain.point(v3(v));
+    let d0 = domain.point(d0);
     // the central difference at each usable step: both points valid, and smooth there (the second
     // difference under a tenth of the first: no fold, seam or branch between lobes within it)
     let steps = around(u);
@@ -352,25 +342,26 @@ enum Local {
     Invalid,
 }
 
-fn local(probe: &[[f32; 4]; 7], u: [f32; 4], at: &[[f32; 4]; AROUND], plane: bool) -> Local {
-    let finite = probe[..6].iter().all(|v| v.iter().all(|x| x.is_finite()));
-    if !finite || probe[0][3] <= 0.0 || !(probe[6][0] > 0.0 && probe[6][0].is_finite()) {
+fn local(probe: &Probe, u: [f32; 4], at: &[[f32; 4]; AROUND], domain: Domain) -> Local {
+    let finite = [probe.sample].iter().chain(&probe.neighbours).flatten().chain(&[probe.share_z, probe.share_w]).all(|x| x.is_finite());
+    if !finite || probe.reported_pdf() <= 0.0 || !(probe.pdf > 0.0 && probe.pdf.is_finite()) {
         return Local::Invalid;
     }
     // the neighbours at the smallest step, as the probe pass drew them
-    if probe[1..5].iter().any(|v| v[3] <= 0.0) {
+    if probe.neighbours.iter().any(|v| v[3] <= 0.0) {
         return Local::Invalid;
     }
     // shares of u.z and u.w: 1 unused, < 0 d moves with it (user_passes.wgsl: lobes_share)
-    let (sz, sw) = (probe[5][0] as f64, probe[5][1] as f64);
+    let (sz, sw) = (probe.share_z as f64, probe.share_w as f64);
     if sz < 0.0 || sw < 0.0 || (sz < 1.0 && sw < 1.0) {
         return Local::Selection;
     }
-    let d0 = v3(probe[0]);
-    let (Some(a), Some(b)) = (derivative(u, 0, d0, &at[..2 * STEPS], plane), derivative(u, 1, d0, &at[2 * STEPS..], plane)) else {
+    let d0 = v3(probe.sample);
+    let (Some(a), Some(b)) = (derivative(u, 0, d0, &at[..2 * STEPS], domain), derivative(u, 1, d0, &at[2 * STEPS..], domain)) else {
         return Local::NotSmooth;
     };
-    let area = if plane { (a.value[0] * b.value[1] - a.value[1] * b.value[0]).abs() } else { norm(cross(a.value, b.value)) };
+    // |∂d/∂u₁ × ∂d/∂u₂|: on the plane (z = 0) the cross product's norm is |det ∂(x, y)/∂(u₁, u₂)|
+    let area = norm(cross(a.value, b.value));
     if area == 0.0 {
         return Local::NotSmooth;
     }
@@ -386,7 +377,7 @@ fn local(probe: &[[f32; 4]; 7], u: [f32; 4], at: &[[f32; 4]; AROUND], plane: boo
 /// uniforms, `at` the map at [`around`] each of them, `conditioning` the pdf's f32 conditioning
 /// at each probe's d (0 where unknown) and `ulps` its multiple allowed.
 /// With `jump` (the map is not one-to-one, [`find_jump`]) every probe is judged as an event's.
-pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]], conditioning: &[f64], ulps: f64, plane: bool, jump: Option<Jump>) -> JacobianCheck {
+pub fn judge(probes: &[Probe], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]], conditioning: &[f64], ulps: f64, domain: Domain, jump: Option<Jump>) -> JacobianCheck {
     let mut c = JacobianCheck {
         probed: probes.len() as u64,
         compared: 0,
@@ -418,13 +409,13 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
     let mut deviations = Vec::new();
     let mut worst = 0.0;
     for (((p, u), at), kappa) in probes.iter().zip(u).zip(at).zip(conditioning) {
-        match local(p, *u, at, plane) {
+        match local(p, *u, at, domain) {
             Local::Invalid => c.skipped_invalid += 1,
             Local::Selection => c.skipped_selection += 1,
             Local::NotSmooth => c.skipped_not_smooth += 1,
             Local::Unresolved => c.skipped_unresolved += 1,
             Local::Jacobian { j, share, error, h } => {
-                let ratio = p[6][0] as f64 * j / share;
+                let ratio = p.pdf as f64 * j / share;
                 ratios.push(ratio);
                 c.largest_step = c.largest_step.max(h);
                 let limit = TOLERANCE + 2.0 * error + ulps * kappa;
@@ -472,36 +463,41 @@ pub fn judge(probes: &[[[f32; 4]; 7]], u: &[[f32; 4]], at: &[[[f32; 4]; AROUND]]
 mod tests {
     use super::*;
 
+    /// The unit square's plane, where these maps live.
+    const PLANE: Domain = Domain::UNIT_SQUARE;
+
     /// The probe of the uniform map onto the plane's unit square (|J| = 1) at (0.3, 0.6), with a
     /// pdf and the shares of u.z and u.w.
-    fn probe(pdf: f32, shares: [f32; 2]) -> [[f32; 4]; 7] {
+    /// A probe whose pdf function gives `pdf` at d, with u.z's and u.w's shares `shares`.
+    fn with(sample: [f32; 4], neighbours: [[f32; 4]; 4], shares: [f32; 2], pdf: f32) -> Probe {
+        Probe { sample, neighbours, share_z: shares[0], share_w: shares[1], pdf, eval: 0.0, length: 0.0, _pad: [0.0; 3] }
+    }
+
+    fn probe(pdf: f32, shares: [f32; 2]) -> Probe {
         let (e, x, y) = (EPS, 0.3f32, 0.6f32);
-        [[x, y, 0.0, pdf], [x + e, y, 0.0, pdf], [x - e, y, 0.0, pdf], [x, y + e, 0.0, pdf], [x, y - e, 0.0, pdf], [shares[0], shares[1], 0.0, 0.0], [pdf, 0.0, 0.0, 0.0]]
+        with([x, y, 0.0, pdf], [[x + e, y, 0.0, pdf], [x - e, y, 0.0, pdf], [x, y + e, 0.0, pdf], [x, y - e, 0.0, pdf]], shares, pdf)
     }
 
     fn judged(pdf: f32, shares: [f32; 2]) -> JacobianCheck {
         let n = MIN_COMPARED as usize;
         let u = [0.3, 0.6, 0.0, 0.0];
         let at = around(u).map(|v| [v[0], v[1], 0.0, pdf]);
-        judge(&vec![probe(pdf, shares); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, None)
+        judge(&vec![probe(pdf, shares); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, PLANE, None)
     }
 
     /// The probe of `map` at `u` with pdf `pdf` (shares 1), and the map around it.
-    fn probed(map: impl Fn([f32; 4]) -> [f32; 4], u: [f32; 4], pdf: f32) -> ([[f32; 4]; 7], [[f32; 4]; AROUND]) {
-        let mut p = [map(u); 7];
-        for (i, (axis, s)) in [(0, EPS), (0, -EPS), (1, EPS), (1, -EPS)].into_iter().enumerate() {
+    fn probed(map: impl Fn([f32; 4]) -> [f32; 4], u: [f32; 4], pdf: f32) -> (Probe, [[f32; 4]; AROUND]) {
+        let neighbours = [(0, EPS), (0, -EPS), (1, EPS), (1, -EPS)].map(|(axis, s)| {
             let mut v = u;
             v[axis] += s;
-            p[i + 1] = map(v);
-        }
-        p[5] = [1.0, 1.0, 0.0, 0.0];
-        p[6] = [pdf, 0.0, 0.0, 0.0];
-        (p, around(u).map(map))
+            map(v)
+        });
+        (with(map(u), neighbours, [1.0, 1.0], pdf), around(u).map(map))
     }
 
-    fn judge_all(p: [[f32; 4]; 7], u: [f32; 4], at: [[f32; 4]; AROUND]) -> JacobianCheck {
+    fn judge_all(p: Probe, u: [f32; 4], at: [[f32; 4]; AROUND]) -> JacobianCheck {
         let n = MIN_COMPARED as usize;
-        judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, None)
+        judge(&vec![p; n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, PLANE, None)
     }
 
     /// The probe u of the two tests below.
@@ -567,7 +563,7 @@ mod tests {
                 us.push(u);
                 ats.push(at);
             }
-            judge(&probes, &us, &ats, &vec![0.0; 400], 4.0, true, None)
+            judge(&probes, &us, &ats, &vec![0.0; 400], 4.0, PLANE, None)
         };
         let c = judged(5e-3);
         assert!(c.share_off == 0.0 && c.resolved == 400 && c.systematic && !c.passed, "{c:?}");
@@ -618,7 +614,7 @@ mod tests {
     #[test]
     fn a_jump_along_u_x_is_found() {
         let lines: Vec<[f32; 4]> = (0..JUMP_LINES).map(|i| [0.5, (i as f32 + 0.5) / JUMP_LINES as f32, 0.0, 0.0]).collect();
-        let found = |f: fn([f32; 4]) -> [f32; 4]| find_jump(&lines, true, &|us| Ok(us.iter().map(|u| f(*u)).collect())).unwrap();
+        let found = |f: fn([f32; 4]) -> [f32; 4]| find_jump(&lines, PLANE, &|us| Ok(us.iter().map(|u| f(*u)).collect())).unwrap();
         let jump = found(|u| [if u[0] < 0.5 { 2.0 * u[0] } else { 2.0 * u[0] - 1.0 }, u[1], 0.0, 0.5]).expect("a jump");
         assert!(jump.axis == 0 && (jump.at - 0.5).abs() < 1e-4 && jump.lines == JUMP_LINES as u64 && jump.scanned == JUMP_LINES as u64, "{jump:?}");
         assert_eq!(found(|u| [u[0], u[1], 0.0, 1.0]), None);
@@ -634,7 +630,7 @@ mod tests {
         let jump = Some(Jump { axis: 0, at: 0.5, lines: 32, scanned: 32 });
         for (pdf, passes) in [(2.0f32, true), (0.5, false)] {
             let at = around(u).map(|v| [v[0], v[1], 0.0, pdf]);
-            let c = judge(&vec![probe(pdf, [1.0, 1.0]); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, true, jump);
+            let c = judge(&vec![probe(pdf, [1.0, 1.0]); n], &vec![u; n], &vec![at; n], &vec![0.0; n], 4.0, PLANE, jump);
             assert_eq!(c.passed, passes, "pdf {pdf}: {c:?}");
         }
     }

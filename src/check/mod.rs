@@ -45,6 +45,7 @@ pub mod modules;
 pub mod jacobian;
 mod judge;
 pub mod power;
+pub mod probe;
 pub mod quadrature;
 pub mod report;
 
@@ -57,7 +58,6 @@ pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
 use report::REPORT_VERSION;
-use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
 /// Why a check could not be run (as opposed to a check that ran and failed).
@@ -122,15 +122,7 @@ impl Setting {
     }
 }
 
-/// Where the sampled points live.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(rename_all = "lowercase", tag = "kind")]
-pub enum Domain {
-    /// Unit directions anywhere on the sphere, binned in (cos θ, φ) as lobes bins its lobes.
-    Sphere,
-    /// Points (d.x, d.y) of the box `[x0, y0, x1, y1]`, binned on a rows × cols grid of it.
-    Plane { bounds: [f64; 4] },
-}
+pub use crate::stats::domain::Domain;
 
 /// A user's sampler: WGSL files and how to call its functions.
 ///
@@ -218,20 +210,16 @@ impl UserSampler {
     /// The same sampler declared in `conventions` (`--incident upper`, `--reflection-only`, …).
     pub fn with_conventions(self, conventions: Conventions) -> Result<Self, CheckError> {
         let s = Self { conventions, ..self };
-        s.conventions.validate(matches!(s.domain, Domain::Plane { .. }))?;
+        s.conventions.validate(s.domain)?;
         Ok(s)
     }
 
     /// The files alone must validate, define the named functions with the contract's
     /// signatures, and leave lobes' own names free.
     pub fn validate(&self) -> Result<(), CheckError> {
-        if let Domain::Plane { bounds: [x0, y0, x1, y1] } = self.domain
-            && !(x0 < x1 && y0 < y1 && [x0, y0, x1, y1].iter().all(|v| v.is_finite()))
-        {
-            return Err(CheckError::Input(format!("--bounds: {x0},{y0},{x1},{y1} is not a box: need X0 < X1 and Y0 < Y1, all finite")));
-        }
-        self.conventions.validate(matches!(self.domain, Domain::Plane { .. }))?;
-        if self.composition.sample_returns == SampleReturns::HalfVector && matches!(self.domain, Domain::Plane { .. }) {
+        self.domain.validate().map_err(|e| CheckError::Input(format!("--bounds: {e}")))?;
+        self.conventions.validate(self.domain)?;
+        if self.composition.sample_returns == SampleReturns::HalfVector && !self.domain.directions() {
             return Err(CheckError::Input("--sample-returns half-vector: a half vector reflects wi into a direction; it does not apply to --domain plane".into()));
         }
         let code = modules::compose_user(&self.sources, &self.composition)?;
@@ -340,10 +328,7 @@ impl Default for Settings {
 
 impl Settings {
     pub fn grid(&self, domain: &Domain) -> (u32, u32) {
-        self.bins.unwrap_or(match domain {
-            Domain::Sphere => (64, 128),
-            Domain::Plane { .. } => (64, 64),
-        })
+        self.bins.unwrap_or(domain.default_grid())
     }
     /// Bad input, named by its [`Setting`]: more than 16 params, an incident θ outside
     /// [0, 180], no samples, an empty or too large grid, a significance outside (0, 1).
@@ -418,10 +403,7 @@ fn params_of(sampler: &UserSampler, settings: &Settings) -> gpu::Params {
         user[i / 4][i % 4] = *p as f32;
     }
     let wi = incident(settings.incident_theta, settings.incident_phi);
-    let bounds = match sampler.domain {
-        Domain::Plane { bounds } => bounds.map(|b| b as f32),
-        Domain::Sphere => [0.0; 4],
-    };
+    let bounds = sampler.domain.uniform_bounds();
     gpu::Params {
         user,
         wi: [wi[0], wi[1], wi[2], 0.0],
@@ -481,7 +463,7 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     settings.validate()?;
     let _deadline = gpu.deadline(settings.timeout);
     sampler.validate()?;
-    if !matches!(sampler.domain, Domain::Plane { .. }) {
+    if sampler.domain.directions() {
         sampler.conventions.check_incident(settings.incident_theta)?;
     }
     let run = judge::Run::new(gpu, sampler, settings)?;
@@ -538,7 +520,7 @@ fn report(run: &judge::Run, m: &judge::Measured, checks: Vec<Check>, adapter: St
 /// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
 /// points), which must lie within 1° of −wi; None for an unconverged quadrature.
 fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<String> {
-    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || sampler.domain != Domain::Sphere {
+    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || !sampler.domain.directions() {
         return None;
     }
     let pole = crate::reference::reflect::spherical((180.0 - settings.incident_theta).to_radians(), (settings.incident_phi + 180.0).to_radians());

@@ -38,6 +38,7 @@ use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
 use crate::engine::gpu::Gpu;
 pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::gauss_legendre::GaussLegendre;
+use crate::stats::domain::Cell;
 use crate::stats::histogram::SphereGrid;
 use serde::{Deserialize, Serialize};
 
@@ -235,19 +236,15 @@ impl Integrand for (&Passes<'_>, &Params) {
 /// An f64 pdf on the CPU: the user's reference through the library API.
 pub(super) struct CpuPdf<'a> {
     pub pdf: &'a (dyn Fn(glam::DVec3) -> f64 + Send + Sync),
-    pub plane: bool,
+    pub domain: Domain,
     /// Whether its parts' support edges are looked for (`None` from [`CpuPdf::edge`] otherwise).
     pub jumps: Jumps,
 }
 
 impl CpuPdf<'_> {
-    /// The point at (a, b) of a part in hemisphere h (`lobes_domain_point` in f64).
+    /// The point at (a, b) of a part in hemisphere h ([`Domain::part_point`]).
     fn point(&self, a: f64, b: f64, h: f32) -> glam::DVec3 {
-        if self.plane {
-            return glam::DVec3::new(a, b, 0.0);
-        }
-        let s = (a * (2.0 - a)).max(0.0).sqrt();
-        glam::DVec3::new(s * b.cos(), s * b.sin(), h as f64 * (1.0 - a))
+        glam::DVec3::from(self.domain.part_point(a, b, h as f64))
     }
     /// `lobes_support_edge` in f64: the pdf at both rules' nodes, the corners and the sides'
     /// midpoints.
@@ -303,9 +300,9 @@ pub const MAX_SPHERE_WIDTH: f64 = 0.0625;
 
 /// The width the bins are first split to: 0.5/√p_max (p_max the largest pdf the probes reported),
 /// within [10⁻⁴, 1], and at most [`MAX_SPHERE_WIDTH`] on the sphere.
-pub(super) fn initial_width(p_max: f64, plane: bool) -> f64 {
+pub(super) fn initial_width(p_max: f64, domain: Domain) -> f64 {
     let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
-    if plane { width } else { width.min(MAX_SPHERE_WIDTH) }
+    if domain.directions() { width.min(MAX_SPHERE_WIDTH) } else { width }
 }
 
 /// The parts a bin starts as: on the sphere its (a, φ) rectangle per hemisphere it touches,
@@ -314,39 +311,30 @@ pub(super) fn initial_width(p_max: f64, plane: bool) -> f64 {
 fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, only: Option<&[bool]>) -> Vec<Part> {
     let mut parts = Vec::new();
     let split = |extent: f64| ((extent / width).ceil() as u32).clamp(1, cap);
-    for r in 0..rows {
-        for c in 0..cols {
-            let bin = r * cols + c;
-            if only.is_some_and(|o| !o[bin as usize]) {
-                continue;
-            }
-            // (a range, b range, hemisphere, initial split per axis)
-            let mut pieces: Vec<Piece> = Vec::new();
-            match *domain {
-                Domain::Plane { bounds: [x0, y0, x1, y1] } => {
-                    let (dx, dy) = ((x1 - x0) / cols as f64, (y1 - y0) / rows as f64);
-                    let a = (x0 + c as f64 * dx, x0 + (c + 1) as f64 * dx);
-                    let b = (y0 + r as f64 * dy, y0 + (r + 1) as f64 * dy);
-                    pieces.push((a, b, 0.0, split(dx.max(dy))));
-                }
-                Domain::Sphere => {
-                    let phi = SphereGrid { rows, cols }.phi_edges();
-                    let b = (phi[c as usize], phi[c as usize + 1]);
-                    for z in row_zones(rows, r) {
-                        pieces.push((z.a, b, z.h, split(z.dtheta.max((b.1 - b.0) * z.smax))));
-                    }
+    let grid = domain.grid(rows, cols);
+    for bin in 0..grid.bins() as u32 {
+        if only.is_some_and(|o| !o[bin as usize]) {
+            continue;
+        }
+        // (a range, b range, hemisphere, initial split per axis)
+        let mut pieces: Vec<Piece> = Vec::new();
+        match grid.cell(bin as usize) {
+            Cell::Plane { x, y } => pieces.push((x, y, 0.0, split((x.1 - x.0).max(y.1 - y.0)))),
+            Cell::Sphere { row, phi } => {
+                for z in row_zones(rows, row) {
+                    pieces.push((z.a, phi, z.h, split(z.dtheta.max((phi.1 - phi.0) * z.smax))));
                 }
             }
-            for (a, b, h, m) in pieces {
-                let (da, db) = ((a.1 - a.0) / m as f64, (b.1 - b.0) / m as f64);
-                for i in 0..m {
-                    let a = (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da);
-                    // a part at a pole in s = √a ([`Rect`])
-                    let radial = if h != 0.0 && a.0 == 0.0 { Radial::RootA } else { Radial::A };
-                    let a = if radial == Radial::RootA { (0.0, a.1.sqrt()) } else { a };
-                    for j in 0..m {
-                        parts.push(Part { a, b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db), h, radial, bin, depth: 0, coarse: None });
-                    }
+        }
+        for (a, b, h, m) in pieces {
+            let (da, db) = ((a.1 - a.0) / m as f64, (b.1 - b.0) / m as f64);
+            for i in 0..m {
+                let a = (a.0 + i as f64 * da, a.0 + (i + 1) as f64 * da);
+                // a part at a pole in s = √a ([`Rect`])
+                let radial = if h != 0.0 && a.0 == 0.0 { Radial::RootA } else { Radial::A };
+                let a = if radial == Radial::RootA { (0.0, a.1.sqrt()) } else { a };
+                for j in 0..m {
+                    parts.push(Part { a, b: (b.0 + j as f64 * db, b.0 + (j + 1) as f64 * db), h, radial, bin, depth: 0, coarse: None });
                 }
             }
         }
@@ -402,7 +390,7 @@ pub(super) fn integrate_leaves(f: &dyn Integrand, domain: &Domain, rows: u32, co
         disputed.sort_by(|x, y| y.0.total_cmp(&x.0));
         let mut added = 0;
         'disputed: for &(_, i) in &disputed {
-            for j in neighbourhood(i, rows, cols, domain) {
+            for j in domain.grid(rows, cols).neighbourhood(i) {
                 if added >= (room - must).min(MAX_DISPUTED) {
                     break 'disputed;
                 }
@@ -555,24 +543,6 @@ pub fn join_unresolved_edges(counts: &[u64], expected: &[f64], strips: &[f64], r
         }
     }
     (counts, expected, joined)
-}
-
-/// Bin `i` and its (up to) eight neighbours, the bin first; columns wrap around on the sphere.
-fn neighbourhood(i: usize, rows: u32, cols: u32, domain: &Domain) -> Vec<usize> {
-    let (rows, cols) = (rows as i64, cols as i64);
-    let (r, c) = (i as i64 / cols, i as i64 % cols);
-    let wrap = matches!(domain, Domain::Sphere);
-    let mut out = vec![i];
-    for (dr, dc) in [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)] {
-        let (rr, mut cc) = (r + dr, c + dc);
-        if wrap {
-            cc = cc.rem_euclid(cols);
-        }
-        if (0..rows).contains(&rr) && (0..cols).contains(&cc) && (rr, cc) != (r, c) {
-            out.push((rr * cols + cc) as usize);
-        }
-    }
-    out
 }
 
 /// A bin's error `e` in units of its count's standard deviation √(N p) at N = `samples`, taken
@@ -758,7 +728,7 @@ fn sphere_integral(f: &dyn Integrand) -> Result<SphereIntegral, CheckError> {
 /// assert!((i.value - std::f64::consts::PI).abs() < 1e-12);
 /// ```
 pub fn sphere_integral_f64(f: &(dyn Fn(glam::DVec3) -> f64 + Send + Sync)) -> SphereIntegral {
-    sphere_integral(&CpuPdf { pdf: f, plane: false, jumps: Jumps::Trust }).expect("the CPU rules do not fail")
+    sphere_integral(&CpuPdf { pdf: f, domain: Domain::Sphere, jumps: Jumps::Trust }).expect("the CPU rules do not fail")
 }
 
 /// A WGSL function `fn name(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`

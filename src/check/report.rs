@@ -248,6 +248,11 @@ impl Check {
 }
 
 impl Report {
+    /// The histogram's grid over the sampler's domain.
+    pub fn grid(&self) -> crate::stats::domain::Grid {
+        self.domain.grid(self.rows, self.cols)
+    }
+
     /// The check called `name`.
     pub fn get(&self, name: &str) -> Option<&Check> {
         self.checks.iter().find(|c| c.name() == name)

@@ -272,7 +272,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         let sampler = args.sampler()?;
         let settings = args.settings()?;
         settings.validate().map_err(input)?;
-        if sampler.domain == Domain::Sphere {
+        if sampler.domain.directions() {
             sampler.conventions.check_incident(settings.incident_theta).map_err(input)?;
         }
         Ok::<_, anyhow::Error>((sampler, settings))

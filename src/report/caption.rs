@@ -77,7 +77,7 @@ mod tests {
         assert_eq!(verdict(false, &fine), format!("FAIL, χ² p = {}", compact(fine.p_value)));
         // a smooth tilt of 1.5 % over 4 × 4 bins: the fine grid's p = 0.09, the 2 × 2 grid's 4.9e-5
         let counts: Vec<u64> = (0..16).map(|i| if i % 4 < 2 { 6344 } else { 6156 }).collect();
-        let grid = crate::stats::family::Grid::plane(4, 4);
+        let grid = crate::stats::domain::Domain::UNIT_SQUARE.grid(4, 4);
         let c = crate::stats::family::judge(grid, (&counts, &[6250.0; 16]), (&[0], &[0.0]), 0.01);
         assert_eq!(verdict(false, &c), format!("FAIL, χ² p = {}, caught at 2 × 2: p = {}", compact(c.p_value), compact(c.family[1].p_value)));
     }

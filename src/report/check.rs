@@ -9,7 +9,7 @@ use super::atomic::write_atomic;
 use super::compare::{self, Bins, Comparison};
 use crate::check::power::PowerSweep;
 use crate::check::report::Chi2Figures;
-use crate::check::{Domain, Report};
+use crate::check::Report;
 use std::path::Path;
 
 /// The file names in the output folder (and the pictures', [`super::compare`]).
@@ -37,11 +37,7 @@ pub fn write_power(dir: &Path, sweep: &PowerSweep) -> anyhow::Result<()> {
 }
 
 fn write_maps(dir: &Path, report: &Report) -> anyhow::Result<()> {
-    let (rows, cols) = (report.rows as usize, report.cols as usize);
-    let bins = match report.domain {
-        Domain::Sphere => Bins::Sphere { rows, cols },
-        Domain::Plane { bounds } => Bins::Plane { rows, cols, bounds },
-    };
+    let bins = Bins::Grid(report.grid());
     let counts: Vec<f64> = report.counts.iter().map(|&c| c as f64).collect();
     let invalid: u64 = report.invalid.iter().sum();
     let verdict = report.figures::<Chi2Figures>().map_or_else(

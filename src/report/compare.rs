@@ -26,6 +26,9 @@
 use super::heatmap::{self, Heatmap, Mapping, Scale};
 use super::marginals::{self, Panel};
 use crate::stats::chi2::MIN_EXPECTED;
+use crate::stats::domain::Grid;
+#[cfg(test)]
+use crate::stats::domain::Domain;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -50,10 +53,8 @@ const PDF_BELOW_ZERO: &str = "pdf < 0";
 /// How the bins of a histogram lie.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Bins {
-    /// Directions: `rows` over cos θ ∈ [−1, 1] by `cols` over φ ∈ [−π, π), row-major.
-    Sphere { rows: usize, cols: usize },
-    /// Points of the box `[x0, y0, x1, y1]`: `rows` over y by `cols` over x, row-major.
-    Plane { rows: usize, cols: usize, bounds: [f64; 4] },
+    /// A grid over a domain (directions, or points of a box), row-major.
+    Grid(Grid),
     /// The items of a discrete distribution.
     Items(usize),
 }
@@ -152,7 +153,7 @@ pub fn write(dir: &Path, c: &Comparison) -> anyhow::Result<()> {
             };
             marginals::write_png(&dir.join(BARS_PNG), c.caption, &[panel])
         }
-        Bins::Sphere { rows, cols } | Bins::Plane { rows, cols, .. } => write_grid(dir, c, rows, cols),
+        Bins::Grid(grid) => write_grid(dir, c, grid),
     }
 }
 
@@ -161,16 +162,14 @@ fn title(c: &Comparison, what: &str) -> String {
     format!("{}\n{what}", c.caption)
 }
 
-fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::Result<()> {
-    draw(dir, c, rows, cols, None)?;
+fn write_grid(dir: &Path, c: &Comparison, grid: Grid) -> anyhow::Result<()> {
+    let (rows, cols) = (grid.rows as usize, grid.cols as usize);
+    draw(dir, c, grid, None)?;
     match c.coarse {
         Some((cr, cc)) if cr > 1 && cc > 1 && (cr, cc) != (rows, cols) && c.measured.len() == rows * cols => {
             let (measured, expected) = (aggregate(c.measured, rows, cols, (cr, cc)), aggregate(c.expected, rows, cols, (cr, cc)));
-            let bins = match c.bins {
-                Bins::Plane { bounds, .. } => Bins::Plane { rows: cr, cols: cc, bounds },
-                _ => Bins::Sphere { rows: cr, cols: cc },
-            };
-            draw(dir, &Comparison { bins, measured: &measured, expected: &expected, coarse: None, ..*c }, cr, cc, Some(RESIDUAL_COARSE_PNG))
+            let coarse = grid.domain.grid(cr as u32, cc as u32);
+            draw(dir, &Comparison { bins: Bins::Grid(coarse), measured: &measured, expected: &expected, coarse: None, ..*c }, coarse, Some(RESIDUAL_COARSE_PNG))
         }
         _ => Ok(()),
     }
@@ -178,7 +177,8 @@ fn write_grid(dir: &Path, c: &Comparison, rows: usize, cols: usize) -> anyhow::R
 
 /// The maps and marginals of a grid; with `residual_only`, its residual map alone into that file
 /// (a coarse grid's, titled with its size).
-fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Option<&str>) -> anyhow::Result<()> {
+fn draw(dir: &Path, c: &Comparison, grid: Grid, residual_only: Option<&str>) -> anyhow::Result<()> {
+    let (rows, cols) = (grid.rows as usize, grid.cols as usize);
     anyhow::ensure!(
         c.measured.len() == rows * cols && c.expected.len() == rows * cols,
         "a {rows} × {cols} histogram with {} measured and {} expected bins",
@@ -186,10 +186,8 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
         c.expected.len()
     );
     let drawn = drawn_rows(c.measured, c.expected, rows, cols);
-    let first = match c.bins {
-        Bins::Sphere { .. } => first_column(c.expected, cols),
-        _ => 0,
-    };
+    // columns that wrap around (φ) start where the lobe is not cut in two
+    let first = if grid.domain.columns_wrap() { first_column(c.expected, cols) } else { 0 };
     // the drawn rows, each from column `first` round to the one before it
     let cells = |values: &[f64]| -> Vec<f64> {
         drawn.clone().flat_map(|r| (0..cols).map(move |k| values[r * cols + (k + first) % cols])).collect()
@@ -197,13 +195,10 @@ fn draw(dir: &Path, c: &Comparison, rows: usize, cols: usize, residual_only: Opt
     let (measured, expected) = (cells(c.measured), cells(c.expected));
     let residuals: Vec<f64> = measured.iter().zip(&expected).map(|(&m, &e)| residual(m, e)).collect();
 
-    let (row_label, col_label, (r0, r1), (c0, c1)) = match c.bins {
-        Bins::Plane { bounds: [x0, y0, x1, y1], .. } => ("y", "x", (y0, y1), (x0, x1)),
-        _ => {
-            let phi0 = -180.0 + first as f64 * 360.0 / cols as f64;
-            ("cos θ", "φ (degrees)", (-1.0, 1.0), (phi0, phi0 + 360.0))
-        }
-    };
+    let [(row_label, (r0, r1)), (col_label, (c0, c1))] = grid.domain.picture_axes();
+    // the column axis from column `first`, one period long
+    let (start, period) = (c0 + first as f64 * (c1 - c0) / cols as f64, c1 - c0);
+    let (c0, c1) = (start, start + period);
     let row_edge = |r: usize| r0 + (r1 - r0) * r as f64 / rows as f64;
     let col_edge = |k: usize| c0 + (c1 - c0) * k as f64 / cols as f64;
     let base = Heatmap {
@@ -345,7 +340,7 @@ mod tests {
         // measured in rows 0 and 1
         let expected = grid(|r, c| if r >= 2 { 100.0 } else if r == 0 && c < 2 { -3.0 } else { 0.0 });
         let measured = grid(|r, _| if r >= 2 { 100.0 } else { 0.0 });
-        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &measured, expected: &expected, caption: "negative", note: "", coarse: None };
+        let c = Comparison { bins: Bins::Grid(Domain::Sphere.grid(4, 8)), measured: &measured, expected: &expected, caption: "negative", note: "", coarse: None };
         write(dir.path(), &c).unwrap();
         let read = |f: &str| image::open(dir.path().join(f)).unwrap().to_rgb8();
         let count = |img: &image::RgbImage, rgb: [u8; 3]| img.pixels().filter(|p| p.0 == rgb).count();
@@ -375,7 +370,7 @@ mod tests {
     fn the_pictures_of_a_grid_and_of_items() {
         let dir = tempfile::tempdir().unwrap();
         let lobe = grid(|r, c| if r >= 2 { 50.0 + 10.0 * c as f64 } else { 0.0 });
-        let c = Comparison { bins: Bins::Sphere { rows: 4, cols: 8 }, measured: &lobe, expected: &lobe, caption: "lobe", note: "", coarse: None };
+        let c = Comparison { bins: Bins::Grid(Domain::Sphere.grid(4, 8)), measured: &lobe, expected: &lobe, caption: "lobe", note: "", coarse: None };
         write(dir.path(), &c).unwrap();
         for png in [MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, MARGINALS_PNG] {
             assert!(dir.path().join(png).is_file(), "{png}");

@@ -221,7 +221,7 @@ impl HistogramFile {
         let (case, report) = (&r.case, &r.report);
         let description = CaseDescription::of_user(case, report.rows, report.cols);
         let cols = description.cols;
-        let sphere = report.domain == Domain::Sphere;
+        let sphere = report.domain.directions();
         let grid = SphereGrid { rows: report.rows, cols: report.cols };
         let wi = crate::reference::reflect::spherical(case.settings.incident_theta.to_radians(), case.settings.incident_phi.to_radians());
         let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = report.invalid;
@@ -293,10 +293,7 @@ pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonSty
     std::fs::create_dir_all(&folder)?;
     let doc = HistogramFile::of_user(r, backend);
     let (rows, cols) = (doc.description.rows, doc.description.cols);
-    let bins = match r.report.domain {
-        Domain::Sphere => Bins::Sphere { rows, cols },
-        Domain::Plane { bounds } => Bins::Plane { rows, cols, bounds },
-    };
+    let bins = Bins::Grid(r.report.grid());
     let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
     let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), &r.chi2));
     let coarse = family::caught_grid(&r.chi2);
@@ -352,7 +349,7 @@ pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, styl
     let doc = HistogramFile::new(r, adapter, backend);
     let (rows, cols) = (doc.description.rows, doc.description.cols);
     let bins = match &r.case.job {
-        Job::Lobe { .. } => Bins::Sphere { rows, cols },
+        Job::Lobe { .. } => Bins::Grid(Domain::Sphere.grid(rows as u32, cols as u32)),
         Job::Discrete { .. } => Bins::Items(cols),
     };
     let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();

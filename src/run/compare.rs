@@ -8,6 +8,7 @@ use crate::reference::dielectric::RoughDielectric;
 use crate::reference::Invalid;
 use crate::reference::effects::Effects;
 use crate::stats::chi2::Chi2;
+use crate::stats::domain::Domain;
 use crate::stats::family::{self, Grid};
 use crate::stats::expected::{self, Expected, Quadrature};
 use crate::stats::weighted::{AlbedoCheck, AlbedoTest, WEIGHT_ERROR_LIMIT, WeightedSums, two_sided};
@@ -32,8 +33,9 @@ pub struct ExpectedCounts {
 /// distribution's entries in one row.
 pub fn grid(job: &Job) -> Grid {
     match job {
-        Job::Lobe { grid, .. } => Grid::sphere(grid.rows, grid.cols),
-        Job::Discrete { dist, .. } => Grid { rows: 1, cols: dist.len() as u32, axes: ["", "entry"] },
+        Job::Lobe { grid, .. } => Domain::Sphere.grid(grid.rows, grid.cols),
+        // entry i is the cell [i, i + 1] × [0, 1] of one row
+        Job::Discrete { dist, .. } => Domain::Plane { bounds: [0.0, 0.0, dist.len() as f64, 1.0] }.grid(1, dist.len() as u32),
     }
 }
 
@@ -51,7 +53,7 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
             let e = expected::lobe_probabilities(lobe, *incident, *grid, q);
             let mut invalid = [0.0; Invalid::COUNT];
             invalid[Invalid::BelowHorizon.code() as usize - 1] = n * e.below_horizon;
-            ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Grid::sphere(grid.rows, grid.cols) }
+            ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Domain::Sphere.grid(grid.rows, grid.cols) }
         }
         Job::Discrete { dist, .. } => {
             ExpectedCounts { bins: dist.pmf().iter().map(|p| n * p).collect(), invalid: [0.0; Invalid::COUNT], quadrature: None, grid: grid(job) }
@@ -111,7 +113,7 @@ fn dielectric_expected(glass: &RoughDielectric, wi: DVec3, grid: crate::stats::h
     let mut invalid = [0.0; Invalid::COUNT];
     invalid[Invalid::BelowHorizon.code() as usize - 1] = n * below;
     invalid[Invalid::RefractedNearSide.code() as usize - 1] = n * near;
-    ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Grid::sphere(grid.rows, grid.cols) }
+    ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Domain::Sphere.grid(grid.rows, grid.cols) }
 }
 
 /// Pearson's χ² over all cells, bins and invalid reasons alike: a sampler that puts mass below
@@ -129,7 +131,7 @@ pub fn chi2_test(counts: &Counts, expected: &ExpectedCounts, significance: f64) 
 /// ```
 /// use lobes::{engine::job::Counts, run::compare::{ExpectedCounts, chi2_failure, chi2_test}};
 /// let counts = Counts { bins: vec![500, 480], invalid: [0, 0, 20, 0, 0] };
-/// let grid = lobes::stats::family::Grid::sphere(1, 2);
+/// let grid = lobes::stats::domain::Domain::Sphere.grid(1, 2);
 /// let expected = ExpectedCounts { bins: vec![500.0, 500.0], invalid: [0.0; 5], quadrature: None, grid };
 /// let why = chi2_failure(&counts, &expected, &chi2_test(&counts, &expected, 0.01));
 /// assert_eq!(why[1], "20 samples rejected as non_finite_pdf, where the reference expects none");

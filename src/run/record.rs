@@ -5,7 +5,6 @@
 
 use crate::engine::job::{Job, Scatter};
 use crate::reference::Invalid;
-use crate::check::Domain;
 use crate::scene::{Case, UserCase};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -96,10 +95,7 @@ impl CaseDescription {
     /// The description of a user's sampler case.
     pub fn of_user(case: &UserCase, rows: u32, cols: u32) -> Self {
         let (s, set) = (&case.sampler, &case.settings);
-        let (domain, bounds, sphere) = match s.domain {
-            Domain::Sphere => ("sphere", None, true),
-            Domain::Plane { bounds } => ("plane", Some(bounds), false),
-        };
+        let (domain, bounds, sphere) = (s.domain.name(), s.domain.bounds(), s.domain.directions());
         CaseDescription {
             lobe: "user".into(),
             method: "wgsl".into(),

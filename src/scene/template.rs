@@ -8,7 +8,7 @@ use crate::check::{Domain, MAX_PARAMS, Settings};
 /// The commented template scene.
 pub fn template() -> String {
     let user = Settings::default();
-    let (sphere, plane) = (user.grid(&Domain::Sphere), user.grid(&Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }));
+    let (sphere, plane) = (user.grid(&Domain::Sphere), user.grid(&Domain::UNIT_SQUARE));
     format!(
         r#"# A lobes scene: every key with its default. Run it with `lobes run scene.toml`.
 # Any key with one number or name sweeps when given an array: one case per value, and several

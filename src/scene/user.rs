@@ -193,7 +193,7 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
         Some(v) => match string(ctx, v, "domain", allowed)? {
             "sphere" => false,
             "plane" => true,
-            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, ["sphere", "plane"])))),
+            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, Domain::NAMES)))),
         },
     };
     if !plane {
@@ -209,10 +209,11 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
         return Err(ctx.err(b.span(), format!("bounds must be an array, got {}; {BOUNDS_ALLOWED}", kind_of(b.get_ref()))));
     };
     let numbers = items.iter().map(|i| number(ctx, &Spanned::new(b.span(), i.clone()), "bounds", |_| true, BOUNDS_ALLOWED)).collect::<Result<Vec<_>, _>>()?;
-    match numbers[..] {
-        [x0, y0, x1, y1] if x0 < x1 && y0 < y1 => Ok(Domain::Plane { bounds: [x0, y0, x1, y1] }),
-        _ => Err(ctx.err(b.span(), format!("bounds = {} is not a box; {BOUNDS_ALLOWED}", b.get_ref()))),
-    }
+    let plane = match numbers[..] {
+        [x0, y0, x1, y1] => Domain::plane([x0, y0, x1, y1]).ok(),
+        _ => None,
+    };
+    plane.ok_or_else(|| ctx.err(b.span(), format!("bounds = {} is not a box; {BOUNDS_ALLOWED}", b.get_ref())))
 }
 
 /// `budget = SECONDS` or `"ci"` / `"thorough"`: the case's count picked by pilot checks when it
@@ -239,7 +240,7 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
         Some(t) => {
             let theta = number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?;
             // a sweep stays where the sampler is declared for (incident = "upper": below 90°)
-            if sampler.domain == Domain::Sphere {
+            if sampler.domain.directions() {
                 sampler.conventions.check_incident(theta).map_err(|e| ctx.err(t.span(), format!("incident_theta: {e}")))?;
             }
             theta

@@ -15,6 +15,8 @@
 //! plane grid in (x, y), so a block of bins is a cell of equal solid angle (or area).
 
 use super::chi2::{self, Chi2};
+#[cfg(test)]
+use super::domain::Domain;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -22,26 +24,7 @@ use serde::{Deserialize, Serialize};
 /// 2 × 2 of the plane's): coarser than that, a grid can no longer tell where the mass went.
 pub const MIN_CELLS: u64 = 4;
 
-/// The fine grid a histogram's bins lie on, row-major, and the names of its axes
-/// (`["cos θ", "φ"]` on the sphere, `["y", "x"]` on the plane).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Grid {
-    pub rows: u32,
-    pub cols: u32,
-    pub axes: [&'static str; 2],
-}
-
-impl Grid {
-    /// lobes' sphere grid: rows over cos θ, columns over φ.
-    pub fn sphere(rows: u32, cols: u32) -> Self {
-        Grid { rows, cols, axes: ["cos θ", "φ"] }
-    }
-
-    /// A plane grid: rows over y, columns over x.
-    pub fn plane(rows: u32, cols: u32) -> Self {
-        Grid { rows, cols, axes: ["y", "x"] }
-    }
-}
+pub use super::domain::Grid;
 
 /// One test of the family: Pearson's χ² over the fine grid's bins grouped into `rows` × `cols`
 /// cells, fine row r into ⌊r · rows / R⌋ and column c into ⌊c · cols / C⌋ (a marginal is a grid
@@ -88,8 +71,8 @@ impl Test {
 /// axis of two cells or more; a grid met twice is tested once.
 ///
 /// ```
-/// use lobes::stats::family::{tests, Grid};
-/// let names: Vec<String> = tests(Grid::sphere(64, 128)).into_iter().map(|t| t.name).collect();
+/// use lobes::stats::{domain::Domain, family::tests};
+/// let names: Vec<String> = tests(Domain::Sphere.grid(64, 128)).into_iter().map(|t| t.name).collect();
 /// assert_eq!(names, ["64 × 128", "32 × 64", "16 × 32", "8 × 16", "4 × 8", "2 × 4", "cos θ", "φ"]);
 /// ```
 pub fn tests(grid: Grid) -> Vec<Test> {
@@ -104,7 +87,7 @@ pub fn tests(grid: Grid) -> Vec<Test> {
         shapes.push(next);
     }
     let mut out: Vec<Test> = shapes.into_iter().map(|(rows, cols)| Test { name: format!("{rows} × {cols}"), rows, cols }).collect();
-    for (rows, cols, axis) in [(grid.rows, 1, grid.axes[0]), (1, grid.cols, grid.axes[1])] {
+    for (rows, cols, axis) in [(grid.rows, 1, grid.domain.axes()[0]), (1, grid.cols, grid.domain.axes()[1])] {
         if rows * cols >= 2 && !out.iter().any(|t| (t.rows, t.cols) == (rows, cols)) {
             out.push(Test { name: axis.to_string(), rows, cols });
         }
@@ -162,13 +145,13 @@ pub fn holm(p: &[f64]) -> Vec<f64> {
 /// `significance`: the family's p-value, Holm's smallest, is at least `significance`.
 ///
 /// ```
-/// use lobes::stats::family::{judge, Grid};
+/// use lobes::stats::{domain::Domain, family::judge};
 /// // 4 × 4 bins, a smooth tilt: +1.5 % in the left half, −1.5 % in the right, 10⁵ samples.
 /// // The fine grid: χ² = 16 · 94²/6250 = 22.6 on 15 dof, p = 0.09; the 2 × 2 grid and the x
 /// // marginal: the same 22.6 on 3 dof, p = 4.9e-5 each, Holm's 4 · 4.9e-5 = 2.0e-4.
 /// let expected = vec![6250.0; 16];
 /// let counts: Vec<u64> = (0..16).map(|i| if i % 4 < 2 { 6344 } else { 6156 }).collect();
-/// let t = judge(Grid::plane(4, 4), (&counts, &expected), (&[0], &[0.0]), 0.01);
+/// let t = judge(Domain::UNIT_SQUARE.grid(4, 4), (&counts, &expected), (&[0], &[0.0]), 0.01);
 /// assert!(!t.passed && t.family[0].p_value > 0.05);
 /// assert_eq!(t.family.iter().filter(|f| f.rejected).map(|f| f.test.as_str()).collect::<Vec<_>>(), ["2 × 2", "x"]);
 /// ```
@@ -249,13 +232,13 @@ mod tests {
     #[test]
     fn the_family_of_each_grid() {
         let names = |g: Grid| tests(g).into_iter().map(|t| (t.name, t.rows, t.cols)).collect::<Vec<_>>();
-        let plane = names(Grid::plane(64, 64));
+        let plane = names(Domain::UNIT_SQUARE.grid(64, 64));
         assert_eq!(plane.iter().map(|t| t.0.as_str()).collect::<Vec<_>>(), ["64 × 64", "32 × 32", "16 × 16", "8 × 8", "4 × 4", "2 × 2", "y", "x"]);
         // odd sizes round up; a 1-D table aggregates along its one axis and has no marginal
-        assert_eq!(names(Grid::sphere(5, 6)), [("5 × 6".into(), 5, 6), ("3 × 3".into(), 3, 3), ("2 × 2".into(), 2, 2), ("cos θ".into(), 5, 1), ("φ".into(), 1, 6)]);
-        assert_eq!(names(Grid::sphere(1, 20)), [("1 × 20".into(), 1, 20), ("1 × 10".into(), 1, 10), ("1 × 5".into(), 1, 5)]);
-        assert_eq!(names(Grid::sphere(1, 1)), [("1 × 1".into(), 1, 1)]);
-        assert_eq!(names(Grid::sphere(2, 1)).len(), 1);
+        assert_eq!(names(Domain::Sphere.grid(5, 6)), [("5 × 6".into(), 5, 6), ("3 × 3".into(), 3, 3), ("2 × 2".into(), 2, 2), ("cos θ".into(), 5, 1), ("φ".into(), 1, 6)]);
+        assert_eq!(names(Domain::Sphere.grid(1, 20)), [("1 × 20".into(), 1, 20), ("1 × 10".into(), 1, 10), ("1 × 5".into(), 1, 5)]);
+        assert_eq!(names(Domain::Sphere.grid(1, 1)), [("1 × 1".into(), 1, 1)]);
+        assert_eq!(names(Domain::Sphere.grid(2, 1)).len(), 1);
     }
 
     /// The cells of an aggregation, summed by hand: 3 × 4 into 2 × 2 groups rows {0, 1}, {2}
@@ -266,13 +249,13 @@ mod tests {
         let counts: Vec<u64> = (0..12).collect();
         let expected: Vec<f64> = (0..12).map(|i| i as f64 + 0.5).collect();
         let t = Test { name: "2 × 2".into(), rows: 2, cols: 2 };
-        let (o, e) = t.cells(Grid::plane(3, 4), &counts, &expected);
+        let (o, e) = t.cells(Domain::UNIT_SQUARE.grid(3, 4), &counts, &expected);
         assert_eq!(o, [0 + 1 + 4 + 5, 2 + 3 + 6 + 7, 8 + 9, 10 + 11]);
         assert_eq!(e, [12.0, 20.0, 18.0, 22.0]);
         // the marginals
-        let (o, _) = Test { name: "y".into(), rows: 3, cols: 1 }.cells(Grid::plane(3, 4), &counts, &expected);
+        let (o, _) = Test { name: "y".into(), rows: 3, cols: 1 }.cells(Domain::UNIT_SQUARE.grid(3, 4), &counts, &expected);
         assert_eq!(o, [6, 22, 38]);
-        let (o, _) = Test { name: "x".into(), rows: 1, cols: 4 }.cells(Grid::plane(3, 4), &counts, &expected);
+        let (o, _) = Test { name: "x".into(), rows: 1, cols: 4 }.cells(Domain::UNIT_SQUARE.grid(3, 4), &counts, &expected);
         assert_eq!(o, [12, 15, 18, 21]);
     }
 
@@ -281,7 +264,7 @@ mod tests {
     /// 2 · 100/50 = 4 on 1 dof, p = P(χ²₁ ≥ 4) = erfc(√2) = 0.0455; columns (50 | 50): 0.
     #[test]
     fn aggregated_statistic_by_hand() {
-        let t = judge(Grid::plane(2, 2), (&[30, 30, 20, 20], &[25.0; 4]), (&[0], &[0.0]), 0.01);
+        let t = judge(Domain::UNIT_SQUARE.grid(2, 2), (&[30, 30, 20, 20], &[25.0; 4]), (&[0], &[0.0]), 0.01);
         let f = |name: &str| t.family.iter().find(|x| x.test == name).unwrap().clone();
         assert_eq!(t.family.len(), 3, "{:?}", t.family); // 2 × 2, y, x
         assert!((f("2 × 2").statistic - 4.0).abs() < 1e-12 && f("2 × 2").dof == 3);
@@ -297,7 +280,7 @@ mod tests {
         assert_eq!(t.family_p_value, Some(f("y").holm_p_value));
         assert!(t.passed);
         // at a level above 3 × 0.0455 the rows' marginal rejects, and names itself
-        let t = judge(Grid::plane(2, 2), (&[30, 30, 20, 20], &[25.0; 4]), (&[0], &[0.0]), 0.2);
+        let t = judge(Domain::UNIT_SQUARE.grid(2, 2), (&[30, 30, 20, 20], &[25.0; 4]), (&[0], &[0.0]), 0.2);
         assert!(!t.passed);
         assert_eq!(caught(&t).unwrap(), "caught at y: p = 4.6e-2 (Holm 1.4e-1); 2 × 2: p = 2.6e-1");
     }
@@ -327,7 +310,7 @@ mod tests {
     /// rejects at about α.
     #[test]
     fn family_error_rate_under_the_null() {
-        let grid = Grid::sphere(8, 16);
+        let grid = Domain::Sphere.grid(8, 16);
         let p: Vec<f64> = (0..128).map(|i| 1.0 + 0.5 * ((i % 16) as f64 * 0.4).sin() + 0.1 * (i / 16) as f64).collect();
         let total: f64 = p.iter().sum();
         let n = 20_000u64;
@@ -364,7 +347,7 @@ mod tests {
     /// = 40.5 on 7 dof, has p ≈ 10⁻⁶.
     #[test]
     fn coarse_levels_see_a_smooth_defect() {
-        let grid = Grid::sphere(64, 128);
+        let grid = Domain::Sphere.grid(64, 128);
         let n = 1e6f64;
         let e = n / 8192.0;
         let expected = vec![e; 8192];
@@ -401,16 +384,16 @@ mod tests {
     #[test]
     fn untested_outcomes_keep_working() {
         // no valid sample: never a pass, whatever the family says
-        let t = judge(Grid::sphere(2, 4), (&[0; 8], &[0.0; 8]), (&[600, 400], &[600.0, 400.0]), 0.01);
+        let t = judge(Domain::Sphere.grid(2, 4), (&[0; 8], &[0.0; 8]), (&[600, 400], &[600.0, 400.0]), 0.01);
         assert_eq!((t.passed, t.untested), (false, Some(Untested::NoValidSample)));
         // one cell after pooling: the family's tests all have dof 0 and count for nothing
         let mut bins = vec![0u64; 64];
         bins[40] = 1_000_000;
-        let t = judge(Grid::sphere(8, 8), (&bins, &[5e-11 / 64.0; 64]), (&[0, 0], &[1e6 - 5e-11, 0.0]), 0.01);
+        let t = judge(Domain::Sphere.grid(8, 8), (&bins, &[5e-11 / 64.0; 64]), (&[0, 0], &[1e6 - 5e-11, 0.0]), 0.01);
         assert_eq!((t.passed, t.untested, t.family_p_value), (false, Some(Untested::OneCell), Some(1.0)));
         assert!(t.family.iter().all(|f| f.dof == 0 && !f.rejected));
         // samples where none may be: rejected at the fine grid, p = 0
-        let t = judge(Grid::sphere(2, 2), (&[1, 100, 100, 100], &[0.0, 101.0, 100.0, 100.0]), (&[0], &[0.0]), 0.01);
+        let t = judge(Domain::Sphere.grid(2, 2), (&[1, 100, 100, 100], &[0.0, 101.0, 100.0, 100.0]), (&[0], &[0.0]), 0.01);
         assert_eq!((t.passed, t.in_impossible_cells, t.family[0].rejected), (false, 1, true));
     }
 }

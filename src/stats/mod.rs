@@ -1,7 +1,8 @@
-//! Statistics: binning, Gauss–Legendre quadrature, expected counts, and the χ² test and its family over
+//! Statistics: domains and their grids, binning, Gauss–Legendre quadrature, expected counts, and the χ² test and its family over
 //! resolutions.
 
 pub mod chi2;
+pub mod domain;
 pub mod expected;
 pub mod family;
 pub mod gauss_legendre;

@@ -11,8 +11,7 @@ use crate::stats::family;
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     let (counts, expected, joined) = judged_cells(run, m)?;
-    let (rows, cols) = (run.rows, run.cols);
-    let grid = if run.plane() { family::Grid::plane(rows, cols) } else { family::Grid::sphere(rows, cols) };
+    let grid = run.grid();
     let invalid = m.invalid(run.bins());
     let expected_invalid = normalization::expected_invalid(run, m);
     let chi2 = family::judge(grid, (&counts, &expected), (&[invalid.iter().sum()], &[expected_invalid]), run.settings.significance);
@@ -31,7 +30,8 @@ pub(crate) fn expected(run: &Run, m: &Measured) -> Vec<f64> {
 /// lobe than f32 binning places it, the two bins beside it as one cell.
 fn judged_cells(run: &Run, m: &Measured) -> Result<(Vec<u64>, Vec<f64>, usize), CheckError> {
     let (counts, expected) = (m.counts(run.bins()), expected(run, m));
-    if run.plane() {
+    // (the plane's edges are exact in f32 binning's sense: x and y themselves are binned)
+    if !run.sampler.domain.directions() {
         return Ok((counts.to_vec(), expected, 0));
     }
     let (rows, cols, samples) = (run.rows, run.cols, run.settings.samples);

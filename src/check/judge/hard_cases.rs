@@ -4,18 +4,15 @@
 use super::Run;
 use crate::check::hard::{self, HardRow};
 use crate::check::report::{Check, Figures};
-use crate::check::{CheckError, Domain, incident};
+use crate::check::{CheckError, incident};
 
 pub(crate) fn check(run: &Run) -> Result<Check, CheckError> {
     let (s, settings) = (run.sampler, run.settings);
     let us = hard::uniforms(&s.conventions.hard_u_values());
-    let thetas: Vec<f64> = if run.plane() { vec![settings.incident_theta] } else { s.conventions.hard_thetas() };
+    let thetas: Vec<f64> = if s.domain.directions() { s.conventions.hard_thetas() } else { vec![settings.incident_theta] };
     let items: Vec<([f32; 4], [f32; 3])> = thetas.iter().flat_map(|&t| us.iter().map(move |u| (*u, incident(t, settings.incident_phi)))).collect();
     let probes = run.passes.probe(&run.params, &items)?;
-    let bounds = match s.domain {
-        Domain::Plane { bounds } => Some(bounds),
-        Domain::Sphere => None,
-    };
+    let bounds = s.domain.bounds();
     let table: Vec<HardRow> = thetas.iter().zip(probes.chunks(us.len())).map(|(&t, p)| hard::row(t, p, &us, bounds)).collect();
     let summary = match failing(&table) {
         None => {

@@ -8,7 +8,7 @@ use crate::check::report::{Check, Figures};
 use crate::check::CONDITIONING_ULPS;
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Check {
-    let jac = map::judge(&m.probes, &m.probe_u, &m.at, &m.kappa, CONDITIONING_ULPS, run.plane(), m.jump);
+    let jac = map::judge(&m.probes, &m.probe_u, &m.at, &m.kappa, CONDITIONING_ULPS, run.sampler.domain, m.jump);
     let summary = if jac.applicable { applicable(&jac, &not_unit(run, m, &jac)) } else { not_applicable(&jac) };
     Check { passed: jac.passed, summary, figures: Figures::Jacobian(jac) }
 }
@@ -16,9 +16,9 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Check {
 /// The length of d at the worst probe: a map onto non-unit vectors has the wrong |J| on the
 /// sphere, and the cause is then the length, not the density.
 fn not_unit(run: &Run, m: &Measured, jac: &JacobianCheck) -> String {
-    let worst_length = m.probes.iter().zip(&m.probe_u).find(|(_, u)| **u == jac.worst_u).map(|(p, _)| p[6][2]);
+    let worst_length = m.probes.iter().zip(&m.probe_u).find(|(_, u)| **u == jac.worst_u).map(|(p, _)| p.length);
     match worst_length {
-        Some(l) if !run.plane() && !jac.passed && !hard::is_unit(l) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
+        Some(l) if run.sampler.domain.directions() && !jac.passed && !hard::is_unit(l) => format!("; |d| = {} at the worst sample, not a unit vector", hard::show(l)),
         _ => String::new(),
     }
 }

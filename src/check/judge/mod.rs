@@ -15,8 +15,10 @@ pub mod pdf_values;
 pub mod weights;
 
 use super::gpu::{Params, Passes};
+use super::probe::Probe;
 use super::quadrature::{self, Integrals, Integrand};
-use super::{CheckError, Domain, Settings, UserSampler, jacobian as map};
+use super::{CheckError, Settings, UserSampler, jacobian as map};
+use crate::stats::domain::Grid;
 use crate::engine::gpu::Gpu;
 use crate::reference::rng;
 
@@ -48,8 +50,9 @@ impl<'a, 'g> Run<'a, 'g> {
     pub fn bins(&self) -> usize {
         (self.rows * self.cols) as usize
     }
-    pub fn plane(&self) -> bool {
-        matches!(self.sampler.domain, Domain::Plane { .. })
+    /// The histogram's grid over the sampler's domain.
+    pub fn grid(&self) -> Grid {
+        self.sampler.domain.grid(self.rows, self.cols)
     }
     pub fn samples(&self) -> f64 {
         self.settings.samples as f64
@@ -65,16 +68,12 @@ impl<'a, 'g> Run<'a, 'g> {
         match &self.settings.reference {
             Some(r) => {
                 let pdf = move |d: glam::DVec3| (r.0)(wi, d);
-                f(&quadrature::CpuPdf { pdf: &pdf, plane: self.plane(), jumps: quadrature::Jumps::Locate })
+                f(&quadrature::CpuPdf { pdf: &pdf, domain: self.sampler.domain, jumps: quadrature::Jumps::Locate })
             }
             None => f(&(&self.passes, &self.params)),
         }
     }
 }
-
-/// The probe of one sample as the probe pass writes it (`lobes_probe`,
-/// shaders/check/user_passes.wgsl).
-pub(crate) type Probe = [[f32; 4]; 7];
 
 /// Everything the checks judge, measured once.
 pub(crate) struct Measured {
@@ -109,10 +108,6 @@ impl Measured {
     pub fn pdf_total(&self) -> f64 {
         self.integrals.probabilities.iter().sum()
     }
-    /// Whether a probe's reported sample is valid: a finite point with a pdf > 0.
-    pub fn valid(p: &Probe) -> bool {
-        p[0][3] > 0.0 && p[0][3].is_finite() && p[0][..3].iter().all(|x| x.is_finite())
-    }
 }
 
 /// Measures `run`: the histogram, the probes, and the quadrature of the pdf.
@@ -121,12 +116,12 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
     let probe_u = probe_uniforms(run.settings);
     let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, run.wi)).collect();
     let probes = run.passes.probe(&run.params, &items)?;
-    let points: Vec<[f32; 3]> = probes.iter().map(|p| [p[0][0], p[0][1], p[0][2]]).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();
+    let points: Vec<[f32; 3]> = probes.iter().map(Probe::d).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();
     let kappa: Vec<f64> = run.passes.conditioning(&run.params, &points)?.iter().map(|v| v[1] as f64).collect();
     let around: Vec<[f32; 4]> = probe_u.iter().flat_map(|u| map::around(*u)).collect();
     let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
-    let p_max = probes.iter().filter(|p| Measured::valid(p)).map(|p| p[0][3] as f64).fold(0.0, f64::max);
-    let width = quadrature::initial_width(p_max, run.plane());
+    let p_max = probes.iter().filter(|p| p.valid()).map(|p| p.reported_pdf() as f64).fold(0.0, f64::max);
+    let width = quadrature::initial_width(p_max, run.sampler.domain);
     let (integrals, f32_moved) = integrate(run, &totals[..run.bins()], width)?;
     let jump = map_jump(run, &probes, &probe_u)?;
     Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
@@ -135,8 +130,8 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
 /// A jump of the sample map along u.x or u.y ([`map::find_jump`]) on the lines through the first
 /// [`map::JUMP_LINES`] probes with a valid sample.
 fn map_jump(run: &Run, probes: &[Probe], probe_u: &[[f32; 4]]) -> Result<Option<map::Jump>, CheckError> {
-    let valid: Vec<[f32; 4]> = probes.iter().zip(probe_u).filter(|(p, _)| Measured::valid(p)).map(|(_, u)| *u).take(map::JUMP_LINES).collect();
-    map::find_jump(&valid, run.plane(), &|us| run.passes.map(&run.params, us))
+    let valid: Vec<[f32; 4]> = probes.iter().zip(probe_u).filter(|(p, _)| p.valid()).map(|(_, u)| *u).take(map::JUMP_LINES).collect();
+    map::find_jump(&valid, run.sampler.domain, &|us| run.passes.map(&run.params, us))
 }
 
 /// The probe's uniforms: away from the edges by 2ε, so that u ± ε stays in [0, 1].

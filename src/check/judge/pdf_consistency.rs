@@ -23,8 +23,8 @@ fn figures(m: &Measured) -> ConsistencyFigures {
         over_limit: 0,
     };
     let mut worst = 0.0;
-    for ((p, u), k) in m.probes.iter().zip(&m.probe_u).zip(&m.kappa).filter(|((p, _), _)| Measured::valid(p)) {
-        let (rep, fun) = (p[0][3] as f64, p[6][0] as f64);
+    for ((p, u), k) in m.probes.iter().zip(&m.probe_u).zip(&m.kappa).filter(|((p, _), _)| p.valid()) {
+        let (rep, fun) = (p.reported_pdf() as f64, p.pdf as f64);
         c.compared += 1;
         if !fun.is_finite() {
             // the worst of all: the first such sample is the one shown

@@ -10,9 +10,9 @@ use crate::check::hard::show;
 use crate::check::report::{Check, Figures, PdfValuesFigures};
 use crate::check::{CheckError, Domain};
 
-/// The grid's rows and columns on the sphere (on the plane: rows × rows).
-const ROWS: u32 = 256;
-const COLS: u32 = 512;
+/// The grid's cells per cell of the domain's default histogram, along each axis (256 × 512 on
+/// the sphere, 256 × 256 on the plane).
+const FINER: u32 = 4;
 
 /// The worst value found and where, in the user's frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,13 +27,13 @@ pub struct Worst {
 impl Worst {
     /// "pdf(d) = NaN at d = (0.1, 0.2, 0.97) (θ 14.1°, φ 63.4°)" (θ, φ on the sphere only), with
     /// `pdf_at_d` the pdf at d as the user named it ([`super::UserSampler::pdf_at_d`]).
-    pub fn describe(&self, pdf_at_d: &str, plane: bool) -> String {
+    pub fn describe(&self, pdf_at_d: &str, domain: Domain) -> String {
         let [x, y, z] = self.d.map(|v| show(v as f32));
-        let angles = if plane {
-            String::new()
-        } else {
+        let angles = if domain.directions() {
             let (t, p) = self.angles;
             format!(" (θ {t:.1}°, φ {p:.1}°)")
+        } else {
+            String::new()
         };
         format!("{pdf_at_d} = {} at d = ({x}, {y}, {z}){angles}", show(self.value))
     }
@@ -58,23 +58,8 @@ fn badness(v: f32) -> Option<(u8, f32)> {
 
 /// The worst point of the grid, if any is bad.
 fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conventions) -> Result<Option<Worst>, CheckError> {
-    let points: Vec<[f32; 4]> = match *domain {
-        Domain::Sphere => (0..ROWS * COLS)
-            .map(|k| {
-                let z = -1.0 + 2.0 * ((k / COLS) as f64 + 0.5) / ROWS as f64;
-                let phi = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * ((k % COLS) as f64 + 0.5) / COLS as f64;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                [(r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32, 0.0]
-            })
-            .collect(),
-        Domain::Plane { bounds: [x0, y0, x1, y1] } => (0..ROWS * ROWS)
-            .map(|k| {
-                let x = x0 + (x1 - x0) * ((k % ROWS) as f64 + 0.5) / ROWS as f64;
-                let y = y0 + (y1 - y0) * ((k / ROWS) as f64 + 0.5) / ROWS as f64;
-                [x as f32, y as f32, 0.0, 0.0]
-            })
-            .collect(),
-    };
+    let (rows, cols) = domain.default_grid();
+    let points: Vec<[f32; 4]> = domain.grid(FINER * rows, FINER * cols).centres().iter().map(|&[x, y, z]| [x as f32, y as f32, z as f32, 0.0]).collect();
     let values = passes.pdf_at(params, &points)?;
     let worst = points
         .iter()
@@ -83,7 +68,7 @@ fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conven
         .max_by(|a, b| a.0.0.cmp(&b.0.0).then(a.0.1.total_cmp(&b.0.1)));
     Ok(worst.map(|(_, d, value)| {
         let d = [d[0] as f64, d[1] as f64, d[2] as f64];
-        Worst { d: if matches!(domain, Domain::Plane { .. }) { d } else { conventions.to_user(d) }, angles: angles(d), value }
+        Worst { d: if domain.directions() { conventions.to_user(d) } else { d }, angles: angles(d), value }
     }))
 }
 
@@ -95,10 +80,10 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     if bad > 0
         && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
     {
-        let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), false));
+        let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), s.domain));
         return Err(CheckError::NoVerdict(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}{pole}", run.pdf())));
     }
-    let worst = worst.map(|w| w.describe(&run.pdf(), run.plane()));
+    let worst = worst.map(|w| w.describe(&run.pdf(), s.domain));
     let summary = if bad == 0 {
         format!("{} finite and ≥ 0 at every quadrature node ({parts} parts)", run.pdf())
     } else {
@@ -119,6 +104,6 @@ mod tests {
         assert!(badness(-2.0) > badness(-1.0));
         assert_eq!(badness(0.0), None);
         let w = Worst { d: [0.0, 0.0, -1.0], angles: angles([0.0, 0.0, -1.0]), value: -1.0 };
-        assert_eq!(w.describe("p(d)", false), "p(d) = -1 at d = (0, 0, -1) (θ 180.0°, φ 0.0°)");
+        assert_eq!(w.describe("p(d)", Domain::Sphere), "p(d) = -1 at d = (0, 0, -1) (θ 180.0°, φ 0.0°)");
     }
 }

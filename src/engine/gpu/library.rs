@@ -75,7 +75,7 @@ macro_rules! shader {
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 32] = [
+static FILES: [File; 33] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -107,8 +107,13 @@ static FILES: [File; 32] = [
     shader!("passes/weighted.wgsl"),
     shader!("passes/quadrature.wgsl"),
     shader!("check/check_params.wgsl"),
+    shader!("check/domain_sphere.wgsl"),
     shader!("check/user_passes.wgsl"),
 ];
+
+/// `lobes::domain` of each domain `lobes check` bins on, by the path its
+/// [`crate::stats::domain::Domain::binning_wgsl`] names (the sphere's is also the built-in one).
+pub const DOMAINS: [File; 2] = [shader!("check/domain_sphere.wgsl"), shader!("check/domain_plane.wgsl")];
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
 pub const MATH_F32_FAST: File = shader!("math/f32_fast.wgsl");
@@ -378,7 +383,7 @@ mod tests {
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
+        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING].into_iter().chain(DOMAINS) {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }

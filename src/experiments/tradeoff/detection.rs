@@ -15,7 +15,7 @@
 use crate::check::report::{Chi2Figures, NormalizationFigures};
 use crate::check::{CheckError, Domain, Settings, Source, UserSampler, check, histograms};
 use crate::engine::gpu::Gpu;
-use crate::stats::family::{self, Grid};
+use crate::stats::family;
 use crate::stats::median::median;
 use serde::{Deserialize, Serialize};
 
@@ -142,7 +142,7 @@ pub fn detection(gpu: &Gpu, set: &DetectionSettings, log: &mut dyn FnMut(&str)) 
     };
     let counts: Vec<u64> = (set.log2_min..=set.log2_max).map(|k| 1u64 << k).collect();
     let (first, last) = (counts[0], *counts.last().expect("a count"));
-    let grid = Grid::sphere(set.rows, set.cols);
+    let grid = Domain::Sphere.grid(set.rows, set.cols);
     let family_tests: Vec<String> = family::tests(grid).into_iter().map(|t| t.name).collect();
     let tests: Vec<String> = std::iter::once(FAMILY.to_string()).chain(family_tests.iter().cloned()).collect();
     let bins = (set.rows * set.cols) as usize;
