@@ -1,7 +1,8 @@
 //! The runtime and glue defects of the second adversarial run (issue 35 items 3, 4, 7, 9, 10,
-//! 14; issue 34 §2), each its own test with the exit code or the check it must give and, for a
-//! hang, the time it must end in. Fixtures: tests/fixtures/samplers/. GPU tests: they need a
-//! wgpu adapter (lavapipe in CI); small sample counts and grids keep each to seconds.
+//! 11, 14; issue 34 §2), each its own test with the exit code or the check it must give and, for
+//! a hang, the time it must end in. Fixtures: tests/fixtures/samplers/. GPU tests (all but item
+//! 11's, which end before any GPU work): they need a wgpu adapter (lavapipe in CI); small sample
+//! counts and grids keep each to seconds.
 
 mod common;
 
@@ -233,6 +234,72 @@ fn sigint_ends_a_loop_only_the_hard_cases_reach_at_once() {
     let (out, _) = finish(child, Duration::from_secs(30));
     assert_eq!(out.status.code(), Some(130), "{}{}", text(&out.stdout), text(&out.stderr));
     assert!(sent.elapsed() < Duration::from_millis(2500), "{:?} after the signal", sent.elapsed());
+}
+
+/// A sampler file importing the last of a chain of `n` naga_oil modules (`chain::m{k}` imports
+/// `chain::m{k-1}`), written under a fresh folder `name`: naga_oil composes 1000 of them in
+/// seconds (its time grows faster than n²).
+fn chain(name: &str, n: usize) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("chain")).unwrap();
+    for k in 0..n {
+        let body = if k == 0 { "return x;".to_string() } else { format!("return chain::m{}::f(x) * 0.5 + 0.25;", k - 1) };
+        let import = if k == 0 { String::new() } else { format!("#import chain::m{}\n", k - 1) };
+        std::fs::write(dir.join(format!("chain/m{k}.wgsl")), format!("#define_import_path chain::m{k}\n{import}fn f(x: f32) -> f32 {{ {body} }}\n")).unwrap();
+    }
+    let sampler = format!(
+        "#import chain::m{last}\n\
+         fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
+         let z = 1.0 - 2.0 * u.x; let r = sqrt(max(0.0, 1.0 - z * z)); let phi = 6.2831853 * u.y;\n\
+         return vec4<f32>(r * cos(phi), r * sin(phi), z, 0.0795774715 + 0.0 * chain::m{last}::f(u.z));\n}}\n\
+         fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{ return 0.0795774715; }}\n",
+        last = n - 1
+    );
+    std::fs::write(dir.join("sampler.wgsl"), sampler).unwrap();
+    dir
+}
+
+/// `lobes check` of a chain's sampler with `args`, its modules under the chain's folder.
+fn spawn_chain_check(dir: &Path, args: &[&str]) -> Child {
+    let root = dir.to_str().unwrap();
+    spawn_check(&dir.join("sampler.wgsl"), &[&["--shader-root", root, "--sample", "s", "--pdf", "p", "--samples", "65536"], args].concat())
+}
+
+/// Issue 35 item 11: `--timeout` runs out while naga_oil composes a chain of 1000 modules: no
+/// verdict (exit 3, never a FAIL row), within a second or two of the limit, saying that the time
+/// went to composing the sampler's file and its 1000 modules (before, the composition ran
+/// unbounded and the GPU's deadline started after it).
+#[test]
+fn a_timeout_while_composing_a_chain_of_modules_is_no_verdict_naming_it() {
+    let dir = chain("chain-timeout", 1000);
+    let (out, took) = finish(spawn_chain_check(&dir, &["--timeout", "1"]), Duration::from_secs(60));
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
+    assert_eq!(out.status.code(), Some(3), "{stdout}{stderr}");
+    assert!(!stdout.contains("FAIL") && stdout.is_empty(), "{stdout}");
+    for want in ["no verdict", "time limit of 1 s (--timeout)", "composing", "sampler.wgsl", "the 1000 naga_oil modules it imports", "before any GPU work"] {
+        assert!(stderr.contains(want), "'{want}' in {stderr}");
+    }
+    assert!(took < Duration::from_millis(3500), "{took:?}");
+}
+
+/// Issue 35 item 11: SIGINT while naga_oil composes a chain of 1000 modules ends the check
+/// within a second or two, exit 130, saying it was composing (before, the signal was either
+/// ignored until the composition ended or, where SIGINT was not ignored, killed the process
+/// without lobes' exit code).
+#[test]
+fn sigint_while_composing_a_chain_of_modules_ends_the_check_at_once() {
+    let dir = chain("chain-sigint", 1000);
+    let child = spawn_chain_check(&dir, &["--timeout", "120"]);
+    // past the start (the signal handler is set before composing begins), well within composing
+    std::thread::sleep(Duration::from_millis(700));
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let sent = Instant::now();
+    let (out, _) = finish(child, Duration::from_secs(60));
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{}{stderr}", text(&out.stdout));
+    assert!(sent.elapsed() < Duration::from_millis(2000), "{:?} after the signal", sent.elapsed());
+    assert!(stderr.contains("interrupted") && stderr.contains("composing") && stderr.contains("no verdict"), "{stderr}");
 }
 
 /// `lobes ARGS` with stdout and stderr into one pipe whose reader reads `lines` lines and closes

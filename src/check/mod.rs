@@ -330,8 +330,9 @@ impl Settings {
     pub fn grid(&self, domain: &Domain) -> (u32, u32) {
         self.bins.unwrap_or(domain.default_grid())
     }
-    /// Bad input, named by its [`Setting`]: more than 16 params, an incident θ outside
-    /// [0, 180], no samples, an empty or too large grid, a significance outside (0, 1).
+    /// Bad input, named by its [`Setting`]: more than 16 params or one that is not a finite
+    /// f32 (named by its index), an incident θ outside [0, 180], no samples, an empty or too
+    /// large grid, a significance outside (0, 1).
     ///
     /// ```
     /// use lobes::check::{CheckError, Setting, Settings};
@@ -344,8 +345,10 @@ impl Settings {
         if self.params.len() > MAX_PARAMS {
             return bad(Setting::Params, format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
         }
-        if let Some(p) = self.params.iter().find(|p| !p.is_finite()) {
-            return bad(Setting::Params, format!("{p} is not a finite number"));
+        // the shader's params are f32: 1e39 is finite here and ∞ there
+        if let Some((i, p)) = self.params.iter().enumerate().find(|(_, p)| !(**p as f32).is_finite()) {
+            let why = if p.is_finite() { format!("{p:e}, beyond f32's range (±{:e}): params are f32 in WGSL", f32::MAX) } else { format!("{p}, not a finite number") };
+            return bad(Setting::Params, format!("the item at index {i} (counting from 0) is {why}"));
         }
         if !(self.incident_theta.is_finite() && (0.0..=180.0).contains(&self.incident_theta)) {
             return bad(Setting::IncidentTheta, format!("{} is outside [0, 180] degrees", self.incident_theta));

@@ -460,12 +460,47 @@ fn tree_key(sources: &[Source], c: &Composition) -> TreeKey {
     (sources.to_vec(), c.clone(), stamp)
 }
 
+/// What this process is composing now, for a message about where the time went
+/// ([`composing`]); `None` between compositions.
+static COMPOSING: std::sync::Mutex<Option<String>> = std::sync::Mutex::new(None);
+
+/// Sets [`COMPOSING`] to a stage of a composition until it is dropped, then back to the stage
+/// it was in (the stage around it, or none).
+struct Stage(Option<String>);
+
+impl Stage {
+    fn enter(what: String) -> Stage {
+        Stage(COMPOSING.lock().unwrap_or_else(|p| p.into_inner()).replace(what))
+    }
+}
+
+impl Drop for Stage {
+    fn drop(&mut self) {
+        *COMPOSING.lock().unwrap_or_else(|p| p.into_inner()) = self.0.take();
+    }
+}
+
+/// What the composition in progress in this process is doing, as a phrase that follows "while
+/// lobes was": "composing diffuse.wgsl and the 1000 naga_oil modules it imports (under
+/// shaders) with naga_oil's Composer", "reading diffuse.wgsl and the modules it imports under
+/// the shader roots (shaders), and composing them"; `None` when nothing is being composed
+/// (plain WGSL is not). `lobes check` composes on a thread of its own and says with this where
+/// the time went when `--timeout` runs out, or a signal comes, first: naga_oil's time grows
+/// faster than N² in the depth N of a chain of imports (each module is parsed against a header
+/// holding every module below it; 1000 modules take about 5 s), and nothing stops it midway.
+/// The command line composes one sampler at a time; a library composing on several threads
+/// sees the latest stage of any of them.
+pub fn composing() -> Option<String> {
+    COMPOSING.lock().unwrap_or_else(|p| p.into_inner()).clone()
+}
+
 /// The user's files composed as their dialect composes them (a tree composed before in this
 /// process, from the same files, is taken from [`TREES`]).
 pub(super) fn compose_user(sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
     if sources.is_empty() || (dialect(sources) == Dialect::Wgsl && c.defines.is_empty()) {
         return compose_anew(sources, c);
     }
+    let _stage = Stage::enter(format!("reading {} and the modules it imports under the shader roots ({}), and composing them", sources[0].name, show_roots(&roots(sources, c))));
     let key = tree_key(sources, c);
     let kept = TREES.lock().unwrap_or_else(|p| p.into_inner()).iter().find(|(k, _)| *k == key).map(|(_, code)| code.clone());
     if let Some(code) = kept {
@@ -743,6 +778,12 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Ori
             m.path, sources[0].name
         )));
     }
+    let _stage = Stage::enter(format!(
+        "composing {} and the {} naga_oil modules it imports (under {}) with naga_oil's Composer",
+        sources[0].name,
+        order.len(),
+        show_roots(&roots)
+    ));
     let mut composer = Composer::default().with_capabilities(naga::valid::Capabilities::all());
     let oil_error = |e: naga_oil::compose::ComposerError, composer: &Composer, module: &str| {
         let text = e.emit_to_string(composer);
@@ -1065,6 +1106,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
     };
     let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
     compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
+    let _stage = Stage::enter(format!("composing {} and the WESL modules it imports (under {}) with the wesl crate", sources[0].name, show_roots(&roots)));
     let result = compiler.compile(&root_path);
     seen.borrow().refusal(c, &sources[0].name)?;
     let result = result.map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;

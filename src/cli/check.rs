@@ -126,8 +126,10 @@ pub struct CheckArgs {
     /// thorough (300 s, a nightly job). Not with --samples or --budget.
     #[arg(long, value_enum, conflicts_with = "samples")]
     pub profile: Option<ProfileChoice>,
-    /// Seconds the whole check may take (default 600): a sampler that is still running then (an
+    /// Seconds the check may take (default 600): a sampler that is still running then (an
     /// endless loop) fails the check with the pass it was in; raise it for a large --samples.
+    /// Composing the sampler's modules, before any GPU work, is bounded by it too: past it,
+    /// no verdict (exit 3).
     #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
     pub timeout: Option<f64>,
     /// Histogram ROWS,COLS (default 64,128 on the sphere, 64,64 on the plane).
@@ -181,7 +183,9 @@ pub(super) fn flag(setting: Setting) -> &'static str {
 }
 
 impl CheckArgs {
-    fn sampler(&self) -> anyhow::Result<UserSampler> {
+    /// What the sampler's flags say beyond its files and functions: its domain, conventions
+    /// and composition (each checked here, at once).
+    fn sampler_parts(&self) -> anyhow::Result<(Domain, Conventions, check::Composition)> {
         let domain = match (self.domain, &self.bounds) {
             (DomainChoice::Sphere, None) => Domain::Sphere,
             (DomainChoice::Sphere, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
@@ -204,9 +208,62 @@ impl CheckArgs {
             },
         )
         .map_err(usage)?;
-        UserSampler::from_repository(&self.files, &self.sample, &self.pdf, self.eval.as_deref(), domain, composition)
-            .and_then(|s| s.with_conventions(conventions))
-            .map_err(input)
+        Ok((domain, conventions, composition))
+    }
+
+    /// The sampler, read and composed on a thread of its own while this one waits for it
+    /// against `limit` and SIGINT/SIGTERM. Composition runs before any GPU work (whose own
+    /// deadline starts when it does) and nothing stops it midway: naga_oil's time grows faster
+    /// than N² in the depth N of a chain of imports (5 s for 1000 modules; issue 35 §11). Past
+    /// `limit` the check ends without a verdict (exit 3) saying what was being composed
+    /// ([`check::modules::composing`]); at a signal it ends with 130. Either way the thread is
+    /// left to the process's exit.
+    fn compose(&self, limit: Duration) -> anyhow::Result<UserSampler> {
+        let started = Instant::now();
+        let (domain, conventions, composition) = self.sampler_parts()?;
+        let (files, sample, pdf, eval) = (self.files.clone(), self.sample.clone(), self.pdf.clone(), self.eval.clone());
+        let (tx, rx) = std::sync::mpsc::channel();
+        // the stack of every parse of the user's WGSL (crate::engine::gpu::stack)
+        let worker = std::thread::Builder::new().name("lobes-compose".into()).stack_size(crate::engine::gpu::stack::BIG_STACK);
+        let worker = worker
+            .spawn(move || {
+                let made = UserSampler::from_repository(&files, &sample, &pdf, eval.as_deref(), domain, composition).and_then(|s| s.with_conventions(conventions));
+                let _ = tx.send(made);
+            })
+            .map_err(|e| anyhow::anyhow!("cannot start a thread to compose the sampler on: {e}"))?;
+        loop {
+            match rx.recv_timeout(Duration::from_millis(50)) {
+                Ok(made) => return made.map_err(input),
+                // a panic while composing stays a panic (exit 101), as it was on this thread
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => match worker.join() {
+                    Err(panic) => std::panic::resume_unwind(panic),
+                    Ok(()) => return Err(anyhow::anyhow!("internal error: the thread composing the sampler ended without a result")),
+                },
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                    if let Some(stopped) = self.composing_stopped(started, limit) {
+                        return Err(stopped);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Why composing that began at `started` ends now, if it does: a signal (exit 130), or
+    /// `limit` gone by (no verdict, exit 3, naming the files and the modules being composed).
+    fn composing_stopped(&self, started: Instant, limit: Duration) -> Option<anyhow::Error> {
+        let doing = || check::modules::composing().unwrap_or_else(|| format!("reading and composing {}", self.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>().join(", ")));
+        let seconds = started.elapsed().as_secs_f64();
+        if interrupt::requested() {
+            return Some(super::Interrupted(format!("lobes check interrupted after {seconds:.1} s while lobes was {}, before any GPU work: no verdict", doing())).into());
+        }
+        (started.elapsed() >= limit).then(|| {
+            let doing = doing();
+            let why = if doing.contains("naga_oil") { " (naga_oil's time grows faster than the square of the depth of a chain of imports: about 5 s for 1000 modules)" } else { "" };
+            anyhow::anyhow!(
+                "no verdict: the time limit of {} s (--timeout) ran out after {seconds:.1} s while lobes was {doing}, before any GPU work{why}; the sampler was not run. Raise --timeout to give composing more time",
+                limit.as_secs_f64()
+            )
+        })
     }
 
     /// The time budget of `--budget` or `--profile`, if either is given.
@@ -238,12 +295,18 @@ impl CheckArgs {
             bins,
             seed: self.seed,
             significance: self.significance,
-            timeout: match self.budget_seconds() {
-                Some(budget) => check::budget::timeout_for(budget, self.timeout.map(Duration::from_secs_f64)),
-                None => self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
-            },
+            timeout: self.time_limit(),
             ..Settings::default()
         })
+    }
+
+    /// The time the check may take: `--timeout` (default [`check::DEFAULT_TIMEOUT`]),
+    /// raised by `--budget` ([`check::budget::timeout_for`]).
+    fn time_limit(&self) -> Duration {
+        match self.budget_seconds() {
+            Some(budget) => check::budget::timeout_for(budget, self.timeout.map(Duration::from_secs_f64)),
+            None => self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
+        }
     }
 }
 
@@ -268,10 +331,16 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     // it, nothing is touched; bad input then removes the earlier check's outputs, so that no
     // report.json is left that reads as this check's
     let existing = args.out.as_deref().map(|dir| OutFolder::claim_existing(dir, Access::Owner, args.wait)).transpose()?.flatten();
+    // before the sampler is composed, which a long chain of imports makes slow: a signal while
+    // it is (also where a script's `&` left SIGINT ignored) ends the check at once (exit 130);
+    // on the GPU the stop is seen within 50 ms of a wait, and 1.5 s after it a process still
+    // held (by a thread in the driver) ends all the same
+    interrupt::watch("stopping the check now (interrupt again to end at once)", Some(Duration::from_millis(1500)))?;
     let started = (|| {
-        let sampler = args.sampler()?;
+        // the settings first: a bad one is refused at once, not after a long composition
         let settings = args.settings()?;
         settings.validate().map_err(input)?;
+        let sampler = args.compose(args.time_limit())?;
         if sampler.domain.directions() {
             sampler.conventions.check_incident(settings.incident_theta).map_err(input)?;
         }
@@ -297,10 +366,6 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     if let Some(folder) = &out_folder {
         folder.clean_files(&CHECK_FILES)?;
     }
-    // before the device opens: a signal while it does is seen at the first submission
-    // the stop is seen within 50 ms of a wait on the GPU; 1.5 s after it, a process still
-    // held (by a thread in the driver) ends all the same
-    interrupt::watch("stopping the check now (interrupt again to end at once)", Some(Duration::from_millis(1500)))?;
     let gpu = Gpu::new()?;
     let _stop = gpu.stop_when(interrupt::requested);
     let settings = match args.budget_seconds() {

@@ -260,7 +260,9 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
     let timeout = match timeout_v {
         Some(t) => {
             let allowed = format!("timeout is the seconds the case's checks may take, a number > 0 and at most {MAX_TIMEOUT_SECONDS:e} (default {})", DEFAULT_TIMEOUT.as_secs());
-            std::time::Duration::from_secs_f64(number(ctx, t, "timeout", |x| x > 0.0 && x <= MAX_TIMEOUT_SECONDS, &allowed)?)
+            // a timeout under a nanosecond would be 0 s, which the check refuses when it runs
+            let positive = |x: f64| x > 0.0 && x <= MAX_TIMEOUT_SECONDS && !std::time::Duration::from_secs_f64(x).is_zero();
+            std::time::Duration::from_secs_f64(number(ctx, t, "timeout", positive, &allowed)?)
         }
         None => defaults.timeout,
     };
@@ -274,14 +276,15 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
     Ok(UserCase { name, sampler: sampler.clone(), settings, budget })
 }
 
-/// `params = [p1, p2, ...]`: at most [`MAX_PARAMS`] finite numbers.
+/// `params = [p1, p2, ...]`: at most [`MAX_PARAMS`] numbers, each finite as an f32 (WGSL's
+/// `params` are f32: 1e39 would be ∞ there).
 fn params(ctx: &Ctx, v: &Val) -> Result<Vec<f64>, SceneError> {
-    let allowed = format!("params is a list of at most {MAX_PARAMS} finite numbers, params[i / 4][i % 4] in WGSL (an array of such lists sweeps)");
+    let allowed = format!("params is a list of at most {MAX_PARAMS} finite numbers within f32's range (±{:e}), params[i / 4][i % 4] in WGSL (an array of such lists sweeps)", f32::MAX);
     let Value::Array(items) = v.get_ref() else {
         return Err(ctx.err(v.span(), format!("params must be an array, got {}; {allowed}", kind_of(v.get_ref()))));
     };
     if items.len() > MAX_PARAMS {
         return Err(ctx.err(v.span(), format!("params has {} numbers; {allowed}", items.len())));
     }
-    items.iter().map(|i| number(ctx, &Spanned::new(v.span(), i.clone()), "params", |_| true, &allowed)).collect()
+    items.iter().map(|i| number(ctx, &Spanned::new(v.span(), i.clone()), "params", |x| (x as f32).is_finite(), &allowed)).collect()
 }
