@@ -230,7 +230,7 @@ fn convention_flags() {
     let hg = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("examples/samplers/henyey_greenstein.wgsl");
     for (extra, said) in [
         (vec!["--incident", "lower"], "upper"),
-        (vec!["--measure", "area"], "projected"),
+        (vec!["--measure", "volume"], "projected"),
         (vec!["--frame", "x-up"], "y-up"),
         (vec!["--incident", "upper", "--incident-theta", "135"], "--incident-theta"),
         (vec!["--reflection-only", "--incident-theta", "90"], "--reflection-only"),
@@ -267,7 +267,7 @@ fn convention_scene_keys() {
     assert!(c.reflection_only && c.u_open && c.measure == Measure::Projected && c.frame == Frame::YUp && c.incident() == Incident::Upper);
     let e = parse(&scene(", incident = \"upper\"", "[0, 120]")).unwrap_err().to_string();
     assert!(e.contains("incident_theta") && e.contains("120"), "{e}");
-    let e = parse(&scene(", measure = \"area\"", "30")).unwrap_err().to_string();
+    let e = parse(&scene(", measure = \"volume\"", "30")).unwrap_err().to_string();
     assert!(e.contains("sampler.measure") && e.contains("projected"), "{e}");
     let e = parse(&scene(", u_open = 1", "30")).unwrap_err().to_string();
     assert!(e.contains("sampler.u_open must be true or false"), "{e}");

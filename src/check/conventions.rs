@@ -36,6 +36,12 @@ pub enum Measure {
     /// |d·n| dσ and eval is f itself (without the cosine); lobes multiplies both by |d·n|.
     #[serde(rename = "projected")]
     Projected,
+    /// The sample is a point of a light per unit area (`--measure area`, with the light's normal
+    /// `--normal`): the sample returns (p, pdf_A), p the point on the light relative to the
+    /// shading point; lobes takes d = p/|p| and pdf_ω = pdf_A |p|² / |n·d| (the area-to-solid-
+    /// angle Jacobian, pbrt-v4 §4.2.3 eq. 4.9). The pdf and eval functions stay per solid angle.
+    #[serde(rename = "area")]
+    Area,
 }
 
 /// The axis of the normal in the sampler's tangent frame.
@@ -98,7 +104,7 @@ macro_rules! named {
     };
 }
 named!(Incident { Sphere = "sphere", Upper = "upper" });
-named!(Measure { SolidAngle = "solid-angle", Projected = "projected" });
+named!(Measure { SolidAngle = "solid-angle", Projected = "projected", Area = "area" });
 named!(Frame { ZUp = "z-up", YUp = "y-up" });
 
 impl Conventions {
@@ -118,6 +124,7 @@ impl Conventions {
             ("--incident upper", self.incident == Incident::Upper),
             ("--reflection-only", self.reflection_only),
             ("--measure projected", self.measure == Measure::Projected),
+            ("--measure area", self.measure == Measure::Area),
             ("--frame y-up", self.frame == Frame::YUp),
         ];
         match directional.iter().find(|(_, set)| !domain.directions() && *set) {
@@ -183,8 +190,8 @@ impl Conventions {
         if self.u_open {
             f.push("--u-open");
         }
-        if self.measure == Measure::Projected {
-            f.push("--measure projected");
+        if self.measure != Measure::SolidAngle {
+            f.push(if self.measure == Measure::Projected { "--measure projected" } else { "--measure area" });
         }
         if self.frame == Frame::YUp {
             f.push("--frame y-up");

@@ -128,9 +128,14 @@ fn names(seed: &str) -> String {
 }
 
 /// The type probe of a call expression: a function `lobes_type_probe` whose `lobes_r` has the
-/// expression's type, over the names of `flag` (`--sample`: wi, u; `--pdf`/`--eval`: wi, d).
+/// expression's type, over the names of `flag` (`--sample`: wi, u; `--normal`: wi, p;
+/// `--pdf`/`--eval`: wi, d).
 pub(super) fn type_probe(flag: &str, expr: &str) -> String {
-    let second = if flag == "--sample" { "u: vec4<f32>" } else { "d: vec3<f32>" };
+    let second = match flag {
+        "--sample" => "u: vec4<f32>",
+        "--normal" => "p: vec3<f32>",
+        _ => "d: vec3<f32>",
+    };
     format!(
         "// the type of {flag}\nfn lobes_type_probe(wi: vec3<f32>, {second}, params: array<vec4<f32>, 4>) {{\n{}    let lobes_r = {expr};\n}}\n",
         names("0u")
@@ -146,6 +151,10 @@ pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], r
         Returned::Contract => format!("    let lobes_r = {}(wi, u, params);\n", sampler.sample),
         _ => format!("{}    // --sample\n    let lobes_r = {};\n", names("lobes_rng_seed(u)"), sampler.sample),
     };
+    if sampler.conventions.measure == super::conventions::Measure::Area {
+        sample += &area_to_solid_angle(returned);
+        return glue_text(sampler, sample, order, reach);
+    }
     sample += if half {
         // A half vector facing away from wi (wi·h ≤ 0, h = (0, 0, 0) among them) is rejected before
         // reflecting, as renderers do: there the reflection's density 1 / (4 wi·h) has no finite
@@ -165,6 +174,43 @@ pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], r
         (Returned::Contract | Returned::Vec4, false) => "    return vec4<f32>(lobes_d, lobes_r.w);\n",
         (Returned::Vec3, _) => "    return vec4<f32>(lobes_d, lobes_glue_pdf(wi, lobes_d, params));\n",
     };
+    glue_text(sampler, sample, order, reach)
+}
+
+/// The sample of a light sampled by area (`--measure area`): the returned point p becomes the
+/// direction d = p/|p| and the area density pdf_A the solid-angle one pdf_A |p|² / |n·d| (pbrt-v4
+/// §4.2.3 eq. 4.9; |p|² as p·p, exact to an ulp, and n the expression `--normal` at p). A rejection
+/// (pdf_A = 0) stays one; a point at the shading point (p = 0) has no direction and is left NaN,
+/// and one seen edge-on (|n·d| = 0) an infinite pdf: invalid samples, each with its reason. An
+/// expression that returns p alone takes the pdf function's value at d, as for directions.
+fn area_to_solid_angle(returned: Returned) -> String {
+    let head = "    let lobes_p = lobes_r.xyz;\n    let lobes_p2 = dot(lobes_p, lobes_p);\n    let lobes_d = lobes_p / sqrt(lobes_p2);\n";
+    let tail = match returned {
+        Returned::Vec3 => "    return vec4<f32>(lobes_d, lobes_glue_pdf(wi, lobes_d, params));\n",
+        Returned::Contract | Returned::Vec4 => {
+            "    if (lobes_r.w == 0.0) {\n\
+             \x20       return vec4<f32>(lobes_p, 0.0);\n\
+             \x20   }\n\
+             \x20   return vec4<f32>(lobes_d, lobes_r.w * lobes_p2 / lobes_light_cos(lobes_p, lobes_d, params));\n"
+        }
+    };
+    format!("{head}{tail}")
+}
+
+/// `lobes_light_cos(p, d, params)`, |n·d| with n the `--normal` expression at the light's point p
+/// (none without `--measure area`).
+fn light_cos(sampler: &UserSampler) -> String {
+    match sampler.composition.normal.as_deref().filter(|_| sampler.conventions.measure == super::conventions::Measure::Area) {
+        Some(normal) => format!(
+            "fn lobes_light_cos(p: vec3<f32>, lobes_d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{}    // --normal\n    return abs(dot({normal}, lobes_d));\n}}\n",
+            names("0u")
+        ),
+        None => String::new(),
+    }
+}
+
+/// The glue's text around the body `sample` of `lobes_glue_sample`.
+fn glue_text(sampler: &UserSampler, sample: String, order: [u32; 4], reach: bool) -> String {
     let density = |flag: &str, call: Option<&str>| match call {
         None => "    return 0.0;\n".to_string(),
         Some(n) if is_name(n) => format!("    return {n}(wi, d, params);\n"),
@@ -222,13 +268,14 @@ pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], r
          {sample}}}\n\
          fn lobes_glue_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{pdf}}}\n\
          fn lobes_glue_eval(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{eval}}}\n\
-         {reach}",
+         {light}{reach}",
         o0 = order[0],
         o1 = order[1],
         o2 = order[2],
         o3 = order[3],
         pdf = density("--pdf", Some(&sampler.pdf)),
         eval = density("--eval", sampler.eval.as_deref()),
+        light = light_cos(sampler),
     )
 }
 
@@ -265,8 +312,23 @@ fn expression_type(code: &UserCode, flag: &str, expr: &str) -> Result<naga::Type
     Ok(info[h][*e].ty.inner_with(&module.types).clone())
 }
 
-/// The call expressions of --sample, --pdf and --eval: none empty, and each density one an f32.
+/// The light's normal expression (`--normal`): a vec3<f32> over p.
+fn check_normal(code: &UserCode, normal: &str) -> Result<(), CheckError> {
+    if normal.trim().is_empty() {
+        return Err(CheckError::Input("--normal is empty; give the light's unit normal at the sampled point p as WGSL, e.g. 'vec3<f32>(0.0, 0.0, -1.0)' or 'normalize(p - p.xyz)'".into()));
+    }
+    match expression_type(code, "--normal", normal)? {
+        naga::TypeInner::Vector { size: naga::VectorSize::Tri, scalar } if scalar == naga::Scalar::F32 => Ok(()),
+        other => Err(CheckError::Input(format!("--normal '{normal}' returns {}; expected vec3<f32> (the light's unit normal at p)", super::compose::describe_inner(&other)))),
+    }
+}
+
+/// The call expressions of --sample, --pdf, --eval and --normal: none empty, each density an f32
+/// and the normal a vec3<f32>.
 pub(super) fn check_expressions(code: &UserCode, sampler: &UserSampler) -> Result<(), CheckError> {
+    if let Some(normal) = &sampler.composition.normal {
+        check_normal(code, normal)?;
+    }
     let calls = [("--sample", Some(sampler.sample.as_str())), ("--pdf", Some(sampler.pdf.as_str())), ("--eval", sampler.eval.as_deref())];
     for (flag, call) in calls {
         let Some(call) = call else { continue };

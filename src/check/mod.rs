@@ -203,7 +203,7 @@ impl UserSampler {
 
     fn build(sources: Vec<Source>, sample: &str, pdf: &str, eval: Option<&str>, domain: Domain, composition: Composition) -> Result<Self, CheckError> {
         let s = Self { sources, sample: sample.into(), pdf: pdf.into(), eval: eval.map(Into::into), domain, conventions: Conventions::default(), composition };
-        s.validate()?;
+        s.validate_code()?;
         Ok(s)
     }
 
@@ -211,14 +211,34 @@ impl UserSampler {
     pub fn with_conventions(self, conventions: Conventions) -> Result<Self, CheckError> {
         let s = Self { conventions, ..self };
         s.conventions.validate(s.domain)?;
+        s.light_measure()?;
         Ok(s)
+    }
+
+    /// `--measure area` and `--normal` come together, and not with a half vector.
+    fn light_measure(&self) -> Result<(), CheckError> {
+        let area = self.conventions.measure == conventions::Measure::Area;
+        match (area, &self.composition.normal) {
+            (true, None) => Err(CheckError::Input("--measure area needs --normal EXPR: the light's unit normal at the sampled point p (WGSL over p and params), for the area-to-solid-angle factor |p|²/|n·d|".into())),
+            (false, Some(_)) => Err(CheckError::Input("--normal: only with --measure area (a sample that is a point of a light, with its area density); remove it".into())),
+            (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => {
+                Err(CheckError::Input("--measure area with --sample-returns half-vector: a light's point is not a half vector; keep one".into()))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The conventions must fit the domain and each other, and the code [`Self::validate_code`].
+    pub fn validate(&self) -> Result<(), CheckError> {
+        self.conventions.validate(self.domain)?;
+        self.light_measure()?;
+        self.validate_code()
     }
 
     /// The files alone must validate, define the named functions with the contract's
     /// signatures, and leave lobes' own names free.
-    pub fn validate(&self) -> Result<(), CheckError> {
+    fn validate_code(&self) -> Result<(), CheckError> {
         self.domain.validate().map_err(|e| CheckError::Input(format!("--bounds: {e}")))?;
-        self.conventions.validate(self.domain)?;
         if self.composition.sample_returns == SampleReturns::HalfVector && !self.domain.directions() {
             return Err(CheckError::Input("--sample-returns half-vector: a half vector reflects wi into a direction; it does not apply to --domain plane".into()));
         }

@@ -50,6 +50,9 @@ pub struct Composition {
     pub rand_order: Option<Vec<Draw>>,
     /// What the sample expression returns (`--sample-returns`).
     pub sample_returns: SampleReturns,
+    /// The light's unit normal at the sampled point `p` (`--normal`, with `--measure area`): a
+    /// WGSL expression over `p`, `params` and `p0` … `p15`.
+    pub normal: Option<String>,
 }
 
 impl Composition {
@@ -75,6 +78,11 @@ impl Composition {
     }
     pub fn sample_returns(mut self, r: SampleReturns) -> Self {
         self.sample_returns = r;
+        self
+    }
+    /// The light's normal at `p` of a sampler that samples a light's area (`--normal`).
+    pub fn normal(mut self, expr: &str) -> Self {
+        self.normal = Some(expr.into());
         self
     }
     /// The command line's flags: `--define NAME[=VALUE]`, `--stub MODULE=FILE`, `--rand-order
@@ -111,7 +119,7 @@ impl Composition {
         if rand_order.is_some() && rand.is_empty() {
             return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
         }
-        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, rand: rand.to_vec(), rand_order, sample_returns })
+        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, rand: rand.to_vec(), rand_order, sample_returns, normal: None })
     }
 
     /// Whether anything beyond the contract's plain files is asked for.

@@ -107,9 +107,15 @@ pub struct CheckArgs {
     #[arg(long)]
     pub u_open: bool,
     /// The measure of the pdf (and eval): solid-angle, or projected (per |cos θ| dσ; eval is then
-    /// f without the cosine).
-    #[arg(long, value_name = "solid-angle|projected", default_value = "solid-angle")]
+    /// f without the cosine), or area: the sample is a point p of a light, relative to the shading
+    /// point, with its density per unit area (needs --normal); lobes judges d = p/|p| with
+    /// pdf_A·|p|²/|n·d|, and --pdf and --eval stay per solid angle.
+    #[arg(long, value_name = "solid-angle|projected|area", default_value = "solid-angle")]
     pub measure: Measure,
+    /// With --measure area: the light's unit normal at the sampled point p, a WGSL expression
+    /// over p, params and p0 … p15 (e.g. 'vec3<f32>(0.0, 0.0, -1.0)' for a light facing down).
+    #[arg(long, value_name = "EXPR")]
+    pub normal: Option<String>,
     /// The sampler's tangent frame: z-up, or y-up (normal +y; --incident-theta from +y, φ from +x
     /// towards +z).
     #[arg(long, value_name = "z-up|y-up", default_value = "z-up")]
@@ -208,6 +214,7 @@ impl CheckArgs {
             },
         )
         .map_err(usage)?;
+        let composition = check::Composition { normal: self.normal.clone(), ..composition };
         Ok((domain, conventions, composition))
     }
 

@@ -33,6 +33,7 @@ pub(super) struct RawSampler {
     define: Option<Val>,
     stub: Option<Val>,
     sample_returns: Option<Val>,
+    normal: Option<Val>,
 }
 
 /// One validated case of a user's sampler: the sampler (shared by the cases of a sweep) and the
@@ -47,7 +48,7 @@ pub struct UserCase {
     pub budget: Option<Budget>,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\", frame = \"y-up\"; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -133,7 +134,7 @@ fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneEr
 }
 
 /// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
-/// stub, sample_returns (the flags of `lobes check`), paths relative to the scene file.
+/// stub, sample_returns, normal (the flags of `lobes check`), paths relative to the scene file.
 fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
     use crate::check::{Composition, Draw, SampleReturns};
     let mut c = Composition::default();
@@ -180,6 +181,9 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
             "half-vector" => SampleReturns::HalfVector,
             other => return Err(ctx.err(v.span(), format!("sampler.sample_returns '{other}' is unknown; use \"direction\" or \"half-vector\""))),
         };
+    }
+    if let Some(v) = &r.normal {
+        c.normal = Some(string(ctx, v, "sampler.normal", "write normal = \"WGSL over p\", the light's unit normal at the sampled point (with measure = \"area\")")?.to_string());
     }
     Ok(c)
 }

@@ -4,12 +4,21 @@
 
 use super::{Measured, Run};
 use crate::check::report::{Check, ConsistencyFigures, Figures};
+use crate::check::conventions::Measure;
 use crate::check::{CONDITIONING_ULPS, PDF_CONSISTENCY_LIMIT};
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Check {
     let c = figures(m);
-    Check { passed: c.over_limit == 0 && c.pdf_function_not_finite == 0, summary: summary(&c, &run.pdf()), figures: Figures::PdfConsistency(c) }
+    let passed = c.over_limit == 0 && c.pdf_function_not_finite == 0;
+    let mut summary = summary(&c, &run.pdf());
+    if !passed && run.sampler.conventions.measure == Measure::Area {
+        summary += AREA_HINT;
+    }
+    Check { passed, summary, figures: Figures::PdfConsistency(c) }
 }
+
+/// What a light sampled by area most often gets wrong, said where the densities disagree.
+const AREA_HINT: &str = "; with --measure area, lobes turns the sample's density per unit area into one per solid angle, pdf_A·|p|²/|n·d| (pbrt-v4 eq. 4.9): the pdf function must be per solid angle too (one left per unit area, or converted without |n·d|, is the classic MIS bug)";
 
 fn figures(m: &Measured) -> ConsistencyFigures {
     let mut c = ConsistencyFigures {

@@ -1,0 +1,110 @@
+//! `lobes check --measure area --normal EXPR` (issue 33 item 2): a light sampler that returns a
+//! point p of the light with its density per unit area is judged in solid angle, lobes
+//! converting pdf_A |p|² / |n·d|. The correct rectangle light passes; its pdf function left per
+//! unit area (the classic MIS bug), converted without the cosine, or a sampler that reports the
+//! area density with its direction (no conversion at all) each fail. Bad combinations of the
+//! flags are exit 2. GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::{Command, Output};
+
+const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
+const LIGHT: &str = "examples/samplers/rect_light.wgsl";
+/// The rectangle: centre (0.3, −0.2, 1), sides 0.8 × 0.6 (about 0.4 sr seen from the origin).
+const PARAMS: &str = "0.3,-0.2,1.0,0.8,0.6";
+const DOWN: &str = "vec3<f32>(0.0, 0.0, -1.0)";
+
+fn lobes(args: &[&str]) -> Output {
+    let out = Command::new(LOBES).current_dir(env!("CARGO_MANIFEST_DIR")).args(args).output().expect("run lobes");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
+    out
+}
+
+/// `lobes check` of the light with `sample` and `pdf`, 2²⁰ samples, a JSON report.
+fn check(sample: &str, pdf: &str, extra: &[&str]) -> Output {
+    let mut args = vec!["check", LIGHT, "--sample", sample, "--pdf", pdf, "--params", PARAMS, "--samples", "1048576", "--json"];
+    args.extend_from_slice(extra);
+    lobes(&args)
+}
+
+/// The names of the checks that failed.
+fn failed(out: &Output) -> Vec<String> {
+    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report on stdout");
+    let checks = v["checks"].as_array().expect("checks");
+    checks.iter().filter(|c| c["passed"] == false).map(|c| c["name"].as_str().unwrap_or("?").to_string()).collect()
+}
+
+#[test]
+fn a_light_sampled_by_area_passes_in_solid_angle() {
+    assert!(Path::new(env!("CARGO_MANIFEST_DIR")).join(LIGHT).is_file());
+    let out = check("rect_sample", "rect_pdf", &["--measure", "area", "--normal", DOWN]);
+    assert_eq!(out.status.code(), Some(0), "the correct light sampler, converted by lobes");
+    assert!(failed(&out).is_empty(), "{:?}", failed(&out));
+    // the normal as an expression over p and params: the same light
+    let out = check("rect_sample", "rect_pdf", &["--measure", "area", "--normal", "normalize(vec3<f32>(0.0, 0.0, -p2))"]);
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
+fn a_pdf_left_per_unit_area_fails() {
+    for (pdf, why) in [("rect_pdf_area", "pdf left per unit area"), ("rect_pdf_no_cosine", "converted without |n·d|")] {
+        let out = check("rect_sample", pdf, &["--measure", "area", "--normal", DOWN]);
+        assert_eq!(out.status.code(), Some(1), "{why}");
+        let f = failed(&out);
+        assert!(f.contains(&"pdf_consistency".to_string()) && f.contains(&"normalization".to_string()), "{why}: {f:?}");
+        let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report");
+        let consistency = v["checks"].as_array().unwrap().iter().find(|c| c["name"] == "pdf_consistency").expect("pdf_consistency").to_string();
+        assert!(consistency.contains("pdf_A·|p|²/|n·d|"), "{why}: the message names the conversion\n{consistency}");
+    }
+}
+
+#[test]
+fn an_area_density_reported_as_solid_angle_fails() {
+    // the sampler itself reports pdf_A with its direction; without --measure area lobes takes
+    // it at its word and the histogram and the pdf function disagree with it
+    let out = check("rect_sample_unconverted", "rect_pdf", &[]);
+    assert_eq!(out.status.code(), Some(1));
+    let f = failed(&out);
+    assert!(f.contains(&"pdf_consistency".to_string()), "{f:?}");
+}
+
+#[test]
+fn the_flags_of_an_area_light_come_together() {
+    let cases: [(&[&str], &str); 4] = [
+        (&["--measure", "area"], "--measure area needs --normal"),
+        (&["--normal", DOWN], "--normal: only with --measure area"),
+        (&["--measure", "area", "--normal", "p0"], "--normal 'p0' returns f32; expected vec3<f32>"),
+        (&["--measure", "area", "--normal", DOWN, "--domain", "plane", "--bounds", "0,0,1,1"], "--measure area: only with --domain sphere"),
+    ];
+    for (extra, message) in cases {
+        let out = check("rect_sample", "rect_pdf", extra);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains(message), "{extra:?}: {stderr}");
+    }
+}
+
+/// The same light as a case of a scene: `measure = "area"` and `normal` are the flags' keys.
+#[test]
+fn a_scene_runs_a_light_sampled_by_area() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-lights-scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let light = Path::new(env!("CARGO_MANIFEST_DIR")).join(LIGHT);
+    let scene = dir.join("lights.toml");
+    let case = |name: &str, pdf: &str| {
+        format!(
+            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{light:?}], sample = \"rect_sample\", pdf = \"{pdf}\", measure = \"area\", normal = \"{DOWN}\" }}\nparams = [{PARAMS}]\nsamples = 1048576\n\n"
+        )
+    };
+    std::fs::write(&scene, format!("{}{}", case("rect", "rect_pdf"), case("rect-area-pdf", "rect_pdf_area"))).unwrap();
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "one case passes, the other fails");
+    let summary: Value = serde_json::from_slice(&out.stdout).expect("a JSON summary");
+    let passed = |name: &str| summary["cases"].as_array().unwrap().iter().find(|c| c["case"] == name).unwrap_or_else(|| panic!("{name} in {summary}"))["passed"].clone();
+    assert_eq!(passed("rect"), Value::Bool(true));
+    assert_eq!(passed("rect-area-pdf"), Value::Bool(false));
+}
