@@ -22,9 +22,9 @@ fn lobes(args: &[&str]) -> Output {
     out
 }
 
-/// `lobes check` of the light with `sample` and `pdf`, 2²⁰ samples, a JSON report.
+/// `lobes check` of the light with `sample` and `pdf`, 2¹⁸ samples, a JSON report.
 fn check(sample: &str, pdf: &str, extra: &[&str]) -> Output {
-    let mut args = vec!["check", LIGHT, "--sample", sample, "--pdf", pdf, "--params", PARAMS, "--samples", "1048576", "--json"];
+    let mut args = vec!["check", LIGHT, "--sample", sample, "--pdf", pdf, "--params", PARAMS, "--samples", "262144", "--json"];
     args.extend_from_slice(extra);
     lobes(&args)
 }
@@ -96,7 +96,7 @@ fn a_scene_runs_a_light_sampled_by_area() {
     let scene = dir.join("lights.toml");
     let case = |name: &str, pdf: &str| {
         format!(
-            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{light:?}], sample = \"rect_sample\", pdf = \"{pdf}\", measure = \"area\", normal = \"{DOWN}\" }}\nparams = [{PARAMS}]\nsamples = 1048576\n\n"
+            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{light:?}], sample = \"rect_sample\", pdf = \"{pdf}\", measure = \"area\", normal = \"{DOWN}\" }}\nparams = [{PARAMS}]\nsamples = 262144\n\n"
         )
     };
     std::fs::write(&scene, format!("{}{}", case("rect", "rect_pdf"), case("rect-area-pdf", "rect_pdf_area"))).unwrap();

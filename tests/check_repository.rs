@@ -389,3 +389,21 @@ fn a_scene_takes_the_same_keys() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("sampler.rand must be an array of strings"), "{}", stderr(&out));
 }
+
+/// Issue 34 §2: a renderer's resource (a storage buffer, a texture) that the pdf reads is bad
+/// input named at its declaration, exit 2 before any GPU work (it was exit 3, "the GPU device was
+/// lost": wgpu's "expects a BindGroup to be set at index 2"); declared and never reached, it is
+/// no obstacle.
+#[test]
+fn a_binding_the_sampler_reaches_is_named() {
+    let file = "tests/fixtures/bindings/lut_sampler.wgsl";
+    for (pdf, name, kind, line) in [("lut_scaled_pdf", "lut", "a storage buffer", 6), ("texture_scaled_pdf", "lut_texture", "a texture", 7)] {
+        let out = lobes(&["check", file, "--sample", "uniform_sample", "--pdf", pdf, "--samples", "65536"]);
+        assert_eq!(out.status.code(), Some(2), "{pdf}: {}", stderr(&out));
+        let e = stderr(&out);
+        assert!(e.contains(&format!("{file}:{line}:")) && e.contains(&format!("`{name}` (@group(2) @binding({}), {kind})", line - 6)), "{pdf}: {e}");
+        assert!(e.contains("--stub"), "{pdf}: says how to proceed: {e}");
+    }
+    let out = lobes(&["check", file, "--sample", "uniform_sample", "--pdf", "uniform_pdf", "--samples", "65536"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+}

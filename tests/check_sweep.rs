@@ -41,12 +41,14 @@ fn rect_light(sample: &str, pdf: &str) -> UserSampler {
     UserSampler::from_repository(&files(&["rect_light.wgsl"]), sample, pdf, None, Domain::Sphere, composition).and_then(|s| s.with_conventions(area)).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// The rectangle light's (centre x, y, height, side x, side y): 0.4 sr off the normal, 0.04 sr
-/// and 2.5·10⁻³ sr overhead, 2.2 sr close above (most of the hemisphere's projected area) and
-/// 0.12 sr towards the horizon (θ 76°). Below about 10⁻⁴ sr the quadrature does not converge on
-/// lobes' sphere grid (no verdict, exit 3): a grid fitted to the light (issue 33 item 1) is for
-/// that.
-const RECT_LIGHTS: [[f64; 5]; 5] = [[0.3, -0.2, 1.0, 0.8, 0.6], [0.0, 0.0, 1.0, 0.2, 0.2], [0.1, 0.1, 1.0, 0.05, 0.05], [0.0, 0.0, 0.5, 4.0, 4.0], [2.0, 0.0, 0.5, 1.0, 1.0]];
+/// The rectangle light's (centre x, y, height, side x, side y): 0.4 sr off the normal,
+/// 2.5·10⁻³ sr overhead, 2.2 sr close above (most of the hemisphere's projected area) and 0.12 sr
+/// towards the horizon (θ 76°). Below about 10⁻⁴ sr the quadrature does not converge on lobes'
+/// sphere grid (no verdict, exit 3): a grid fitted to the light (issue 33 item 1) is for that.
+const RECT_LIGHTS: [[f64; 5]; 4] = [[0.3, -0.2, 1.0, 0.8, 0.6], [0.1, 0.1, 1.0, 0.05, 0.05], [0.0, 0.0, 0.5, 4.0, 4.0], [2.0, 0.0, 0.5, 1.0, 1.0]];
+
+/// The light runs' samples: 2²⁰ (the locating of its edges, not the histogram, costs the time).
+const LIGHT_SAMPLES: u64 = 1 << 20;
 
 /// The statistical checks: at significance α each fails a correct sampler with probability
 /// about α (`normalization` is a 4σ bound, far less).
@@ -138,7 +140,7 @@ fn correct_samplers_pass_over_their_documented_range() {
     }
     let light = rect_light("rect_sample", "rect_pdf");
     for params in RECT_LIGHTS {
-        runs.push(run(&gpu, format!("rect_light {params:?}"), &light, Settings { params: params.to_vec(), ..Settings::default() }));
+        runs.push(run(&gpu, format!("rect_light {params:?}"), &light, Settings { params: params.to_vec(), samples: LIGHT_SAMPLES, ..Settings::default() }));
     }
     // lobes' own samplers as a user's: every other configuration of the grid each
     for (j, spec) in REGISTRY.iter().enumerate() {
@@ -195,8 +197,8 @@ fn broken_samplers_still_fail_by_their_check() {
         ("ibl_prefilter pdf of h", ibl("ibl_pdf(wi, d, p0) * 4.0 * max(dot(wi, normalize(wi + d)), 0.0)"), vec![0.1], 30.0, &["jacobian"]),
         // a light sampled by area whose pdf function is left per unit area (the classic MIS bug),
         // or converted without |n·d|, towards the horizon (2 away, |n·d| about 0.24)
-        ("rect_light pdf per area", rect_light("rect_sample", "rect_pdf_area"), RECT_LIGHTS[4].to_vec(), 30.0, &["pdf_consistency", "normalization"]),
-        ("rect_light pdf without |n·d|", rect_light("rect_sample", "rect_pdf_no_cosine"), RECT_LIGHTS[4].to_vec(), 30.0, &["pdf_consistency", "normalization"]),
+        ("rect_light pdf per area", rect_light("rect_sample", "rect_pdf_area"), RECT_LIGHTS[3].to_vec(), 30.0, &["pdf_consistency", "normalization"]),
+        ("rect_light pdf without |n·d|", rect_light("rect_sample", "rect_pdf_no_cosine"), RECT_LIGHTS[3].to_vec(), 30.0, &["pdf_consistency", "normalization"]),
     ];
     let mut caught = 0;
     let mut missed = Vec::new();

@@ -200,6 +200,11 @@ impl Composed {
     }
 
     /// A diagnostic at `span`: "file:line:col: error: message", the offending line and a caret.
+    /// `message` at the user's file and line of `span` of the composed text.
+    pub fn diagnostic_at(&self, span: naga::Span, message: &str) -> String {
+        self.diagnostic(Some(span.location(&self.text)), message, &[])
+    }
+
     fn diagnostic(&self, span: Option<naga::SourceLocation>, message: &str, labels: &[String]) -> String {
         let caret = |column: u32, length: u32| " ".repeat(column.saturating_sub(1) as usize) + &"^".repeat((length as usize).clamp(1, 60));
         let mut out = match span {

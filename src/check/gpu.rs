@@ -516,8 +516,43 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
             c.push(&path, &text);
         }
     }
-    c.validate()?;
+    let (module, info) = c.validate_with(naga::valid::Capabilities::default())?;
+    unbound_resources(&c, &module, &info)?;
     Ok(c)
+}
+
+/// The renderer's resources that lobes' passes reach through the sampler: lobes binds only its
+/// own (`lobes_` names in group 0), so a texture, buffer or sampler of the user's files or stubs
+/// that the sampler, pdf or eval reads would have nothing bound at dispatch (wgpu: "expects a
+/// BindGroup to be set"): bad input, named at its declaration, before any GPU work. Declared and
+/// never reached is fine.
+fn unbound_resources(c: &Composed, module: &naga::Module, info: &naga::valid::ModuleInfo) -> Result<(), CheckError> {
+    // by lobes' passes (a renderer's own entry points, where a file keeps them, bind their own)
+    let passes: Vec<usize> = module.entry_points.iter().enumerate().filter(|(_, e)| e.name.starts_with("lobes_")).map(|(i, _)| i).collect();
+    let reached = |h: naga::Handle<naga::GlobalVariable>| passes.iter().any(|&i| !info.get_entry_point(i)[h].is_empty());
+    let unbound = module.global_variables.iter().find(|(h, g)| g.binding.is_some() && !g.name.as_deref().is_some_and(|n| n.starts_with("lobes_")) && reached(*h));
+    let Some((h, g)) = unbound else { return Ok(()) };
+    let b = g.binding.as_ref().expect("a binding");
+    let what = format!(
+        "`{}` (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads; lobes binds none: give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
+        g.name.as_deref().unwrap_or("?"),
+        b.group,
+        b.binding,
+        resource_kind(g, &module.types[g.ty].inner)
+    );
+    Err(CheckError::Input(c.diagnostic_at(module.global_variables.get_span(h), &what)))
+}
+
+/// What kind of resource a bound global is, for messages: "a storage buffer", "a texture", ….
+fn resource_kind(g: &naga::GlobalVariable, inner: &naga::TypeInner) -> &'static str {
+    match (g.space, inner) {
+        (naga::AddressSpace::Storage { .. }, _) => "a storage buffer",
+        (naga::AddressSpace::Uniform, _) => "a uniform buffer",
+        (_, naga::TypeInner::Image { .. }) => "a texture",
+        (_, naga::TypeInner::Sampler { .. }) => "a sampler",
+        (_, naga::TypeInner::AccelerationStructure { .. }) => "an acceleration structure",
+        _ => "a resource",
+    }
 }
 
 /// `lobes::domain` of the sampler's domain: where its points lie and which bin each falls in.
