@@ -151,35 +151,9 @@ const TOKENS: &[&str] = &[
     "=", ",", ".", "\n", "#", "é", "\u{0}", "[[case]]", "[defaults]", "name = \"sphere\"", "true",
 ];
 
-/// `VALID` with `edits` (position fraction, what to do, token index) applied: insert a token,
-/// delete up to 8 characters, replace the word there with a token, or duplicate the line.
+/// `VALID` with `edits` applied ([`common::mutate`]).
 fn mutate(edits: &[(f64, u8, usize)]) -> String {
-    let mut s = VALID.to_string();
-    for &(pos, op, tok) in edits {
-        let mut at = ((s.len() as f64) * pos) as usize;
-        while !s.is_char_boundary(at) {
-            at -= 1;
-        }
-        let token = TOKENS[tok % TOKENS.len()];
-        match op % 4 {
-            0 => s.insert_str(at, token),
-            1 => {
-                let end = s[at..].char_indices().nth(8).map_or(s.len(), |(i, _)| at + i);
-                s.replace_range(at..end, "");
-            }
-            2 => {
-                let end = s[at..].find(|c: char| !c.is_alphanumeric() && c != '_' && c != '.').map_or(s.len(), |i| at + i);
-                s.replace_range(at..end, token);
-            }
-            _ => {
-                let start = s[..at].rfind('\n').map_or(0, |i| i + 1);
-                let end = s[at..].find('\n').map_or(s.len(), |i| at + i);
-                let line = s[start..end].to_string();
-                s.insert_str(start, &(line + "\n"));
-            }
-        }
-    }
-    s
+    common::mutate(VALID, TOKENS, edits)
 }
 
 /// A scene's outcome: a rejection at a line and column of the text with a message; an accepted

@@ -3,6 +3,7 @@
 //! GPU adapter, and a case that fails mid-way (no complete-looking `histogram.json` may be left).
 //! The scene parser and the tutorial commands are fuzzed with proptest for panics.
 
+mod common;
 use lobes::reference::{effects::Effects, fresnel::Fresnel, masking::Masking};
 use lobes::scene::{Scene, SceneError};
 use proptest::prelude::*;
@@ -226,35 +227,7 @@ fn check_outcome(text: &str, result: Result<Scene, SceneError>) {
 
 /// Edits of the valid scene: (position fraction, what to do, token index).
 fn mutate(edits: &[(f64, u8, usize)]) -> String {
-    let mut s = VALID.to_string();
-    for &(pos, op, tok) in edits {
-        let mut at = ((s.len() as f64) * pos) as usize;
-        while !s.is_char_boundary(at) {
-            at -= 1;
-        }
-        let token = TOKENS[tok % TOKENS.len()];
-        match op % 4 {
-            0 => s.insert_str(at, token),
-            1 => {
-                // delete up to 8 characters
-                let end = s[at..].char_indices().nth(8).map_or(s.len(), |(i, _)| at + i);
-                s.replace_range(at..end, "");
-            }
-            2 => {
-                // replace the word at `at` with the token
-                let end = s[at..].find(|c: char| !c.is_alphanumeric() && c != '_' && c != '.').map_or(s.len(), |i| at + i);
-                s.replace_range(at..end, token);
-            }
-            _ => {
-                // duplicate a line
-                let start = s[..at].rfind('\n').map_or(0, |i| i + 1);
-                let end = s[at..].find('\n').map_or(s.len(), |i| at + i);
-                let line = s[start..end].to_string();
-                s.insert_str(start, &(line + "\n"));
-            }
-        }
-    }
-    s
+    common::mutate(VALID, TOKENS, edits)
 }
 
 proptest! {

@@ -48,3 +48,38 @@ pub fn edited_copy(name: &str, from: &Path, file: &str, edit: impl Fn(&str) -> S
     std::fs::write(&f, edited).unwrap();
     dir
 }
+
+/// `valid` with `edits` (position fraction, what to do, token index) applied: insert a token of
+/// `tokens`, delete up to 8 characters, replace the word there with a token, or duplicate the
+/// line. The fuzzing of scene files in tests/bad_input.rs and tests/adversarial_parsers.rs.
+pub fn mutate(valid: &str, tokens: &[&str], edits: &[(f64, u8, usize)]) -> String {
+    let mut s = valid.to_string();
+    for &(pos, op, tok) in edits {
+        let mut at = ((s.len() as f64) * pos) as usize;
+        while !s.is_char_boundary(at) {
+            at -= 1;
+        }
+        let token = tokens[tok % tokens.len()];
+        match op % 4 {
+            0 => s.insert_str(at, token),
+            1 => {
+                // delete up to 8 characters
+                let end = s[at..].char_indices().nth(8).map_or(s.len(), |(i, _)| at + i);
+                s.replace_range(at..end, "");
+            }
+            2 => {
+                // replace the word at `at` with the token
+                let end = s[at..].find(|c: char| !c.is_alphanumeric() && c != '_' && c != '.').map_or(s.len(), |i| at + i);
+                s.replace_range(at..end, token);
+            }
+            _ => {
+                // duplicate a line
+                let start = s[..at].rfind('\n').map_or(0, |i| i + 1);
+                let end = s[at..].find('\n').map_or(s.len(), |i| at + i);
+                let line = s[start..end].to_string();
+                s.insert_str(start, &(line + "\n"));
+            }
+        }
+    }
+    s
+}
