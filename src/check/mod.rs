@@ -48,6 +48,7 @@ pub mod power;
 pub mod probe;
 pub mod quadrature;
 pub mod report;
+pub mod support;
 
 pub use compose::Source;
 pub use conventions::{Conventions, Frame, Incident, Measure};
@@ -292,6 +293,9 @@ pub struct Settings {
     /// that loops forever never returns), and the device is abandoned
     /// ([`crate::engine::gpu::dispatch::Bounds`]).
     pub timeout: std::time::Duration,
+    /// Whether a sampler on the sphere whose samples fall in a small cap is binned on a grid
+    /// fitted to it ([`support`]).
+    pub fit: support::Fit,
 }
 
 /// The time a check may take unless told otherwise: 10 minutes (the default 2²² samples take
@@ -342,6 +346,7 @@ impl Default for Settings {
             probe_samples: 4096,
             reference: None,
             timeout: DEFAULT_TIMEOUT,
+            fit: support::Fit::Auto,
         }
     }
 }
@@ -521,7 +526,7 @@ fn report(run: &judge::Run, m: &judge::Measured, checks: Vec<Check>, adapter: St
         format_version: REPORT_VERSION,
         passed: checks.iter().all(|c| c.passed),
         checks,
-        sampler: describe(run.sampler) + &run.draws,
+        sampler: describe(&run.sampler) + &run.draws,
         domain: run.sampler.domain,
         samples: run.settings.samples,
         rows: run.rows,

@@ -325,6 +325,12 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
                     pieces.push((z.a, phi, z.h, split(z.dtheta.max((phi.1 - phi.0) * z.smax))));
                 }
             }
+            // a cap's cell is one piece about its axis, as a sphere's row about the pole (h = 1)
+            Cell::Cap { a, phi } => {
+                let theta = |a: f64| 2.0 * (0.5 * a).sqrt().asin();
+                let smax = (a.1 * (2.0 - a.1)).max(0.0).sqrt();
+                pieces.push((a, phi, 1.0, split((theta(a.1) - theta(a.0)).max((phi.1 - phi.0) * smax))));
+            }
         }
         for (a, b, h, m) in pieces {
             let (da, db) = ((a.1 - a.0) / m as f64, (b.1 - b.0) / m as f64);

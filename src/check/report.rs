@@ -16,6 +16,8 @@ pub const REPORT_VERSION: u32 = 1;
 
 /// Names of the invalid-sample reasons, in the order of their cells after the bins.
 pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
+/// The index of `outside_domain` in [`REASONS`].
+pub const OUTSIDE_DOMAIN: usize = 1;
 
 /// Everything a check of a user's sampler found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]

@@ -83,6 +83,11 @@ pub struct CheckArgs {
     pub sample_returns: ReturnsChoice,
     #[arg(long, value_enum, default_value = "sphere")]
     pub domain: DomainChoice,
+    /// On the sphere, whether the histogram's grid is fitted to a small support: auto (a cap
+    /// about the samples where they all fall within about 0.1 sr: small lights), never (the
+    /// whole sphere), always (a cap wherever they fall within a hemisphere).
+    #[arg(long, value_name = "auto|never|always", value_parser = parse_fit, default_value = "auto")]
+    pub fit: check::support::Fit,
     /// The plane's box, X0,Y0,X1,Y1 (with --domain plane).
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_number_list, allow_hyphen_values = true)]
     pub bounds: Option<NumberList>,
@@ -303,6 +308,7 @@ impl CheckArgs {
             seed: self.seed,
             significance: self.significance,
             timeout: self.time_limit(),
+            fit: self.fit,
             ..Settings::default()
         })
     }
@@ -315,6 +321,11 @@ impl CheckArgs {
             None => self.timeout.map_or(check::DEFAULT_TIMEOUT, Duration::from_secs_f64),
         }
     }
+}
+
+/// `--fit`: one of [`check::support::Fit::NAMES`].
+fn parse_fit(s: &str) -> Result<check::support::Fit, String> {
+    check::support::Fit::parse(s).ok_or_else(|| format!("'{s}' is not one of {}", check::support::Fit::NAMES.join(", ")))
 }
 
 /// `--budget`: seconds, a number > 0 and at most [`check::MAX_TIMEOUT_SECONDS`].

@@ -5,8 +5,10 @@
 //! the quadrature integrates), its neighbours and its centre.
 //!
 //! On the sphere, rows are uniform in cos θ ∈ [−1, 1] and columns in φ ∈ [−π, π), so every cell
-//! spans 4π / (rows · cols) sr (Archimedes' hat-box theorem; [`SphereGrid`]); on the plane,
-//! rows are uniform in y and columns in x over the box.
+//! spans 4π / (rows · cols) sr (Archimedes' hat-box theorem; [`SphereGrid`]); on a cap about an
+//! axis, rows are uniform in 1 − cos θ′ ∈ [0, h] and columns in φ′, θ′ and φ′ measured about the
+//! axis, so every cell spans 2π h / (rows · cols) sr by the same theorem; on the plane, rows are
+//! uniform in y and columns in x over the box.
 
 use super::histogram::SphereGrid;
 use glam::DVec3;
@@ -20,6 +22,48 @@ pub enum Domain {
     Sphere,
     /// Points (d.x, d.y) of the box `[x0, y0, x1, y1]`, binned on a rows × cols grid of it.
     Plane { bounds: [f64; 4] },
+    /// Unit directions within the spherical cap about the unit `axis` of height `height` = 1 −
+    /// cos ρ (ρ the cap's angular radius, ≤ π/2): the grid fitted around a small support (a
+    /// light seen from afar), binned in (1 − cos θ′, φ′) about the axis ([`Frame`]). Both are
+    /// f32 values, as the GPU's binning reads them.
+    Cap { axis: [f64; 3], height: f64 },
+}
+
+/// The orthonormal frame (t, b, axis) of a cap: Duff et al. 2017, "Building an Orthonormal
+/// Basis, Revisited" (JCGT 6(1)), listing 3, whose branchless form the WGSL twin
+/// (`lobes_cap_frame`, shaders/check/domain_cap.wgsl) repeats.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub t: DVec3,
+    pub b: DVec3,
+    pub axis: DVec3,
+}
+
+impl Frame {
+    pub fn of(axis: [f64; 3]) -> Self {
+        let n = DVec3::from(axis);
+        // the sign as the WGSL's select(−1, 1, n.z ≥ 0) takes it (+1 at −0)
+        let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        Frame { t: DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), b: DVec3::new(b, sign + n.y * n.y * a, -n.y), axis: n }
+    }
+
+    /// A direction's 1 − cos θ′ about the axis in the stable form |d × n|² / (|d| (|d| + d·n))
+    /// (1 − cos θ′ itself loses every digit for a cap of 10⁻³ rad in f32), and its components
+    /// (x, y) across it: ((1 − cos θ′), x, y).
+    pub fn local(&self, d: DVec3) -> (f64, f64, f64) {
+        let l = d.length();
+        let z = d.dot(self.axis);
+        let a = if z > 0.0 { d.cross(self.axis).length_squared() / (l * (l + z)) } else { 1.0 - z / l };
+        (a, d.dot(self.t), d.dot(self.b))
+    }
+
+    /// The direction at local coordinates (a = 1 − cos θ′, φ′).
+    pub fn direction(&self, a: f64, phi: f64) -> DVec3 {
+        let s = (a * (2.0 - a)).max(0.0).sqrt();
+        s * phi.cos() * self.t + s * phi.sin() * self.b + (1.0 - a) * self.axis
+    }
 }
 
 /// Why a box `[x0, y0, x1, y1]` is not one: the text a message quotes after naming its field.
@@ -48,19 +92,55 @@ impl Domain {
         if finite && x0 < x1 && y0 < y1 { Ok(Domain::Plane { bounds }) } else { Err(NotABox(bounds)) }
     }
 
-    /// Whether the box of a plane is one (the sphere always is a domain).
+    /// The cap about `axis` (a direction, normalised here) of height 1 − cos ρ = `height` ∈ (0,
+    /// 1], both rounded to f32 as the GPU reads them; `None` for an axis that is not a
+    /// direction or a height out of range.
+    ///
+    /// ```
+    /// use lobes::stats::domain::Domain;
+    /// let cap = Domain::cap([0.0, 0.0, 2.0], 1e-4).unwrap();
+    /// assert!(cap.directions());
+    /// assert!(Domain::cap([0.0, 0.0, 1.0], 1.5).is_none());
+    /// ```
+    pub fn cap(axis: [f64; 3], height: f64) -> Option<Self> {
+        let n = DVec3::from(axis).normalize_or_zero();
+        let axis = [n.x as f32 as f64, n.y as f32 as f64, n.z as f32 as f64];
+        let height = height as f32 as f64;
+        (n != DVec3::ZERO && height > 0.0 && height <= 1.0).then_some(Domain::Cap { axis, height })
+    }
+
+    /// Whether the box of a plane is one (the sphere and a cap always are domains).
     pub fn validate(&self) -> Result<(), NotABox> {
         match *self {
             Domain::Plane { bounds } => Domain::plane(bounds).map(|_| ()),
-            Domain::Sphere => Ok(()),
+            Domain::Sphere | Domain::Cap { .. } => Ok(()),
         }
     }
 
-    /// Its name in scene files, flags and output files: `sphere` or `plane`.
+    /// A cap's frame.
+    pub fn frame(&self) -> Option<Frame> {
+        match *self {
+            Domain::Cap { axis, .. } => Some(Frame::of(axis)),
+            _ => None,
+        }
+    }
+
+    /// The solid angle it spans (sr): 4π, a cap's 2π h; `None` on the plane.
+    pub fn solid_angle(&self) -> Option<f64> {
+        match *self {
+            Domain::Sphere => Some(4.0 * std::f64::consts::PI),
+            Domain::Cap { height, .. } => Some(2.0 * std::f64::consts::PI * height),
+            Domain::Plane { .. } => None,
+        }
+    }
+
+    /// Its name in scene files, flags and output files: `sphere`, `plane` or `cap` (a cap is
+    /// fitted, not named by users: [`Self::NAMES`] leaves it out).
     pub fn name(&self) -> &'static str {
         match self {
             Domain::Sphere => "sphere",
             Domain::Plane { .. } => "plane",
+            Domain::Cap { .. } => "cap",
         }
     }
 
@@ -73,6 +153,7 @@ impl Domain {
         match self {
             Domain::Sphere => ["cos θ", "φ"],
             Domain::Plane { .. } => ["y", "x"],
+            Domain::Cap { .. } => ["1 − cos θ′", "φ′"],
         }
     }
 
@@ -88,6 +169,7 @@ impl Domain {
         match *self {
             Domain::Sphere => [("cos θ", (-1.0, 1.0)), ("φ (degrees)", (-180.0, 180.0))],
             Domain::Plane { bounds: [x0, y0, x1, y1] } => [("y", (y0, y1)), ("x", (x0, x1))],
+            Domain::Cap { height, .. } => [("1 − cos θ′ (θ′ from the cap's axis)", (0.0, height)), ("φ′ (degrees)", (-180.0, 180.0))],
         }
     }
 
@@ -97,6 +179,15 @@ impl Domain {
     /// Whether a point is a direction from a shading point lit from an incident direction, so
     /// that incidence, frames, half vectors and solid angle apply to it.
     pub fn directions(&self) -> bool {
+        matches!(self, Domain::Sphere | Domain::Cap { .. })
+    }
+
+    /// Whether f32 binning places its column edges off the axes coarser than a sample's own
+    /// rounding: on the sphere, where φ = atan2(y, x) rounds to 2·10⁻⁷ rad near ±π wherever the
+    /// direction is (`quadrature::edge_strips`). On the plane x and y themselves are binned; on
+    /// a cap, φ′ comes from the direction's components across the axis, whose rounding is the
+    /// sample's own.
+    pub fn rounds_phi_edges(&self) -> bool {
         matches!(self, Domain::Sphere)
     }
 
@@ -108,7 +199,8 @@ impl Domain {
 
     /// The point at coordinates (a, b) of a quadrature part: on the sphere in hemisphere `h`
     /// (±1), with a = 1 − |cos θ| and b = φ, the direction (s cos φ, s sin φ, h (1 − a)),
-    /// s = √(a (2 − a)), whose solid-angle element is da dφ; on the plane the point (a, b, 0).
+    /// s = √(a (2 − a)), whose solid-angle element is da dφ; on a cap the same about its axis
+    /// ([`Frame::direction`], h = 1); on the plane the point (a, b, 0).
     /// The f64 twin of `lobes_domain_point` ([`Domain::binning_wgsl`]).
     pub fn part_point(&self, a: f64, b: f64, h: f64) -> [f64; 3] {
         match self {
@@ -116,6 +208,7 @@ impl Domain {
                 let s = (a * (2.0 - a)).max(0.0).sqrt();
                 [s * b.cos(), s * b.sin(), h * (1.0 - a)]
             }
+            Domain::Cap { axis, .. } => Frame::of(*axis).direction(a, b).into(),
             Domain::Plane { .. } => [a, b, 0.0],
         }
     }
@@ -124,21 +217,28 @@ impl Domain {
     pub fn bounds(&self) -> Option<[f64; 4]> {
         match *self {
             Domain::Plane { bounds } => Some(bounds),
-            Domain::Sphere => None,
+            Domain::Sphere | Domain::Cap { .. } => None,
         }
     }
 
-    /// The box the GPU's binning reads from its uniforms (unused on the sphere).
+    /// What the GPU's binning reads from its uniforms: the plane's box, a cap's (axis,
+    /// height); unused on the sphere.
     pub fn uniform_bounds(&self) -> [f32; 4] {
-        self.bounds().map_or([0.0; 4], |b| b.map(|v| v as f32))
+        match *self {
+            Domain::Cap { axis: [x, y, z], height } => [x as f32, y as f32, z as f32, height as f32],
+            _ => self.bounds().map_or([0.0; 4], |b| b.map(|v| v as f32)),
+        }
     }
 
     /// The histogram's rows × cols unless asked for others: cells of about equal extent in
-    /// both axes (64 × 128 over cos θ × φ on the sphere, 64 × 64 on the plane).
+    /// both axes (64 × 128 over cos θ × φ on the sphere, 64 × 64 on the plane); on a cap 16 × 32,
+    /// as many cells as a support of 0.8 sr gets on the sphere, with the outer row's width in
+    /// θ′ (3 % of ρ) far above f32's resolution of a direction even at 10⁻⁶ sr.
     pub fn default_grid(&self) -> (u32, u32) {
         match self {
             Domain::Sphere => (64, 128),
             Domain::Plane { .. } => (64, 64),
+            Domain::Cap { .. } => (16, 32),
         }
     }
 
@@ -153,6 +253,7 @@ impl Domain {
         match self {
             Domain::Sphere => "shaders/check/domain_sphere.wgsl",
             Domain::Plane { .. } => "shaders/check/domain_plane.wgsl",
+            Domain::Cap { .. } => "shaders/check/domain_cap.wgsl",
         }
     }
 }
@@ -173,6 +274,8 @@ pub enum Cell {
     Sphere { row: u32, phi: (f64, f64) },
     /// The x and y ranges of a cell of the plane.
     Plane { x: (f64, f64), y: (f64, f64) },
+    /// The 1 − cos θ′ and φ′ ranges of a cell of a cap.
+    Cap { a: (f64, f64), phi: (f64, f64) },
 }
 
 impl Grid {
@@ -193,6 +296,11 @@ impl Grid {
                 let (dx, dy) = ((x1 - x0) / self.cols as f64, (y1 - y0) / self.rows as f64);
                 Cell::Plane { x: (x0 + c as f64 * dx, x0 + (c + 1) as f64 * dx), y: (y0 + r as f64 * dy, y0 + (r + 1) as f64 * dy) }
             }
+            Domain::Cap { height, .. } => {
+                let phi = SphereGrid { rows: self.rows, cols: self.cols }.phi_edges();
+                let da = height / self.rows as f64;
+                Cell::Cap { a: (r as f64 * da, (r + 1) as f64 * da), phi: (phi[c as usize], phi[c as usize + 1]) }
+            }
         }
     }
 
@@ -211,6 +319,10 @@ impl Grid {
                         [s * phi.cos(), s * phi.sin(), z]
                     }
                     Domain::Plane { bounds: [x0, y0, x1, y1] } => [x0 + (x1 - x0) * c / cols as f64, y0 + (y1 - y0) * r / rows as f64, 0.0],
+                    Domain::Cap { height, .. } => {
+                        let phi = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * c / cols as f64;
+                        self.domain.part_point(height * r / rows as f64, phi, 1.0)
+                    }
                 }
             })
             .collect()
@@ -236,8 +348,9 @@ impl Grid {
     }
 
     /// The cell of a point, `None` outside the domain: on the sphere a direction within 10⁻³ of
-    /// unit length ([`SphereGrid::bin_of`]), on the plane (x, y) inside the box, its far edges
-    /// in the last row and column. The CPU twin of `lobes_domain_cell` ([`Domain::binning_wgsl`]).
+    /// unit length ([`SphereGrid::bin_of`]), on a cap such a direction with 1 − cos θ′ ≤ h
+    /// ([`Frame::local`], its column as the sphere's), on the plane (x, y) inside the box, its far
+    /// edges in the last row and column. The CPU twin of `lobes_domain_cell` ([`Domain::binning_wgsl`]).
     pub fn cell_of(&self, p: [f64; 3]) -> Option<usize> {
         match self.domain {
             Domain::Sphere => {
@@ -249,6 +362,15 @@ impl Grid {
                 let index = |t: f64, n: u32| ((t * n as f64) as u32).min(n - 1);
                 let (col, row) = (index((p[0] - x0) / (x1 - x0), self.cols), index((p[1] - y0) / (y1 - y0), self.rows));
                 inside.then_some((row * self.cols + col) as usize)
+            }
+            Domain::Cap { axis, height } => {
+                let d = DVec3::from(p);
+                let (a, x, y) = Frame::of(axis).local(d);
+                if (d.length() - 1.0).abs() > 1e-3 || !(a <= height) {
+                    return None;
+                }
+                let row = ((a / height * self.rows as f64) as u32).min(self.rows - 1);
+                Some((row * self.cols + SphereGrid { rows: self.rows, cols: self.cols }.column_of(x, y)) as usize)
             }
         }
     }
@@ -271,8 +393,51 @@ mod tests {
     }
 
     #[test]
+    fn a_cell_of_a_cap_spans_its_solid_angle_over_the_cells() {
+        // a cap of ρ = 10⁻³ rad: a Monte Carlo of directions uniform in the cone (the cos θ′
+        // uniform on [cos ρ, 1]: Archimedes again) falls in each of the 4 × 8 cells equally, and
+        // a cell's extent is 2π h / 32 sr, h = 2 sin²(ρ/2)
+        let rho: f64 = 1e-3;
+        let cap = Domain::cap([0.3, -0.4, 0.5], 2.0 * (0.5 * rho).sin().powi(2)).unwrap();
+        let Domain::Cap { axis, height } = cap else { panic!() };
+        let g = cap.grid(4, 8);
+        let frame = Frame::of(axis);
+        let mut counts = [0u32; 32];
+        let n = 65_536;
+        for i in 0..n {
+            // a stratified (a, φ) pair: a uniform on [0, h], φ uniform
+            let (u, v) = (((i % 256) as f64 + 0.5) / 256.0, ((i / 256) as f64 + 0.5) / 256.0);
+            let d = frame.direction(u * height, std::f64::consts::TAU * v - std::f64::consts::PI);
+            counts[g.cell_of(d.into()).expect("inside the cap")] += 1;
+        }
+        assert!(counts.iter().all(|&c| c == n / 32), "{counts:?}");
+        for bin in 0..g.bins() {
+            let Cell::Cap { a, phi } = g.cell(bin) else { panic!("a cap cell") };
+            let sr = (a.1 - a.0) * (phi.1 - phi.0);
+            assert!((sr - cap.solid_angle().unwrap() / 32.0).abs() < 1e-18, "cell {bin}: {sr}");
+        }
+        // the cone's edge: just inside and just outside (the f32 resolution is 6·10⁻⁸ rad)
+        let inside = frame.direction(height * (1.0 - 1e-3), 0.1);
+        let outside = frame.direction(height * (1.0 + 1e-3), 0.1);
+        assert!(g.cell_of(inside.into()).is_some_and(|c| c / 8 == 3));
+        assert_eq!(g.cell_of(outside.into()), None);
+        assert_eq!(g.cell_of((-frame.axis).into()), None, "the antipode");
+    }
+
+    #[test]
+    fn a_caps_frame_is_orthonormal_and_right_handed() {
+        for axis in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.3, -0.4, 0.866], [1e-9, 0.0, -1.0]] {
+            let f = Frame::of(DVec3::from(axis).normalize().into());
+            for (u, v) in [(f.t, f.b), (f.b, f.axis), (f.axis, f.t)] {
+                assert!(u.dot(v).abs() < 1e-12 && (u.length() - 1.0).abs() < 1e-12, "{axis:?}");
+            }
+            assert!((f.t.cross(f.b) - f.axis).length() < 1e-12, "{axis:?}");
+        }
+    }
+
+    #[test]
     fn every_centre_falls_in_its_own_cell() {
-        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9)] {
+        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9), Domain::cap([0.0, 1.0, 0.1], 3e-6).unwrap().grid(5, 12)] {
             for (bin, c) in g.centres().into_iter().enumerate() {
                 assert_eq!(g.cell_of(c), Some(bin), "{g:?}: the centre {c:?}");
             }

@@ -26,15 +26,22 @@ impl SphereGrid {
         let z = w.z.clamp(-1.0, 1.0);
         let row = (((z + 1.0) * 0.5 * self.rows as f64) as u32).min(self.rows - 1);
         // at the poles φ is undefined (atan2 of two zeros depends on their signs): use φ = 0
-        let t = if w.x == 0.0 && w.y == 0.0 { 0.5 } else { (w.y.atan2(w.x) + PI) / (2.0 * PI) };
+        (row * self.cols + self.column_of(w.x, w.y)) as usize
+    }
+
+    /// The column of a direction whose components across the axis are (x, y): ⌊(φ+π)/2π ·
+    /// cols⌋ with φ = atan2(y, x), φ = π wrapped to column 0, φ = 0 at x = y = 0, exact on the
+    /// axes' edges ([`Self::axis_exact_column`]).
+    pub fn column_of(&self, x: f64, y: f64) -> u32 {
+        let t = if x == 0.0 && y == 0.0 { 0.5 } else { (y.atan2(x) + PI) / (2.0 * PI) };
         let mut col = (t.max(0.0) * self.cols as f64) as u32;
         if col >= self.cols {
             col = 0;
         }
-        if !(w.x == 0.0 && w.y == 0.0) {
-            col = self.axis_exact_column(col, w.x, w.y);
+        if !(x == 0.0 && y == 0.0) {
+            col = self.axis_exact_column(col, x, y);
         }
-        (row * self.cols + col) as usize
+        col
     }
 
     /// `col`, from the rounded t, moved across the seam by the sign of y, and into the half (for an

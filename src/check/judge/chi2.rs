@@ -30,8 +30,7 @@ pub(crate) fn expected(run: &Run, m: &Measured) -> Vec<f64> {
 /// lobe than f32 binning places it, the two bins beside it as one cell.
 fn judged_cells(run: &Run, m: &Measured) -> Result<(Vec<u64>, Vec<f64>, usize), CheckError> {
     let (counts, expected) = (m.counts(run.bins()), expected(run, m));
-    // (the plane's edges are exact in f32 binning's sense: x and y themselves are binned)
-    if !run.sampler.domain.directions() {
+    if !run.sampler.domain.rounds_phi_edges() {
         return Ok((counts.to_vec(), expected, 0));
     }
     let (rows, cols, samples) = (run.rows, run.cols, run.settings.samples);

@@ -7,7 +7,7 @@ use crate::check::report::{Check, Figures};
 use crate::check::{CheckError, incident};
 
 pub(crate) fn check(run: &Run) -> Result<Check, CheckError> {
-    let (s, settings) = (run.sampler, run.settings);
+    let (s, settings) = (&*run.sampler, run.settings);
     let us = hard::uniforms(&s.conventions.hard_u_values());
     let thetas: Vec<f64> = if s.domain.directions() { s.conventions.hard_thetas() } else { vec![settings.incident_theta] };
     let items: Vec<([f32; 4], [f32; 3])> = thetas.iter().flat_map(|&t| us.iter().map(move |u| (*u, incident(t, settings.incident_phi)))).collect();

@@ -25,9 +25,10 @@ use crate::reference::rng;
 /// The most samples of one dispatch of the histogram and weights passes.
 pub(super) const CHUNK: u64 = 1 << 26;
 
-/// One check of one sampler at one setting: the composed passes and their parameters.
+/// One check of one sampler at one setting: the composed passes and their parameters. Its
+/// sampler is the user's, on the cap fitted to its support where one is ([`super::support`]).
 pub(crate) struct Run<'a, 'g> {
-    pub sampler: &'a UserSampler,
+    pub sampler: std::borrow::Cow<'a, UserSampler>,
     pub settings: &'a Settings,
     pub passes: Passes<'g>,
     pub params: Params,
@@ -40,12 +41,27 @@ pub(crate) struct Run<'a, 'g> {
 }
 
 impl<'a, 'g> Run<'a, 'g> {
+    /// The run of `sampler`, on a grid fitted to its support where the settings and its samples
+    /// call for one ([`super::support::fit`]).
     pub fn new(gpu: &'g Gpu, sampler: &'a UserSampler, settings: &'a Settings) -> Result<Self, CheckError> {
-        let (rows, cols) = settings.grid(&sampler.domain);
         let params = super::params_of(sampler, settings);
         let (passes, draws) = super::compose_passes(gpu, sampler, settings, &params)?;
+        let run = Self::on(std::borrow::Cow::Borrowed(sampler), settings, passes, draws);
+        if settings.fit.limit().is_none() || sampler.domain != super::Domain::Sphere {
+            return Ok(run);
+        }
+        let probes = run.passes.probe(&run.params, &probe_items(&run))?;
+        Ok(match super::support::fit(gpu, sampler, settings, &probes)? {
+            Some((domain, passes, draws)) => Self::on(std::borrow::Cow::Owned(UserSampler { domain, ..sampler.clone() }), settings, passes, draws),
+            None => run,
+        })
+    }
+
+    fn on(sampler: std::borrow::Cow<'a, UserSampler>, settings: &'a Settings, passes: Passes<'g>, draws: String) -> Self {
+        let (rows, cols) = settings.grid(&sampler.domain);
+        let params = super::params_of(&sampler, settings);
         let wi = super::incident(settings.incident_theta, settings.incident_phi);
-        Ok(Self { sampler, settings, passes, params, draws, wi, rows, cols })
+        Self { sampler, settings, passes, params, draws, wi, rows, cols }
     }
     pub fn bins(&self) -> usize {
         (self.rows * self.cols) as usize
@@ -112,10 +128,9 @@ impl Measured {
 
 /// Measures `run`: the histogram, the probes, and the quadrature of the pdf.
 pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
-    let totals = histogram(&run.passes, &run.params, run.sampler, run.settings.samples, run.bins())?;
+    let totals = histogram(&run.passes, &run.params, &run.sampler, run.settings.samples, run.bins())?;
     let probe_u = probe_uniforms(run.settings);
-    let items: Vec<([f32; 4], [f32; 3])> = probe_u.iter().map(|u| (*u, run.wi)).collect();
-    let probes = run.passes.probe(&run.params, &items)?;
+    let probes = run.passes.probe(&run.params, &probe_items(run))?;
     let points: Vec<[f32; 3]> = probes.iter().map(Probe::d).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();
     let kappa: Vec<f64> = run.passes.conditioning(&run.params, &points)?.iter().map(|v| v[1] as f64).collect();
     let around: Vec<[f32; 4]> = probe_u.iter().flat_map(|u| map::around(*u)).collect();
@@ -135,6 +150,11 @@ fn map_jump(run: &Run, probes: &[Probe], probe_u: &[[f32; 4]]) -> Result<Option<
 }
 
 /// The probe's uniforms: away from the edges by 2ε, so that u ± ε stays in [0, 1].
+/// The probed uniforms with the run's incident direction.
+fn probe_items(run: &Run) -> Vec<([f32; 4], [f32; 3])> {
+    probe_uniforms(run.settings).into_iter().map(|u| (u, run.wi)).collect()
+}
+
 fn probe_uniforms(settings: &Settings) -> Vec<[f32; 4]> {
     let margin = 2.0 * map::EPS as f64;
     (0..settings.probe_samples as u64)
@@ -185,7 +205,7 @@ pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler,
 /// expected counts the quadrature could not resolve give no verdict.
 pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckError> {
     if m.integrals.bad_parts == 0 {
-        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(e + &super::half_vector_pole(run.sampler, run.settings, None).unwrap_or_default()))?;
+        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(e + &super::half_vector_pole(&run.sampler, run.settings, None).unwrap_or_default()))?;
     }
     Ok(())
 }

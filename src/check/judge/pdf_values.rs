@@ -75,7 +75,7 @@ fn worst(passes: &Passes, params: &Params, domain: &Domain, conventions: &Conven
 /// `pdf_values`: the pdf finite and ≥ 0 at every quadrature node; where not, its worst point.
 pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     let (bad, parts) = (m.integrals.bad_parts, m.integrals.parts);
-    let s = run.sampler;
+    let s = &*run.sampler;
     let worst = if bad > 0 { worst(&run.passes, &run.params, &s.domain, &s.conventions)? } else { None };
     if bad > 0
         && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))

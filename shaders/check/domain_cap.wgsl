@@ -1,0 +1,68 @@
+#define_import_path lobes::domain
+#import lobes::check_params::lobes_check
+#import lobes::bins::lobes_axis_column
+
+// A spherical cap fitted around a small support as the domain of `lobes check`'s passes
+// (src/stats/domain.rs, Domain::Cap: the CPU twin of each function here; domain_sphere.wgsl says
+// what each function is for). The uniforms' `bounds` hold the cap's unit axis n (xyz) and its
+// height h = 1 − cos ρ (w). Rows are uniform in a = 1 − cos θ′ over [0, h] and columns in φ′,
+// both about n in the frame (t, b, n): every cell spans 2π h / (rows · cols) sr.
+
+// The frame (t, b, n) of Duff et al. 2017, "Building an Orthonormal Basis, Revisited" (JCGT
+// 6(1)), listing 3; Frame::of is its f64 twin.
+fn lobes_cap_frame(n: vec3<f32>) -> mat3x3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return mat3x3<f32>(vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), vec3<f32>(b, sign + n.y * n.y * a, -n.y), n);
+}
+
+// The direction at (a, b) of a quadrature rectangle, as on the sphere (h = 1: the cap's axis is
+// its pole, and b is φ′ measured from the local axis k quarter turns from t), turned into the
+// cap's frame: the local direction's components across n keep their f32 resolution, so a cap of
+// 10⁻³ rad is resolved to an ulp of its radius, not of 1.
+fn lobes_domain_point(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
+    let s = sqrt(max(0.0, a * (2.0 - a)));
+    let e = vec2<f32>(cos(b), sin(b));
+    var t = e;
+    t = select(t, vec2<f32>(-e.y, e.x), k == 1u);
+    t = select(t, -e, k == 2u);
+    t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
+    return lobes_cap_frame(lobes_check.bounds.xyz) * vec3<f32>(s * t.x, s * t.y, 1.0 - a);
+}
+
+// A sample's point as the domain reads it: a direction, all three components.
+fn lobes_domain_coordinates(p: vec3<f32>) -> vec3<f32> {
+    return p;
+}
+
+// The bin of a finite sample point, or LOBES_DOMAIN_OUTSIDE where it is not a unit direction
+// (within 10⁻³) or lies outside the cap: a = |p × n|² / (|p| (|p| + p·n)), the stable form of
+// 1 − cos θ′ (which in f32 has no digit left for a cap of 10⁻³ rad), the column of (p·t, p·b) as
+// the sphere's (shaders/lib/bins.wgsl).
+fn lobes_domain_cell(p: vec3<f32>) -> u32 {
+    let l = length(p);
+    let f = lobes_cap_frame(lobes_check.bounds.xyz);
+    let z = dot(p, f[2]);
+    if (abs(l - 1.0) > 1e-3 || z <= 0.0) {
+        return LOBES_DOMAIN_OUTSIDE;
+    }
+    let c = cross(p, f[2]);
+    let a = dot(c, c) / (l * (l + z));
+    let height = lobes_check.bounds.w;
+    if (!(a <= height)) {
+        return LOBES_DOMAIN_OUTSIDE;
+    }
+    let row = min(u32(a / height * f32(lobes_check.rows)), lobes_check.rows - 1u);
+    let x = dot(p, f[0]);
+    let y = dot(p, f[1]);
+    var t = 0.5;
+    if (x != 0.0 || y != 0.0) {
+        t = (atan2(y, x) + 3.14159265358979) * (0.5 / 3.14159265358979);
+    }
+    let col = lobes_axis_column(u32(max(t, 0.0) * f32(lobes_check.cols)), lobes_check.cols, x, y);
+    return row * lobes_check.cols + col;
+}
+
+// What lobes_domain_cell returns for a point outside the domain.
+const LOBES_DOMAIN_OUTSIDE: u32 = 0xffffffffu;
