@@ -11,8 +11,9 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The version of the layout of [`Report`] (and of [`super::power::PowerSweep`]).
-pub const REPORT_VERSION: u32 = 1;
+/// The version of the layout of [`Report`] (and of [`super::power::PowerSweep`]): 2 since a
+/// report's `domain` may be a fitted cap (`{"kind": "cap", "axis", "height"}`).
+pub const REPORT_VERSION: u32 = 2;
 
 /// Names of the invalid-sample reasons, in the order of their cells after the bins.
 pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
