@@ -1056,9 +1056,12 @@ impl Roots {
             _ => (format!("no file {rel}.wesl or .wgsl under the shader roots ({})", show_roots(&self.roots)), String::new()),
         };
         let close = closest_modules(&shown, &self.known);
-        let close = if close.is_empty() { "no modules found there".to_string() } else { format!("closest: {}", close.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ")) };
+        let close = match close.is_empty() {
+            true => format!("none of the {} modules found is close", self.known.len()),
+            false => format!("closest: {} of the {} modules found", close.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", "), self.known.len()),
+        };
         let hint = if hint.is_empty() { "Add its folder with --shader-root, ".to_string() } else { hint };
-        format!("unresolved import: {looked} ({close} of {} found). {hint}or stand in for it with --stub {shown}=FILE", self.known.len())
+        format!("unresolved import: {looked} ({close}). {hint}or stand in for it with --stub {shown}=FILE")
     }
     /// `text` (the file `name`) with its `@if` blocks resolved; a malformed condition is an
     /// error at its file, line and column.

@@ -145,7 +145,7 @@ fn chains(text: &str, features: &HashMap<String, bool>) -> Result<Vec<Vec<Member
             b'@' => {
                 if let Some(m) = attribute(text, i, features)? {
                     i = m.attr.1;
-                    add(&mut chains, open.last_mut().expect("the module level"), m)?;
+                    add(text, &mut chains, open.last_mut().expect("the module level"), m)?;
                     continue;
                 }
             }
@@ -157,10 +157,13 @@ fn chains(text: &str, features: &HashMap<String, bool>) -> Result<Vec<Vec<Member
 }
 
 /// `m` added to its level's chain: an `@if` starts one, `@elif`/`@else` continue the open one.
-fn add(chains: &mut Vec<Vec<Member>>, level: &mut Option<usize>, m: Member) -> Result<(), BlockError> {
+/// A block's end is known, so a chain whose block is not followed by `@elif`/`@else` ends there
+/// (a single node's end is the `wesl` crate's to find).
+fn add(text: &str, chains: &mut Vec<Vec<Member>>, level: &mut Option<usize>, m: Member) -> Result<(), BlockError> {
+    let ends = m.block.is_some_and(|(_, close)| !continued(text, close + 1));
     if m.kind == Kind::If {
         chains.push(vec![m]);
-        *level = Some(chains.len() - 1);
+        *level = (!ends).then_some(chains.len() - 1);
         return Ok(());
     }
     let what = m.kind.name();
@@ -174,7 +177,21 @@ fn add(chains: &mut Vec<Vec<Member>>, level: &mut Option<usize>, m: Member) -> R
         return Err(BlockError { at: m.attr.0, message: format!("{what} after an @else: the @else ends its chain; start a new one with @if") });
     }
     chain.push(m);
+    if ends {
+        *level = None;
+    }
     Ok(())
+}
+
+/// Whether the next token from `at` on is an `@elif` or `@else` attribute.
+fn continued(text: &str, at: usize) -> bool {
+    let b = text.as_bytes();
+    let i = skip_blank(b, at);
+    if b.get(i) != Some(&b'@') {
+        return false;
+    }
+    let name = &text[skip_blank(b, i + 1)..];
+    ["elif", "else"].iter().any(|k| name.strip_prefix(k).is_some_and(|r| !r.starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_')))
 }
 
 /// Where a comment that starts at `i` ends (WGSL: `//` to the line's end, `/* */` nested).
@@ -430,7 +447,8 @@ mod tests {
         assert_eq!((e.at, e.message.starts_with("@if(A +): `+` is not allowed here")), (13, true), "{e:?}");
         assert!(e.message.contains(EXPRESSIONS));
         assert!(err("@else { }").message.starts_with("@else without an @if before it"));
-        assert!(err("@if(A) { } @else { } @else { }").message.starts_with("@else after an @else"));
+        assert!(err("@if(A) x; @else y; @else z;").message.starts_with("@else after an @else"));
+        assert!(err("@if(A) { } fn f() {} @else { }").message.starts_with("@else without an @if before it"));
         assert!(err("@if A { }").message.starts_with("@if needs a condition in parentheses"));
         assert!(err("@if(A { }").message.contains("no closing parenthesis"));
         assert!(err("@if(A) { const b = 1;").message.contains("no closing `}`"));
