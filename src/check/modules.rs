@@ -43,6 +43,10 @@ pub struct Composition {
     /// Stand-ins for modules the test does not need (`--stub MODULE=FILE`): bind groups, scene
     /// bindings, ray queries.
     pub stubs: Vec<(String, PathBuf)>,
+    /// Where another WESL package's modules are (`--package NAME=DIR`): `NAME::a::b` is
+    /// `DIR/a/b.wesl` (or `.wgsl`). A package not named here is looked for under the shader roots
+    /// without its name (`NAME::a::b` as `a/b.wesl`).
+    pub packages: Vec<(String, PathBuf)>,
     /// The user's random functions (`--rand NAME`): their bodies are replaced by lobes' queue of
     /// u.x, u.y, u.z, u.w in call order.
     pub rand: Vec<String>,
@@ -66,6 +70,11 @@ impl Composition {
     }
     pub fn stub(mut self, module: &str, file: impl Into<PathBuf>) -> Self {
         self.stubs.push((module.into(), file.into()));
+        self
+    }
+    /// Another WESL package's folder: `NAME::a::b` is `dir/a/b.wesl` (`--package NAME=DIR`).
+    pub fn package(mut self, name: &str, dir: impl Into<PathBuf>) -> Self {
+        self.packages.push((name.into(), dir.into()));
         self
     }
     pub fn rand(mut self, name: &str) -> Self {
@@ -119,13 +128,37 @@ impl Composition {
         if rand_order.is_some() && rand.is_empty() {
             return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
         }
-        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, rand: rand.to_vec(), rand_order, sample_returns, normal: None })
+        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
+    }
+
+    /// `--package NAME=DIR` flags (repeatable): NAME a WESL package name, each at most once.
+    pub fn parse_packages(flags: &[String]) -> Result<Vec<(String, PathBuf)>, String> {
+        let mut out: Vec<(String, PathBuf)> = Vec::new();
+        for f in flags {
+            let Some((name, dir)) = f.split_once('=').map(|(n, d)| (n.trim(), d.trim())).filter(|(n, d)| !n.is_empty() && !d.is_empty()) else {
+                return Err(format!("--package '{f}': give NAME=DIR, e.g. --package bevy_render=crates/bevy_render/src (then bevy_render::maths is DIR/maths.wesl)"));
+            };
+            check_package(name, &out)?;
+            out.push((name.to_string(), PathBuf::from(dir)));
+        }
+        Ok(out)
     }
 
     /// Whether anything beyond the contract's plain files is asked for.
     pub fn is_plain(&self) -> bool {
         *self == Self::default()
     }
+}
+
+/// A `--package` name: an identifier, not `package` (the sampler's own root), given once.
+fn check_package(name: &str, given: &[(String, PathBuf)]) -> Result<(), String> {
+    if !super::gpu::is_name(name) || name == "package" || name == "super" {
+        return Err(format!("--package {name}=…: a package name is an identifier other than package and super (WESL's own path starts), as an import names it: bevy_render in `import bevy_render::maths::PI;`"));
+    }
+    if given.iter().any(|(n, _)| n == name) {
+        return Err(format!("--package {name}: given twice; one package has one folder"));
+    }
+    Ok(())
 }
 
 /// What a sample expression's result means.
@@ -454,6 +487,9 @@ fn tree_key(sources: &[Source], c: &Composition) -> TreeKey {
     let mut files = Vec::new();
     for r in roots(sources, c) {
         scan(&r, &["wgsl", "wesl"], &mut files);
+    }
+    for (_, dir) in &c.packages {
+        scan(dir, &["wgsl", "wesl"], &mut files);
     }
     files.extend(c.stubs.iter().map(|(_, f)| f.clone()));
     let stamp = files
@@ -932,6 +968,12 @@ fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<WeslTree, CheckErro
 #[cfg(feature = "wesl")]
 struct Roots {
     roots: Vec<PathBuf>,
+    /// `--package NAME=DIR`: where `NAME::…` paths are, instead of the roots.
+    packages: Vec<(String, PathBuf)>,
+    /// The `@if` features, for the conditional blocks `wesl` 0.4 cannot read ([`wesl_blocks`]).
+    ///
+    /// [`wesl_blocks`]: super::dialect::wesl_blocks
+    features: std::collections::HashMap<String, bool>,
     stubs: Vec<(String, Source)>,
     /// Module paths (`package::a::b`) of the files under the roots, for "closest" names.
     known: Vec<String>,
@@ -966,10 +1008,15 @@ impl Resolved {
 
 #[cfg(feature = "wesl")]
 impl Roots {
-    /// The files that `path` names: `a/b.wesl` and `a/b.wgsl` under every root.
+    /// The files that `path` names: `a/b.wesl` and `a/b.wgsl` under every root; a path of a
+    /// package given by `--package NAME=DIR` (`NAME::a::b`) under DIR alone.
     fn files(&self, path: &wesl::ModulePath) -> Vec<PathBuf> {
         let mut out = Vec::new();
-        for r in &self.roots {
+        let package = match &path.origin {
+            wesl::syntax::PathOrigin::Package(name) => self.packages.iter().find(|(n, _)| n == name).map(|(_, d)| std::slice::from_ref(d)),
+            _ => None,
+        };
+        for r in package.unwrap_or(&self.roots) {
             let mut p = r.clone();
             p.extend(&path.components);
             out.extend(["wesl", "wgsl"].iter().map(|e| p.with_extension(e)).filter(|f| f.is_file()));
@@ -992,6 +1039,37 @@ impl Roots {
     fn stub(&self, path: &wesl::ModulePath) -> Option<&(String, Source)> {
         let shown = path.to_string();
         self.stubs.iter().find(|(m, _)| *m == shown || format!("package::{m}") == shown)
+    }
+    /// Why no file holds `path`: where lobes looked, the closest modules it found, and the flags
+    /// that say where the module is.
+    fn not_found(&self, path: &wesl::ModulePath) -> String {
+        let shown = path.to_string();
+        let rel = path.components.join("/");
+        let (looked, hint) = match &path.origin {
+            wesl::syntax::PathOrigin::Package(name) => match self.packages.iter().find(|(n, _)| n == name) {
+                Some((_, dir)) => (format!("no file {rel}.wesl or .wgsl in {} (--package {name})", dir.display()), format!("Check the folder of --package {name}=DIR (it holds {name}'s modules: {name}::a::b is DIR/a/b.wesl), ")),
+                None => (
+                    format!("no package {name} given (--package), and no file {rel}.wesl or .wgsl under the shader roots ({}), where lobes looks for it without its name", show_roots(&self.roots)),
+                    format!("Say where {name} is with --package {name}=DIR, "),
+                ),
+            },
+            _ => (format!("no file {rel}.wesl or .wgsl under the shader roots ({})", show_roots(&self.roots)), String::new()),
+        };
+        let close = closest_modules(&shown, &self.known);
+        let close = match close.is_empty() {
+            true => format!("none of the {} modules found is close", self.known.len()),
+            false => format!("closest: {} of the {} modules found", close.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", "), self.known.len()),
+        };
+        let hint = if hint.is_empty() { "Add its folder with --shader-root, ".to_string() } else { hint };
+        format!("unresolved import: {looked} ({close}). {hint}or stand in for it with --stub {shown}=FILE")
+    }
+    /// `text` (the file `name`) with its `@if` blocks resolved; a malformed condition is an
+    /// error at its file, line and column.
+    fn conditional_blocks(&self, path: &wesl::ModulePath, name: &str, text: &str) -> Result<String, wesl::ResolveError> {
+        super::dialect::wesl_blocks::resolve(text, &self.features).map_err(|e| {
+            let (line, col) = line_col(text, e.at);
+            self.refuse(path, format!("{name}:{line}:{col}: {}", e.message))
+        })
     }
     /// An error of the resolver's own, kept for the tree's caller (and a short one for wesl).
     fn refuse(&self, path: &wesl::ModulePath, why: String) -> wesl::ResolveError {
@@ -1027,20 +1105,12 @@ impl wesl::Resolver for Roots {
     fn resolve_source<'a>(&'a self, path: &wesl::ModulePath) -> Result<std::borrow::Cow<'a, str>, wesl::ResolveError> {
         if let Some((m, s)) = self.stub(path) {
             self.seen.borrow_mut().stubs_used.push(m.clone());
-            return Ok(s.text.as_str().into());
+            return self.conditional_blocks(path, &s.name, &s.text).map(Into::into);
         }
         let shown = path.to_string();
         let files = self.files(path);
         let Some(f) = files.first() else {
-            let close = crate::suggest::closest(&shown, self.known.iter().map(String::as_str));
-            let known: Vec<&str> = self.known.iter().map(String::as_str).collect();
-            return Err(wesl::ResolveError::ModuleNotFound(path.clone(), format!(
-                "unresolved import: no file {}.wesl or .wgsl under the shader roots ({}){}; {}. Add its folder with --shader-root, or stand in for it with --stub {shown}=FILE",
-                path.components.join("/"),
-                show_roots(&self.roots),
-                close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
-                some_names("modules found", &known, &shown),
-            )));
+            return Err(wesl::ResolveError::ModuleNotFound(path.clone(), self.not_found(path)));
         };
         if files.len() > 1 {
             let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
@@ -1056,7 +1126,7 @@ impl wesl::Resolver for Roots {
                 f.display()
             )));
         }
-        Ok(text.into())
+        self.conditional_blocks(path, &f.display().to_string(), &text).map(Into::into)
     }
     fn display_name(&self, path: &wesl::ModulePath) -> Option<String> {
         match self.stub(path) {
@@ -1066,11 +1136,10 @@ impl wesl::Resolver for Roots {
     }
 }
 
-/// The tree of `sources[0]` composed by the wesl crate: WGSL text (the root's names as written,
-/// imported ones mangled), each mangled name's origin, and each declaration's.
+/// The sampler's file as a WESL module: the roots (each a folder, as each `--package` DIR) and
+/// its path under the first root that holds it.
 #[cfg(feature = "wesl")]
-fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError> {
-    use wesl::SourceMap;
+fn wesl_root(sources: &[Source], c: &Composition) -> Result<(Vec<PathBuf>, wesl::ModulePath), CheckError> {
     if let Some(s) = sources.get(1) {
         return Err(CheckError::Input(format!(
             "{}: with WESL imports give only the sampler's file; the modules it imports are found under --shader-root",
@@ -1083,24 +1152,30 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
             return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
         }
     }
-    // the root's module path: its file under the first root that holds it
+    for (name, dir) in &c.packages {
+        check_package(name, &[]).map_err(CheckError::Input)?;
+        if !dir.is_dir() {
+            return Err(CheckError::Input(format!("--package {name}={}: not a folder; give the folder that holds {name}'s modules ({name}::a::b is DIR/a/b.wesl)", dir.display())));
+        }
+    }
     let file = std::fs::canonicalize(&sources[0].name).map_err(|e| CheckError::Input(format!("{}: {e}", sources[0].name)))?;
-    let (base, rel) = roots
+    let rel = roots
         .iter()
-        .find_map(|r| {
-            let r = std::fs::canonicalize(r).ok()?;
-            file.strip_prefix(&r).ok().map(|rel| (r.clone(), rel.with_extension("")))
-        })
+        .find_map(|r| file.strip_prefix(std::fs::canonicalize(r).ok()?).ok().map(|rel| rel.with_extension("")))
         .ok_or_else(|| CheckError::Input(format!("{}: not under any shader root ({}); WESL's `package::` paths start at a root", sources[0].name, show_roots(&roots))))?;
-    let known = wesl_known(&roots);
     let components: Vec<String> = rel.iter().map(|c| c.to_string_lossy().into_owned()).collect();
-    let root_path = wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components };
-    let _ = base;
-    let root_path_shown = root_path.to_string();
+    Ok((roots, wesl::ModulePath { origin: wesl::syntax::PathOrigin::Absolute, components }))
+}
+
+/// The tree of `sources[0]` composed by the wesl crate: WGSL text (the root's names as written,
+/// imported ones mangled), each mangled name's origin, and each declaration's.
+#[cfg(feature = "wesl")]
+fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError> {
+    let (roots, root_path) = wesl_root(sources, c)?;
+    let known = wesl_known(&roots, &c.packages);
     let seen = std::rc::Rc::new(std::cell::RefCell::new(Resolved::default()));
-    let resolver = Roots { roots: roots.clone(), stubs: stubs(c)?, known: known.clone(), seen: seen.clone() };
-    let resolver_files = Roots { roots: roots.clone(), stubs: Vec::new(), known, seen: seen.clone() };
-    let features = wesl_features(c)?;
+    let flags = feature_flags(c)?;
+    let resolver = |stubs| Roots { roots: roots.clone(), packages: c.packages.clone(), features: flags.clone(), stubs, known: known.clone(), seen: seen.clone() };
     let options = wesl::CompileOptions {
         imports: true,
         condcomp: true,
@@ -1109,15 +1184,51 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         keep_root: true,
         mangle_root: false,
         validate: false,
-        features,
+        features: wesl_features(&flags),
         ..Default::default()
     };
-    let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver);
+    let mut compiler = wesl::Wesl::new_barebones().set_custom_resolver(resolver(stubs(c)?));
     compiler.set_options(options).set_mangler(wesl::ManglerKind::Escape).use_sourcemap(true);
     let _stage = Stage::enter(format!("composing {} and the WESL modules it imports (under {}) with the wesl crate", sources[0].name, show_roots(&roots)));
     let result = compiler.compile(&root_path);
     seen.borrow().refusal(c, &sources[0].name)?;
-    let result = result.map_err(|e| CheckError::Wgsl(format!("{}: {}", sources[0].name, strip_ansi(&e.to_string()))))?;
+    let files = resolver(Vec::new());
+    let result = result.map_err(|e| wesl_error(&e, &sources[0], &files))?;
+    wesl_origins(&result, &root_path.to_string(), &files, &sources[0])
+}
+
+/// A `wesl` error at the file, line and column its span belongs to: the crate's diagnostic
+/// carries the span's module, its source and its display name (this resolver's file name), and
+/// its Display heads it with the root's name and a byte range.
+#[cfg(feature = "wesl")]
+fn wesl_error(e: &wesl::Error, root: &Source, files: &Roots) -> CheckError {
+    let whole = || CheckError::Wgsl(format!("{}: {}", root.name, strip_ansi(&e.to_string())));
+    let wesl::Error::Error(d) = e else { return whole() };
+    let Some(span) = d.detail.span else { return whole() };
+    let module = d.detail.module_path.as_ref();
+    let file = d.detail.display_name.clone().or_else(|| module.and_then(|m| wesl::Resolver::display_name(files, m))).unwrap_or_else(|| root.name.clone());
+    let source = d.detail.source.clone().or_else(|| std::fs::read_to_string(&file).ok());
+    let Some(source) = source.filter(|s| span.range().end <= s.len()) else { return whole() };
+    let (line, col) = line_col(&source, span.range().start);
+    // the inner error's text, without wgsl_parse's "chars A..B: " (a byte range of that file)
+    let inner = strip_ansi(&d.error.to_string());
+    let inner = match inner.strip_prefix("chars ") {
+        Some(rest) => rest.split_once(": ").map_or(inner.clone(), |(_, m)| m.to_string()),
+        None => inner.clone(),
+    };
+    let text = source.lines().nth(line - 1).unwrap_or("");
+    let within = match (&d.detail.declaration, module) {
+        (Some(decl), Some(m)) => format!("in `{decl}` of module {m}"),
+        (None, Some(m)) => format!("in module {m}"),
+        _ => String::new(),
+    };
+    CheckError::Wgsl(format!("{file}:{line}:{col}: {inner}\n   | {text}\n   = note: {within}"))
+}
+
+/// The origins of a composed WESL tree's mangled names and of its declarations.
+#[cfg(feature = "wesl")]
+fn wesl_origins(result: &wesl::CompileResult, root_path_shown: &str, resolver_files: &Roots, root: &Source) -> Result<WeslTree, CheckError> {
+    use wesl::SourceMap;
     let mut origins = Vec::new();
     use wesl::syntax::GlobalDeclaration as G;
     let ident = |decl: &G| match decl {
@@ -1147,7 +1258,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
         from = at + written.len();
         let first = text[..at].matches('\n').count() as u32 + 1;
         let lines = (first, first + written.trim_end().matches('\n').count() as u32);
-        let Some((file, module, item, source)) = declared_in(result.sourcemap.as_ref(), &name, &root_path_shown, &resolver_files, &sources[0]) else { continue };
+        let Some((file, module, item, source)) = declared_in(result.sourcemap.as_ref(), &name, root_path_shown, resolver_files, root) else { continue };
         // the declaration's text in its file: its span there, or (a span that does not hold its
         // name) from the line that declares it to the next declaration
         let span = decl.span();
@@ -1184,36 +1295,59 @@ fn declared_in(map: Option<&wesl::BasicSourceMap>, name: &str, root_path: &str, 
     }
 }
 
-/// The module paths (`package::a::b`) of the WESL and WGSL files under the roots.
+/// The few modules of `known` closest to `wanted`: those that share its last segment first
+/// (`bevy_render::maths` and `package::maths`), then by the edit distance of the last segment
+/// and of the whole path.
 #[cfg(feature = "wesl")]
-fn wesl_known(roots: &[PathBuf]) -> Vec<String> {
+fn closest_modules<'a>(wanted: &str, known: &'a [String]) -> Vec<&'a str> {
+    let last = |p: &str| p.rsplit("::").next().unwrap_or("").to_string();
+    let want = last(wanted);
+    let score = |k: &str| (strsim::normalized_levenshtein(&want, &last(k)), strsim::normalized_levenshtein(wanted, k));
+    let mut by: Vec<((f64, f64), &str)> = known.iter().map(|k| (score(k), k.as_str())).filter(|(s, _)| s.0 >= 0.5 || s.1 >= 0.5).collect();
+    by.sort_by(|a, b| b.0.0.total_cmp(&a.0.0).then(b.0.1.total_cmp(&a.0.1)).then(a.1.cmp(b.1)));
+    by.into_iter().take(5).map(|(_, k)| k).collect()
+}
+
+/// The module paths of the WESL and WGSL files under the roots (`package::a::b`) and under each
+/// `--package` folder (`NAME::a::b`).
+#[cfg(feature = "wesl")]
+fn wesl_known(roots: &[PathBuf], packages: &[(String, PathBuf)]) -> Vec<String> {
+    let named = roots.iter().map(|r| ("package", r)).chain(packages.iter().map(|(n, d)| (n.as_str(), d)));
     let mut known = Vec::new();
-    for r in roots {
+    for (name, r) in named {
         let mut files = Vec::new();
         scan(r, &["wesl", "wgsl"], &mut files);
         for f in files {
             if let Ok(rel) = f.strip_prefix(r) {
                 let comps: Vec<String> = rel.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
-                known.push(format!("package::{}", comps.join("::")));
+                known.push(format!("{name}::{}", comps.join("::")));
             }
         }
     }
     known
 }
 
-/// `--define` values as WESL's `@if` features: true or false.
+/// `--define` values as WESL's `@if` features: true or false (one not given is false).
 #[cfg(feature = "wesl")]
-fn wesl_features(c: &Composition) -> Result<wesl::Features, CheckError> {
-    let mut features = wesl::Features::default();
+fn feature_flags(c: &Composition) -> Result<std::collections::HashMap<String, bool>, CheckError> {
+    let mut flags = std::collections::HashMap::new();
     for (n, v) in &c.defines {
         let on = match v.as_deref() {
             None | Some("true") => true,
             Some("false") => false,
             Some(other) => return Err(CheckError::Input(format!("--define {n}={other}: WESL's @if features are true or false"))),
         };
-        features.flags.insert(n.clone(), on.into());
+        flags.insert(n.clone(), on);
     }
-    Ok(features)
+    Ok(flags)
+}
+
+/// [`feature_flags`] as the `wesl` crate's features.
+#[cfg(feature = "wesl")]
+fn wesl_features(flags: &std::collections::HashMap<String, bool>) -> wesl::Features {
+    let mut features = wesl::Features::default();
+    features.flags.extend(flags.iter().map(|(n, on)| (n.clone(), (*on).into())));
+    features
 }
 
 /// Where the declaration of `name` starts in a WGSL/WESL text (a line `fn NAME(`, `const NAME`,

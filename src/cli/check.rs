@@ -69,6 +69,10 @@ pub struct CheckArgs {
     /// ray queries. MODULE as the imports name it (a::b, package::a::b).
     #[arg(long, value_name = "MODULE=FILE")]
     pub stub: Vec<String>,
+    /// Where another WESL package's modules are (repeatable): NAME::a::b is DIR/a/b.wesl (or
+    /// .wgsl). Without it, lobes looks for NAME::a::b as a/b.wesl under the shader roots.
+    #[arg(long, value_name = "NAME=DIR")]
+    pub package: Vec<String>,
     /// The sampler's random function (repeatable): its body becomes lobes' queue of u.x, u.y, u.z,
     /// u.w in call order (vec2/3/4 results take 2/3/4); at most four draws per sample.
     #[arg(long, value_name = "NAME")]
@@ -219,7 +223,8 @@ impl CheckArgs {
             },
         )
         .map_err(usage)?;
-        let composition = check::Composition { normal: self.normal.clone(), ..composition };
+        let packages = check::Composition::parse_packages(&self.package).map_err(usage)?;
+        let composition = check::Composition { normal: self.normal.clone(), packages, ..composition };
         Ok((domain, conventions, composition))
     }
 

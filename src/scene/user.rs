@@ -32,6 +32,7 @@ pub(super) struct RawSampler {
     shader_root: Option<Val>,
     define: Option<Val>,
     stub: Option<Val>,
+    package: Option<Val>,
     sample_returns: Option<Val>,
     normal: Option<Val>,
 }
@@ -48,7 +49,7 @@ pub struct UserCase {
     pub budget: Option<Budget>,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -134,7 +135,7 @@ fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneEr
 }
 
 /// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
-/// stub, sample_returns, normal (the flags of `lobes check`), paths relative to the scene file.
+/// stub, package, sample_returns, normal (the flags of `lobes check`), paths relative to the scene file.
 fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
     use crate::check::{Composition, Draw, SampleReturns};
     let mut c = Composition::default();
@@ -174,6 +175,16 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
             };
             c.stubs.push((module, base.join(f)));
         }
+    }
+    if let Some(v) = &r.package {
+        for (name, dir) in table(v, "package")? {
+            let Value::String(d) = dir else {
+                return Err(ctx.err(v.span(), format!("sampler.package.{name} must be a folder name (a string); {SAMPLER_ALLOWED}")));
+            };
+            c.packages.push((name, base.join(d)));
+        }
+        let flags: Vec<String> = c.packages.iter().map(|(n, d)| format!("{n}={}", d.display())).collect();
+        Composition::parse_packages(&flags).map_err(|e| ctx.err(v.span(), format!("sampler.package: {e}")))?;
     }
     if let Some(v) = &r.sample_returns {
         c.sample_returns = match string(ctx, v, "sampler.sample_returns", "use \"direction\" or \"half-vector\"")? {

@@ -12,6 +12,7 @@
 
 pub mod glsl;
 pub mod spirv;
+pub mod wesl_blocks;
 
 use super::CheckError;
 use super::compose::Source;
