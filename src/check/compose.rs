@@ -162,6 +162,8 @@ pub struct Composed {
     /// (first line, 1-based, of the part in `text`; the part's name; where its declarations
     /// came from, for a tree that the wesl crate wrote).
     parts: Vec<(u32, String, Vec<DeclOrigin>)>,
+    /// The user's resources bound for lobes' passes ([`super::resources`]).
+    pub bound: Vec<super::resources::Bound>,
 }
 
 impl Composed {

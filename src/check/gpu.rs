@@ -64,6 +64,52 @@ pub(super) struct Passes<'g> {
     gpu_seconds: std::cell::Cell<Option<f64>>,
     /// Each entry point's pipeline, created at its first run (a quadrature runs one per round).
     pipelines: std::cell::RefCell<std::collections::HashMap<String, wgpu::ComputePipeline>>,
+    /// The user's textures and tables on the GPU, by their binding in group 1, with the entry
+    /// points that read each.
+    resources: Vec<(u32, Vec<String>, GpuResource)>,
+    /// Each entry point's group 1 (its layout is the pipeline's own), where it reads any.
+    group1: std::cell::RefCell<std::collections::HashMap<String, Option<wgpu::BindGroup>>>,
+}
+
+/// A user's resource uploaded.
+enum GpuResource {
+    Texture(wgpu::TextureView),
+    Buffer(wgpu::Buffer),
+}
+
+impl GpuResource {
+    fn upload(gpu: &Gpu, b: &super::resources::Bound) -> Self {
+        use super::resources::Data;
+        use wgpu::util::DeviceExt;
+        match &*b.data {
+            Data::Texture { width, height, texels } => {
+                let desc = wgpu::TextureDescriptor {
+                    label: Some(&b.name),
+                    size: wgpu::Extent3d { width: *width, height: *height, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba32Float,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                };
+                let t = gpu.device.create_texture_with_data(&gpu.queue, &desc, wgpu::util::TextureDataOrder::LayerMajor, bytemuck::cast_slice(texels));
+                GpuResource::Texture(t.create_view(&Default::default()))
+            }
+            Data::Buffer { words, .. } => {
+                let mut bytes = bytemuck::cast_slice::<u32, u8>(words).to_vec();
+                bytes.resize(bytes.len().max(4), 0);
+                GpuResource::Buffer(gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(&b.name), contents: &bytes, usage: wgpu::BufferUsages::STORAGE }))
+            }
+        }
+    }
+    fn entry(&self, binding: u32) -> wgpu::BindGroupEntry<'_> {
+        let resource = match self {
+            GpuResource::Texture(v) => wgpu::BindingResource::TextureView(v),
+            GpuResource::Buffer(b) => b.as_entire_binding(),
+        };
+        wgpu::BindGroupEntry { binding, resource }
+    }
 }
 
 /// Whether `s` names a function (with the contract's signature) rather than being a call
@@ -516,31 +562,70 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
             c.push(&path, &text);
         }
     }
+    let declared = move_resources(&mut c)?;
     let (module, info) = c.validate_with(naga::valid::Capabilities::default())?;
-    unbound_resources(&c, &module, &info)?;
+    bind_resources(&mut c, &module, &info, &sampler.composition.resources, &declared)?;
     Ok(c)
 }
 
-/// The renderer's resources that lobes' passes reach through the sampler: lobes binds only its
-/// own (`lobes_` names in group 0), so a texture, buffer or sampler of the user's files or stubs
-/// that the sampler, pdf or eval reads would have nothing bound at dispatch (wgpu: "expects a
-/// BindGroup to be set"): bad input, named at its declaration, before any GPU work. Declared and
-/// never reached is fine.
-fn unbound_resources(c: &Composed, module: &naga::Module, info: &naga::valid::ModuleInfo) -> Result<(), CheckError> {
+/// Moves every resource the user's files declare to `@group(1)`, binding 0, 1, … in declaration
+/// order, in `c`'s text (lobes' own are group 0; a renderer's `@group(0) @binding(0)` would
+/// collide with them), and returns each one's name and binding as declared, for messages.
+fn move_resources(c: &mut Composed) -> Result<Vec<(String, naga::ResourceBinding)>, CheckError> {
+    // a text that does not parse is reported by the validation that follows
+    let Ok(module) = naga::front::wgsl::parse_str(&c.text) else { return Ok(Vec::new()) };
+    let users: Vec<_> = module.global_variables.iter().filter(|(_, g)| g.binding.is_some() && !g.name.as_deref().is_some_and(|n| n.starts_with("lobes_"))).collect();
+    // from the last declaration up, so that the spans before each stay where they are
+    for (k, (h, g)) in users.iter().enumerate().rev() {
+        let range = module.global_variables.get_span(*h).to_range().ok_or_else(|| CheckError::Internal("a global without a span".into()))?;
+        c.text = super::resources::rebind(&c.text, range, k as u32)
+            .ok_or_else(|| CheckError::Internal(format!("no @group/@binding before `{}` in the composed text", g.name.as_deref().unwrap_or("?"))))?;
+    }
+    Ok(users.iter().map(|(_, g)| (g.name.clone().unwrap_or_default(), g.binding.clone().expect("a binding"))).collect())
+}
+
+/// The renderer's resources that lobes' passes reach through the sampler, bound from the files
+/// the user gave (`--texture`, `--buffer`; [`super::resources`]; already in group 1,
+/// [`move_resources`]): each one's file read and held to its declaration, and recorded in
+/// `c.bound` with its binding and the passes that read it. One without a file would have
+/// nothing bound at dispatch (wgpu: "expects a BindGroup to be set"): bad input, named at its
+/// declaration (with the group and binding it was `declared` with), before any GPU work.
+/// Declared and never reached is fine.
+fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::ModuleInfo, given: &[(String, super::resources::Resource)], declared: &[(String, naga::ResourceBinding)]) -> Result<(), CheckError> {
+    use super::resources;
     // by lobes' passes (a renderer's own entry points, where a file keeps them, bind their own)
     let passes: Vec<usize> = module.entry_points.iter().enumerate().filter(|(_, e)| e.name.starts_with("lobes_")).map(|(i, _)| i).collect();
-    let reached = |h: naga::Handle<naga::GlobalVariable>| passes.iter().any(|&i| !info.get_entry_point(i)[h].is_empty());
-    let unbound = module.global_variables.iter().find(|(h, g)| g.binding.is_some() && !g.name.as_deref().is_some_and(|n| n.starts_with("lobes_")) && reached(*h));
-    let Some((h, g)) = unbound else { return Ok(()) };
-    let b = g.binding.as_ref().expect("a binding");
-    let what = format!(
-        "`{}` (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads; lobes binds none: give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
-        g.name.as_deref().unwrap_or("?"),
+    let readers = |h: naga::Handle<naga::GlobalVariable>| -> Vec<String> { passes.iter().filter(|&&i| !info.get_entry_point(i)[h].is_empty()).map(|&i| module.entry_points[i].name.clone()).collect() };
+    let mut bound = Vec::new();
+    for (h, g) in module.global_variables.iter().filter(|(_, g)| g.binding.is_some() && !g.name.as_deref().is_some_and(|n| n.starts_with("lobes_"))) {
+        let entries = readers(h);
+        if entries.is_empty() {
+            continue;
+        }
+        let span = module.global_variables.get_span(h);
+        let global = g.name.as_deref().unwrap_or("?");
+        let Some((name, resource)) = given.iter().find(|(n, _)| resources::names(global, n)) else {
+            let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| b.clone()).or_else(|| g.binding.clone()).expect("a binding");
+            return Err(CheckError::Input(c.diagnostic_at(span, &unbound(g, &as_declared, module))));
+        };
+        let data = resources::load(name, resource).map_err(CheckError::Input)?;
+        resources::fits(name, &data, g, module).map_err(|e| CheckError::Input(c.diagnostic_at(span, &e)))?;
+        let binding = g.binding.as_ref().expect("a binding").binding;
+        bound.push(resources::Bound { name: name.clone(), binding, data: std::sync::Arc::new(data), entries });
+    }
+    c.bound = bound;
+    Ok(())
+}
+
+/// Why a reached resource of the user's has nothing bound, and what to give.
+fn unbound(g: &naga::GlobalVariable, b: &naga::ResourceBinding, module: &naga::Module) -> String {
+    let name = g.name.as_deref().unwrap_or("?");
+    format!(
+        "`{name}` (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture {name}=FILE.hdr for a texture_2d<f32>, --buffer {name}=FILE.npy for a storage array), or give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
         b.group,
         b.binding,
         resource_kind(g, &module.types[g.ty].inner)
-    );
-    Err(CheckError::Input(c.diagnostic_at(module.global_variables.get_span(h), &what)))
+    )
 }
 
 /// What kind of resource a bound global is, for messages: "a storage buffer", "a texture", ….
@@ -586,7 +671,20 @@ impl<'g> Passes<'g> {
         // `composed` is already validated with its errors mapped to the user's files
         let module = gpu.module_unvalidated("lobes check", &composed.text)?;
         gpu.check_errors()?;
-        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default() })
+        let resources = composed.bound.iter().map(|b| (b.binding, b.entries.clone(), GpuResource::upload(gpu, b))).collect();
+        gpu.check_errors()?;
+        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default(), resources, group1: Default::default() })
+    }
+
+    /// Group 1 of `entry`'s pipeline: the user's resources it reads; `None` where it reads none.
+    fn group1(&self, entry: &str, pipeline: &wgpu::ComputePipeline) -> Option<wgpu::BindGroup> {
+        if let Some(g) = self.group1.borrow().get(entry) {
+            return g.clone();
+        }
+        let entries: Vec<wgpu::BindGroupEntry> = self.resources.iter().filter(|(_, readers, _)| readers.iter().any(|r| r == entry)).map(|(k, _, r)| r.entry(*k)).collect();
+        let g = (!entries.is_empty()).then(|| self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check group 1"), layout: &pipeline.get_bind_group_layout(1), entries: &entries }));
+        self.group1.borrow_mut().insert(entry.to_string(), g.clone());
+        g
     }
 
     /// GPU time of the passes run so far, where the adapter has timestamp queries.
@@ -619,7 +717,8 @@ impl<'g> Passes<'g> {
         entries.push(wgpu::BindGroupEntry { binding: output.binding(), resource: out.as_entire_binding() });
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(entry), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
         let step = Step { pipeline: &pipeline, groups: invocations.div_ceil(WG) as u64 };
-        let seconds = gpu.dispatch(&[Pass { label: entry, bind: &bind, offset: None, steps: vec![step] }])?;
+        let group1 = self.group1(entry, &pipeline);
+        let seconds = gpu.dispatch(&[Pass { label: entry, bind: &bind, offset: None, steps: vec![step], group1: group1.as_ref() }])?;
         self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));
         Ok(gpu.read(&out, out_bytes)?)
     }
@@ -700,9 +799,10 @@ impl<'g> Passes<'g> {
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check slabs"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
         };
         let (sample_bind, reduce_bind) = (bind(&sample, &[(0, &uniform), (4, &slab_buffer)]), bind(&reduce, &[(0, &uniform), (3, &counts), (4, &slab_buffer)]));
+        let sample_group1 = self.group1("lobes_histogram_slabs", &sample);
         let passes = [
-            Pass { label: "lobes_histogram_slabs", bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &sample, groups: (slabs / SLAB_WORKGROUP) as u64 }] },
-            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (all as u32).div_ceil(WG) as u64 }] },
+            Pass { label: "lobes_histogram_slabs", bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &sample, groups: (slabs / SLAB_WORKGROUP) as u64 }], group1: sample_group1.as_ref() },
+            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (all as u32).div_ceil(WG) as u64 }], group1: None },
         ];
         let seconds = gpu.dispatch(&passes)?;
         self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));

@@ -48,6 +48,7 @@ pub mod power;
 pub mod probe;
 pub mod quadrature;
 pub mod report;
+pub mod resources;
 pub mod support;
 
 pub use compose::Source;

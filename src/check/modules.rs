@@ -57,6 +57,9 @@ pub struct Composition {
     /// The light's unit normal at the sampled point `p` (`--normal`, with `--measure area`): a
     /// WGSL expression over `p`, `params` and `p0` … `p15`.
     pub normal: Option<String>,
+    /// The renderer's textures and tables, by the name the sampler's files declare them with
+    /// (`--texture NAME=FILE`, `--buffer NAME=FILE`; [`super::resources`]).
+    pub resources: Vec<(String, super::resources::Resource)>,
 }
 
 impl Composition {
@@ -71,6 +74,32 @@ impl Composition {
     pub fn stub(mut self, module: &str, file: impl Into<PathBuf>) -> Self {
         self.stubs.push((module.into(), file.into()));
         self
+    }
+    /// A `.hdr` image bound as the sampler's `name: texture_2d<f32>` (`--texture NAME=FILE`).
+    pub fn texture(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
+        self.resources.push((name.into(), super::resources::Resource::Texture(file.into())));
+        self
+    }
+    /// A `.npy` table bound as the sampler's `var<storage, read> name: array<…>` (`--buffer
+    /// NAME=FILE`).
+    pub fn buffer(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
+        self.resources.push((name.into(), super::resources::Resource::Buffer(file.into())));
+        self
+    }
+    /// `--texture` and `--buffer` flags, each NAME=FILE, named once each.
+    pub fn parse_resources(textures: &[String], buffers: &[String]) -> Result<Vec<(String, super::resources::Resource)>, String> {
+        use super::resources::Resource;
+        let mut out: Vec<(String, Resource)> = Vec::new();
+        let flags = textures.iter().map(|t| ("--texture", t)).chain(buffers.iter().map(|b| ("--buffer", b)));
+        for (flag, item) in flags {
+            let (name, file) = item.split_once('=').map(|(n, f)| (n.trim(), f.trim())).filter(|(n, f)| super::gpu::is_name(n) && !f.is_empty()).ok_or_else(|| format!("{flag} '{item}': give NAME=FILE, NAME the variable the sampler's files declare, e.g. {flag} env_map={}", if flag == "--texture" { "sky.hdr" } else { "cdf.npy" }))?;
+            if out.iter().any(|(n, _)| n == name) {
+                return Err(format!("{flag} '{item}': {name} is bound twice"));
+            }
+            let file = PathBuf::from(file);
+            out.push((name.to_string(), if flag == "--texture" { Resource::Texture(file) } else { Resource::Buffer(file) }));
+        }
+        Ok(out)
     }
     /// Another WESL package's folder: `NAME::a::b` is `dir/a/b.wesl` (`--package NAME=DIR`).
     pub fn package(mut self, name: &str, dir: impl Into<PathBuf>) -> Self {
@@ -128,7 +157,7 @@ impl Composition {
         if rand_order.is_some() && rand.is_empty() {
             return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
         }
-        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
+        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), resources: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
     }
 
     /// `--package NAME=DIR` flags (repeatable): NAME a WESL package name, each at most once.

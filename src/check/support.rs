@@ -95,7 +95,7 @@ pub fn fitted(axis: [f64; 3], height: f64, counts: &[u64]) -> Option<Domain> {
 /// The cap to bin `sampler`'s samples on, and the passes composed for it; `None` where the
 /// settings or the sampler's domain ask for none, or the samples do not fit one. `probes` are
 /// the run's probed samples (drawn by any domain's passes: probes do not bin).
-pub(crate) fn fit<'g>(gpu: &'g crate::engine::gpu::Gpu, sampler: &UserSampler, settings: &Settings, probes: &[Probe]) -> Result<Option<(Domain, Passes<'g>, String)>, CheckError> {
+pub(super) fn fit<'g>(gpu: &'g crate::engine::gpu::Gpu, sampler: &UserSampler, settings: &Settings, probes: &[Probe]) -> Result<Option<(Domain, Passes<'g>, String)>, CheckError> {
     let Some(limit) = settings.fit.limit() else { return Ok(None) };
     if sampler.domain != Domain::Sphere {
         return Ok(None);

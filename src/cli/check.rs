@@ -73,6 +73,14 @@ pub struct CheckArgs {
     /// .wgsl). Without it, lobes looks for NAME::a::b as a/b.wesl under the shader roots.
     #[arg(long, value_name = "NAME=DIR")]
     pub package: Vec<String>,
+    /// A renderer's texture the sampler reads (repeatable): a Radiance .hdr image bound as the
+    /// files' NAME: texture_2d<f32> (rgba32float, for textureLoad).
+    #[arg(long, value_name = "NAME=FILE")]
+    pub texture: Vec<String>,
+    /// A renderer's table the sampler reads (repeatable): a .npy array of float32, uint32 or int32
+    /// bound as the files' var<storage, read> NAME: array<f32> (or u32, i32).
+    #[arg(long, value_name = "NAME=FILE")]
+    pub buffer: Vec<String>,
     /// The sampler's random function (repeatable): its body becomes lobes' queue of u.x, u.y, u.z,
     /// u.w in call order (vec2/3/4 results take 2/3/4); at most four draws per sample.
     #[arg(long, value_name = "NAME")]
@@ -224,7 +232,8 @@ impl CheckArgs {
         )
         .map_err(usage)?;
         let packages = check::Composition::parse_packages(&self.package).map_err(usage)?;
-        let composition = check::Composition { normal: self.normal.clone(), packages, ..composition };
+        let resources = check::Composition::parse_resources(&self.texture, &self.buffer).map_err(usage)?;
+        let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
     }
 

@@ -62,12 +62,14 @@ pub struct Step<'a> {
 }
 
 /// A compute pass: its steps in order over one bind group (at `offset` where the group has a
-/// dynamic uniform).
+/// dynamic uniform), and group 1 where the steps read one (a user's textures and tables,
+/// `check::resources`).
 pub struct Pass<'a> {
     pub label: &'a str,
     pub bind: &'a wgpu::BindGroup,
     pub offset: Option<u32>,
     pub steps: Vec<Step<'a>>,
+    pub group1: Option<&'a wgpu::BindGroup>,
 }
 
 impl Gpu {
@@ -188,6 +190,9 @@ impl Gpu {
             });
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(p.label), timestamp_writes });
             pass.set_bind_group(0, p.bind, p.offset.as_slice());
+            if let Some(g) = p.group1 {
+                pass.set_bind_group(1, g, &[]);
+            }
             for step in &p.steps {
                 pass.set_pipeline(step.pipeline);
                 let (x, y) = self.grid(step.groups);
@@ -378,7 +383,7 @@ impl<'g> SamplingPasses<'g> {
                 .map(|(c, &chunk)| {
                     let offset = c as u64 * self.stride;
                     self.gpu.queue.write_buffer(&self.params, offset, bytemuck::bytes_of(&params(chunk)));
-                    Pass { label: "sample", bind, offset: Some(offset as u32), steps: steps(chunk) }
+                    Pass { label: "sample", bind, offset: Some(offset as u32), steps: steps(chunk), group1: None }
                 })
                 .collect();
             let t = self.gpu.dispatch(&passes)?;

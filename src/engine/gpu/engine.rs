@@ -360,7 +360,7 @@ impl GpuEngine {
         let unused = || gpu.buffer("unused", 16, wgpu::BufferUsages::STORAGE);
         gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&Params::new(job, range)));
         let bind = self.bind_group([&params, &unused(), &unused(), input, &unused(), &out, &unused()]);
-        gpu.dispatch(&[Pass { label: "per sample", bind: &bind, offset: Some(0), steps: vec![Step { pipeline, groups }] }])?;
+        gpu.dispatch(&[Pass { label: "per sample", bind: &bind, offset: Some(0), steps: vec![Step { pipeline, groups }], group1: None }])?;
         let bytes = gpu.read(&out, size)?;
         gpu.check_errors()?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())

@@ -96,7 +96,7 @@ pub fn gpu_probabilities(engine: &GpuEngine, lobe: &Lobe, wi: DVec3, grid: Spher
     });
     let start = Instant::now();
     let steps = vec![Step { pipeline: &pipeline, groups: bins.div_ceil(64) }];
-    let gpu_seconds = gpu.dispatch(&[Pass { label: "quadrature", bind: &bind, offset: None, steps }])?;
+    let gpu_seconds = gpu.dispatch(&[Pass { label: "quadrature", bind: &bind, offset: None, steps, group1: None }])?;
     let probabilities: Vec<f32> = bytemuck::cast_slice(&gpu.read(&out, bins * 4)?).to_vec();
     let wall_seconds = start.elapsed().as_secs_f64();
     Ok(GpuQuadrature { probabilities, gpu_seconds, wall_seconds })

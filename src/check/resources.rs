@@ -1,0 +1,232 @@
+//! A renderer's textures and tables, bound where its sampler reads them: an environment map's
+//! radiance and its CDF tables, as the renderer builds them, instead of a stand-in. `--texture
+//! NAME=FILE` binds a Radiance `.hdr` image as `NAME: texture_2d<f32>` (rgba32float, read with
+//! `textureLoad`); `--buffer NAME=FILE` binds a `.npy` array of float32, uint32 or int32 (any
+//! shape, C order, read as flat) as `var<storage, read> NAME: array<f32>` (or `u32`, `i32`).
+//! Each resource the passes reach is moved to `@group(1)`, binding 0, 1, … in declaration
+//! order (lobes' own are group 0), in the composed text only: the lines stay where they were.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// What a name is bound to.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Resource {
+    /// A `.hdr` image, bound as a `texture_2d<f32>`.
+    Texture(PathBuf),
+    /// A `.npy` array, bound as a read-only storage buffer.
+    Buffer(PathBuf),
+}
+
+impl Resource {
+    pub fn path(&self) -> &Path {
+        match self {
+            Resource::Texture(p) | Resource::Buffer(p) => p,
+        }
+    }
+    fn flag(&self) -> &'static str {
+        match self {
+            Resource::Texture(_) => "--texture",
+            Resource::Buffer(_) => "--buffer",
+        }
+    }
+}
+
+/// The element type of a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scalar {
+    F32,
+    U32,
+    I32,
+}
+
+impl Scalar {
+    fn wgsl(self) -> &'static str {
+        match self {
+            Scalar::F32 => "f32",
+            Scalar::U32 => "u32",
+            Scalar::I32 => "i32",
+        }
+    }
+}
+
+/// A resource's contents, read before any GPU work.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Data {
+    /// rgba texels, row-major from the image's top row, alpha 1.
+    Texture { width: u32, height: u32, texels: Vec<[f32; 4]> },
+    /// The array's elements as 32-bit words, and their type.
+    Buffer { scalar: Scalar, words: Vec<u32> },
+}
+
+/// A user's resource bound at `@group(1) @binding(binding)`, and the passes that read it.
+#[derive(Debug, Clone)]
+pub struct Bound {
+    pub name: String,
+    pub binding: u32,
+    pub data: Arc<Data>,
+    pub entries: Vec<String>,
+}
+
+/// Reads `r`; the message says what is wrong with the file, after `{flag} NAME=FILE: `.
+pub fn load(name: &str, r: &Resource) -> Result<Data, String> {
+    let at = format!("{} {name}={}", r.flag(), r.path().display());
+    let bytes = std::fs::read(r.path()).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
+    match r {
+        Resource::Texture(_) => read_hdr(&bytes).map_err(|e| format!("{at}: {e}")),
+        Resource::Buffer(_) => read_npy(&bytes).map(|(scalar, words)| Data::Buffer { scalar, words }).map_err(|e| format!("{at}: {e}")),
+    }
+}
+
+/// A Radiance RGBE image (the `image` crate's decoder) as rgba32float texels.
+fn read_hdr(bytes: &[u8]) -> Result<Data, String> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr).map_err(|e| format!("not a Radiance .hdr image: {e}"))?.into_rgb32f();
+    let (width, height) = img.dimensions();
+    let texels = img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect();
+    Ok(Data::Texture { width, height, texels })
+}
+
+/// A `.npy` file (NumPy's format, version 1–3: the magic, a header dict, the raw data) of
+/// little-endian float32, uint32 or int32 in C order. Written here: no crate for it builds on
+/// this toolchain offline, and lobes needs only these three types of it.
+fn read_npy(bytes: &[u8]) -> Result<(Scalar, Vec<u32>), String> {
+    const MAGIC: &[u8] = b"\x93NUMPY";
+    if bytes.len() < 10 || &bytes[..6] != MAGIC {
+        return Err("not a .npy file (no \\x93NUMPY magic)".into());
+    }
+    let (len, start) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize, 12),
+        v => return Err(format!(".npy version {v} is not one lobes reads (1, 2, 3)")),
+    };
+    let header = bytes.get(start..start + len).and_then(|h| std::str::from_utf8(h).ok()).ok_or("the .npy header is cut short")?;
+    let field = |key: &str| header.split_once(&format!("'{key}':")).map(|(_, rest)| rest.trim_start());
+    let descr = field("descr").and_then(|r| r.strip_prefix('\'')).and_then(|r| r.split_once('\'')).map(|(d, _)| d).ok_or("the .npy header has no 'descr'")?;
+    let scalar = match descr {
+        "<f4" => Scalar::F32,
+        "<u4" => Scalar::U32,
+        "<i4" => Scalar::I32,
+        d => return Err(format!("dtype '{d}' is not allowed: give little-endian float32 ('<f4'), uint32 ('<u4') or int32 ('<i4'), e.g. numpy's a.astype(np.float32)")),
+    };
+    if field("fortran_order").is_some_and(|r| r.starts_with("True")) {
+        return Err("the array is in Fortran order: save it in C order (np.ascontiguousarray)".into());
+    }
+    let shape = field("shape").and_then(|r| r.strip_prefix('(')).and_then(|r| r.split_once(')')).map(|(s, _)| s).ok_or("the .npy header has no 'shape'")?;
+    let count = shape.split(',').map(str::trim).filter(|s| !s.is_empty()).try_fold(1usize, |n, s| s.parse::<usize>().ok().and_then(|d| n.checked_mul(d))).ok_or("the .npy shape is not a tuple of whole numbers")?;
+    let data = &bytes[start + len..];
+    if data.len() != count * 4 {
+        return Err(format!("the shape ({shape}) holds {count} elements, {} bytes, but the file has {} bytes of data", count * 4, data.len()));
+    }
+    Ok((scalar, data.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()))
+}
+
+/// Whether `data` fits the declared global `g`: a texture for `texture_2d<f32>`, a table of the
+/// array's element type for `var<storage, read>`; else what the declaration needs.
+pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Module) -> Result<(), String> {
+    use naga::{ImageClass, ImageDimension, ScalarKind, TypeInner};
+    let inner = &module.types[g.ty].inner;
+    match (data, inner) {
+        (Data::Texture { .. }, TypeInner::Image { dim: ImageDimension::D2, arrayed: false, class: ImageClass::Sampled { kind: ScalarKind::Float, multi: false } }) => Ok(()),
+        (Data::Texture { .. }, _) => Err(format!("--texture {name}: `{name}` is not declared as a texture_2d<f32>; --texture binds an image as one")),
+        (Data::Buffer { scalar, .. }, TypeInner::Array { base, .. }) if matches!(g.space, naga::AddressSpace::Storage { .. }) => {
+            let want = match module.types[*base].inner {
+                TypeInner::Scalar(s) if s.width == 4 => match s.kind {
+                    ScalarKind::Float => Some(Scalar::F32),
+                    ScalarKind::Uint => Some(Scalar::U32),
+                    ScalarKind::Sint => Some(Scalar::I32),
+                    _ => None,
+                },
+                _ => None,
+            };
+            match want {
+                Some(w) if w == *scalar => Ok(()),
+                Some(w) => Err(format!("--buffer {name}: the file holds {} and `{name}` is an array<{}>", scalar.wgsl(), w.wgsl())),
+                None => Err(format!("--buffer {name}: `{name}` is not an array of f32, u32 or i32; --buffer binds a flat table")),
+            }
+        }
+        (Data::Buffer { .. }, _) => Err(format!("--buffer {name}: `{name}` is not declared as var<storage, read> {name}: array<f32> (or u32, i32)")),
+    }
+}
+
+/// Whether the composed module's global `global` is the user's `name`: the same, or as naga_oil
+/// (`nameX_naga_oil_mod_X…`) or the wesl crate (`…_1name`) renamed it.
+pub fn names(global: &str, name: &str) -> bool {
+    global == name || global.strip_prefix(name).is_some_and(|r| r.starts_with("X_naga_oil_mod_X")) || global.ends_with(&format!("_1{name}"))
+}
+
+/// `text` with the `@group(…)` and `@binding(…)` attributes of the declaration that ends at
+/// `end` (from the previous `;` or `}` on) set to group 1 and `binding`; `None` where they are
+/// not found.
+pub fn rebind(text: &str, decl: std::ops::Range<usize>, binding: u32) -> Option<String> {
+    let from = text[..decl.start].rfind([';', '}']).map_or(0, |i| i + 1);
+    let mut window = text[from..decl.end].to_string();
+    set_attribute(&mut window, "@group", 1)?;
+    set_attribute(&mut window, "@binding", binding)?;
+    Some(format!("{}{window}{}", &text[..from], &text[decl.end..]))
+}
+
+/// `attr(…)` in `text` set to `attr(value)`.
+fn set_attribute(text: &mut String, attr: &str, value: u32) -> Option<()> {
+    let at = text.find(attr)?;
+    let open = at + text[at..].find('(')?;
+    let close = open + text[open..].find(')')?;
+    text.replace_range(open + 1..close, &value.to_string());
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn npy(descr: &str, shape: &str, data: &[u8]) -> Vec<u8> {
+        let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend((header.len() as u16).to_le_bytes());
+        out.extend(header.bytes());
+        out.extend(data);
+        out
+    }
+
+    #[test]
+    fn a_npy_array_is_read_as_numpy_writes_it() {
+        let data: Vec<u8> = [0.5f32, -2.0, 3.25, 1e-30].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let (s, words) = read_npy(&npy("<f4", "(2, 2)", &data)).unwrap();
+        assert_eq!(s, Scalar::F32);
+        assert_eq!(words.iter().map(|w| f32::from_bits(*w)).collect::<Vec<_>>(), vec![0.5, -2.0, 3.25, 1e-30]);
+        let (s, words) = read_npy(&npy("<u4", "(3,)", &[1, 0, 0, 0, 2, 0, 0, 0, 255, 255, 255, 255])).unwrap();
+        assert_eq!((s, words), (Scalar::U32, vec![1, 2, u32::MAX]));
+    }
+
+    #[test]
+    fn a_bad_npy_says_what_is_wrong() {
+        assert!(read_npy(b"P6 not numpy").unwrap_err().contains("magic"));
+        assert!(read_npy(&npy("<f8", "(1,)", &[0; 8])).unwrap_err().contains("'<f8' is not allowed"));
+        assert!(read_npy(&npy("<f4", "(3,)", &[0; 8])).unwrap_err().contains("holds 3 elements"));
+        let fortran = npy("<f4", "(1,)", &[0; 4]);
+        let fortran = String::from_utf8_lossy(&fortran).replace("False", "True ").into_bytes();
+        assert!(read_npy(&fortran).is_err());
+    }
+
+    #[test]
+    fn a_declarations_group_and_binding_are_rewritten_in_place() {
+        let text = "const a = 1;\n@group(2) @binding(7)\nvar<storage, read> t: array<f32>;\nfn f() {}\n";
+        let decl = text.find("var").unwrap()..text.find("f32>;").unwrap() + 4;
+        let out = rebind(text, decl, 3).unwrap();
+        assert_eq!(out, "const a = 1;\n@group(1) @binding(3)\nvar<storage, read> t: array<f32>;\nfn f() {}\n");
+        let text = "@binding(0) @group(0) var tex: texture_2d<f32>;";
+        let out = rebind(text, text.find("var").unwrap()..text.len() - 1, 5).unwrap();
+        assert_eq!(out, "@binding(5) @group(1) var tex: texture_2d<f32>;");
+    }
+
+    #[test]
+    fn renamed_globals_are_the_users_name() {
+        assert!(names("env_cdf", "env_cdf"));
+        assert!(names("env_cdfX_naga_oil_mod_XMJSXM6K7", "env_cdf"));
+        assert!(names("_1bevy_pbr_1env_cdf", "env_cdf"));
+        assert!(!names("env_cdf2", "env_cdf"));
+    }
+}
