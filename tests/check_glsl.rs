@@ -8,35 +8,17 @@
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one. glslangValidator
 //! (Debian's `glslang-tools`, installed by .ci/install) is required, not optional.
 
-use serde_json::Value;
 mod common;
+use common::{lobes, root, stderr, verdicts};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
 const GLSL: &str = "tests/fixtures/repository/glsl";
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
-fn lobes(args: &[&str]) -> Output {
-    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
-    out
-}
 
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
 
-/// The report's (name, passed) per check.
-fn verdicts(out: &Output) -> Vec<(String, bool)> {
-    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report on stdout");
-    v["checks"].as_array().expect("checks").iter().map(|c| (c["name"].as_str().unwrap_or("?").to_string(), c["passed"].as_bool().unwrap())).collect()
-}
 
 fn failed(out: &Output) -> Vec<String> {
     verdicts(out).into_iter().filter(|(_, p)| !p).map(|(n, _)| n).collect()

@@ -7,28 +7,16 @@
 
 use serde_json::Value;
 mod common;
+use common::{lobes, root, stderr};
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
 const WESL: &str = "tests/fixtures/repository/wesl";
 const OIL: &str = "tests/fixtures/repository/naga_oil";
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
-fn lobes(args: &[&str]) -> Output {
-    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
-    out
-}
 
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
 
 /// The report's verdict per check.
 fn verdicts(out: &Output) -> Vec<(String, bool, String)> {

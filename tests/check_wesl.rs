@@ -7,35 +7,18 @@
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
 mod common;
+use common::{lobes, root, stderr, verdicts};
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
-const LOBES: &str = env!("CARGO_BIN_EXE_lobes");
 const IF: &str = "tests/fixtures/repository/wesl_if";
 const PACKAGES: &str = "tests/fixtures/repository/wesl_packages";
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
 
-fn lobes(args: &[&str]) -> Output {
-    let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
-    out
-}
 
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
 
-/// (check, passed) of a `--json` report.
-fn verdicts(out: &Output) -> Vec<(String, bool)> {
-    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report on stdout");
-    v["checks"].as_array().expect("checks").iter().map(|c| (c["name"].as_str().unwrap_or("?").to_string(), c["passed"].as_bool().unwrap())).collect()
-}
 
 fn copy_tree(name: &str, from: &str, file: &str, edit: impl Fn(&str) -> String) -> PathBuf {
     common::edited_copy(&format!("check-wesl-{name}"), &root().join(from), file, edit)

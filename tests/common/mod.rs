@@ -10,6 +10,28 @@ pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
+/// The repository, where the tests run `lobes`.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `lobes ARGS` run from the repository, its output printed for a failing test's log.
+pub fn lobes(args: &[&str]) -> Output {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lobes")).current_dir(root()).args(args).output().expect("run lobes");
+    println!("$ lobes {}\n{}{}", args.join(" "), text(&out.stdout), text(&out.stderr));
+    out
+}
+
+pub fn stderr(out: &Output) -> String {
+    text(&out.stderr)
+}
+
+/// (check, passed) of a `--json` report on stdout.
+pub fn verdicts(out: &Output) -> Vec<(String, bool)> {
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("a JSON report on stdout");
+    v["checks"].as_array().expect("checks").iter().map(|c| (c["name"].as_str().unwrap_or("?").to_string(), c["passed"].as_bool().unwrap())).collect()
+}
+
 /// Waits for `child` at most `limit`; kills it (and fails) past that. The output and the time
 /// it took.
 pub fn finish(mut child: Child, limit: Duration) -> (Output, Duration) {
