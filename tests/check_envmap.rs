@@ -100,3 +100,31 @@ fn bindings_without_the_right_file_are_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("env_marginal is bound twice"));
 }
+
+/// The same map as a case of a scene: `texture` and `buffer` are the flags' keys, paths relative
+/// to the scene file.
+#[test]
+fn a_scene_binds_the_maps_texture_and_tables() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-envmap-scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join(DIR);
+    let case = |name: &str, sample: &str| {
+        format!(
+            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"{sample}\", pdf = \"env_pdf\", texture = {{ env_radiance = {hdr:?} }}, buffer = {{ env_marginal = {m:?}, env_conditional = {c:?} }} }}\nparams = [{INTEGRAL}]\nsamples = 262144\n\n",
+            wgsl = maps.join("envmap.wgsl"),
+            hdr = maps.join("sky.hdr"),
+            m = maps.join("marginal.npy"),
+            c = maps.join("conditional.npy"),
+        )
+    };
+    let scene = dir.join("envmap.toml");
+    std::fs::write(&scene, format!("{}{}", case("env", "env_sample"), case("env-corners", "env_sample_corners"))).unwrap();
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(1), "one case passes, the other fails");
+    let summary: Value = serde_json::from_slice(&out.stdout).expect("a JSON summary");
+    let passed = |name: &str| summary["cases"].as_array().unwrap().iter().find(|c| c["case"] == name).unwrap_or_else(|| panic!("{name} in {summary}"))["passed"].clone();
+    assert_eq!(passed("env"), Value::Bool(true));
+    assert_eq!(passed("env-corners"), Value::Bool(false));
+}

@@ -33,6 +33,8 @@ pub(super) struct RawSampler {
     define: Option<Val>,
     stub: Option<Val>,
     package: Option<Val>,
+    texture: Option<Val>,
+    buffer: Option<Val>,
     sample_returns: Option<Val>,
     normal: Option<Val>,
 }
@@ -49,7 +51,7 @@ pub struct UserCase {
     pub budget: Option<Budget>,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, texture = { NAME = \"file.hdr\" }, buffer = { NAME = \"file.npy\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -135,7 +137,8 @@ fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneEr
 }
 
 /// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
-/// stub, package, sample_returns, normal (the flags of `lobes check`), paths relative to the scene file.
+/// stub, package, texture, buffer, sample_returns, normal (the flags of `lobes check`), paths
+/// relative to the scene file.
 fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
     use crate::check::{Composition, Draw, SampleReturns};
     let mut c = Composition::default();
@@ -168,23 +171,29 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
             c.defines.push((name, value));
         }
     }
-    if let Some(v) = &r.stub {
-        for (module, file) in table(v, "stub")? {
-            let Value::String(f) = file else {
-                return Err(ctx.err(v.span(), format!("sampler.stub.\"{module}\" must be a file name (a string); {SAMPLER_ALLOWED}")));
+    // the tables of names to paths: `key = { NAME = "path" }`
+    let paths = |v: &Val, key: &str, what: &str| -> Result<Vec<(String, std::path::PathBuf)>, SceneError> {
+        let mut out = Vec::new();
+        for (name, path) in table(v, key)? {
+            let Value::String(p) = path else {
+                return Err(ctx.err(v.span(), format!("sampler.{key}.\"{name}\" must be {what} (a string); {SAMPLER_ALLOWED}")));
             };
-            c.stubs.push((module, base.join(f)));
+            out.push((name, base.join(p)));
         }
+        Ok(out)
+    };
+    let flags = |named: &[(String, std::path::PathBuf)]| -> Vec<String> { named.iter().map(|(n, p)| format!("{n}={}", p.display())).collect() };
+    if let Some(v) = &r.stub {
+        c.stubs = paths(v, "stub", "a file name")?;
     }
     if let Some(v) = &r.package {
-        for (name, dir) in table(v, "package")? {
-            let Value::String(d) = dir else {
-                return Err(ctx.err(v.span(), format!("sampler.package.{name} must be a folder name (a string); {SAMPLER_ALLOWED}")));
-            };
-            c.packages.push((name, base.join(d)));
-        }
-        let flags: Vec<String> = c.packages.iter().map(|(n, d)| format!("{n}={}", d.display())).collect();
-        Composition::parse_packages(&flags).map_err(|e| ctx.err(v.span(), format!("sampler.package: {e}")))?;
+        c.packages = paths(v, "package", "a folder name")?;
+        Composition::parse_packages(&flags(&c.packages)).map_err(|e| ctx.err(v.span(), format!("sampler.package: {e}")))?;
+    }
+    let (textures, buffers) = (r.texture.as_ref().map(|v| paths(v, "texture", "a file name")).transpose()?, r.buffer.as_ref().map(|v| paths(v, "buffer", "a file name")).transpose()?);
+    if textures.is_some() || buffers.is_some() {
+        let at = r.texture.as_ref().or(r.buffer.as_ref()).expect("one of them").span();
+        c.resources = Composition::parse_resources(&flags(&textures.unwrap_or_default()), &flags(&buffers.unwrap_or_default())).map_err(|e| ctx.err(at, format!("sampler.texture/buffer: {e}")))?;
     }
     if let Some(v) = &r.sample_returns {
         c.sample_returns = match string(ctx, v, "sampler.sample_returns", "use \"direction\" or \"half-vector\"")? {
