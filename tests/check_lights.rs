@@ -181,3 +181,25 @@ fn a_tiny_rectangle_light_gets_a_verdict() {
         assert_eq!(out.status.code(), Some(0), "{params}: {:?}", failed(&out));
     }
 }
+
+/// `lobes run` fits the grid as `lobes check` does: a small cone light's case is binned on a
+/// cap, and its histogram.json says so (domain "cap", its axis and height, no sphere edges).
+#[test]
+fn a_scene_case_of_a_small_light_records_its_fitted_cap() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-lights-cap-scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let cone = Path::new(env!("CARGO_MANIFEST_DIR")).join(CONE);
+    let scene = dir.join("cone.toml");
+    std::fs::write(&scene, format!("[[case]]\nname = \"cone\"\nsampler = {{ wgsl = [{cone:?}], sample = \"cone_sample\", pdf = \"cone_pdf\" }}\nparams = [0.5, 0.3, 0.002]\nsamples = 262144\n")).unwrap();
+    let out_dir = dir.join("out");
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let h: Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("cone/histogram.json")).unwrap()).unwrap();
+    assert_eq!(h["params"]["domain"], "cap", "{}", h["params"]);
+    let height = h["params"]["cap_height"].as_f64().unwrap();
+    let cone_height = 2.0 * (0.5 * 0.002f64.asin()).sin().powi(2);
+    assert!(height >= cone_height && height < 1.3 * cone_height, "{height}");
+    assert!(h["cos_theta_edges"].is_null() && h["phi_edges"].is_null());
+    assert_eq!((h["rows"].as_u64(), h["cols"].as_u64()), (Some(16), Some(32)));
+}

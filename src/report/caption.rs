@@ -28,7 +28,8 @@ pub fn parameters(d: &CaseDescription) -> String {
                 (Some(t), Some(p)) => format!(", {}", angles(*t, *p)),
                 _ => String::new(),
             };
-            format!("WGSL sampler {sample} on the {domain}{at}")
+            let on = if domain == "cap" { "a cap fitted to its samples".to_string() } else { format!("the {domain}") };
+            format!("WGSL sampler {sample} on {on}{at}")
         }
     }
 }

@@ -34,8 +34,9 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// The version of the layout of `histogram.json` (2: the times moved to `timing.json`; 3:
-/// `counting` in place of `workgroup_counting`).
-pub const HISTOGRAM_VERSION: u32 = 3;
+/// `counting` in place of `workgroup_counting`; 4: a user's case may be binned on a fitted cap,
+/// `domain = "cap"` with `cap_axis` and `cap_height`).
+pub const HISTOGRAM_VERSION: u32 = 4;
 /// The version of the layout of `timing.json`.
 pub const TIMING_VERSION: u32 = 1;
 /// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
@@ -219,9 +220,11 @@ impl HistogramFile {
     /// The `histogram.json` of a user's sampler case.
     pub fn of_user(r: &UserResult, backend: &str) -> Self {
         let (case, report) = (&r.case, &r.report);
-        let description = CaseDescription::of_user(case, report.rows, report.cols);
+        let description = CaseDescription::of_user(case, &report.domain, report.rows, report.cols);
         let cols = description.cols;
-        let sphere = report.domain.directions();
+        // the sphere's edges on the sphere's grid only (a cap's are its description's)
+        let sphere = report.domain == crate::stats::domain::Domain::Sphere;
+        let directions = report.domain.directions();
         let grid = SphereGrid { rows: report.rows, cols: report.cols };
         let wi = crate::reference::reflect::spherical(case.settings.incident_theta.to_radians(), case.settings.incident_phi.to_radians());
         let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = report.invalid;
@@ -229,7 +232,7 @@ impl HistogramFile {
             format_version: HISTOGRAM_VERSION,
             case: case.name.clone(),
             description,
-            incident: sphere.then(|| wi.to_array()),
+            incident: directions.then(|| wi.to_array()),
             samples: case.settings.samples,
             seed: case.settings.seed,
             adapter: report.adapter.clone(),

@@ -50,10 +50,14 @@ pub enum Params {
         eval: Option<String>,
         /// The numbers passed as `params` (before zero-padding).
         params: Vec<f64>,
-        /// `sphere` or `plane`.
+        /// `sphere`, `plane` or `cap` (a cap fitted to the samples, `lobes::check::support`).
         domain: String,
-        /// The plane's box `[x0, y0, x1, y1]` (null on the sphere).
+        /// The plane's box `[x0, y0, x1, y1]` (null elsewhere).
         bounds: Option<[f64; 4]>,
+        /// A fitted cap's unit axis and height 1 − cos ρ: rows uniform in 1 − cos θ′ over [0,
+        /// height], columns in φ′ ∈ [−π, π) about the axis (null elsewhere).
+        cap_axis: Option<[f64; 3]>,
+        cap_height: Option<f64>,
         /// The incident direction (null on the plane, where there is none).
         incident_theta_deg: Option<f64>,
         incident_phi_deg: Option<f64>,
@@ -92,10 +96,15 @@ impl CaseDescription {
 }
 
 impl CaseDescription {
-    /// The description of a user's sampler case.
-    pub fn of_user(case: &UserCase, rows: u32, cols: u32) -> Self {
+    /// The description of a user's sampler case, binned on `domain` (the sampler's, or a cap
+    /// fitted to its samples).
+    pub fn of_user(case: &UserCase, domain: &crate::stats::domain::Domain, rows: u32, cols: u32) -> Self {
         let (s, set) = (&case.sampler, &case.settings);
-        let (domain, bounds, sphere) = (s.domain.name(), s.domain.bounds(), s.domain.directions());
+        let (bounds, sphere) = (domain.bounds(), domain.directions());
+        let (cap_axis, cap_height) = match *domain {
+            crate::stats::domain::Domain::Cap { axis, height } => (Some(axis), Some(height)),
+            _ => (None, None),
+        };
         CaseDescription {
             lobe: "user".into(),
             method: "wgsl".into(),
@@ -105,8 +114,10 @@ impl CaseDescription {
                 pdf: s.pdf.clone(),
                 eval: s.eval.clone(),
                 params: set.params.clone(),
-                domain: domain.into(),
+                domain: domain.name().into(),
                 bounds,
+                cap_axis,
+                cap_height,
                 incident_theta_deg: sphere.then_some(set.incident_theta),
                 incident_phi_deg: sphere.then_some(set.incident_phi),
             },

@@ -296,9 +296,7 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
     };
     let timeout = budget.map_or(timeout, |b| crate::check::budget::timeout_for(b.seconds, timeout_v.is_some().then_some(timeout)));
     let Common { name, samples, seed } = common;
-    // a case's histogram file records a grid of the sphere or the plane: no fitted cap
-    let fit = crate::check::support::Fit::Never;
-    let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, timeout, fit, ..defaults };
+    let settings = Settings { params, incident_theta, incident_phi, samples, bins: bins.map(|g| (g.rows, g.cols)), seed, timeout, ..defaults };
     Ok(UserCase { name, sampler: sampler.clone(), settings, budget })
 }
 
