@@ -469,7 +469,8 @@ fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, 
 /// `runs`, the passes composed once: counts per bin then per reason of [`REASONS`], and the
 /// wall seconds of each histogram. For measurements over many seeds and counts (`lobes
 /// tradeoff`'s detection table), judged against the expected counts of one [`check`] of the
-/// same settings.
+/// same settings, on the sampler's own domain: a grid fitted to the samples
+/// ([`support`]) would differ from run to run, so such a check takes `fit: Fit::Never`.
 pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &[(u64, u64)]) -> Result<Vec<(Vec<u64>, f64)>, CheckError> {
     settings.validate()?;
     let _deadline = gpu.deadline(settings.timeout);

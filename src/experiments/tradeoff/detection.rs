@@ -138,6 +138,8 @@ pub fn detection(gpu: &Gpu, set: &DetectionSettings, log: &mut dyn FnMut(&str)) 
         samples,
         bins: Some((set.rows, set.cols)),
         significance: set.significance,
+        // the histograms below are counted on the sphere's grid (`histograms`)
+        fit: crate::check::support::Fit::Never,
         ..Settings::default()
     };
     let counts: Vec<u64> = (set.log2_min..=set.log2_max).map(|k| 1u64 << k).collect();
