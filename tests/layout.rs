@@ -52,28 +52,33 @@ fn imported_modules(code: &str) -> BTreeSet<String> {
 /// Which top-level module imports which, over the files of `src/`.
 fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-    let mut stack = vec![src.to_path_buf()];
+    for path in rust_files(src) {
+        let relative = path.strip_prefix(src).unwrap();
+        let first = relative.components().next().unwrap().as_os_str().to_string_lossy().into_owned();
+        let module = first.trim_end_matches(".rs").to_string();
+        if module == "lib" || module == "main" {
+            continue;
+        }
+        let imports = imported_modules(&strip_comments(&std::fs::read_to_string(&path).unwrap()));
+        graph.entry(module.clone()).or_default().extend(imports.into_iter().filter(|m| *m != module));
+    }
+    graph
+}
+
+/// The `.rs` files under `dir`, in every folder.
+fn rust_files(dir: &Path) -> Vec<std::path::PathBuf> {
+    let (mut files, mut stack) = (Vec::new(), vec![dir.to_path_buf()]);
     while let Some(dir) = stack.pop() {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             if path.is_dir() {
                 stack.push(path);
-                continue;
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
             }
-            if path.extension().is_none_or(|e| e != "rs") {
-                continue;
-            }
-            let relative = path.strip_prefix(src).unwrap();
-            let first = relative.components().next().unwrap().as_os_str().to_string_lossy().into_owned();
-            let module = first.trim_end_matches(".rs").to_string();
-            if module == "lib" || module == "main" {
-                continue;
-            }
-            let imports = imported_modules(&strip_comments(&std::fs::read_to_string(&path).unwrap()));
-            graph.entry(module.clone()).or_default().extend(imports.into_iter().filter(|m| *m != module));
         }
     }
-    graph
+    files
 }
 
 /// The pairs (a, b), a < b, of modules that import each other.
@@ -323,25 +328,17 @@ const OWN_FILE: &str = "mod.rs";
 /// its file names; `lib.rs` and `main.rs` are left out (the crate root only lists the layers).
 fn crate_files(src: &Path) -> BTreeMap<Vec<String>, Vec<NamedPath>> {
     let mut files = BTreeMap::new();
-    let mut stack = vec![src.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-                continue;
-            }
-            let relative = path.strip_prefix(src).unwrap();
-            if path.extension().is_none_or(|e| e != "rs") || relative == Path::new("lib.rs") || relative == Path::new("main.rs") {
-                continue;
-            }
-            let mut module: Vec<String> = relative.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
-            if module.last().is_some_and(|m| m == "mod") {
-                module.pop();
-            }
-            let text = std::fs::read_to_string(&path).unwrap();
-            files.insert(module, named_paths(&tokens(&code_of(&text))));
+    for path in rust_files(src) {
+        let relative = path.strip_prefix(src).unwrap();
+        if relative == Path::new("lib.rs") || relative == Path::new("main.rs") {
+            continue;
         }
+        let mut module: Vec<String> = relative.with_extension("").iter().map(|c| c.to_string_lossy().into_owned()).collect();
+        if module.last().is_some_and(|m| m == "mod") {
+            module.pop();
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        files.insert(module, named_paths(&tokens(&code_of(&text))));
     }
     files
 }

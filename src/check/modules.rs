@@ -1093,6 +1093,7 @@ pub(super) fn replace_bodies(text: &str, module: &naga::Module, functions: &[(na
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check::composition::Draw;
 
     #[test]
     fn draw_orders() {
