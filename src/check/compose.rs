@@ -16,20 +16,6 @@ pub struct Source {
     pub text: String,
 }
 
-impl Source {
-    /// Reads a WGSL file, naming it by its path.
-    pub fn read(path: &std::path::Path) -> Result<Self, CheckError> {
-        if super::dialect::spirv::is_spirv(path) {
-            return super::dialect::spirv::read(path);
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| match std::fs::read(path) {
-            Ok(b) if super::dialect::spirv::has_magic(&b) => CheckError::Input(format!("{}: a SPIR-V module: name it FILE.spv", path.display())),
-            _ => CheckError::Input(format!("{}: cannot read the shader file: {e}", path.display())),
-        })?;
-        Ok(Self { name: path.display().to_string(), text })
-    }
-}
-
 /// What a user's function must look like: its role, and its signature in the contract.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Signature {
@@ -360,4 +346,52 @@ pub(super) fn global_names(module: &naga::Module) -> Vec<String> {
     let o = module.overrides.iter().filter_map(|(_, o)| o.name.clone());
     let t = module.types.iter().filter_map(|(_, t)| t.name.clone());
     f.chain(c).chain(g).chain(o).chain(t).collect()
+}
+
+/// A validated module written back as WGSL, with the names as the module holds them: naga's
+/// writer appends `_` to a name that ends in a digit (`v0` → `v0_`), which is undone here.
+pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities) -> Result<String, CheckError> {
+    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
+        .validate(module)
+        .map_err(|e| CheckError::Internal(format!("the composed module does not validate: {}", e.as_inner())))?;
+    let text = naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty())
+        .map_err(|e| CheckError::Internal(format!("naga's WGSL writer failed: {e}")))?;
+    Ok(undo_digit_suffix(&text))
+}
+
+/// `name0_` → `name0` for every identifier that ends in a digit and one underscore.
+fn undo_digit_suffix(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let b = text.as_bytes();
+    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    let mut i = 0;
+    while i < b.len() {
+        if ident(b[i]) && (i == 0 || !ident(b[i - 1])) {
+            let start = i;
+            while i < b.len() && ident(b[i]) {
+                i += 1;
+            }
+            let word = &text[start..i];
+            let w = word.as_bytes();
+            if w.len() >= 3 && !w[0].is_ascii_digit() && w[w.len() - 1] == b'_' && w[w.len() - 2].is_ascii_digit() {
+                out.push_str(&word[..word.len() - 1]);
+            } else {
+                out.push_str(word);
+            }
+        } else {
+            out.push(text[i..].chars().next().expect("in range"));
+            i += text[i..].chars().next().expect("in range").len_utf8();
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn digit_suffixes_are_undone() {
+        assert_eq!(undo_digit_suffix("fn f0_(a: f32) -> f32 { let x_1 = a; return v2_ + b_; }"), "fn f0(a: f32) -> f32 { let x_1 = a; return v2 + b_; }");
+    }
 }

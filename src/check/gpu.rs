@@ -2,7 +2,8 @@
 //! quadrature of rectangles and the probe of the sample map.
 
 use super::compose::{Composed, Source};
-use super::modules::{Draw, UserCode, compose_user};
+use super::composition::{Draw, UserCode, is_name};
+use super::modules::compose_user;
 use super::probe::Probe;
 use super::{CheckError, Domain, UserSampler};
 use crate::engine::gpu::library::{self, File};
@@ -112,13 +113,6 @@ impl GpuResource {
     }
 }
 
-/// Whether `s` names a function (with the contract's signature) rather than being a call
-/// expression over lobes' names.
-pub(super) fn is_name(s: &str) -> bool {
-    let mut c = s.trim().chars();
-    c.next().is_some_and(|f| f.is_ascii_alphabetic() || f == '_') && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
-}
-
 /// What the sample call returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Returned {
@@ -148,6 +142,35 @@ impl Counted {
     fn new(words: &[u32], cells: usize) -> Self {
         Self { counts: words[..cells].to_vec(), over_drawn: words[cells], most_draws: words[cells + 1] }
     }
+}
+
+/// The most samples of one dispatch of the histogram and weights passes.
+pub(super) const CHUNK: u64 = 1 << 26;
+
+/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
+/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
+/// numbers, counted on every sample, are bad input ([`too_many_draws`]).
+pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
+    let mut totals = vec![0u64; bins + 4];
+    let (mut over, mut most) = (0u64, 0u32);
+    let mut first = 0;
+    while first < samples {
+        let n = CHUNK.min(samples - first) as u32;
+        let counted = passes.histogram(params, first, n, bins + 4, None)?;
+        for (t, c) in totals.iter_mut().zip(counted.counts) {
+            *t += c as u64;
+        }
+        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
+        first += n as u64;
+    }
+    if over > 0 {
+        return Err(too_many_draws(sampler, most, over, samples));
+    }
+    let counted: u64 = totals.iter().sum();
+    if counted != samples {
+        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
+    }
+    Ok(totals)
 }
 
 /// The error of a sampler of which `over` of `of` samples drew more than the queue's four
@@ -504,7 +527,7 @@ pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Sour
     let sampler = &resolved;
     let returned = returned(&code, sampler)?;
     let rand = &sampler.composition.rand;
-    if code.dialect == super::modules::Dialect::Wgsl {
+    if code.dialect == super::composition::Dialect::Wgsl {
         let mut parts = replace_rand(&code.parts, &code, rand)?;
         parts.push(Source { name: GLUE.into(), text: glue(sampler, returned, order, false) });
         return Ok(parts);
@@ -521,7 +544,7 @@ pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Sour
     let text = crate::engine::gpu::stack::with_big_stack(move || {
         naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
         module.entry_points.clear();
-        super::modules::write_wgsl(&module, naga::valid::Capabilities::all())
+        super::compose::write_wgsl(&module, naga::valid::Capabilities::all())
     })?;
     Ok(vec![Source { name: code.parts[0].name.clone(), text }])
 }

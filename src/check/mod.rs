@@ -37,6 +37,7 @@
 pub mod budget;
 mod builtin;
 pub mod compose;
+pub mod composition;
 pub mod conventions;
 pub mod dialect;
 mod gpu;
@@ -55,7 +56,7 @@ pub use compose::Source;
 pub use conventions::{Conventions, Frame, Incident, Measure};
 /// glam, whose `DVec3` [`Reference`] takes: a renderer's tests need no glam of their own.
 pub use glam;
-pub use modules::{Composition, Dialect, Draw, SampleReturns};
+pub use composition::{Composition, Dialect, Draw, SampleReturns};
 pub use report::{Check, Figures, REASONS, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
@@ -153,7 +154,7 @@ impl UserSampler {
     /// name (`my_pdf(d)`), a call expression as written (`ggx_vndf_pdf(wi, d, p0)`, never
     /// `ggx_vndf_pdf(wi, d, p0)(d)`).
     pub fn pdf_at_d(&self) -> String {
-        if gpu::is_name(self.pdf.trim()) { format!("{}(d)", self.pdf.trim()) } else { self.pdf.clone() }
+        if composition::is_name(self.pdf.trim()) { format!("{}(d)", self.pdf.trim()) } else { self.pdf.clone() }
     }
 
     /// Reads the files (in order) and checks the functions against the contract.
@@ -250,7 +251,7 @@ impl UserSampler {
         if let Some(e) = &self.eval {
             functions.push((e.as_str(), compose::EVAL));
         }
-        functions.retain(|(n, _)| gpu::is_name(n));
+        functions.retain(|(n, _)| composition::is_name(n));
         let module = compose::check_user(&code.parts, &code.decls, &functions)?;
         let imported = |n: &String| code.origins.iter().any(|o| &o.0 == n);
         if let Some(name) = compose::global_names(&module).into_iter().find(|n| gpu::reserved(n) && !imported(n)) {
@@ -292,7 +293,7 @@ pub struct Settings {
     /// The time the whole check may take ([`DEFAULT_TIMEOUT`]; at most [`MAX_TIMEOUT_SECONDS`]): the
     /// GPU's work still unfinished then ends the check with [`GpuError::TimedOut`] (a sampler
     /// that loops forever never returns), and the device is abandoned
-    /// ([`crate::engine::gpu::dispatch::Bounds`]).
+    /// ([`crate::engine::gpu::context::Bounds`]).
     pub timeout: std::time::Duration,
     /// Whether a sampler on the sphere whose samples fall in a small cap is binned on a grid
     /// fitted to it ([`support`]).
@@ -481,7 +482,7 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
         .map(|&(samples, seed)| {
             let params = params_of(sampler, &Settings { seed, ..settings.clone() });
             let started = std::time::Instant::now();
-            let counts = judge::histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
+            let counts = gpu::histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
             Ok((counts, started.elapsed().as_secs_f64()))
         })
         .collect()

@@ -5,7 +5,7 @@
 use super::report::{Chi2Figures, REPORT_VERSION, Report};
 use super::{CheckError, Settings, UserSampler, check};
 use crate::engine::gpu::Gpu;
-use crate::stats::family::FamilyTest;
+use crate::stats::chi2::FamilyTest;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -252,7 +252,7 @@ addEventListener('load', () => {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::family::FamilyTest;
+    use crate::stats::chi2::FamilyTest;
 
     fn case(name: &str, passed: bool, error: Option<&str>) -> CaseSummary {
         CaseSummary {

@@ -89,7 +89,7 @@ mod tests {
                 dof: 2,
                 p_value: 0.2,
                 family_p_value: Some(0.4),
-                family: vec![crate::stats::family::FamilyTest { test: "2 × 4".into(), rows: 2, cols: 4, statistic: 3.0, dof: 2, p_value: 0.2, holm_p_value: 0.4, rejected: false }],
+                family: vec![crate::stats::chi2::FamilyTest { test: "2 × 4".into(), rows: 2, cols: 4, statistic: 3.0, dof: 2, p_value: 0.2, holm_p_value: 0.4, rejected: false }],
                 albedo: None,
                 max_angle_rad: None,
             }),

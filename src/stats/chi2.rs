@@ -31,7 +31,26 @@ pub struct Chi2 {
     pub family_p_value: Option<f64>,
     /// Every test of the family, the fine grid first: the aggregations and the marginals.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub family: Vec<super::family::FamilyTest>,
+    pub family: Vec<FamilyTest>,
+}
+
+/// One test's figures in a verdict: its statistic, and its p-value before and after Holm's
+/// adjustment for the family.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct FamilyTest {
+    /// The test ([`Test::name`]): "64 × 128" (a grid of rows × cols cells), "cos θ", "φ", "y" or
+    /// "x" (a marginal).
+    pub test: String,
+    pub rows: u32,
+    pub cols: u32,
+    pub statistic: f64,
+    /// Its degrees of freedom after pooling; a test of 0 (one cell) tests nothing and is left
+    /// out of the family's count.
+    pub dof: u64,
+    pub p_value: f64,
+    /// Holm's adjusted p-value ([`super::family::holm`]): the test rejects where it is below the significance.
+    pub holm_p_value: f64,
+    pub rejected: bool,
 }
 
 /// Why a χ² test judged nothing. Neither is a pass: a test that tested nothing says nothing of

@@ -14,11 +14,9 @@
 //! grids are equal-area where the fine grid is: lobes' sphere grid is uniform in (cos θ, φ), a
 //! plane grid in (x, y), so a block of bins is a cell of equal solid angle (or area).
 
-use super::chi2::{self, Chi2};
+use super::chi2::{self, Chi2, FamilyTest};
 #[cfg(test)]
 use super::domain::Domain;
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
 
 /// The fewest cells an aggregated grid may have (the 2 × 4 of the default sphere grid, the
 /// 2 × 2 of the plane's): coarser than that, a grid can no longer tell where the mass went.
@@ -93,25 +91,6 @@ pub fn tests(grid: Grid) -> Vec<Test> {
         }
     }
     out
-}
-
-/// One test's figures in a verdict: its statistic, and its p-value before and after Holm's
-/// adjustment for the family.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct FamilyTest {
-    /// The test ([`Test::name`]): "64 × 128" (a grid of rows × cols cells), "cos θ", "φ", "y" or
-    /// "x" (a marginal).
-    pub test: String,
-    pub rows: u32,
-    pub cols: u32,
-    pub statistic: f64,
-    /// Its degrees of freedom after pooling; a test of 0 (one cell) tests nothing and is left
-    /// out of the family's count.
-    pub dof: u64,
-    pub p_value: f64,
-    /// Holm's adjusted p-value ([`holm`]): the test rejects where it is below the significance.
-    pub holm_p_value: f64,
-    pub rejected: bool,
 }
 
 /// Holm's adjusted p-values, in the order given: with p₍₁₎ ≤ … ≤ p₍ₘ₎ sorted,

@@ -17,7 +17,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::modules::Composition;
+use super::super::composition::Composition;
 use super::Translation;
 use std::path::{Path, PathBuf};
 

@@ -16,7 +16,23 @@ pub mod wesl_blocks;
 
 use super::CheckError;
 use super::compose::Source;
-use super::modules::{Composition, Dialect, Origin, UserCode};
+use super::composition::{Composition, Dialect, Origin, UserCode};
+
+// A file's dialect decides how it is read, so the reading is the front ends' (here), not the
+// type's (`compose`, below them).
+impl Source {
+    /// Reads a WGSL file, naming it by its path.
+    pub fn read(path: &std::path::Path) -> Result<Self, CheckError> {
+        if spirv::is_spirv(path) {
+            return spirv::read(path);
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| match std::fs::read(path) {
+            Ok(b) if spirv::has_magic(&b) => CheckError::Input(format!("{}: a SPIR-V module: name it FILE.spv", path.display())),
+            _ => CheckError::Input(format!("{}: cannot read the shader file: {e}", path.display())),
+        })?;
+        Ok(Self { name: path.display().to_string(), text })
+    }
+}
 
 /// GLSL or SPIR-V, where the files are: a SPIR-V module by its `.spv` name, GLSL by its file
 /// extension or a `#version` line; else `None` (a WGSL dialect).
@@ -67,7 +83,7 @@ pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&nag
     module.entry_points.clear();
     let caps = naga::valid::Capabilities::all();
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| CheckError::Wgsl(locate(&e)))?;
-    let text = free_writer_names(&super::modules::write_wgsl(&module, caps)?);
+    let text = free_writer_names(&super::compose::write_wgsl(&module, caps)?);
     // naga's WGSL writer writes the functions in the module's order, each on a line `fn NAME(`
     let written: Vec<&str> = text.lines().filter_map(|l| l.strip_prefix("fn ")).filter_map(|l| l.split_once('(')).map(|(n, _)| n).collect();
     if written.len() != module.functions.len() {

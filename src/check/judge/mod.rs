@@ -14,16 +14,13 @@ pub mod pdf_consistency;
 pub mod pdf_values;
 pub mod weights;
 
-use super::gpu::{Params, Passes};
+use super::gpu::{CHUNK, Params, Passes, histogram};
 use super::probe::Probe;
 use super::quadrature::{self, Integrals, Integrand};
 use super::{CheckError, Settings, UserSampler, jacobian as map};
 use crate::stats::domain::Grid;
 use crate::engine::gpu::Gpu;
 use crate::reference::rng;
-
-/// The most samples of one dispatch of the histogram and weights passes.
-pub(super) const CHUNK: u64 = 1 << 26;
 
 /// One check of one sampler at one setting: the composed passes and their parameters. Its
 /// sampler is the user's, on the cap fitted to its support where one is ([`super::support`]).
@@ -173,32 +170,6 @@ fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64)
     }
     let moved = if run.settings.reference.is_some() { 0.0 } else { quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? };
     Ok((integrals, moved))
-}
-
-/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
-/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
-/// numbers, counted on every sample, are bad input ([`super::gpu::too_many_draws`]).
-pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
-    let mut totals = vec![0u64; bins + 4];
-    let (mut over, mut most) = (0u64, 0u32);
-    let mut first = 0;
-    while first < samples {
-        let n = CHUNK.min(samples - first) as u32;
-        let counted = passes.histogram(params, first, n, bins + 4, None)?;
-        for (t, c) in totals.iter_mut().zip(counted.counts) {
-            *t += c as u64;
-        }
-        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
-        first += n as u64;
-    }
-    if over > 0 {
-        return Err(super::gpu::too_many_draws(sampler, most, over, samples));
-    }
-    let counted: u64 = totals.iter().sum();
-    if counted != samples {
-        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
-    }
-    Ok(totals)
 }
 
 /// A pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise

@@ -4,6 +4,7 @@
 #[cfg(feature = "check")]
 use super::pipeline_cache::{self, DiskCache};
 use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 use thiserror::Error;
 
 /// Why no GPU could be used.
@@ -30,7 +31,7 @@ pub enum GpuError {
     Readback(String),
     #[error("the GPU device was lost or ran out of memory: {0}")]
     Lost(String),
-    /// A wait passed its deadline ([`super::dispatch::Bounds`]); the device still runs the
+    /// A wait passed its deadline ([`Bounds`]); the device still runs the
     /// work and is abandoned.
     #[error("no result within {seconds} s (the time limit): the GPU was still running {pass}")]
     TimedOut { seconds: f64, pass: String },
@@ -77,6 +78,24 @@ fn backend_from_env() -> Result<Option<String>, GpuError> {
     }
 }
 
+/// What bounds the device's work: a deadline ([`Gpu::deadline`]) and a stop asked for
+/// ([`Gpu::stop_when`], SIGINT/SIGTERM), seen before every submission and every 50 ms of every
+/// wait. A wait that gives up leaves its work running on the device (a shader may loop forever,
+/// and no API takes a submission back): the device is then abandoned, nothing more is submitted
+/// to it, and it is never dropped (dropping a device waits for its work), so that the process
+/// can still report and exit.
+#[derive(Default)]
+pub struct Bounds {
+    /// When the work in hand must end, and the time it was given.
+    pub(super) deadline: Mutex<Option<(Instant, Duration)>>,
+    /// Whether a stop was asked for.
+    pub(super) stop: Mutex<Option<fn() -> bool>>,
+    /// The label of the pass last submitted, for messages.
+    pub(super) pass: Mutex<String>,
+    /// Why the device was abandoned, once it was.
+    pub(super) abandoned: Mutex<Option<String>>,
+}
+
 /// A wgpu device and what its adapter offers.
 pub struct Gpu {
     pub device: wgpu::Device,
@@ -92,9 +111,9 @@ pub struct Gpu {
     /// The first error the device reported outside a call that returns one (validation, out
     /// of memory, loss), until [`Gpu::check_errors`] takes it.
     errors: Arc<Mutex<Option<String>>>,
-    /// The deadline and the stop that bound waits on the device ([`super::dispatch::Bounds`]).
+    /// The deadline and the stop that bound waits on the device ([`Bounds`]).
     #[cfg(feature = "check")]
-    pub(super) bounds: super::dispatch::Bounds,
+    pub(super) bounds: Bounds,
 }
 
 /// The first adapter whose name contains `wanted`, ignoring case (what `WGPU_ADAPTER_NAME` means

@@ -125,7 +125,7 @@ impl Counting {
     pub fn groups(self, count: u64) -> u64 {
         match self {
             Counting::Slabs { slabs } => (slabs / SLAB_WORKGROUP) as u64,
-            _ => super::dispatch::SamplingPasses::groups(count),
+            _ => super::layout::sampling_groups(count),
         }
     }
 

@@ -1,34 +1,14 @@
 //! The one dispatcher: every pass of the engine (counting, weighted, per-sample) and of the
 //! tradeoff quadrature is compiled, encoded, submitted, timed and read back here.
 
-use super::compose;
 use super::layout::{SAMPLES_PER_THREAD, WG_SIZE};
 use super::context::{Gpu, GpuError};
 use super::params::Params;
 use crate::engine::job::SampleRange;
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// How long a wait on the device sleeps before it looks at its [`Bounds`] again.
 const SLICE: Duration = Duration::from_millis(50);
-
-/// What bounds the device's work: a deadline ([`Gpu::deadline`]) and a stop asked for
-/// ([`Gpu::stop_when`], SIGINT/SIGTERM), seen before every submission and every 50 ms of every
-/// wait. A wait that gives up leaves its work running on the device (a shader may loop forever,
-/// and no API takes a submission back): the device is then abandoned, nothing more is submitted
-/// to it, and it is never dropped (dropping a device waits for its work), so that the process
-/// can still report and exit.
-#[derive(Default)]
-pub struct Bounds {
-    /// When the work in hand must end, and the time it was given.
-    deadline: Mutex<Option<(Instant, Duration)>>,
-    /// Whether a stop was asked for.
-    stop: Mutex<Option<fn() -> bool>>,
-    /// The label of the pass last submitted, for messages.
-    pass: Mutex<String>,
-    /// Why the device was abandoned, once it was.
-    abandoned: Mutex<Option<String>>,
-}
 
 /// A delay before each pipeline creation, from `LOBES_TEST_CREATION_DELAY_MS`:
 /// the tests' stand-in for a driver that compiles a shader for minutes (tests/hangs.rs), which
@@ -87,7 +67,7 @@ impl Gpu {
     /// `source` validated by naga (errors name `what`) and made a shader module, within the
     /// bounds ([`Gpu::bounded`]).
     pub fn module(&self, what: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
-        compose::validate(what, source)?;
+        super::library::validate_module(what, source)?;
         self.module_unvalidated(what, source)
     }
 
@@ -356,11 +336,6 @@ impl<'g> SamplingPasses<'g> {
     /// The uniform buffer to bind at binding 0 ([`Params::bind_entry`]).
     pub fn params(&self) -> &wgpu::Buffer {
         &self.params
-    }
-
-    /// Workgroups of the sampling kernels for `count` samples.
-    pub fn groups(count: u64) -> u64 {
-        count.div_ceil((WG_SIZE * SAMPLES_PER_THREAD) as u64)
     }
 
     /// Runs `steps` once per chunk of `range` with `bind` and the chunk's `params`; `progress`

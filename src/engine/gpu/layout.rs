@@ -14,6 +14,11 @@ pub const SAMPLES_PER_THREAD: u32 = 255;
 pub const WG_SIZE: u32 = 256;
 const _: () = assert!(SAMPLES_PER_THREAD * WG_SIZE <= 0xffff);
 
+/// Workgroups of the sampling kernels for `count` samples.
+pub fn sampling_groups(count: u64) -> u64 {
+    count.div_ceil((WG_SIZE * SAMPLES_PER_THREAD) as u64)
+}
+
 /// Counters after a histogram's bins: one per invalid reason, codes 1 ..= N_REASONS in the
 /// order of [`Invalid::ALL`] (`shaders/lib/histogram.wgsl`).
 pub const N_REASONS: u32 = Invalid::ALL.len() as u32;

@@ -4,7 +4,7 @@
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, SamplingPasses, Step};
 use super::effects::{self, Composed};
-use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS};
+use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS, sampling_groups};
 use super::params::{Params, storage_entry};
 use crate::engine::job::{Job, SampleRange};
 use crate::reference::effects::Effects;
@@ -103,7 +103,7 @@ impl WeightedPipelines {
             ],
         });
         let start = Instant::now();
-        let steps = |chunk: SampleRange| vec![Step { pipeline: &pipeline, groups: SamplingPasses::groups(chunk.count) }];
+        let steps = |chunk: SampleRange| vec![Step { pipeline: &pipeline, groups: sampling_groups(chunk.count) }];
         let gpu_seconds = passes.run(range, &bind, |chunk| Params::new(job, chunk), steps, &mut |_| {})?;
         let cells = gpu.read_u64(&sums, words / 2)?;
         let max_error: Vec<f32> = bytemuck::cast_slice(&gpu.read(&errors, bins * 4)?).to_vec();

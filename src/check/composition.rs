@@ -1,0 +1,332 @@
+//! How a user's sampler is composed and called: the settings beyond the contract's three
+//! functions ([`Composition`], [`Draw`], [`SampleReturns`]), the dialect of its files
+//! ([`Dialect`]), and the composed code that lobes' glue calls ([`UserCode`]). The vocabulary
+//! that `modules` (which composes), `dialect` (the front ends) and `gpu` (the glue) share.
+
+use super::compose::Source;
+use std::path::PathBuf;
+
+/// How lobes finds and calls a sampler beyond the contract's three functions (issue 23 §1–2).
+///
+/// ```
+/// use lobes::check::{Composition, Draw, SampleReturns};
+/// let c = Composition::default()
+///     .shader_root("shaders")
+///     .define("MULTISCATTER", None)
+///     .stub("renderer::bindings", "tests/stub_bindings.wgsl")
+///     .rand("rand_f")
+///     .rand_order(&[Draw::Event, Draw::X, Draw::Y]);
+/// assert_eq!(c.shader_roots.len(), 1);
+/// assert_eq!(c.sample_returns, SampleReturns::Direction);
+/// assert_eq!(lobes::check::Draw::parse_list("event,x,y").unwrap(), vec![Draw::Event, Draw::X, Draw::Y]);
+/// ```
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Composition {
+    /// Where modules are found (`--shader-root`, repeatable); none: the first file's folder.
+    pub shader_roots: Vec<PathBuf>,
+    /// Shader defs (`--define NAME[=VALUE]`): naga_oil's `#ifdef`/`#if`, WESL's `@if` features.
+    pub defines: Vec<(String, Option<String>)>,
+    /// Stand-ins for modules the test does not need (`--stub MODULE=FILE`): bind groups, scene
+    /// bindings, ray queries.
+    pub stubs: Vec<(String, PathBuf)>,
+    /// Where another WESL package's modules are (`--package NAME=DIR`): `NAME::a::b` is
+    /// `DIR/a/b.wesl` (or `.wgsl`). A package not named here is looked for under the shader roots
+    /// without its name (`NAME::a::b` as `a/b.wesl`).
+    pub packages: Vec<(String, PathBuf)>,
+    /// The user's random functions (`--rand NAME`): their bodies are replaced by lobes' queue of
+    /// u.x, u.y, u.z, u.w in call order.
+    pub rand: Vec<String>,
+    /// Which draw takes which uniform (`--rand-order`); `None`: found by lobes' probe.
+    pub rand_order: Option<Vec<Draw>>,
+    /// What the sample expression returns (`--sample-returns`).
+    pub sample_returns: SampleReturns,
+    /// The light's unit normal at the sampled point `p` (`--normal`, with `--measure area`): a
+    /// WGSL expression over `p`, `params` and `p0` … `p15`.
+    pub normal: Option<String>,
+    /// The renderer's textures and tables, by the name the sampler's files declare them with
+    /// (`--texture NAME=FILE`, `--buffer NAME=FILE`; [`super::resources`]).
+    pub resources: Vec<(String, super::resources::Resource)>,
+}
+
+impl Composition {
+    pub fn shader_root(mut self, dir: impl Into<PathBuf>) -> Self {
+        self.shader_roots.push(dir.into());
+        self
+    }
+    pub fn define(mut self, name: &str, value: Option<&str>) -> Self {
+        self.defines.push((name.into(), value.map(Into::into)));
+        self
+    }
+    pub fn stub(mut self, module: &str, file: impl Into<PathBuf>) -> Self {
+        self.stubs.push((module.into(), file.into()));
+        self
+    }
+    /// A `.hdr` image bound as the sampler's `name: texture_2d<f32>` (`--texture NAME=FILE`).
+    pub fn texture(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
+        self.resources.push((name.into(), super::resources::Resource::Texture(file.into())));
+        self
+    }
+    /// A `.npy` table bound as the sampler's `var<storage, read> name: array<…>` (`--buffer
+    /// NAME=FILE`).
+    pub fn buffer(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
+        self.resources.push((name.into(), super::resources::Resource::Buffer(file.into())));
+        self
+    }
+    /// `--texture` and `--buffer` flags, each NAME=FILE, named once each.
+    pub fn parse_resources(textures: &[String], buffers: &[String]) -> Result<Vec<(String, super::resources::Resource)>, String> {
+        use super::resources::Resource;
+        let mut out: Vec<(String, Resource)> = Vec::new();
+        let flags = textures.iter().map(|t| ("--texture", t)).chain(buffers.iter().map(|b| ("--buffer", b)));
+        for (flag, item) in flags {
+            let (name, file) = item.split_once('=').map(|(n, f)| (n.trim(), f.trim())).filter(|(n, f)| is_name(n) && !f.is_empty()).ok_or_else(|| format!("{flag} '{item}': give NAME=FILE, NAME the variable the sampler's files declare, e.g. {flag} env_map={}", if flag == "--texture" { "sky.hdr" } else { "cdf.npy" }))?;
+            if out.iter().any(|(n, _)| n == name) {
+                return Err(format!("{flag} '{item}': {name} is bound twice"));
+            }
+            let file = PathBuf::from(file);
+            out.push((name.to_string(), if flag == "--texture" { Resource::Texture(file) } else { Resource::Buffer(file) }));
+        }
+        Ok(out)
+    }
+    /// Another WESL package's folder: `NAME::a::b` is `dir/a/b.wesl` (`--package NAME=DIR`).
+    pub fn package(mut self, name: &str, dir: impl Into<PathBuf>) -> Self {
+        self.packages.push((name.into(), dir.into()));
+        self
+    }
+    pub fn rand(mut self, name: &str) -> Self {
+        self.rand.push(name.into());
+        self
+    }
+    pub fn rand_order(mut self, order: &[Draw]) -> Self {
+        self.rand_order = Some(order.to_vec());
+        self
+    }
+    pub fn sample_returns(mut self, r: SampleReturns) -> Self {
+        self.sample_returns = r;
+        self
+    }
+    /// The light's normal at `p` of a sampler that samples a light's area (`--normal`).
+    pub fn normal(mut self, expr: &str) -> Self {
+        self.normal = Some(expr.into());
+        self
+    }
+    /// The command line's flags: `--define NAME[=VALUE]`, `--stub MODULE=FILE`, `--rand-order
+    /// event,x,y`; a bad one is an error naming the flag.
+    pub fn from_flags(
+        shader_roots: &[PathBuf],
+        defines: &[String],
+        stubs: &[String],
+        rand: &[String],
+        rand_order: Option<&str>,
+        sample_returns: SampleReturns,
+    ) -> Result<Self, String> {
+        let defines = defines
+            .iter()
+            .map(|d| match d.split_once('=') {
+                Some((n, v)) => Ok((n.trim().to_string(), Some(v.trim().to_string()))),
+                None => Ok((d.trim().to_string(), None)),
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        if let Some((n, _)) = defines.iter().find(|(n, _)| !is_name(n)) {
+            return Err(format!("--define '{n}': a shader def is a name (letters, digits, _), as in --define UNIFORM_HEMISPHERE or --define SAMPLES=4"));
+        }
+        let stubs = stubs
+            .iter()
+            .map(|s| match s.split_once('=') {
+                Some((m, f)) if !m.trim().is_empty() && !f.trim().is_empty() => Ok((m.trim().to_string(), PathBuf::from(f.trim()))),
+                _ => Err(format!("--stub '{s}': give MODULE=FILE, e.g. --stub package::bindings=tests/no_bindings.wesl")),
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        if let Some((m, _)) = stubs.iter().enumerate().find(|(i, (m, _))| stubs[..*i].iter().any(|(n, _)| n == m)).map(|(_, s)| s) {
+            return Err(format!("--stub {m}: given twice; one module has one stand-in"));
+        }
+        let rand_order = rand_order.map(|o| Draw::parse_list(o).map_err(|e| format!("--rand-order: {e}"))).transpose()?;
+        if rand_order.is_some() && rand.is_empty() {
+            return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
+        }
+        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), resources: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
+    }
+
+    /// `--package NAME=DIR` flags (repeatable): NAME a WESL package name, each at most once.
+    pub fn parse_packages(flags: &[String]) -> Result<Vec<(String, PathBuf)>, String> {
+        let mut out: Vec<(String, PathBuf)> = Vec::new();
+        for f in flags {
+            let Some((name, dir)) = f.split_once('=').map(|(n, d)| (n.trim(), d.trim())).filter(|(n, d)| !n.is_empty() && !d.is_empty()) else {
+                return Err(format!("--package '{f}': give NAME=DIR, e.g. --package bevy_render=crates/bevy_render/src (then bevy_render::maths is DIR/maths.wesl)"));
+            };
+            check_package(name, &out)?;
+            out.push((name.to_string(), PathBuf::from(dir)));
+        }
+        Ok(out)
+    }
+
+    /// Whether anything beyond the contract's plain files is asked for.
+    pub fn is_plain(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// A `--package` name: an identifier, not `package` (the sampler's own root), given once.
+pub(super) fn check_package(name: &str, given: &[(String, PathBuf)]) -> Result<(), String> {
+    if !is_name(name) || name == "package" || name == "super" {
+        return Err(format!("--package {name}=…: a package name is an identifier other than package and super (WESL's own path starts), as an import names it: bevy_render in `import bevy_render::maths::PI;`"));
+    }
+    if given.iter().any(|(n, _)| n == name) {
+        return Err(format!("--package {name}: given twice; one package has one folder"));
+    }
+    Ok(())
+}
+
+/// What a sample expression's result means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SampleReturns {
+    /// The sampled direction d (vec3) or (d, pdf) (vec4).
+    #[default]
+    Direction,
+    /// A half vector h (vec3) or (h, pdf of h) (vec4): lobes reflects wi about h, d = 2 (wi·h) h − wi,
+    /// and divides the pdf of h by the reflection's Jacobian 4 |wi·h| (Walter et al. 2007, eq. 14).
+    HalfVector,
+}
+
+/// What one random draw of the user's sampler decides (`--rand-order`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Draw {
+    /// The first coordinate that moves the direction smoothly: u.x.
+    X,
+    /// The second: u.y.
+    Y,
+    /// A draw that chooses an event (a lobe of a mixture): u.z, the next one u.w. lobes' Jacobian
+    /// check differentiates in u.x and u.y and measures events' shares along u.z and u.w.
+    Event,
+}
+
+impl Draw {
+    /// `event,x,y`: at most one x, one y and two events.
+    pub fn parse_list(s: &str) -> Result<Vec<Draw>, String> {
+        let allowed = "a comma-separated list of x, y and event (at most one x, one y, two events), e.g. event,x,y";
+        let draws = s
+            .split(',')
+            .map(|w| match w.trim() {
+                "x" => Ok(Draw::X),
+                "y" => Ok(Draw::Y),
+                "event" => Ok(Draw::Event),
+                other => Err(format!("'{other}' is not a draw; give {allowed}")),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let count = |d| draws.iter().filter(|&&x| x == d).count();
+        if count(Draw::X) > 1 || count(Draw::Y) > 1 || count(Draw::Event) > 2 {
+            return Err(format!("'{s}' gives u.x, u.y or u.z/u.w twice; give {allowed}"));
+        }
+        Ok(draws)
+    }
+
+    /// The component of u each draw takes, in call order; draws past the list take the
+    /// components left, in the order x, y, z, w.
+    pub fn components(order: &[Draw]) -> [u32; 4] {
+        let mut out = Vec::new();
+        let mut events = [2u32, 3].into_iter();
+        for d in order {
+            out.push(match d {
+                Draw::X => 0,
+                Draw::Y => 1,
+                Draw::Event => events.next().expect("at most two events (parse_list)"),
+            });
+        }
+        for c in 0..4 {
+            if !out.contains(&c) {
+                out.push(c);
+            }
+        }
+        [out[0], out[1], out[2], out[3]]
+    }
+
+    /// The order as written: `event,x,y`.
+    pub fn list(components: &[u32; 4], draws: usize) -> String {
+        let names: Vec<&str> = components.iter().take(draws).map(|c| match c {
+            0 => "x",
+            1 => "y",
+            _ => "event",
+        }).collect();
+        names.join(",")
+    }
+}
+
+/// The way the files compose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dialect {
+    /// Plain WGSL files, concatenated in order.
+    Wgsl,
+    /// naga_oil's `#import` / `#define_import_path` / shader defs.
+    NagaOil,
+    /// WESL's `import package::…;`.
+    Wesl,
+    /// GLSL, translated by naga ([`super::dialect::glsl`]).
+    Glsl,
+    /// A SPIR-V module, translated by naga ([`super::dialect::spirv`]).
+    Spirv,
+}
+
+impl Dialect {
+    pub fn name(self) -> &'static str {
+        match self {
+            Dialect::Wgsl => "WGSL",
+            Dialect::NagaOil => "naga_oil",
+            Dialect::Wesl => "WESL",
+            Dialect::Glsl => "GLSL",
+            Dialect::Spirv => "SPIR-V",
+        }
+    }
+}
+
+/// The dialect of the files, from their text: a naga_oil directive at the start of a line, a WESL
+/// `import …;` statement (or a `.wesl` file), else plain WGSL.
+pub fn dialect(sources: &[Source]) -> Dialect {
+    if let Some(d) = super::dialect::sniff(sources) {
+        return d;
+    }
+    let directive = |l: &str| {
+        let l = l.trim_start();
+        ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if ", "#else", "#endif"].iter().any(|d| l.starts_with(d))
+    };
+    let wesl_import = |l: &str| {
+        let l = l.trim_start();
+        l.starts_with("import ") && (l.contains("::") || l.trim_end().ends_with(';'))
+    };
+    if sources.iter().any(|s| s.text.lines().any(directive)) {
+        Dialect::NagaOil
+    } else if sources.iter().any(|s| s.name.ends_with(".wesl") || s.text.lines().any(wesl_import)) {
+        Dialect::Wesl
+    } else {
+        Dialect::Wgsl
+    }
+}
+
+/// Whether `s` names a function (with the contract's signature) rather than being a call
+/// expression over lobes' names.
+pub(super) fn is_name(s: &str) -> bool {
+    let mut c = s.trim().chars();
+    c.next().is_some_and(|f| f.is_ascii_alphabetic() || f == '_') && c.all(|x| x.is_ascii_alphanumeric() || x == '_')
+}
+
+/// An item of an imported module: (its name in the composed text, the module path, its name in
+/// that module).
+pub(super) type Origin = (String, String, String);
+
+/// The user's code before lobes' glue: the parts of its text, and where names from other modules
+/// came from.
+#[derive(Debug, Clone)]
+pub(super) struct UserCode {
+    pub dialect: Dialect,
+    /// The files as they are (plain WGSL), or one part: the composed tree.
+    pub parts: Vec<Source>,
+    /// Where the items of imported modules came from.
+    pub origins: Vec<Origin>,
+    /// The files the tree was read from (for messages).
+    pub files: Vec<String>,
+    /// Where the declarations of a WESL tree came from (the wesl crate writes the tree anew).
+    pub decls: Vec<super::compose::DeclOrigin>,
+    /// The functions naga's WGSL writer renamed in `parts` (`würfel` → `wrfel`, `rand_` → `rand`).
+    pub renamed: Renamed,
+}
+
+/// (the name naga's WGSL writer gave a function, its name in the module it wrote).
+pub(super) type Renamed = Vec<(String, String)>;
