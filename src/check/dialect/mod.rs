@@ -11,6 +11,7 @@
 //! file does ([`call_names`]).
 
 pub mod glsl;
+pub mod out_params;
 pub mod spirv;
 pub mod wesl_blocks;
 
