@@ -258,3 +258,38 @@ fn spirv_with_out_parameters_is_checked_by_naming_a_variable() {
         assert_eq!(failed(&out).contains(&"pdf_consistency".to_string()), code == 1, "{:?}", failed(&out));
     }
 }
+
+/// A `switch` whose cases end in `return` (naga's GLSL front end marks them as falling through,
+/// which its WGSL writer refused as an internal error, exit 3) is checked; a case that does fall
+/// through into the next with statements of its own is exit 2 at the `switch`'s line, saying
+/// what to write instead.
+#[test]
+fn switch_cases_ending_in_return_pass_and_a_real_fall_through_is_named() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-glsl-switch");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cosine = "vec3 cosdir(vec2 u) { float r = sqrt(u.x); float phi = 6.2831853 * u.y; return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x))); }\nfloat cospdf(vec3 L) { return L.z > 0.0 ? L.z / 3.14159265 : 0.0; }\n";
+    let returns = format!("#version 450\n{cosine}vec3 s(vec2 u, int k) {{\n    switch (k) {{\n        case 0: return cosdir(u);\n        default: return vec3(0.0, 0.0, 1.0);\n    }}\n}}\n");
+    let falls = format!("#version 450\n{cosine}vec3 s(vec2 u, int k) {{\n    vec3 d = vec3(0.0);\n    switch (k) {{\n        case 0: d = cosdir(u);\n        case 1: d.z += 0.0; break;\n        default: d = vec3(0.0, 0.0, 1.0);\n    }}\n    return d;\n}}\n");
+    for (name, text, code) in [("returns.glsl", returns, 0), ("falls.glsl", falls, 2)] {
+        let file = dir.join(name);
+        std::fs::write(&file, &text).unwrap();
+        let out = lobes(&["check", file.to_str().unwrap(), "--sample", "s(u.xy, 0)", "--pdf", "cospdf(d)", "--samples", "65536", "--json"]);
+        assert_eq!(out.status.code(), Some(code), "{name}: {}", stderr(&out));
+        if code == 0 {
+            assert!(verdicts(&out).iter().all(|(_, p)| *p), "{:?}", verdicts(&out));
+            continue;
+        }
+        let line = text.lines().position(|l| l.contains("switch (k)")).unwrap() + 1;
+        let e = stderr(&out);
+        assert!(e.contains(&format!("falls.glsl:{line}:5:")) && e.contains("in `s`, a `switch` case falls through into the next one") && e.contains("with `break` or `return`"), "{e}");
+    }
+}
+
+/// One name passed to out parameters of two types is exit 2 naming both types.
+#[test]
+fn one_variable_at_out_parameters_of_two_types_is_refused() {
+    let out = lobes(&vndf_args(PATHTRACER, "vec4(SampleGgx(wi, p0, u.xy, x), x); SampleBsdf(x, wi); vec4(x.L, 1.0)", &[]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(e.contains("the variable `x` is passed to an out/inout parameter of type f32 and to one of type BsdfState"), "{e}");
+}
