@@ -195,7 +195,7 @@ fn next_call(s: &str, signatures: &[Signature]) -> Option<(usize, String)> {
 }
 
 /// The offset of the `)` that closes the `(` at `open`.
-fn closing(s: &str, open: usize) -> Option<usize> {
+pub(crate) fn closing(s: &str, open: usize) -> Option<usize> {
     let mut depth = 0;
     for (i, ch) in s[open..].char_indices() {
         match ch {
