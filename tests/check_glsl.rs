@@ -171,3 +171,125 @@ fn lobes_wgsl_glsl_compiles_in_naga_and_in_glslang() {
     let compiled = Command::new(tool).args(["-V", file.to_str().unwrap(), "-o"]).arg(file.with_extension("spv")).output().unwrap();
     assert!(compiled.status.success(), "glslang: {}", String::from_utf8_lossy(&compiled.stdout));
 }
+
+// --- out and inout parameters (issue 34 §1): tests/fixtures/repository/glsl/pathtracer, a GLSL
+// path tracer's sampling file with its helpers in ../include: Heitz's (2018) GGX VNDF sampler,
+// the reflected direction's pdf returned through `out float pdf`, the renderer's global-seed
+// rand(), and a BSDF state passed `inout`.
+
+const PATHTRACER: &str = "tests/fixtures/repository/glsl/pathtracer/shaders/sampling.glsl";
+
+/// The VNDF sampler's command at α = 0.5, θi 40°, with `sample` as --sample.
+fn vndf_args<'a>(file: &'a str, sample: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut a = vec!["check", file, "--sample", sample, "--pdf", "GgxVndfPdf(wi, d, p0)", "--params", "0.5", "--incident-theta", "40", "--samples", "262144", "--json"];
+    a.extend_from_slice(extra);
+    a
+}
+
+/// The three ways a GLSL path tracer hands back its pdf: an `out float` with the uniforms given
+/// (`vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)`: `pdf` is a variable lobes declares), the same
+/// with the renderer's `rand()`, and an `inout` state struct set up by a statement before the
+/// call. Each passes every check.
+#[test]
+fn a_glsl_sampler_returning_its_pdf_through_out_and_inout_parameters_passes() {
+    let ways: [(&str, &[&str]); 3] = [
+        ("vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)", &[]),
+        ("vec4(SampleGgxRand(wi, p0, pdf), pdf)", &["--rand", "rand"]),
+        ("s.roughness = p0; SampleBsdf(s, wi); vec4(s.L, s.pdf)", &["--rand", "rand"]),
+    ];
+    for (sample, extra) in ways {
+        let out = lobes(&vndf_args(PATHTRACER, sample, extra));
+        assert_eq!(out.status.code(), Some(0), "{sample}: {}", stderr(&out));
+        let v = verdicts(&out);
+        assert!(v.len() == 6 && v.iter().all(|(_, p)| *p), "{sample}: {v:?}");
+    }
+}
+
+/// The out pdf is the one judged: SampleGgx's `pdf` written without Smith's G1(V) (the density
+/// of h over 4 V·h of the other GGX sampler) while the pdf function keeps it fails
+/// pdf_consistency; the sampler itself is unchanged, so the Jacobian of its map holds.
+#[test]
+fn a_wrong_pdf_through_an_out_parameter_fails_pdf_consistency() {
+    let dir = copy_tree("out-pdf", "pathtracer/shaders/sampling.glsl", |t| t.replacen("pdf = SmithG1(V, a, a) * GgxD(H, a, a) / (4.0 * V.z);", "pdf = GgxD(H, a, a) * H.z / (4.0 * dot(V, H));", 1));
+    let file = dir.join("pathtracer/shaders/sampling.glsl");
+    let out = lobes(&vndf_args(file.to_str().unwrap(), "vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)", &[]));
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let f = failed(&out);
+    assert!(f.contains(&"pdf_consistency".to_string()) && !f.contains(&"normalization".to_string()), "{f:?}");
+}
+
+/// The VNDF with Heitz's blend s = (1 + Vh.z) / 2 taken as 1/2 (the lower half of the disk
+/// squeezed as for normal incidence): the directions no longer follow the pdf, which fails the
+/// Jacobian and χ², by the out parameter and by the inout state alike.
+#[test]
+fn a_vndf_sampler_with_a_wrong_disk_blend_fails() {
+    let dir = copy_tree("vndf-blend", "pathtracer/shaders/sampling.glsl", |t| t.replacen("float s = 0.5 * (1.0 + Vh.z);", "float s = 0.5;", 1));
+    let file = dir.join("pathtracer/shaders/sampling.glsl");
+    for (sample, extra) in [("vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)", &[][..]), ("s.roughness = p0; SampleBsdf(s, wi); vec4(s.L, s.pdf)", &["--rand", "rand"][..])] {
+        let out = lobes(&vndf_args(file.to_str().unwrap(), sample, extra));
+        assert_eq!(out.status.code(), Some(1), "{sample}: {}", stderr(&out));
+        let f = failed(&out);
+        assert!(f.contains(&"jacobian".to_string()) && f.contains(&"chi2".to_string()), "{sample}: {f:?}");
+    }
+}
+
+/// SPIR-V compiled by glslang from the path tracer's file: every parameter is a pointer there,
+/// the out one included; a call naming a variable (`pdf`) calls the module's function itself
+/// with pointers, and the verdicts are those of the GLSL: the correct file passes, the one
+/// with the wrong out pdf fails pdf_consistency.
+#[test]
+fn spirv_with_out_parameters_is_checked_by_naming_a_variable() {
+    let tool = glslang();
+    let good = root().join(GLSL);
+    let bad = copy_tree("out-pdf-spirv", "pathtracer/shaders/sampling.glsl", |t| t.replacen("pdf = SmithG1(V, a, a) * GgxD(H, a, a) / (4.0 * V.z);", "pdf = GgxD(H, a, a) * H.z / (4.0 * dot(V, H));", 1));
+    for (tree, code) in [(good, 0), (bad, 1)] {
+        let shaders = tree.join("pathtracer/shaders");
+        let main = "\nlayout(local_size_x = 1) in;\nlayout(std430, binding = 0) buffer Out { vec4 o; };\nvoid main() { float pdf; BsdfState s; s.roughness = 0.5; SampleBsdf(s, vec3(0.0, 0.0, 1.0)); o = vec4(SampleGgx(vec3(0.0, 0.0, 1.0), 0.5, vec2(0.5), pdf), pdf + GgxVndfPdf(vec3(0.0, 0.0, 1.0), s.L, 0.5)); }\n";
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("check-glsl-out-spirv-{code}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        // the includes (../include/…) found under the shaders' folder, as glslang's -I gives
+        let comp = dir.join("sampling.comp");
+        std::fs::write(&comp, std::fs::read_to_string(shaders.join("sampling.glsl")).unwrap() + main).unwrap();
+        let spv = dir.join("sampling.spv");
+        let compiled = Command::new(tool).arg("-V").arg(format!("-I{}", shaders.display())).args([comp.to_str().unwrap(), "-o", spv.to_str().unwrap()]).output().unwrap();
+        assert!(compiled.status.success(), "{}", String::from_utf8_lossy(&compiled.stdout));
+        let out = lobes(&vndf_args(spv.to_str().unwrap(), "vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)", &[]));
+        assert_eq!(out.status.code(), Some(code), "{}", stderr(&out));
+        assert_eq!(failed(&out).contains(&"pdf_consistency".to_string()), code == 1, "{:?}", failed(&out));
+    }
+}
+
+/// A `switch` whose cases end in `return` (naga's GLSL front end marks them as falling through,
+/// which its WGSL writer refused as an internal error, exit 3) is checked; a case that does fall
+/// through into the next with statements of its own is exit 2 at the `switch`'s line, saying
+/// what to write instead.
+#[test]
+fn switch_cases_ending_in_return_pass_and_a_real_fall_through_is_named() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-glsl-switch");
+    std::fs::create_dir_all(&dir).unwrap();
+    let cosine = "vec3 cosdir(vec2 u) { float r = sqrt(u.x); float phi = 6.2831853 * u.y; return vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x))); }\nfloat cospdf(vec3 L) { return L.z > 0.0 ? L.z / 3.14159265 : 0.0; }\n";
+    let returns = format!("#version 450\n{cosine}vec3 s(vec2 u, int k) {{\n    switch (k) {{\n        case 0: return cosdir(u);\n        default: return vec3(0.0, 0.0, 1.0);\n    }}\n}}\n");
+    let falls = format!("#version 450\n{cosine}vec3 s(vec2 u, int k) {{\n    vec3 d = vec3(0.0);\n    switch (k) {{\n        case 0: d = cosdir(u);\n        case 1: d.z += 0.0; break;\n        default: d = vec3(0.0, 0.0, 1.0);\n    }}\n    return d;\n}}\n");
+    for (name, text, code) in [("returns.glsl", returns, 0), ("falls.glsl", falls, 2)] {
+        let file = dir.join(name);
+        std::fs::write(&file, &text).unwrap();
+        let out = lobes(&["check", file.to_str().unwrap(), "--sample", "s(u.xy, 0)", "--pdf", "cospdf(d)", "--samples", "65536", "--json"]);
+        assert_eq!(out.status.code(), Some(code), "{name}: {}", stderr(&out));
+        if code == 0 {
+            assert!(verdicts(&out).iter().all(|(_, p)| *p), "{:?}", verdicts(&out));
+            continue;
+        }
+        let line = text.lines().position(|l| l.contains("switch (k)")).unwrap() + 1;
+        let e = stderr(&out);
+        assert!(e.contains(&format!("falls.glsl:{line}:5:")) && e.contains("in `s`, a `switch` case falls through into the next one") && e.contains("with `break` or `return`"), "{e}");
+    }
+}
+
+/// One name passed to out parameters of two types is exit 2 naming both types.
+#[test]
+fn one_variable_at_out_parameters_of_two_types_is_refused() {
+    let out = lobes(&vndf_args(PATHTRACER, "vec4(SampleGgx(wi, p0, u.xy, x), x); SampleBsdf(x, wi); vec4(x.L, 1.0)", &[]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(e.contains("the variable `x` is passed to an out/inout parameter of type f32 and to one of type BsdfState"), "{e}");
+}

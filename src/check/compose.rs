@@ -359,8 +359,20 @@ pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities)
     Ok(undo_digit_suffix(&text))
 }
 
-/// `name0_` → `name0` for every identifier that ends in a digit and one underscore.
+/// `name0_` → `name0` for every identifier that ends in a digit and one underscore, unless the
+/// text holds `name0` too (the writer's namer gave a clash of `name` the name `name0`: a GLSL
+/// parameter `u` beside its copy `u_1`, written `u_1` and `u_1_`).
 fn undo_digit_suffix(text: &str) -> String {
+    let taken: std::collections::HashSet<&str> = text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).collect();
+    identifiers(text, |word| {
+        let w = word.as_bytes();
+        let suffixed = w.len() >= 3 && !w[0].is_ascii_digit() && w[w.len() - 1] == b'_' && w[w.len() - 2].is_ascii_digit();
+        if suffixed && !taken.contains(&word[..word.len() - 1]) { word[..word.len() - 1].to_string() } else { word.to_string() }
+    })
+}
+
+/// `text` with each identifier-like word replaced by `f(word)`.
+fn identifiers(text: &str, f: impl Fn(&str) -> String) -> String {
     let mut out = String::with_capacity(text.len());
     let b = text.as_bytes();
     let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
@@ -371,13 +383,7 @@ fn undo_digit_suffix(text: &str) -> String {
             while i < b.len() && ident(b[i]) {
                 i += 1;
             }
-            let word = &text[start..i];
-            let w = word.as_bytes();
-            if w.len() >= 3 && !w[0].is_ascii_digit() && w[w.len() - 1] == b'_' && w[w.len() - 2].is_ascii_digit() {
-                out.push_str(&word[..word.len() - 1]);
-            } else {
-                out.push_str(word);
-            }
+            out.push_str(&f(&text[start..i]));
         } else {
             out.push(text[i..].chars().next().expect("in range"));
             i += text[i..].chars().next().expect("in range").len_utf8();
@@ -393,5 +399,7 @@ mod tests {
     #[test]
     fn digit_suffixes_are_undone() {
         assert_eq!(undo_digit_suffix("fn f0_(a: f32) -> f32 { let x_1 = a; return v2_ + b_; }"), "fn f0(a: f32) -> f32 { let x_1 = a; return v2 + b_; }");
+        // a name the namer gave a clash stays: `u_1_` (the user's u_1) beside `u_1` (its u)
+        assert_eq!(undo_digit_suffix("fn g(u: f32, u_1: f32) { var u_1_ = u_1; }"), "fn g(u: f32, u_1: f32) { var u_1_ = u_1; }");
     }
 }

@@ -196,6 +196,15 @@ fn names(seed: &str) -> String {
     out
 }
 
+/// The lines of a call expression `S1; S2; E` (statements before the value, such as those that
+/// declare the variables of out parameters: [`super::dialect::out_params`]), the value `E` as
+/// `head E;`.
+fn statements(expr: &str, head: &str) -> String {
+    let parts: Vec<&str> = expr.split(';').map(str::trim).filter(|s| !s.is_empty()).collect();
+    let Some((value, before)) = parts.split_last() else { return format!("    {head}{expr};\n") };
+    before.iter().map(|s| format!("    {s};\n")).chain([format!("    {head}{value};\n")]).collect()
+}
+
 /// The type probe of a call expression: a function `lobes_type_probe` whose `lobes_r` has the
 /// expression's type, over the names of `flag` (`--sample`: wi, u; `--normal`: wi, p;
 /// `--pdf`/`--eval`: wi, d).
@@ -206,8 +215,9 @@ pub(super) fn type_probe(flag: &str, expr: &str) -> String {
         _ => "d: vec3<f32>",
     };
     format!(
-        "// the type of {flag}\nfn lobes_type_probe(wi: vec3<f32>, {second}, params: array<vec4<f32>, 4>) {{\n{}    let lobes_r = {expr};\n}}\n",
-        names("0u")
+        "// the type of {flag}\nfn lobes_type_probe(wi: vec3<f32>, {second}, params: array<vec4<f32>, 4>) {{\n{}{}}}\n",
+        names("0u"),
+        statements(expr, "let lobes_r = ")
     )
 }
 
@@ -218,7 +228,7 @@ pub(super) fn glue(sampler: &UserSampler, returned: Returned, order: [u32; 4], r
     let half = sampler.composition.sample_returns == super::SampleReturns::HalfVector;
     let mut sample = match returned {
         Returned::Contract => format!("    let lobes_r = {}(wi, u, params);\n", sampler.sample),
-        _ => format!("{}    // --sample\n    let lobes_r = {};\n", names("lobes_rng_seed(u)"), sampler.sample),
+        _ => format!("{}    // --sample\n{}", names("lobes_rng_seed(u)"), statements(&sampler.sample, "let lobes_r = ")),
     };
     if sampler.conventions.measure == super::conventions::Measure::Area {
         sample += &area_to_solid_angle(returned);
@@ -283,7 +293,7 @@ fn glue_text(sampler: &UserSampler, sample: String, order: [u32; 4], reach: bool
     let density = |flag: &str, call: Option<&str>| match call {
         None => "    return 0.0;\n".to_string(),
         Some(n) if is_name(n) => format!("    return {n}(wi, d, params);\n"),
-        Some(e) => format!("{}    // {flag}\n    return {e};\n", names("lobes_rng_seed(vec4<f32>(d, 0.0))")),
+        Some(e) => format!("{}    // {flag}\n{}", names("lobes_rng_seed(vec4<f32>(d, 0.0))"), statements(e, "return ")),
     };
     let reach = if reach {
         "// (what the glue reaches is what the composed module keeps)\n\

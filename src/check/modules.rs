@@ -46,7 +46,8 @@ impl UserCode {
     /// segments. A name no imported module holds is an error naming the imported items.
     pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
         if matches!(self.dialect, Dialect::Glsl | Dialect::Spirv) {
-            return super::dialect::call_names(flag, expr, &self.origins);
+            let named = super::dialect::call_names(flag, expr, &self.origins)?;
+            return super::dialect::out_params::rewrite(flag, &named, &self.parts[0].text);
         }
         if self.dialect == Dialect::Wgsl && !expr.contains("::") {
             return Ok(expr.to_string());
@@ -1057,21 +1058,7 @@ pub(super) fn replace_bodies(text: &str, module: &naga::Module, functions: &[(na
         let decl = &text[span.clone()];
         // the body: the first `{` after the argument list's `)`
         let open_args = decl.find('(').ok_or_else(|| CheckError::Internal("a function without arguments".into()))?;
-        let mut depth = 0i32;
-        let mut close_args = None;
-        for (i, ch) in decl[open_args..].char_indices() {
-            match ch {
-                '(' => depth += 1,
-                ')' => {
-                    depth -= 1;
-                    if depth == 0 {
-                        close_args = Some(open_args + i);
-                        break;
-                    }
-                }
-                _ => {}
-            }
-        }
+        let close_args = super::dialect::out_params::closing(decl, open_args);
         let close_args = close_args.ok_or_else(|| CheckError::Internal("unbalanced parentheses".into()))?;
         let open = close_args + decl[close_args..].find('{').ok_or_else(|| CheckError::Internal("a function without a body".into()))?;
         let end = decl.rfind('}').ok_or_else(|| CheckError::Internal("a function without a body".into()))?;

@@ -105,11 +105,15 @@ pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translati
         }
         other => other,
     };
-    let module = module.map_err(|errors| {
+    let mut module = module.map_err(|errors| {
         let mut messages: Vec<String> = errors.iter().map(|e| message(&x, e)).collect();
         messages.dedup();
         CheckError::Wgsl(messages.into_iter().take(8).collect::<Vec<_>>().join("\n"))
     })?;
+    if let Some((span, f)) = super::fall_through(&mut module) {
+        let m = format!("in `{f}`, a `switch` case falls through into the next one, which WGSL (what lobes runs) cannot express; end each case that has statements with `break` or `return` (repeat the next case's statements in it if it meant to fall through)");
+        return Err(CheckError::Wgsl(x.diagnostic(Some(span.location(&x.text)), &m)));
+    }
     let shown = sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
     super::to_wgsl(module, &shown, |e| {
         let mut message = e.as_inner().to_string();

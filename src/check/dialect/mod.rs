@@ -11,6 +11,7 @@
 //! file does ([`call_names`]).
 
 pub mod glsl;
+pub mod out_params;
 pub mod spirv;
 pub mod wesl_blocks;
 
@@ -98,6 +99,57 @@ pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&nag
         }
     }
     Ok(Translation { text, origins })
+}
+
+/// The `switch` cases of `module` that fall through into the next (naga's GLSL front end marks
+/// every case that does not end in `break` so) made plain cases where they end in a jump
+/// (`return`, `break`, `continue`, `discard`), since WGSL has no fall-through; the first that
+/// falls through with statements of its own (WGSL cannot write it): its span and function.
+pub(super) fn fall_through(module: &mut naga::Module) -> Option<(naga::Span, String)> {
+    let mut found = None;
+    for (_, f) in module.functions.iter_mut() {
+        let name = f.name.clone().unwrap_or_default();
+        if let Some(span) = cases(&mut f.body).filter(|_| found.is_none()) {
+            found = Some((span, name));
+        }
+    }
+    found
+}
+
+/// [`fall_through`] in one block, its nested blocks included.
+fn cases(block: &mut naga::Block) -> Option<naga::Span> {
+    use naga::Statement as S;
+    let mut found = None;
+    let spans: Vec<naga::Span> = block.span_iter().map(|(_, s)| *s).collect();
+    for (statement, span) in block.iter_mut().zip(spans) {
+        let inner = match statement {
+            S::Block(b) => cases(b),
+            S::If { accept, reject, .. } => cases(accept).or(cases(reject)),
+            S::Loop { body, continuing, .. } => cases(body).or(cases(continuing)),
+            S::Switch { cases: list, .. } => {
+                let mut bad = None;
+                for c in list.iter_mut().filter(|c| c.fall_through && !c.body.is_empty()) {
+                    c.fall_through = !ends_in_jump(&c.body);
+                    bad = bad.or(c.fall_through.then_some(span));
+                }
+                list.iter_mut().map(|c| cases(&mut c.body)).fold(bad, Option::or)
+            }
+            _ => None,
+        };
+        found = found.or(inner);
+    }
+    found
+}
+
+/// Whether `block` ends in a jump on every path (`return`, `break`, `continue`, `discard`).
+fn ends_in_jump(block: &naga::Block) -> bool {
+    use naga::Statement as S;
+    match block.last() {
+        Some(S::Return { .. } | S::Break | S::Continue | S::Kill) => true,
+        Some(S::Block(b)) => ends_in_jump(b),
+        Some(S::If { accept, reject, .. }) => ends_in_jump(accept) && ends_in_jump(reject),
+        _ => false,
+    }
 }
 
 /// A call expression (`--sample`, `--pdf`, `--eval`) over the functions as the user's file names

@@ -66,6 +66,9 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Source, CheckError> {
             "{name}: the module has no debug names (OpName), so lobes cannot find its functions; compile it with debug information (glslc -g, glslangValidator -g, dxc -Zi, slangc -g)"
         )));
     }
+    if let Some((_, f)) = super::fall_through(&mut module) {
+        return Err(CheckError::Input(format!("{name}: in `{f}`, a `switch` case falls through into the next one, which WGSL (what lobes runs) cannot express; end each case that has statements with `break` or `return` in the source")));
+    }
     let t = super::to_wgsl(module, name, |e| format!("{name}: error: naga translated the module into one it does not accept: {}", e.as_inner()))?;
     let wrappers: Vec<String> = wrapped.iter().filter_map(|n| by_value(&t.text, n)).collect();
     Ok(Source { name: name.to_string(), text: format!("{}\n{}", t.text, wrappers.join("\n")) })
