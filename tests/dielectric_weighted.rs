@@ -216,7 +216,7 @@ fn transmitted_g2_on_gpu(gpu: &Gpu, precision: Precision, g1s: &[f64]) -> Vec<f6
         layout: &group,
         entries: &[wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() }],
     });
-    gpu.dispatch(&[lobes::engine::gpu::dispatch::Pass { label: "g2", bind: &bind, offset: None, steps: vec![lobes::engine::gpu::dispatch::Step { pipeline: &pipeline, groups: 4 }] }]).unwrap();
+    gpu.dispatch(&[lobes::engine::gpu::dispatch::Pass { label: "g2", bind: &bind, offset: None, steps: vec![lobes::engine::gpu::dispatch::Step { pipeline: &pipeline, groups: 4 }], group1: None }]).unwrap();
     let out = gpu.read(&output, size).unwrap();
     if f64s { bytemuck::cast_slice::<u8, f64>(&out).to_vec() } else { bytemuck::cast_slice::<u8, f32>(&out).iter().map(|&g| g as f64).collect() }
 }

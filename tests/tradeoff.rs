@@ -96,7 +96,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{
         layout: &pipeline.get_bind_group_layout(0),
         entries: &[wgpu::BindGroupEntry { binding: 0, resource: xb.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: ob.as_entire_binding() }],
     });
-    gpu.dispatch(&[Pass { label: "f32_pair", bind: &bind, offset: None, steps: vec![Step { pipeline: &pipeline, groups: 4 }] }]).expect("dispatch");
+    gpu.dispatch(&[Pass { label: "f32_pair", bind: &bind, offset: None, steps: vec![Step { pipeline: &pipeline, groups: 4 }], group1: None }]).expect("dispatch");
     let out: Vec<[f32; 4]> = bytemuck::cast_slice(&gpu.read(&ob, size).expect("readback")).to_vec();
     let mut folded = 0;
     for (i, x) in xs.iter().enumerate() {
