@@ -126,7 +126,7 @@ impl DeclOrigin {
 }
 
 /// `text` with every whole word `from` (an identifier) replaced by `to`.
-fn replace_word(text: &str, from: &str, to: &str) -> String {
+pub(super) fn replace_word(text: &str, from: &str, to: &str) -> String {
     let ident = |c: char| c.is_alphanumeric() || c == '_';
     let mut out = String::with_capacity(text.len());
     let mut rest = text;

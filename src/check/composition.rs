@@ -326,6 +326,9 @@ pub(super) struct UserCode {
     pub decls: Vec<super::compose::DeclOrigin>,
     /// The functions naga's WGSL writer renamed in `parts` (`würfel` → `wrfel`, `rand_` → `rand`).
     pub renamed: Renamed,
+    /// OpenGL's loose uniforms that a GLSL translation made module variables (0 until set):
+    /// each one's name and `file:line`.
+    pub uniforms: Vec<(String, String)>,
 }
 
 /// (the name naga's WGSL writer gave a function, its name in the module it wrote).

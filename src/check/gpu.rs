@@ -551,12 +551,29 @@ pub(super) fn prepare(sampler: &UserSampler, order: [u32; 4]) -> Result<Vec<Sour
     c.push(GLUE, &glue(sampler, returned, order, true));
     let (mut module, _) = c.validate_with(naga::valid::Capabilities::all())?;
     // compacted and written on a large stack, as parsed (a tree thousands of calls deep)
+    let uniforms = code.uniforms.clone();
+    let expressions: Vec<String> = [Some(&sampler.sample), Some(&sampler.pdf), sampler.eval.as_ref()].into_iter().flatten().cloned().collect();
     let text = crate::engine::gpu::stack::with_big_stack(move || {
         naga::compact::compact(&mut module, naga::compact::KeepUnused::No);
         module.entry_points.clear();
+        unset_uniform(&module, &uniforms, &expressions)?;
         super::compose::write_wgsl(&module, naga::valid::Capabilities::all())
     })?;
     Ok(vec![Source { name: code.parts[0].name.clone(), text }])
+}
+
+/// An OpenGL uniform (a GLSL file's loose `uniform int n;`, 0 here: `dialect::gl_uniforms`)
+/// that the sampler, pdf or eval reads (it survived compaction to what the glue reaches) and no
+/// call expression names, to set it: bad input, since its value in the renderer is unknown.
+fn unset_uniform(module: &naga::Module, uniforms: &[(String, String)], expressions: &[String]) -> Result<(), CheckError> {
+    let reached = |name: &str| module.global_variables.iter().any(|(_, g)| g.name.as_deref() == Some(name));
+    let set = |name: &str| expressions.iter().any(|e| e.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == name));
+    match uniforms.iter().find(|(name, _)| reached(name) && !set(name)) {
+        Some((name, at)) => Err(CheckError::Input(format!(
+            "{at}: the sampler reads the OpenGL uniform `{name}`, which the renderer sets with glUniform and lobes cannot (it is 0 here); set it where the call expression starts, e.g. --sample '{name} = 1; …' (or --params and p0)"
+        ))),
+        None => Ok(()),
+    }
 }
 
 /// The user's code, the glue and lobes' passes as one module, validated by naga (errors at the
@@ -592,7 +609,7 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
             }
             c.push(USER_MODULE, &glue);
         } else {
-            c.push(&path, &text);
+            c.push(&path, &lobes_own_names(&text));
         }
     }
     let declared = move_resources(&mut c)?;
@@ -678,11 +695,18 @@ fn domain_file(domain: Domain) -> File {
     library::DOMAINS.into_iter().find(|f| f.path == domain.binning_wgsl()).expect("library::DOMAINS holds every domain's binning_wgsl")
 }
 
-/// Whether the user's files may not use `name` at module scope: lobes' RNG functions, and the
-/// `lobes_`/`LOBES_`/`Lobes` prefix of the passes.
+/// Whether the user's files may not use `name` at module scope: the `lobes_`/`LOBES_`/`Lobes`
+/// prefix of the passes (and of lobes' RNG in them, [`lobes_own_names`]).
 pub(super) fn reserved(name: &str) -> bool {
+    name.starts_with("lobes_") || name.starts_with("LOBES_") || name.starts_with("Lobes")
+}
+
+/// A file of lobes' own (the RNG, the passes) with the RNG's functions named `lobes_…`: the
+/// library exports them as `pcg4d`, `rng_uniforms`, … (`lobes wgsl`), names a renderer's own
+/// files hold too (GLSL-PathTracer's RNG is a `pcg4d`), and a composed check holds both.
+fn lobes_own_names(text: &str) -> String {
     const RNG_NAMES: [&str; 4] = ["pcg4d", "rng_to_unit", "rng_uniforms", "add64"];
-    RNG_NAMES.contains(&name) || name.starts_with("lobes_") || name.starts_with("LOBES_") || name.starts_with("Lobes")
+    RNG_NAMES.iter().fold(text.to_string(), |t, name| super::compose::replace_word(&t, name, &format!("lobes_{name}")))
 }
 
 impl Drop for Passes<'_> {
@@ -1011,7 +1035,7 @@ mod tests {
         let c = compose(&sampler(text)).unwrap();
         let line = c.text.lines().position(|l| l.starts_with("fn s(")).unwrap() as u32 + 1;
         assert_eq!(c.locate(line, 1), "t.wgsl:2:1");
-        for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn rng_uniforms(", "fn lobes_user_sample("] {
+        for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn lobes_rng_uniforms(", "fn lobes_user_sample("] {
             assert!(c.text.contains(entry), "{entry}");
         }
     }

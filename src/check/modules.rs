@@ -292,7 +292,7 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
             if let Some((m, _)) = c.stubs.first() {
                 return Err(CheckError::Input(format!("--stub {m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
             }
-            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new(), renamed: Vec::new() })
+            Ok(UserCode { dialect: d, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new(), renamed: Vec::new(), uniforms: Vec::new() })
         }
         Dialect::NagaOil => naga_oil_tree(sources, c).map(|(text, origins, renamed)| UserCode {
             dialect: d,
@@ -301,6 +301,7 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
             files,
             decls: Vec::new(),
             renamed,
+            uniforms: Vec::new(),
         }),
         Dialect::Wesl => wesl_tree(sources, c).map(|(text, origins, decls)| UserCode {
             dialect: d,
@@ -309,6 +310,7 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
             files,
             decls,
             renamed: Vec::new(),
+            uniforms: Vec::new(),
         }),
         Dialect::Glsl | Dialect::Spirv => super::dialect::compose(d, sources, c),
     }

@@ -18,7 +18,7 @@
 use super::super::CheckError;
 use super::super::compose::Source;
 use super::super::composition::Composition;
-use super::Translation;
+use super::{Translation, gl_uniforms};
 use std::path::{Path, PathBuf};
 
 /// The file extensions of GLSL: sources, includes and the stages glslang names by extension.
@@ -52,9 +52,16 @@ struct Expanded {
     missing: Vec<(usize, String)>,
     /// Files with `#pragma once` already expanded.
     once: Vec<PathBuf>,
+    /// OpenGL's loose uniforms, where they are declared ([`gl_uniforms`]).
+    uniforms: Vec<(gl_uniforms::Uniform, At)>,
 }
 
 impl Expanded {
+    /// `file:line` of a line of a file.
+    fn place(&self, at: At) -> String {
+        format!("{}:{}", self.files[at.file], at.line)
+    }
+
     fn push(&mut self, line: &str, at: At) {
         self.text.push_str(line);
         self.text.push('\n');
@@ -124,6 +131,7 @@ pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translati
         }
         x.diagnostic(e.location(&x.text), &format!("naga translated the GLSL into a module it does not accept: {message}"))
     })
+    .map(|t| super::Translation { uniforms: x.uniforms.iter().filter(|(u, _)| !u.opaque).map(|(u, at)| (u.name.clone(), x.place(*at))).collect(), ..t })
 }
 
 fn parse(x: &Expanded, options: &naga::front::glsl::Options) -> Result<naga::Module, Vec<naga::front::glsl::Error>> {
@@ -142,8 +150,18 @@ fn message(x: &Expanded, e: &naga::front::glsl::Error) -> String {
     match loc.and_then(|l| x.missing.iter().find(|(line, _)| *line + 1 == l.line_number as usize)) {
         // the include line as the user wrote it, from its start
         Some((line, m)) => x.diagnostic(Some(naga::SourceLocation { line_number: *line as u32 + 1, line_position: 1, offset: 0, length: 0 }), m),
-        None => x.diagnostic(loc, &e.kind.to_string()),
+        None => x.diagnostic(loc, &left_out(x, e).unwrap_or_else(|| e.kind.to_string())),
     }
+}
+
+/// The message for a use of an opaque loose uniform that lobes left out ([`gl_uniforms`]).
+fn left_out(x: &Expanded, e: &naga::front::glsl::Error) -> Option<String> {
+    let naga::front::glsl::ErrorKind::UnknownVariable(name) = &e.kind else { return None };
+    let (_, at) = x.uniforms.iter().find(|(u, _)| u.opaque && &u.name == name)?;
+    Some(format!(
+        "`{name}` is an OpenGL uniform sampler or image ({}), which naga's GLSL reader cannot take, so lobes left it out; the function here uses it: give lobes the files that define the sampler without this one (or this function behind an #ifdef that --define leaves off)",
+        x.place(*at)
+    ))
 }
 
 /// `#include "x"` or `#include <x>` on this line: (x, whether quoted).
@@ -185,6 +203,11 @@ fn expand(x: &mut Expanded, s: &Source, roots: &[PathBuf], stack: &mut Vec<PathB
             let kept = first && !versioned && ["440", "450", "460"].iter().any(|v| line.split_whitespace().any(|w| w == *v || w == format!("version{v}")));
             x.push(if kept { line } else if first && !versioned { "#version 450" } else { "" }, at);
             versioned = true;
+            continue;
+        }
+        if let Some((text, uniforms)) = gl_uniforms::rewrite(line) {
+            x.push(&text, at);
+            x.uniforms.extend(uniforms.into_iter().map(|u| (u, at)));
             continue;
         }
         let Some((name, quoted)) = include(line) else {

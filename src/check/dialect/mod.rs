@@ -10,6 +10,8 @@
 //! recorded as origins, so that `--rand` and call expressions name the functions as the user's
 //! file does ([`call_names`]).
 
+mod callees_first;
+mod gl_uniforms;
 pub mod glsl;
 pub mod out_params;
 pub mod spirv;
@@ -51,7 +53,7 @@ pub(super) fn compose(dialect: Dialect, sources: &[Source], c: &Composition) -> 
     if let Some((m, _)) = c.stubs.first() {
         return Err(CheckError::Input(format!("--stub {m}: {} has no modules to stand in for ({} reads the files as they are)", files.join(", "), dialect.name())));
     }
-    let (text, origins) = match dialect {
+    let (text, origins, uniforms) = match dialect {
         Dialect::Spirv => {
             if sources.len() > 1 {
                 return Err(CheckError::Input(format!("{}: give one SPIR-V module alone (it is a whole program; link several with spirv-link first)", files.join(", "))));
@@ -59,15 +61,15 @@ pub(super) fn compose(dialect: Dialect, sources: &[Source], c: &Composition) -> 
             if !c.defines.is_empty() {
                 return Err(CheckError::Input("--define: a SPIR-V module is already compiled; give the defines to the compiler that made it".into()));
             }
-            (sources[0].text.clone(), Vec::new())
+            (sources[0].text.clone(), Vec::new(), Vec::new())
         }
         _ => {
             let t = glsl::translate(sources, c)?;
-            (t.text, t.origins)
+            (t.text, t.origins, t.uniforms)
         }
     };
     let name = format!("<{} translated to WGSL by naga's {} front end>", files.join(", "), dialect.name());
-    Ok(UserCode { dialect, parts: vec![Source { name, text }], origins, files, decls: Vec::new(), renamed: Vec::new() })
+    Ok(UserCode { dialect, parts: vec![Source { name, text }], origins, files, decls: Vec::new(), renamed: Vec::new(), uniforms })
 }
 
 /// A module read from another language, as WGSL: its text and where renamed functions came from.
@@ -76,12 +78,16 @@ pub(super) struct Translation {
     /// (name in `text`, the file, name in the file) of each function WGSL could not name as the
     /// file does, and of every overload of an overloaded name.
     pub origins: Vec<Origin>,
+    /// OpenGL's loose uniforms made module variables (GLSL only, [`gl_uniforms`]): each one's
+    /// name and `file:line`.
+    pub uniforms: Vec<(String, String)>,
 }
 
 /// `module` (from `file`, without its entry points: lobes calls the functions) validated and
 /// written as WGSL. `locate` turns a validation error into a message at the user's file.
 pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&naga::WithSpan<naga::valid::ValidationError>) -> String) -> Result<Translation, CheckError> {
     module.entry_points.clear();
+    callees_first::callees_first(&mut module);
     let caps = naga::valid::Capabilities::all();
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| CheckError::Wgsl(locate(&e)))?;
     let text = free_writer_names(&super::compose::write_wgsl(&module, caps)?);
@@ -98,7 +104,7 @@ pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&nag
             origins.push((w.to_string(), file.to_string(), name.to_string()));
         }
     }
-    Ok(Translation { text, origins })
+    Ok(Translation { text, origins, uniforms: Vec::new() })
 }
 
 /// The `switch` cases of `module` that fall through into the next (naga's GLSL front end marks
