@@ -293,3 +293,25 @@ fn one_variable_at_out_parameters_of_two_types_is_refused() {
     let e = stderr(&out);
     assert!(e.contains("the variable `x` is passed to an out/inout parameter of type f32 and to one of type BsdfState"), "{e}");
 }
+
+/// An OpenGL renderer's loose uniforms (the fixture's include/uniforms.glsl, outside Vulkan):
+/// the sampler above passes with them declared (the three ways of the test before). One that
+/// the sampler reads is 0 here, since no glUniform sets it: exit 2 at its declaration, before
+/// any GPU work, unless the call expression sets it; an OpenGL sampler2D, which naga cannot
+/// take, is left out, and a function that uses it is exit 2 naming the declaration.
+#[test]
+fn opengl_uniforms_are_named_where_the_sampler_reads_them() {
+    let reads = copy_tree("uniform-read", "pathtracer/shaders/sampling.glsl", |t| t.replacen("float r1 = rand();", "float r1 = rand() * float(numOfLights);", 1));
+    let file = reads.join("pathtracer/shaders/sampling.glsl");
+    let out = lobes(&vndf_args(file.to_str().unwrap(), "vec4(SampleGgxRand(wi, p0, pdf), pdf)", &["--rand", "rand"]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    assert!(e.contains("include/uniforms.glsl:6: the sampler reads the OpenGL uniform `numOfLights`") && e.contains("--sample 'numOfLights = 1; …'"), "{e}");
+    let texture = copy_tree("uniform-sampler", "pathtracer/shaders/sampling.glsl", |t| format!("{t}\nvec3 Sky(vec2 uv) {{ return texture(envMapTex, uv).rgb; }}\n"));
+    let file = texture.join("pathtracer/shaders/sampling.glsl");
+    let out = lobes(&vndf_args(file.to_str().unwrap(), "vec4(SampleGgx(wi, p0, u.xy, pdf), pdf)", &[]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    let e = stderr(&out);
+    let line = std::fs::read_to_string(&file).unwrap().lines().position(|l| l.starts_with("vec3 Sky")).unwrap() + 1;
+    assert!(e.contains(&format!("sampling.glsl:{line}:")) && e.contains("`envMapTex` is an OpenGL uniform sampler or image (") && e.contains("include/uniforms.glsl:8)"), "{e}");
+}

@@ -151,3 +151,26 @@ fn a_module_missing_from_its_package_names_the_closest_few() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--package package=…: a package name is an identifier other than package and super"), "{}", stderr(&out));
 }
+
+/// The scene key `package` is `--package`: a `lobes run` scene whose user case names the
+/// library's folder composes the library's modules (the roots' fallback alone takes the app's
+/// `consts`, which lacks INV_PI, and the case would be an input error) and passes.
+#[test]
+fn a_scene_case_finds_another_package_where_its_package_key_says() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-wesl-scene-package");
+    std::fs::create_dir_all(&dir).unwrap();
+    let packages = root().join(PACKAGES);
+    let scene = dir.join("package.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[[case]]\nname = \"cosine-from-mathlib\"\nsampler = {{ wgsl = [\"{0}/app/shaders/sampling/cosine.wesl\"], shader_root = [\"{0}/app/shaders\"], package = {{ mathlib = \"{0}/mathlib/src\" }}, sample = \"sample_cosine(rng)\", pdf = \"cosine_pdf(d)\", rand = [\"rand_f\"] }}\nsamples = 262144\n",
+            packages.display()
+        ),
+    )
+    .unwrap();
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let summary: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["cases"][0]["passed"], Value::Bool(true), "{summary}");
+}
