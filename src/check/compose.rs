@@ -349,14 +349,27 @@ pub(super) fn global_names(module: &naga::Module) -> Vec<String> {
 }
 
 /// A validated module written back as WGSL, with the names as the module holds them: naga's
-/// writer appends `_` to a name that ends in a digit (`v0` → `v0_`), which is undone here.
+/// writer appends `_` to a name that ends in a digit (`v0` → `v0_`), which is undone here. What
+/// the writer cannot write (ray queries, and what calls them) is left out first.
 pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities) -> Result<String, CheckError> {
+    let module = &*writable(module);
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps)
         .validate(module)
         .map_err(|e| CheckError::Internal(format!("the composed module does not validate: {}", e.as_inner())))?;
     let text = naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty())
         .map_err(|e| CheckError::Internal(format!("naga's WGSL writer failed: {e}")))?;
     Ok(undo_digit_suffix(&text))
+}
+
+/// `module` without what naga's WGSL writer cannot write (ray queries and their callers,
+/// `dialect::callees_first::drop_ray_queries`); itself where it has none.
+pub(super) fn writable(module: &naga::Module) -> std::borrow::Cow<'_, naga::Module> {
+    if !super::dialect::callees_first::needs_cut(module) {
+        return std::borrow::Cow::Borrowed(module);
+    }
+    let mut m = module.clone();
+    super::dialect::callees_first::drop_ray_queries(&mut m);
+    std::borrow::Cow::Owned(m)
 }
 
 /// `name0_` → `name0` for every identifier that ends in a digit and one underscore, unless the

@@ -617,6 +617,7 @@ fn root_name(s: &Source) -> String {
 /// text parsed again holds the functions in the module's order (the writer writes them in arena
 /// order, callees first, and the parser keeps that order), so each is paired with its handle's.
 pub(super) fn write_wgsl_renamed(module: &naga::Module, caps: naga::valid::Capabilities) -> Result<(String, Renamed), CheckError> {
+    let module = &*super::compose::writable(module);
     let text = write_wgsl(module, caps)?;
     let written = naga::front::wgsl::parse_str(&text).map_err(|e| CheckError::Internal(format!("the written WGSL does not parse: {}", e.message())))?;
     if written.functions.len() != module.functions.len() {

@@ -6,7 +6,8 @@
 //! handle at the prototype, before the functions its body calls once it is defined, and its
 //! validator then refuses the module ("depends on [29] … which has not been processed yet").
 //! The order of definitions means nothing to WGSL, so the arena is rebuilt in a depth-first
-//! order of the call graph, every handle remapped.
+//! order of the call graph, every handle remapped. The same rebuilding leaves out what naga's
+//! WGSL writer cannot write ([`drop_ray_queries`]).
 
 use naga::{Block, Expression, Function, Handle, Module, Statement};
 
@@ -19,8 +20,49 @@ pub(super) fn callees_first(module: &mut Module) {
     if order.iter().enumerate().all(|(i, &old)| i == old) {
         return;
     }
-    // new index of the function at each old index
-    let mut new_of = vec![0; order.len()];
+    rebuild(module, &order);
+}
+
+/// The functions that use ray queries (naga 30's WGSL writer cannot write them: it panics,
+/// "entered unreachable code") and every function and entry point that calls one, left out of
+/// `module`; their names. A renderer's tree holds them beside its samplers (Bevy Solari's
+/// `scene_bindings` traces shadow rays); a sampler cannot reach them in lobes' compute passes,
+/// which have no acceleration structure to trace.
+pub(in crate::check) fn drop_ray_queries(module: &mut Module) -> Vec<String> {
+    let uses = uses_ray_queries;
+    let callees: Vec<Vec<usize>> = module.functions.iter().map(|(_, f)| calls(&f.body).iter().map(|h| h.index()).collect()).collect();
+    let mut dropped: Vec<bool> = module.functions.iter().map(|(_, f)| uses(f)).collect();
+    // callers of a dropped function, until none is added
+    while let Some(i) = (0..dropped.len()).find(|&i| !dropped[i] && callees[i].iter().any(|&c| dropped[c])) {
+        dropped[i] = true;
+    }
+    if !dropped.contains(&true) {
+        return Vec::new();
+    }
+    let names = module.functions.iter().filter(|(h, _)| dropped[h.index()]).map(|(_, f)| f.name.clone().unwrap_or_default()).collect();
+    module.entry_points.retain(|e| !uses(&e.function) && !calls(&e.function.body).iter().any(|h| dropped[h.index()]));
+    let kept: Vec<usize> = (0..dropped.len()).filter(|&i| !dropped[i]).collect();
+    rebuild(module, &kept);
+    names
+}
+
+/// Whether a function or entry point of `module` uses ray queries ([`drop_ray_queries`]).
+pub(in crate::check) fn needs_cut(module: &Module) -> bool {
+    module.functions.iter().any(|(_, f)| uses_ray_queries(f)) || module.entry_points.iter().any(|e| uses_ray_queries(&e.function))
+}
+
+/// Whether `f` itself (not its callees) uses a ray query.
+fn uses_ray_queries(f: &Function) -> bool {
+    let mut found = f.expressions.iter().any(|(_, e)| matches!(e, Expression::RayQueryGetIntersection { .. } | Expression::RayQueryVertexPositions { .. } | Expression::RayQueryProceedResult));
+    for_each_block(&f.body, &mut |s| found |= matches!(s, Statement::RayQuery { .. }));
+    found
+}
+
+/// `module.functions` rebuilt from the functions at the old indices `order`, in that order
+/// (those left out are called by none kept), every call remapped.
+fn rebuild(module: &mut Module, order: &[usize]) {
+    // new index of the function at each old index kept
+    let mut new_of = vec![usize::MAX; module.functions.len()];
     for (new, &old) in order.iter().enumerate() {
         new_of[old] = new;
     }
@@ -28,7 +70,7 @@ pub(super) fn callees_first(module: &mut Module) {
     let remap = |h: Handle<Function>| handles[new_of[h.index()]];
     let old: Vec<(Function, naga::Span)> = module.functions.iter().map(|(h, f)| (f.clone(), module.functions.get_span(h))).collect();
     let mut arena = naga::Arena::new();
-    for &i in &order {
+    for &i in order {
         let (mut f, span) = old[i].clone();
         remap_function(&mut f, &remap);
         arena.append(f, span);
@@ -154,6 +196,24 @@ mod tests {
         assert!(at("helper") < at("eval") && at("eval") < at("draw"), "{names:?}");
         let called: Vec<&str> = calls(&m.functions.iter().find(|(_, f)| f.name.as_deref() == Some("eval")).unwrap().1.body).iter().map(|h| m.functions[*h].name.as_deref().unwrap()).collect();
         assert_eq!(called, ["helper", "helper"]);
+    }
+
+    /// A tree with a shadow-ray function (a ray query) and its caller beside a sampler: naga's
+    /// WGSL writer panics on the query; both are left out and the rest is written.
+    #[test]
+    fn ray_queries_and_their_callers_are_left_out_of_the_written_tree() {
+        let text = "enable wgpu_ray_query;\n\
+            @group(0) @binding(0) var tlas: acceleration_structure;\n\
+            fn visible(o: vec3<f32>, d: vec3<f32>) -> bool { var q: ray_query; rayQueryInitialize(&q, tlas, RayDesc(0u, 0xFFu, 0.001, 10.0, o, d)); rayQueryProceed(&q); return rayQueryGetCommittedIntersection(&q).kind == RAY_QUERY_INTERSECTION_NONE; }\n\
+            fn shade(o: vec3<f32>) -> f32 { return select(0.0, 1.0, visible(o, vec3(0.0, 0.0, 1.0))); }\n\
+            fn cosine(u: vec2<f32>) -> vec3<f32> { let r = sqrt(u.x); return vec3(r * cos(6.2831853 * u.y), r * sin(6.2831853 * u.y), sqrt(1.0 - u.x)); }\n";
+        let mut m = naga::front::wgsl::parse_str(text).unwrap_or_else(|e| panic!("{}", e.emit_to_string(text)));
+        assert!(needs_cut(&m));
+        assert_eq!(drop_ray_queries(&mut m), ["visible", "shade"]);
+        assert!(!needs_cut(&m));
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all()).validate(&m).unwrap();
+        let written = naga::back::wgsl::write_string(&m, &info, naga::back::wgsl::WriterFlags::empty()).unwrap();
+        assert!(written.contains("fn cosine(") && !written.contains("fn shade("), "{written}");
     }
 
     #[test]

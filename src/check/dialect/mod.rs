@@ -10,7 +10,7 @@
 //! recorded as origins, so that `--rand` and call expressions name the functions as the user's
 //! file does ([`call_names`]).
 
-mod callees_first;
+pub(super) mod callees_first;
 mod gl_uniforms;
 pub mod glsl;
 pub mod out_params;
