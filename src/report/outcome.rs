@@ -1,13 +1,13 @@
 //! A case that ran, as the per-case outputs see it: a lobe's ([`CaseResult`], `lobes run` and
 //! `lobes merge`) or a user's WGSL sampler's ([`UserResult`], a `sampler` case of `lobes run`).
 //! Each output has one builder over an [`Outcome`] ([`super::output::HistogramFile::of`],
-//! [`super::output::TimingFile::of`], [`super::output::CaseSummary::of`],
+//! [`super::output::TimingFile::of`], [`super::output::CaseSummary::of`] with
+//! [`super::output::AlbedoSummary::of`],
 //! [`super::output::table_row`], [`super::output::write_case`]): what both kinds have comes
 //! through the methods here, the sections only one kind has through [`Outcome::lobe`] and
 //! [`Outcome::user`].
 
 use super::compare::Bins;
-use super::output::AlbedoSummary;
 use crate::engine::job::Job;
 use crate::run::CaseResult;
 use crate::run::record::Subject;
@@ -157,29 +157,5 @@ impl<'a> Outcome<'a> {
     /// The checks a user's sampler failed, by name (None for a lobe's case).
     pub fn failed_checks(self) -> Option<Vec<&'a str>> {
         self.user().map(UserResult::failed_checks)
-    }
-
-    /// The albedo checks: a weighted lobe's, or a user's sampler's with an eval.
-    pub fn albedo(self) -> Option<AlbedoSummary> {
-        match self {
-            Outcome::Lobe(r) => r.weighted.as_ref().map(|w| AlbedoSummary {
-                albedo: w.check.reflected.albedo,
-                reference: w.check.reflected.reference,
-                relative_error: w.check.reflected.relative_error,
-                p_value: w.check.reflected.p_value,
-                max_weight_error: w.check.max_weight_error,
-                passed: w.check.passed,
-                transmitted: w.check.transmitted,
-            }),
-            Outcome::User(r) => r.albedo.map(|a| AlbedoSummary {
-                albedo: a.mean_weight,
-                reference: a.quadrature,
-                relative_error: a.relative_error(),
-                p_value: a.p_value,
-                max_weight_error: a.max_weight_error as f32,
-                passed: a.passed,
-                transmitted: None,
-            }),
-        }
     }
 }

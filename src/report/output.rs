@@ -6,6 +6,8 @@
 //! reader share, with a `format_version`; `docs/schema/` holds their JSON Schema
 //! ([`super::schema`]). Every file is written atomically ([`super::atomic`]), and
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
+//! A case's files have one builder each over [`super::outcome::Outcome`], a lobe's case or a
+//! user's sampler's alike.
 //!
 //! `histogram.json` holds only what the scene and the adapter determine: the times are in
 //! `timing.json`, so two runs of a scene on one adapter write byte-identical `histogram.json`
@@ -487,6 +489,32 @@ pub struct AlbedoSummary {
     pub transmitted: Option<AlbedoTest>,
 }
 
+impl AlbedoSummary {
+    /// The albedo checks of a case: a weighted lobe's, or a user's sampler's with an eval.
+    pub fn of(r: Outcome) -> Option<Self> {
+        match r {
+            Outcome::Lobe(r) => r.weighted.as_ref().map(|w| AlbedoSummary {
+                albedo: w.check.reflected.albedo,
+                reference: w.check.reflected.reference,
+                relative_error: w.check.reflected.relative_error,
+                p_value: w.check.reflected.p_value,
+                max_weight_error: w.check.max_weight_error,
+                passed: w.check.passed,
+                transmitted: w.check.transmitted,
+            }),
+            Outcome::User(r) => r.albedo.map(|a| AlbedoSummary {
+                albedo: a.mean_weight,
+                reference: a.quadrature,
+                relative_error: a.relative_error(),
+                p_value: a.p_value,
+                max_weight_error: a.max_weight_error as f32,
+                passed: a.passed,
+                transmitted: None,
+            }),
+        }
+    }
+}
+
 impl CaseSummary {
     /// The summary of a case that ran, with its outputs in `out/<case>`.
     pub fn of(r: Outcome, out: &Path) -> Self {
@@ -506,7 +534,7 @@ impl CaseSummary {
                 p_value: r.chi2().p_value,
                 family_p_value: r.chi2().family_p_value,
                 family: r.chi2().family.clone(),
-                albedo: r.albedo(),
+                albedo: AlbedoSummary::of(r),
                 max_angle_rad: r.lobe().and_then(|l| l.angle.as_ref()).map(|a| a.max_angle_rad),
             }),
             error: None,
@@ -639,7 +667,7 @@ pub fn table_row(r: Outcome) -> [String; 9] {
         format!("{:.4}", r.chi2().p_value),
         verdict,
         angle.map_or("-".into(), |a| format!("{:.2e} rad", a.max_angle_rad)),
-        r.albedo().map_or("-".into(), |a| albedo_cell(&a)),
+        AlbedoSummary::of(r).map_or("-".into(), |a| albedo_cell(&a)),
     ]
 }
 
