@@ -5,6 +5,7 @@
 use super::{ChecksFailed, FileArgs, OutputArgs, emit, emit_json, parse_level};
 use crate::report::folder::Access;
 use crate::scene::Entry;
+use crate::report::outcome::Outcome;
 use crate::report::output::{self, CaseSummary, RunSummary};
 use crate::run::{Expected, judge};
 use crate::run::merge::{merge, read_shards};
@@ -61,19 +62,18 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     // as `lobes run`: a case whose outputs cannot be written is an error, the others still run
     for (case, sampled, parts) in merged.iter() {
         let judged = judge(case, sampled.clone(), Expected::of(case), level).and_then(|result| {
-            output::write_case(&args.out, &result, adapter, backend, args.files.style())
+            output::write_case(&args.out, Outcome::Lobe(&result), adapter, backend, args.files.style())
                 .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", args.out.join(&case.name).display()))
                 .map(|()| result)
         });
         match judged {
             Ok(result) => {
-                rows.push(output::table_row(&result));
-                summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(&result, &args.out) });
+                rows.push(output::table_row(Outcome::Lobe(&result)));
+                summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::of(Outcome::Lobe(&result), &args.out) });
             }
             Err(e) => {
                 crate::console::say(format_args!("lobes: error: case '{}': {e:#}; no histogram.json was written for it", case.name));
-                let dash = || "-".to_string();
-                rows.push([case.name.clone(), case.samples.to_string(), dash(), dash(), dash(), dash(), "ERROR".into(), dash(), dash()]);
+                rows.push(output::dash_row(&Entry::Lobe(case), "ERROR"));
                 summary.push(CaseSummary { shards: Some(parts), ..CaseSummary::error(&Entry::Lobe(case), format!("{e:#}")) });
             }
         }

@@ -3,6 +3,7 @@
 //! case, written as raw results for `lobes merge`.
 
 use super::{ChecksFailed, FileArgs, Interrupted, OutputArgs, emit, emit_json, interrupt, parse_level, usage};
+use crate::report::outcome::Outcome;
 use crate::report::output::{self, CaseSummary, JsonStyle, RunStatus, RunSummary, SUMMARY_VERSION, ShardCaseSummary, ShardSummary};
 use crate::run::shard::{SceneSource, Shard, ShardFile, ShardOrigin, fnv1a64};
 use crate::run::user::run_user;
@@ -121,7 +122,7 @@ fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, sty
     });
     let result = judge(case, sampled?, expected, level)?;
     let adapter = backend.adapter();
-    output::write_case(out, &result, &adapter, backend.name(), style)
+    output::write_case(out, Outcome::Lobe(&result), &adapter, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
     Ok(result)
 }
@@ -129,9 +130,10 @@ fn run_and_write(backend: &mut Backend, case: &Case, level: f64, out: &Path, sty
 /// Runs the checks of a user's sampler case and writes its outputs, as [`run_and_write`].
 fn run_user_and_write(backend: &Backend, case: &UserCase, level: f64, out: &Path, style: JsonStyle) -> anyhow::Result<([String; 9], CaseSummary)> {
     let result = run_user(backend, case, level)?;
-    output::write_user_case(out, &result, backend.name(), style)
+    let ran = Outcome::User(&result);
+    output::write_case(out, ran, &result.report.adapter, backend.name(), style)
         .map_err(|e| anyhow::anyhow!("writing the outputs into {}: {e:#}", out.join(&case.name).display()))?;
-    Ok((output::user_table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of_user(&result, out) }))
+    Ok((output::table_row(ran), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(ran, out) }))
 }
 
 /// The first user's sampler case of a scene and its location, if any.
@@ -279,8 +281,7 @@ struct Table {
 impl Table {
     /// The row of a case that has no result: its name, samples and the word.
     fn push_dashes(&mut self, entry: &Entry, word: &str) {
-        let dash = || "-".to_string();
-        self.rows.push([entry.name().to_string(), entry.samples().to_string(), dash(), dash(), dash(), dash(), word.into(), dash(), dash()]);
+        self.rows.push(output::dash_row(entry, word));
     }
 
     fn text(&self, args: &RunArgs, heading: &[String], summary: &RunSummary, n: usize) -> String {
@@ -368,7 +369,8 @@ fn run_entry(args: &RunArgs, backend: &mut Backend, entry: &Entry, level: f64, p
             bar.finish_and_clear();
             outcome.map(|result| {
                 table.wall_rows |= result.gpu_seconds.is_none();
-                (output::table_row(&result), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(&result, &args.out) })
+                let ran = Outcome::Lobe(&result);
+                (output::table_row(ran), CaseSummary { backend: Some(backend.name().into()), ..CaseSummary::of(ran, &args.out) })
             })
         }
         Entry::User(case) => {

@@ -20,6 +20,7 @@ pub mod folder;
 pub mod html;
 pub mod label;
 pub mod marginals;
+pub mod outcome;
 pub mod output;
 pub mod schema;
 #[cfg(feature = "cli")]

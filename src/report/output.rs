@@ -6,6 +6,8 @@
 //! reader share, with a `format_version`; `docs/schema/` holds their JSON Schema
 //! ([`super::schema`]). Every file is written atomically ([`super::atomic`]), and
 //! `histogram.json` last, so a case folder with a `histogram.json` is complete.
+//! A case's files have one builder each over [`super::outcome::Outcome`], a lobe's case or a
+//! user's sampler's alike.
 //!
 //! `histogram.json` holds only what the scene and the adapter determine: the times are in
 //! `timing.json`, so two runs of a scene on one adapter write byte-identical `histogram.json`
@@ -13,12 +15,10 @@
 
 use super::atomic::write_atomic;
 use super::caption;
-use super::compare::{self, Bins, Comparison};
+use super::compare::{self, Comparison};
 use super::heatmap::{self, Heatmap, Scale};
 use super::npy;
-use crate::check::Domain;
-use crate::engine::job::Job;
-use crate::stats::histogram::SphereGrid;
+use super::outcome::Outcome;
 use crate::stats::weighted::AlbedoTest;
 use crate::reference::effects::Effects;
 use crate::run::record::{ByReason, CaseDescription, Timing, WeightedTiming};
@@ -103,27 +103,17 @@ pub struct TimingFile {
 }
 
 impl TimingFile {
-    /// The `timing.json` of a case.
-    pub fn new(r: &CaseResult) -> Self {
+    /// The `timing.json` of a case: the histogram pass, the quadrature and the weighted pass of
+    /// a lobe's, the checks of a user's sampler.
+    pub fn of(r: Outcome) -> Self {
+        let lobe = r.lobe();
         TimingFile {
             format_version: TIMING_VERSION,
-            case: r.case.name.clone(),
-            histogram: Some(Timing { gpu_seconds: r.gpu_seconds, histogram_wall_seconds: r.histogram_seconds }),
-            quadrature_seconds: r.expected.quadrature.as_ref().map(|_| r.quadrature_seconds),
-            weighted: r.weighted.as_ref().map(|w| WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds }),
-            checks_wall_seconds: None,
-        }
-    }
-
-    /// The `timing.json` of a user's sampler case.
-    pub fn of_user(r: &UserResult) -> Self {
-        TimingFile {
-            format_version: TIMING_VERSION,
-            case: r.case.name.clone(),
-            histogram: None,
-            quadrature_seconds: None,
-            weighted: None,
-            checks_wall_seconds: Some(r.wall_seconds),
+            case: r.name().into(),
+            histogram: lobe.map(|l| Timing { gpu_seconds: l.gpu_seconds, histogram_wall_seconds: l.histogram_seconds }),
+            quadrature_seconds: lobe.and_then(|l| l.expected.quadrature.as_ref().map(|_| l.quadrature_seconds)),
+            weighted: lobe.and_then(|l| l.weighted.as_ref()).map(|w| WeightedTiming { gpu_seconds: w.gpu_seconds, wall_seconds: w.wall_seconds }),
+            checks_wall_seconds: r.user().map(|u| u.wall_seconds),
         }
     }
 }
@@ -181,80 +171,35 @@ fn nested<T: Copy>(values: &[T], cols: usize) -> Vec<Vec<T>> {
 
 impl HistogramFile {
     /// The `histogram.json` of a case.
-    pub fn new(r: &CaseResult, adapter: &str, backend: &str) -> Self {
-        let case = &r.case;
-        let description = CaseDescription::of(case);
+    pub fn of(r: Outcome, adapter: &str, backend: &str) -> Self {
+        let description = CaseDescription::of(r.subject());
         let cols = description.cols;
-        let (incident, cos_theta_edges, phi_edges) = match &case.job {
-            Job::Lobe { incident, grid, .. } => (Some(incident.to_array()), Some(grid.cos_theta_edges()), Some(grid.phi_edges())),
-            Job::Discrete { .. } => (None, None, None),
-        };
+        let (lobe, grid) = (r.lobe(), r.sphere_grid());
         HistogramFile {
             format_version: HISTOGRAM_VERSION,
-            case: case.name.clone(),
+            case: r.name().into(),
             description,
-            incident,
-            samples: case.samples,
-            seed: case.seed,
+            incident: r.incident(),
+            samples: r.samples(),
+            seed: r.seed(),
             adapter: adapter.into(),
             backend: backend.into(),
-            cos_theta_edges,
-            phi_edges,
-            counts: nested(&r.counts.bins, cols),
-            expected: nested(&r.expected.bins, cols),
-            invalid: Some(r.counts.invalid.into()),
-            expected_invalid: Some(r.expected.invalid.into()),
-            chi2: r.chi2.clone(),
-            per_sample_check: r.angle.clone(),
-            quadrature: r.expected.quadrature.as_ref().map(|q| QuadratureRecord {
+            cos_theta_edges: grid.map(|g| g.cos_theta_edges()),
+            phi_edges: grid.map(|g| g.phi_edges()),
+            counts: nested(r.counts(), cols),
+            expected: nested(r.expected(), cols),
+            invalid: lobe.map(|l| l.counts.invalid.into()),
+            expected_invalid: lobe.map(|l| l.expected.invalid.into()),
+            chi2: r.chi2().clone(),
+            per_sample_check: lobe.and_then(|l| l.angle.clone()),
+            quadrature: lobe.and_then(|l| l.expected.quadrature.as_ref()).map(|q| QuadratureRecord {
                 error_estimate: q.error_estimate,
                 max_error_sigma_at_1e8: q.max_error_sigma,
                 below_horizon_probability: q.below_horizon,
             }),
-            counting: r.counting.clone(),
-            weighted: r.weighted.as_ref().map(|w| WeightedRecord::new(r, w, cols)),
-            user_sampler: None,
-        }
-    }
-
-    /// The `histogram.json` of a user's sampler case.
-    pub fn of_user(r: &UserResult, backend: &str) -> Self {
-        let (case, report) = (&r.case, &r.report);
-        let description = CaseDescription::of_user(case, &report.domain, report.rows, report.cols);
-        let cols = description.cols;
-        // the sphere's edges on the sphere's grid only (a cap's are its description's)
-        let sphere = report.domain == crate::stats::domain::Domain::Sphere;
-        let directions = report.domain.directions();
-        let grid = SphereGrid { rows: report.rows, cols: report.cols };
-        let wi = crate::reference::reflect::spherical(case.settings.incident_theta.to_radians(), case.settings.incident_phi.to_radians());
-        let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = report.invalid;
-        HistogramFile {
-            format_version: HISTOGRAM_VERSION,
-            case: case.name.clone(),
-            description,
-            incident: directions.then(|| wi.to_array()),
-            samples: case.settings.samples,
-            seed: case.settings.seed,
-            adapter: report.adapter.clone(),
-            backend: backend.into(),
-            cos_theta_edges: sphere.then(|| grid.cos_theta_edges()),
-            phi_edges: sphere.then(|| grid.phi_edges()),
-            counts: nested(&report.counts, cols),
-            expected: nested(&report.expected, cols),
-            invalid: None,
-            expected_invalid: None,
-            chi2: r.chi2.clone(),
-            per_sample_check: None,
-            quadrature: None,
-            counting: None,
-            weighted: None,
-            user_sampler: Some(UserSamplerRecord {
-                passed: report.passed,
-                checks: report.checks.to_vec(),
-                invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
-                expected_invalid: r.expected_invalid,
-                budget: r.budget.clone(),
-            }),
+            counting: lobe.and_then(|l| l.counting.clone()),
+            weighted: lobe.and_then(|l| Some(WeightedRecord::new(l, l.weighted.as_ref()?, cols))),
+            user_sampler: r.user().map(UserSamplerRecord::of),
         }
     }
 
@@ -280,6 +225,19 @@ impl WeightedRecord {
     }
 }
 
+impl UserSamplerRecord {
+    fn of(r: &UserResult) -> Self {
+        let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = r.report.invalid;
+        UserSamplerRecord {
+            passed: r.report.passed,
+            checks: r.report.checks.to_vec(),
+            invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
+            expected_invalid: r.expected_invalid,
+            budget: r.budget.clone(),
+        }
+    }
+}
+
 /// Writes a shard file to `dir/<case>/shard-I-of-N.json` and returns its path.
 pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     let folder = dir.join(&shard.case);
@@ -287,22 +245,6 @@ pub fn write_shard(dir: &Path, shard: &ShardFile) -> anyhow::Result<PathBuf> {
     let file = folder.join(shard.shard.file_name());
     write_atomic(&file, serde_json::to_string(shard)?.as_bytes())?;
     Ok(file)
-}
-
-/// Writes the pictures, the arrays, `timing.json` and then `histogram.json` of a user's
-/// sampler case into `dir/<case>/`.
-pub fn write_user_case(dir: &Path, r: &UserResult, backend: &str, style: JsonStyle) -> anyhow::Result<()> {
-    let folder = dir.join(&r.case.name);
-    std::fs::create_dir_all(&folder)?;
-    let doc = HistogramFile::of_user(r, backend);
-    let (rows, cols) = (doc.description.rows, doc.description.cols);
-    let bins = Bins::Grid(r.report.grid());
-    let measured: Vec<f64> = r.report.counts.iter().map(|&c| c as f64).collect();
-    let caption = format!("{} ({}): {}", r.case.name, caption::parameters(&doc.description), caption::verdict(r.passed(), &r.chi2));
-    let coarse = family::caught_grid(&r.chi2);
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.report.expected, caption: &caption, note: "", coarse })?;
-    let files = CaseFiles { counts: &r.report.counts, expected: &r.report.expected, timing: TimingFile::of_user(r), histogram: doc };
-    files.write(&folder, [rows, cols], style)
 }
 
 /// How JSON files are laid out: compact (one line), or indented for people (`--pretty`).
@@ -346,34 +288,38 @@ impl CaseFiles<'_> {
 }
 
 /// Writes the heat maps, the arrays, `timing.json` and then `histogram.json` into `dir/<case>/`.
-pub fn write_case(dir: &Path, r: &CaseResult, adapter: &str, backend: &str, style: JsonStyle) -> anyhow::Result<()> {
-    let folder = dir.join(&r.case.name);
+pub fn write_case(dir: &Path, r: Outcome, adapter: &str, backend: &str, style: JsonStyle) -> anyhow::Result<()> {
+    let folder = dir.join(r.name());
     std::fs::create_dir_all(&folder)?;
-    let doc = HistogramFile::new(r, adapter, backend);
+    let doc = HistogramFile::of(r, adapter, backend);
     let (rows, cols) = (doc.description.rows, doc.description.cols);
-    let bins = match &r.case.job {
-        Job::Lobe { .. } => Bins::Grid(Domain::Sphere.grid(rows as u32, cols as u32)),
-        Job::Discrete { .. } => Bins::Items(cols),
-    };
-    let measured: Vec<f64> = r.counts.bins.iter().map(|&c| c as f64).collect();
-    let mut verdict = caption::verdict(r.passed(), &r.chi2);
-    if r.weighted.as_ref().is_some_and(|w| !w.check.passed) {
+    let lobe = r.lobe();
+    let weighted = lobe.and_then(|l| l.weighted.as_ref());
+    let measured: Vec<f64> = r.counts().iter().map(|&c| c as f64).collect();
+    let mut verdict = caption::verdict(r.passed(), r.chi2());
+    if weighted.is_some_and(|w| !w.check.passed) {
         verdict += ", albedo check failed";
     }
-    let caption = format!("{} ({}): {verdict}", r.case.name, caption::parameters(&doc.description));
-    let invalid: u64 = r.counts.invalid.iter().sum();
+    let caption = format!("{} ({}): {verdict}", r.name(), caption::parameters(&doc.description));
+    // a lobe's invalid samples (a user's sampler's are in its report)
+    let invalid: u64 = lobe.map_or(0, |l| l.counts.invalid.iter().sum());
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
-    let coarse = family::caught_grid(&r.chi2);
-    compare::write(&folder, &Comparison { bins, measured: &measured, expected: &r.expected.bins, caption: &caption, note: &note, coarse })?;
-    if let Some(w) = &r.weighted {
-        let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
-        let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
-        let pi = std::f64::consts::PI;
-        let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi), marked_key: "" };
-        heatmap::write_png(&map, &folder.join("albedo.png"))?;
+    let coarse = family::caught_grid(r.chi2());
+    compare::write(&folder, &Comparison { bins: r.bins(), measured: &measured, expected: r.expected(), caption: &caption, note: &note, coarse })?;
+    if let (Some(l), Some(w)) = (lobe, weighted) {
+        write_albedo_map(&folder, l, w, [rows, cols])?;
     }
-    let files = CaseFiles { counts: &r.counts.bins, expected: &r.expected.bins, timing: TimingFile::new(r), histogram: doc };
+    let files = CaseFiles { counts: r.counts(), expected: r.expected(), timing: TimingFile::of(r), histogram: doc };
     files.write(&folder, [rows, cols], style)
+}
+
+/// `albedo.png`: a weighted case's albedo estimate per bin; `shape` its rows × cols.
+fn write_albedo_map(folder: &Path, r: &CaseResult, w: &WeightedResult, [rows, cols]: [usize; 2]) -> anyhow::Result<()> {
+    let albedo: Vec<f64> = (0..w.sums.bins.len()).map(|i| w.sums.bin_albedo(i, r.case.samples)).collect();
+    let title = format!("{}: albedo per bin (sum of f cos / pdf over N)", r.case.name);
+    let pi = std::f64::consts::PI;
+    let map = Heatmap { title: &title, rows, cols, values: &albedo, scale: Scale::Sequential, row_label: "cos θ", col_label: "φ", row_range: (-1.0, 1.0), col_range: (-pi, pi), marked_key: "" };
+    Ok(heatmap::write_png(&map, &folder.join("albedo.png"))?)
 }
 
 /// The summary of `lobes run` and `lobes merge`: `OUT/summary.json` (written on every run that
@@ -543,75 +489,56 @@ pub struct AlbedoSummary {
     pub transmitted: Option<AlbedoTest>,
 }
 
-impl CaseSummary {
-    /// The summary of a case that ran, with its outputs in `out/<case>`.
-    pub fn of(r: &CaseResult, out: &Path) -> Self {
-        CaseSummary {
-            case: r.case.name.clone(),
-            samples: r.case.samples,
-            shards: None,
-            backend: None,
-            passed: r.passed(),
-            failed_checks: None,
-            failure: failure(r),
-            measured: Some(CaseMeasured {
-                gpu_seconds: r.gpu_seconds,
-                wall_seconds: r.histogram_seconds,
-                chi2: r.chi2.statistic,
-                dof: r.chi2.dof,
-                p_value: r.chi2.p_value,
-                family_p_value: r.chi2.family_p_value,
-                family: r.chi2.family.clone(),
-                albedo: r.weighted.as_ref().map(|w| AlbedoSummary {
-                    albedo: w.check.reflected.albedo,
-                    reference: w.check.reflected.reference,
-                    relative_error: w.check.reflected.relative_error,
-                    p_value: w.check.reflected.p_value,
-                    max_weight_error: w.check.max_weight_error,
-                    passed: w.check.passed,
-                    transmitted: w.check.transmitted,
-                }),
-                max_angle_rad: r.angle.as_ref().map(|a| a.max_angle_rad),
+impl AlbedoSummary {
+    /// The albedo checks of a case: a weighted lobe's, or a user's sampler's with an eval.
+    pub fn of(r: Outcome) -> Option<Self> {
+        match r {
+            Outcome::Lobe(r) => r.weighted.as_ref().map(|w| AlbedoSummary {
+                albedo: w.check.reflected.albedo,
+                reference: w.check.reflected.reference,
+                relative_error: w.check.reflected.relative_error,
+                p_value: w.check.reflected.p_value,
+                max_weight_error: w.check.max_weight_error,
+                passed: w.check.passed,
+                transmitted: w.check.transmitted,
             }),
-            error: None,
-            output: Some(out.join(&r.case.name)),
+            Outcome::User(r) => r.albedo.map(|a| AlbedoSummary {
+                albedo: a.mean_weight,
+                reference: a.quadrature,
+                relative_error: a.relative_error(),
+                p_value: a.p_value,
+                max_weight_error: a.max_weight_error as f32,
+                passed: a.passed,
+                transmitted: None,
+            }),
         }
     }
+}
 
-    /// The summary of a user's sampler case, with its outputs in `out/<case>`.
-    pub fn of_user(r: &UserResult, out: &Path) -> Self {
+impl CaseSummary {
+    /// The summary of a case that ran, with its outputs in `out/<case>`.
+    pub fn of(r: Outcome, out: &Path) -> Self {
         CaseSummary {
-            case: r.case.name.clone(),
-            samples: r.case.settings.samples,
+            case: r.name().into(),
+            samples: r.samples(),
             shards: None,
             backend: None,
             passed: r.passed(),
-            failed_checks: Some(r.failed_checks().into_iter().map(String::from).collect()),
-            failure: (!r.passed()).then(|| {
-                let failed = r.report.checks.iter().filter(|c| !c.passed);
-                failed.map(|c| format!("{}: {}", c.name(), c.summary)).collect::<Vec<_>>().join("; ")
-            }),
+            failed_checks: r.failed_checks().map(|names| names.into_iter().map(String::from).collect()),
+            failure: failure(r),
             measured: Some(CaseMeasured {
-                gpu_seconds: None,
-                wall_seconds: r.wall_seconds,
-                chi2: r.chi2.statistic,
-                dof: r.chi2.dof,
-                p_value: r.chi2.p_value,
-                family_p_value: r.chi2.family_p_value,
-                family: r.chi2.family.clone(),
-                albedo: r.albedo.map(|a| AlbedoSummary {
-                    albedo: a.mean_weight,
-                    reference: a.quadrature,
-                    relative_error: a.relative_error(),
-                    p_value: a.p_value,
-                    max_weight_error: a.max_weight_error as f32,
-                    passed: a.passed,
-                    transmitted: None,
-                }),
-                max_angle_rad: None,
+                gpu_seconds: r.gpu_seconds(),
+                wall_seconds: r.wall_seconds(),
+                chi2: r.chi2().statistic,
+                dof: r.chi2().dof,
+                p_value: r.chi2().p_value,
+                family_p_value: r.chi2().family_p_value,
+                family: r.chi2().family.clone(),
+                albedo: AlbedoSummary::of(r),
+                max_angle_rad: r.lobe().and_then(|l| l.angle.as_ref()).map(|a| a.max_angle_rad),
             }),
             error: None,
-            output: Some(out.join(&r.case.name)),
+            output: Some(out.join(r.name())),
         }
     }
 
@@ -632,8 +559,19 @@ impl CaseSummary {
     }
 }
 
-/// Why a case failed, in one line: the χ² test and, where weighted, the albedo checks.
-fn failure(r: &CaseResult) -> Option<String> {
+/// Why a case failed, in one line: a user's sampler's failed checks with their summaries.
+fn failure(r: Outcome) -> Option<String> {
+    match r {
+        Outcome::Lobe(r) => lobe_failure(r),
+        Outcome::User(r) => (!r.passed()).then(|| {
+            let failed = r.report.checks.iter().filter(|c| !c.passed);
+            failed.map(|c| format!("{}: {}", c.name(), c.summary)).collect::<Vec<_>>().join("; ")
+        }),
+    }
+}
+
+/// Why a lobe's case failed: the χ² test and, where weighted, the albedo checks.
+fn lobe_failure(r: &CaseResult) -> Option<String> {
     let mut why = Vec::new();
     let c = &r.chi2;
     if !c.passed {
@@ -705,44 +643,48 @@ impl ShardCaseSummary {
     }
 }
 
-/// One line of the run table.
-pub fn table_row(r: &CaseResult) -> [String; 9] {
-    let time = match r.gpu_seconds {
-        Some(g) => format!("{g:.3} s"),
-        None => format!("{:.3} s*", r.histogram_seconds),
+/// One line of the run table. A user's sampler's time is the wall time of all its checks
+/// (marked †), and its verdict names the checks that failed.
+pub fn table_row(r: Outcome) -> [String; 9] {
+    let time = match (r.user(), r.gpu_seconds()) {
+        (Some(_), _) => format!("{:.3} s†", r.wall_seconds()),
+        (None, Some(g)) => format!("{g:.3} s"),
+        (None, None) => format!("{:.3} s*", r.wall_seconds()),
     };
-    let angle = r.angle.as_ref().map_or("-".into(), |a| format!("{:.2e} rad", a.max_angle_rad));
+    let budget = r.user().is_some_and(|u| u.budget.is_some());
+    let failed = r.failed_checks().filter(|f| !f.is_empty());
+    let verdict = match failed {
+        Some(names) => format!("FAIL ({})", names.join(", ")),
+        None => if r.passed() { "pass" } else { "FAIL" }.into(),
+    };
+    let angle = r.lobe().and_then(|l| l.angle.as_ref());
     [
-        r.case.name.clone(),
-        r.case.samples.to_string(),
+        r.name().into(),
+        format!("{}{}", r.samples(), if budget { BUDGET_MARK } else { "" }),
         time,
-        format!("{:.1}", r.chi2.statistic),
-        r.chi2.dof.to_string(),
-        format!("{:.4}", r.chi2.p_value),
-        if r.passed() { "pass".into() } else { "FAIL".into() },
-        angle,
-        r.weighted.as_ref().map_or("-".into(), |w| match &w.check.transmitted {
-            None => format!("{:.5} ({:+.1e})", w.check.reflected.albedo, w.check.reflected.relative_error),
-            Some(t) => format!("R {:.5} ({:+.1e}) T {:.5} ({:+.1e})", w.check.reflected.albedo, w.check.reflected.relative_error, t.albedo, t.relative_error),
-        }),
+        format!("{:.1}", r.chi2().statistic),
+        r.chi2().dof.to_string(),
+        format!("{:.4}", r.chi2().p_value),
+        verdict,
+        angle.map_or("-".into(), |a| format!("{:.2e} rad", a.max_angle_rad)),
+        AlbedoSummary::of(r).map_or("-".into(), |a| albedo_cell(&a)),
     ]
 }
 
-/// One line of the run table for a user's sampler: its time is the wall time of all its checks
-/// (marked †), its verdict names the checks that failed.
-pub fn user_table_row(r: &UserResult) -> [String; 9] {
-    let failed = r.failed_checks();
-    [
-        r.case.name.clone(),
-        format!("{}{}", r.case.settings.samples, if r.budget.is_some() { BUDGET_MARK } else { "" }),
-        format!("{:.3} s†", r.wall_seconds),
-        format!("{:.1}", r.chi2.statistic),
-        r.chi2.dof.to_string(),
-        format!("{:.4}", r.chi2.p_value),
-        if failed.is_empty() { "pass".into() } else { format!("FAIL ({})", failed.join(", ")) },
-        "-".into(),
-        r.albedo.map_or("-".into(), |a| format!("{:.5} ({:+.1e})", a.mean_weight, a.relative_error())),
-    ]
+/// The row of a case that has no result (it could not run, or ran out of time): its name,
+/// samples and `word` (`ERROR`, `FAIL`), dashes elsewhere.
+pub fn dash_row(case: &crate::scene::Entry, word: &str) -> [String; 9] {
+    let dash = || "-".to_string();
+    [case.name().to_string(), case.samples().to_string(), dash(), dash(), dash(), dash(), word.into(), dash(), dash()]
+}
+
+/// The albedo column: the estimate and its relative error, a rough dielectric's reflected (R)
+/// and transmitted (T) ones.
+fn albedo_cell(a: &AlbedoSummary) -> String {
+    match &a.transmitted {
+        None => format!("{:.5} ({:+.1e})", a.albedo, a.relative_error),
+        Some(t) => format!("R {:.5} ({:+.1e}) T {:.5} ({:+.1e})", a.albedo, a.relative_error, t.albedo, t.relative_error),
+    }
 }
 
 /// The mark of a sample count picked by a case's `budget` in the run table.
@@ -753,4 +695,24 @@ pub const TABLE_HEADER: [&str; 9] = ["case", "samples", "GPU time", "chi2", "dof
 /// The run table (`lobes run`, `lobes merge`).
 pub fn format_table(rows: &[[String; 9]]) -> String {
     super::table::render(&TABLE_HEADER, rows.iter().map(|r| r.to_vec()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_albedo_column_names_a_dielectrics_sides() {
+        let reflected = AlbedoSummary { albedo: 0.5, reference: 0.5, relative_error: 1e-4, p_value: 0.5, max_weight_error: 0.0, passed: true, transmitted: None };
+        assert_eq!(albedo_cell(&reflected), "0.50000 (+1.0e-4)");
+        let transmitted = Some(AlbedoTest::new(0.25, 1e-3, 0.25));
+        assert_eq!(albedo_cell(&AlbedoSummary { transmitted, ..reflected }), "R 0.50000 (+1.0e-4) T 0.25000 (+0.0e0)");
+    }
+
+    #[test]
+    fn a_case_without_a_result_is_a_row_of_dashes() {
+        let scene = crate::scene::Scene::from_bytes("t.toml", b"[[case]]\nname = \"g\"\nlobe = \"ggx\"\nalpha = 0.3\nsamples = 1000\n").unwrap();
+        let row = dash_row(&crate::scene::Entry::Lobe(&scene.cases[0]), "ERROR");
+        assert_eq!(row, ["g", "1000", "-", "-", "-", "-", "ERROR", "-", "-"]);
+    }
 }

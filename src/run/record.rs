@@ -6,6 +6,7 @@
 use crate::engine::job::{Job, Scatter};
 use crate::reference::Invalid;
 use crate::scene::{Case, UserCase};
+use crate::stats::domain::{Domain, Grid};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -64,8 +65,29 @@ pub enum Params {
     },
 }
 
+/// What a case samples, as its records describe it: a lobe's case, or a user's sampler with the
+/// grid its samples were binned on (its domain's, or a cap fitted to them).
+#[derive(Debug, Clone, Copy)]
+pub enum Subject<'a> {
+    Lobe(&'a Case),
+    User(&'a UserCase, Grid),
+}
+
 impl CaseDescription {
-    pub fn of(case: &Case) -> Self {
+    /// The description of a case: a lobe's from its job, a user's sampler's from its settings
+    /// and the grid it was binned on.
+    pub fn of(subject: Subject<'_>) -> Self {
+        match subject {
+            Subject::User(case, grid) => {
+                let (rows, cols) = (grid.rows as usize, grid.cols as usize);
+                CaseDescription { lobe: "user".into(), method: "wgsl".into(), params: Params::user(case, &grid.domain), rows, cols }
+            }
+            Subject::Lobe(case) => Self::of_job(case),
+        }
+    }
+
+    /// A lobe's or a discrete distribution's case, from its job.
+    fn of_job(case: &Case) -> Self {
         match &case.job {
             Job::Lobe { lobe, grid, scatter, .. } => CaseDescription {
                 lobe: lobe.kind.name().into(),
@@ -95,34 +117,27 @@ impl CaseDescription {
     }
 }
 
-impl CaseDescription {
-    /// The description of a user's sampler case, binned on `domain` (the sampler's, or a cap
-    /// fitted to its samples).
-    pub fn of_user(case: &UserCase, domain: &crate::stats::domain::Domain, rows: u32, cols: u32) -> Self {
+impl Params {
+    /// The parameters of a user's sampler case binned on `domain`.
+    fn user(case: &UserCase, domain: &Domain) -> Self {
         let (s, set) = (&case.sampler, &case.settings);
-        let (bounds, sphere) = (domain.bounds(), domain.directions());
+        let sphere = domain.directions();
         let (cap_axis, cap_height) = match *domain {
-            crate::stats::domain::Domain::Cap { axis, height } => (Some(axis), Some(height)),
+            Domain::Cap { axis, height } => (Some(axis), Some(height)),
             _ => (None, None),
         };
-        CaseDescription {
-            lobe: "user".into(),
-            method: "wgsl".into(),
-            params: Params::User {
-                wgsl: s.sources.iter().map(|f| f.name.clone()).collect(),
-                sample: s.sample.clone(),
-                pdf: s.pdf.clone(),
-                eval: s.eval.clone(),
-                params: set.params.clone(),
-                domain: domain.name().into(),
-                bounds,
-                cap_axis,
-                cap_height,
-                incident_theta_deg: sphere.then_some(set.incident_theta),
-                incident_phi_deg: sphere.then_some(set.incident_phi),
-            },
-            rows: rows as usize,
-            cols: cols as usize,
+        Params::User {
+            wgsl: s.sources.iter().map(|f| f.name.clone()).collect(),
+            sample: s.sample.clone(),
+            pdf: s.pdf.clone(),
+            eval: s.eval.clone(),
+            params: set.params.clone(),
+            domain: domain.name().into(),
+            bounds: domain.bounds(),
+            cap_axis,
+            cap_height,
+            incident_theta_deg: sphere.then_some(set.incident_theta),
+            incident_phi_deg: sphere.then_some(set.incident_phi),
         }
     }
 }

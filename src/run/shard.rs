@@ -18,7 +18,7 @@
 //! another) changes the checksum. Both are refused as bad input. (The checksum finds edits and
 //! damage, not an attacker: anyone can recompute it.)
 
-use super::record::{ByReason, CaseDescription, Timing, WeightedTiming};
+use super::record::{ByReason, CaseDescription, Subject, Timing, WeightedTiming};
 use super::Sampled;
 use crate::engine::gpu::WeightedRun;
 use crate::engine::job::Counts;
@@ -224,7 +224,7 @@ impl ShardFile {
             case: case.name.clone(),
             case_index,
             cases: origin.cases,
-            description: CaseDescription::of(case),
+            description: CaseDescription::of(Subject::Lobe(case)),
             seed: case.seed,
             samples: case.samples,
             shard,
