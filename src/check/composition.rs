@@ -310,6 +310,14 @@ pub(super) struct UserCode {
 pub(super) type Renamed = Vec<(String, String)>;
 
 impl UserCode {
+    /// A tree composed into one part (its name says the sampler's file and `by`, what composed
+    /// it: `naga_oil`, `wesl`), without declarations' origins or renamed functions.
+    pub(super) fn tree(dialect: Dialect, sources: &[Source], by: &str, text: String, origins: Vec<Origin>) -> Self {
+        let part = Source { name: format!("<{} with its modules, composed by {by}>", sources[0].name), text };
+        let files = sources.iter().map(|s| s.name.clone()).collect();
+        UserCode { dialect, parts: vec![part], origins, files, decls: Vec::new(), renamed: Vec::new() }
+    }
+
     /// The functions named `name` (plain, or `module::path::name`) in `module`.
     pub fn functions_named(&self, module: &naga::Module, name: &str) -> Vec<naga::Handle<naga::Function>> {
         module

@@ -28,14 +28,7 @@ impl FrontEnd for NagaOil {
     fn compose(&self, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
         foreign_directives(sources)?;
         let (text, origins, renamed) = naga_oil_tree(sources, c)?;
-        Ok(UserCode {
-            dialect: Dialect::NagaOil,
-            parts: vec![Source { name: format!("<{} with its modules, composed by naga_oil>", sources[0].name), text }],
-            origins,
-            files: sources.iter().map(|s| s.name.clone()).collect(),
-            decls: Vec::new(),
-            renamed,
-        })
+        Ok(UserCode { renamed, ..UserCode::tree(Dialect::NagaOil, sources, "naga_oil", text, origins) })
     }
 
     /// Qualified names ([`super::qualified`]), an `#import a::b as x`'s `x` standing for `a::b`.

@@ -57,7 +57,7 @@ pub(crate) fn read(path: &Path) -> Result<Source, CheckError> {
 
 /// A SPIR-V module's bytes as WGSL, named `name` in messages.
 pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Source, CheckError> {
-    if bytes.len() % 4 != 0 || !has_magic(bytes) {
+    if !bytes.len().is_multiple_of(4) || !has_magic(bytes) {
         return Err(CheckError::Input(format!(
             "{name}: not a SPIR-V module ({} bytes, first word {}; a module is 32-bit words starting with 0x07230203)",
             bytes.len(),

@@ -38,14 +38,7 @@ impl FrontEnd for Wesl {
     fn compose(&self, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
         foreign_directives(sources)?;
         let (text, origins, decls) = wesl_tree(sources, c)?;
-        Ok(UserCode {
-            dialect: Dialect::Wesl,
-            parts: vec![Source { name: format!("<{} with its modules, composed by wesl>", sources[0].name), text }],
-            origins,
-            files: sources.iter().map(|s| s.name.clone()).collect(),
-            decls,
-            renamed: Vec::new(),
-        })
+        Ok(UserCode { decls, ..UserCode::tree(Dialect::Wesl, sources, "wesl", text, origins) })
     }
 
     /// Qualified names ([`super::qualified`]): WESL has no import aliases lobes reads.
