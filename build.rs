@@ -3,7 +3,8 @@
 //! each fact stays in one place: the files of `shaders/lib` and `shaders/math` are the only
 //! source of every form (plain prefixed WGSL, naga_oil modules, the WESL package), and of each
 //! module's names and dependencies. The text rules are `src/embed/text.rs` and
-//! `src/embed/namespace.rs`, compiled into this script as they are into the crate;
+//! `src/embed/namespace.rs` (over the lexer `src/wgsl_tokens.rs`), compiled into this script as
+//! they are into the crate;
 //! `src/embed/mod.rs`'s unit tests parse the results with naga and compare them with the
 //! composition lobes' own kernels run.
 
@@ -15,6 +16,9 @@ mod namespace;
 #[path = "src/embed/text.rs"]
 #[allow(dead_code)]
 mod text;
+#[path = "src/wgsl_tokens.rs"]
+#[allow(dead_code)]
+mod wgsl_tokens;
 
 /// lobes::embed's modules in dependency order (each after those it imports), with their files
 /// under `shaders/`: the order and names of `embed::Module::ALL` (a unit test holds the two

@@ -7,6 +7,9 @@
 //! The folders are the layers, from the math up; each imports only layers listed before it
 //! (`tests/layout.rs` checks that no two import each other):
 //!
+//! - `wgsl_tokens`: WGSL's tokens (names, `::` paths, numbers, punctuation; comments skipped),
+//!   the one lexer of every rewrite of WGSL text ([`embed`]'s namespace, the GPU library's
+//!   imports, [`check`]'s dialects).
 //! - [`atomic`]: the one way lobes writes a file (the outputs, and the GPU engine's pipeline
 //!   cache); [`console`]: the one way it writes a line on stderr.
 //! - [`reference`](mod@reference): the f64 math, one module per lobe, each the twin of a WGSL
@@ -46,6 +49,8 @@ pub mod check;
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod embed;
+#[cfg_attr(not(feature = "check"), allow(dead_code))]
+pub(crate) mod wgsl_tokens;
 #[cfg(feature = "check")]
 pub mod engine;
 #[cfg(feature = "check")]

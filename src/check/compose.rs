@@ -7,6 +7,7 @@
 //! naga diagnostic anywhere maps back to `file:line:column` of the part it came from.
 
 use super::CheckError;
+use crate::wgsl_tokens::{Kind, replace, tokens};
 use naga::{ScalarKind, TypeInner, VectorSize};
 
 /// One WGSL source: its name as shown in messages (usually the path) and its text.
@@ -125,20 +126,9 @@ impl DeclOrigin {
     }
 }
 
-/// `text` with every whole word `from` (an identifier) replaced by `to`.
+/// `text` with every name `from` replaced by `to`.
 pub(super) fn replace_word(text: &str, from: &str, to: &str) -> String {
-    let ident = |c: char| c.is_alphanumeric() || c == '_';
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(i) = rest.find(from) {
-        let starts = rest[..i].chars().next_back().is_none_or(|c| !ident(c));
-        let ends = rest[i + from.len()..].chars().next().is_none_or(|c| !ident(c));
-        out.push_str(&rest[..i]);
-        out.push_str(if starts && ends { to } else { from });
-        rest = &rest[i + from.len()..];
-    }
-    out.push_str(rest);
-    out
+    replace(text, tokens(text), |t| t.is_name(from).then(|| to.to_string()))
 }
 
 /// Composed text with the first line of each part, for mapping diagnostics back.
@@ -372,37 +362,57 @@ pub(super) fn writable(module: &naga::Module) -> std::borrow::Cow<'_, naga::Modu
     std::borrow::Cow::Owned(m)
 }
 
-/// `name0_` → `name0` for every identifier that ends in a digit and one underscore, unless the
-/// text holds `name0` too (the writer's namer gave a clash of `name` the name `name0`: a GLSL
+/// `name0_` → `name0` for every name that ends in a digit and one underscore, unless the text
+/// holds `name0` too (the writer's namer gave a clash of `name` the name `name0`: a GLSL
 /// parameter `u` beside its copy `u_1`, written `u_1` and `u_1_`).
 fn undo_digit_suffix(text: &str) -> String {
-    let taken: std::collections::HashSet<&str> = text.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).collect();
-    identifiers(text, |word| {
-        let w = word.as_bytes();
-        let suffixed = w.len() >= 3 && !w[0].is_ascii_digit() && w[w.len() - 1] == b'_' && w[w.len() - 2].is_ascii_digit();
-        if suffixed && !taken.contains(&word[..word.len() - 1]) { word[..word.len() - 1].to_string() } else { word.to_string() }
-    })
+    let names: std::collections::HashSet<&str> = tokens(text).filter(|t| t.kind == Kind::Ident).map(|t| t.text).collect();
+    let unsuffixed = |name: &str| {
+        let plain = name.strip_suffix('_')?;
+        (plain.ends_with(|c: char| c.is_ascii_digit()) && plain.len() >= 2 && !names.contains(plain)).then(|| plain.to_string())
+    };
+    replace(text, tokens(text), |t| unsuffixed(t.text).filter(|_| t.kind == Kind::Ident))
 }
 
-/// `text` with each identifier-like word replaced by `f(word)`.
-fn identifiers(text: &str, f: impl Fn(&str) -> String) -> String {
-    let mut out = String::with_capacity(text.len());
-    let b = text.as_bytes();
-    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
-    let mut i = 0;
-    while i < b.len() {
-        if ident(b[i]) && (i == 0 || !ident(b[i - 1])) {
-            let start = i;
-            while i < b.len() && ident(b[i]) {
-                i += 1;
-            }
-            out.push_str(&f(&text[start..i]));
-        } else {
-            out.push(text[i..].chars().next().expect("in range"));
-            i += text[i..].chars().next().expect("in range").len_utf8();
-        }
+/// Replaces the body of each function in `functions` (handles of `module`, parsed from `text`)
+/// with `body(function)`, keeping the text's line count (the body's newlines stay), so that
+/// every later line keeps its number.
+pub(super) fn replace_bodies(text: &str, module: &naga::Module, functions: &[(naga::Handle<naga::Function>, String)]) -> Result<String, CheckError> {
+    let mut spans: Vec<(usize, usize, &str)> = Vec::new();
+    for (h, body) in functions {
+        let span = module.functions.get_span(*h).to_range().ok_or_else(|| CheckError::Internal("a function without a span".into()))?;
+        let (open, end) = body_of(&text[span.clone()])?;
+        spans.push((span.start + open, span.start + end, body.as_str()));
     }
-    out
+    spans.sort();
+    let mut out = String::with_capacity(text.len());
+    let mut at = 0;
+    for (start, end, body) in spans {
+        out.push_str(&text[at..start]);
+        out.push_str(body);
+        out.push_str(&"\n".repeat(text[start..end].matches('\n').count()));
+        at = end;
+    }
+    out.push_str(&text[at..]);
+    Ok(out)
+}
+
+/// The byte range of the body of the function declared by `decl`: from the first `{` after its
+/// argument list's `)` to its last `}`.
+fn body_of(decl: &str) -> Result<(usize, usize), CheckError> {
+    let internal = |what: &str| CheckError::Internal(what.into());
+    let mut after = tokens(decl).skip_while(|t| !t.is("("));
+    let mut depth = 0;
+    after.find(|t| {
+        depth += i32::from(t.is("(")) - i32::from(t.is(")"));
+        depth == 0
+    });
+    if depth != 0 {
+        return Err(internal(if tokens(decl).any(|t| t.is("(")) { "unbalanced parentheses" } else { "a function without arguments" }));
+    }
+    let open = after.find(|t| t.is("{")).ok_or_else(|| internal("a function without a body"))?;
+    let end = tokens(decl).filter(|t| t.is("}")).last().ok_or_else(|| internal("a function without a body"))?;
+    Ok((open.start, end.end()))
 }
 
 #[cfg(test)]
@@ -414,5 +424,22 @@ mod tests {
         assert_eq!(undo_digit_suffix("fn f0_(a: f32) -> f32 { let x_1 = a; return v2_ + b_; }"), "fn f0(a: f32) -> f32 { let x_1 = a; return v2 + b_; }");
         // a name the namer gave a clash stays: `u_1_` (the user's u_1) beside `u_1` (its u)
         assert_eq!(undo_digit_suffix("fn g(u: f32, u_1: f32) { var u_1_ = u_1; }"), "fn g(u: f32, u_1: f32) { var u_1_ = u_1; }");
+        // numbers are no names: 1e3 and 2u stay as they are
+        assert_eq!(undo_digit_suffix("let a2_ = 1e3 + 2u;"), "let a2 = 1e3 + 2u;");
+    }
+
+    #[test]
+    fn bodies_are_replaced_keeping_lines() {
+        let text = "fn a() -> f32 {\n  return 1.0;\n}\nfn r(s: ptr<function, u32>) -> f32 {\n  *s = *s + 1u;\n  return f32(*s);\n}\nfn b() -> f32 { return r_(); }\n";
+        let text = text.replace("r_()", "2.0");
+        let module = naga::front::wgsl::parse_str(&text).unwrap();
+        let (h, _) = module.functions.iter().find(|(_, f)| f.name.as_deref() == Some("r")).unwrap();
+        let out = replace_bodies(&text, &module, &[(h, "{ return 0.5; }".into())]).unwrap();
+        assert_eq!(out.lines().count(), text.lines().count());
+        assert!(out.contains("fn r(s: ptr<function, u32>) -> f32 { return 0.5; }"), "{out}");
+        assert_eq!(out.lines().nth(7), Some("fn b() -> f32 { return 2.0; }"));
+        naga::front::wgsl::parse_str(&out).unwrap();
+        // a parenthesis or a brace in a comment is no part of the declaration's shape
+        assert_eq!(body_of("fn f(a: f32 /* ) { */) -> f32 { return a; } // }").unwrap(), (30, 43));
     }
 }

@@ -1,7 +1,8 @@
 //! How a user's sampler is composed and called: the settings beyond the contract's three
 //! functions ([`Composition`], [`Draw`], [`SampleReturns`]), the dialect of its files
-//! ([`Dialect`]), and the composed code that lobes' glue calls ([`UserCode`]). The vocabulary
-//! that `modules` (which composes), `dialect` (the front ends) and `gpu` (the glue) share.
+//! ([`Dialect`]; `dialect::sniff` tells it), and the composed code that lobes' glue calls
+//! ([`UserCode`]). The vocabulary that `modules` (which composes), `dialect` (the front ends) and
+//! `gpu` (the glue) share.
 
 use super::compose::Source;
 use std::path::PathBuf;
@@ -277,29 +278,6 @@ impl Dialect {
     }
 }
 
-/// The dialect of the files, from their text: a naga_oil directive at the start of a line, a WESL
-/// `import …;` statement (or a `.wesl` file), else plain WGSL.
-pub fn dialect(sources: &[Source]) -> Dialect {
-    if let Some(d) = super::dialect::sniff(sources) {
-        return d;
-    }
-    let directive = |l: &str| {
-        let l = l.trim_start();
-        ["#import", "#define_import_path", "#ifdef", "#ifndef", "#if ", "#else", "#endif"].iter().any(|d| l.starts_with(d))
-    };
-    let wesl_import = |l: &str| {
-        let l = l.trim_start();
-        l.starts_with("import ") && (l.contains("::") || l.trim_end().ends_with(';'))
-    };
-    if sources.iter().any(|s| s.text.lines().any(directive)) {
-        Dialect::NagaOil
-    } else if sources.iter().any(|s| s.name.ends_with(".wesl") || s.text.lines().any(wesl_import)) {
-        Dialect::Wesl
-    } else {
-        Dialect::Wgsl
-    }
-}
-
 /// Whether `s` names a function (with the contract's signature) rather than being a call
 /// expression over lobes' names.
 pub(super) fn is_name(s: &str) -> bool {
@@ -333,3 +311,43 @@ pub(super) struct UserCode {
 
 /// (the name naga's WGSL writer gave a function, its name in the module it wrote).
 pub(super) type Renamed = Vec<(String, String)>;
+
+impl UserCode {
+    /// A tree composed into one part (its name says the sampler's file and `by`, what composed
+    /// it: `naga_oil`, `wesl`), without declarations' origins or renamed functions.
+    pub(super) fn tree(dialect: Dialect, sources: &[Source], by: &str, text: String, origins: Vec<Origin>) -> Self {
+        let part = Source { name: format!("<{} with its modules, composed by {by}>", sources[0].name), text };
+        let files = sources.iter().map(|s| s.name.clone()).collect();
+        UserCode { dialect, parts: vec![part], origins, files, decls: Vec::new(), renamed: Vec::new(), uniforms: Vec::new() }
+    }
+
+    /// The functions named `name` (plain, or `module::path::name`) in `module`.
+    pub fn functions_named(&self, module: &naga::Module, name: &str) -> Vec<naga::Handle<naga::Function>> {
+        module
+            .functions
+            .iter()
+            .filter(|(_, f)| {
+                let Some(n) = f.name.as_deref() else { return false };
+                n == name
+                    || self.renamed.iter().any(|(written, original)| written == n && original == name)
+                    || self.origins.iter().any(|(m, path, item)| m == n && (item == name || format!("{path}::{item}") == name))
+            })
+            .map(|(h, _)| h)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn draw_orders() {
+        assert_eq!(Draw::components(&[]), [0, 1, 2, 3]);
+        assert_eq!(Draw::components(&[Draw::Event, Draw::X, Draw::Y]), [2, 0, 1, 3]);
+        assert_eq!(Draw::components(&[Draw::X, Draw::Event, Draw::Event, Draw::Y]), [0, 2, 3, 1]);
+        assert_eq!(Draw::list(&[2, 0, 1, 3], 3), "event,x,y");
+        assert!(Draw::parse_list("x,x").is_err());
+        assert!(Draw::parse_list("z").unwrap_err().contains("'z' is not a draw"));
+    }
+}

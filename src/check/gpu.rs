@@ -505,7 +505,7 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String]) -> Result<Ve
             }
         }
     }
-    let text = super::modules::replace_bodies(&c.text, &module, &bodies)?;
+    let text = super::compose::replace_bodies(&c.text, &module, &bodies)?;
     // the lines are kept: each part takes back as many as it had
     let mut lines = text.lines();
     Ok(parts

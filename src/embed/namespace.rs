@@ -5,11 +5,13 @@
 //! WGSL has no namespaces, and a renderer's shader is one module with its own `PI`, `sample` or
 //! `stretch`; so what [`super::wgsl`] returns renames whatever it defines. The library files
 //! keep their short names (they are naga_oil modules, and naga_oil namespaces by import path):
-//! the rename is done on the exported text, token by token: comments are copied unchanged, an
-//! identifier is renamed only as a whole token and only where it can name a module-scope
-//! declaration (not after `.`, a member or swizzle, nor after `@`, an attribute). Renaming every
-//! occurrence of a name is an α-renaming, so the code stays the same; `tests` in
+//! the rename is done on the exported text, token by token (`crate::wgsl_tokens`): comments are
+//! copied unchanged, an identifier is renamed only as a whole token and only where it can name a
+//! module-scope declaration (not after `.`, a member or swizzle, nor after `@`, an attribute).
+//! Renaming every occurrence of a name is an α-renaming, so the code stays the same; `tests` in
 //! `super` parse both texts with naga and compare their IR with the names mapped.
+
+use crate::wgsl_tokens::{Kind, Token, replace, tokens};
 
 /// The exported name of `name` under `prefix` (`"lobes"`, or `"lobes_lights"` for a discrete
 /// table named `lights`): `SHOUTING` constants get `PREFIX_`, `CamelCase` types `Prefix`
@@ -38,69 +40,12 @@ pub fn prefixed(prefix: &str, name: &str) -> String {
 /// `rename(t)` where that is `Some`; comments (`//` and nested `/* */`), literals, members and
 /// swizzles (after `.`) and attributes (after `@`) are left as they are.
 pub(crate) fn rename(source: &str, rename: impl Fn(&str) -> Option<String>) -> String {
-    let bytes = source.as_bytes();
-    let mut out = String::with_capacity(source.len() + source.len() / 8);
-    let mut i = 0;
-    // the last character before the current token that is not white space
-    let mut previous = b' ';
-    let ident = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
-    while i < bytes.len() {
-        let start = i;
-        let c = bytes[i];
-        if source[i..].starts_with("//") {
-            i = source[i..].find('\n').map_or(bytes.len(), |n| i + n);
-            out.push_str(&source[start..i]);
-            continue;
-        }
-        if source[i..].starts_with("/*") {
-            let mut depth = 0;
-            while i < bytes.len() {
-                if source[i..].starts_with("/*") {
-                    depth += 1;
-                    i += 2;
-                } else if source[i..].starts_with("*/") {
-                    depth -= 1;
-                    i += 2;
-                    if depth == 0 {
-                        break;
-                    }
-                } else {
-                    i += 1;
-                }
-            }
-            out.push_str(&source[start..i]);
-            continue;
-        }
-        if c.is_ascii_digit() {
-            // a number with its suffix (`1.0e18`, `0x7f800000u`, `1.0lf`): never an identifier
-            while i < bytes.len() && (ident(bytes[i]) || bytes[i] == b'.') {
-                i += 1;
-            }
-            out.push_str(&source[start..i]);
-            previous = b'0';
-            continue;
-        }
-        if c.is_ascii_alphabetic() || c == b'_' {
-            while i < bytes.len() && ident(bytes[i]) {
-                i += 1;
-            }
-            let token = &source[start..i];
-            match (previous, rename(token)) {
-                (b'.' | b'@', _) | (_, None) => out.push_str(token),
-                (_, Some(new)) => out.push_str(&new),
-            }
-            previous = b'a';
-            continue;
-        }
-        // any other character, whole (UTF-8 in comments is handled above; elsewhere it is copied)
-        let len = source[i..].chars().next().map_or(1, char::len_utf8);
-        i += len;
-        out.push_str(&source[start..i]);
-        if !c.is_ascii_whitespace() {
-            previous = c;
-        }
-    }
-    out
+    let mut previous: Option<Token> = None;
+    replace(source, tokens(source), |t| {
+        let member_or_attribute = previous.is_some_and(|p| p.is(".") || p.is("@"));
+        previous = Some(*t);
+        (t.kind == Kind::Ident && !member_or_attribute).then(|| rename(t.text)).flatten()
+    })
 }
 
 #[cfg(test)]

@@ -17,9 +17,26 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::Composition;
-use super::{Translation, gl_uniforms};
+use super::super::composition::{Composition, Dialect, UserCode};
+use super::front_end::FrontEnd;
+use super::gl_uniforms;
+use super::translate::{Translation, fall_through, to_wgsl, translated};
 use std::path::{Path, PathBuf};
+
+/// The GLSL front end.
+pub(in crate::check) struct Glsl;
+
+impl FrontEnd for Glsl {
+    fn sniff(&self, sources: &[Source]) -> bool {
+        sources.iter().any(is_glsl)
+    }
+    fn compose(&self, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
+        translated(Dialect::Glsl, sources, c, || translate(sources, c))
+    }
+    fn call(&self, code: &UserCode, flag: &str, expr: &str, _root_text: &str) -> Result<String, CheckError> {
+        super::translate::call(code, flag, expr)
+    }
+}
 
 /// The file extensions of GLSL: sources, includes and the stages glslang names by extension.
 const EXTENSIONS: [&str; 16] = ["glsl", "vert", "frag", "comp", "geom", "tesc", "tese", "mesh", "task", "rgen", "rchit", "rmiss", "rahit", "rint", "rcall", "glslinc"];
@@ -117,12 +134,12 @@ pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translati
         messages.dedup();
         CheckError::Wgsl(messages.into_iter().take(8).collect::<Vec<_>>().join("\n"))
     })?;
-    if let Some((span, f)) = super::fall_through(&mut module) {
+    if let Some((span, f)) = fall_through(&mut module) {
         let m = format!("in `{f}`, a `switch` case falls through into the next one, which WGSL (what lobes runs) cannot express; end each case that has statements with `break` or `return` (repeat the next case's statements in it if it meant to fall through)");
         return Err(CheckError::Wgsl(x.diagnostic(Some(span.location(&x.text)), &m)));
     }
     let shown = sources.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
-    super::to_wgsl(module, &shown, |e| {
+    to_wgsl(module, &shown, |e| {
         let mut message = e.as_inner().to_string();
         let mut source: Option<&dyn std::error::Error> = std::error::Error::source(e.as_inner());
         while let Some(s) = source {
@@ -131,7 +148,7 @@ pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translati
         }
         x.diagnostic(e.location(&x.text), &format!("naga translated the GLSL into a module it does not accept: {message}"))
     })
-    .map(|t| super::Translation { uniforms: x.uniforms.iter().filter(|(u, _)| !u.opaque).map(|(u, at)| (u.name.clone(), x.place(*at))).collect(), ..t })
+    .map(|t| Translation { uniforms: x.uniforms.iter().filter(|(u, _)| !u.opaque).map(|(u, at)| (u.name.clone(), x.place(*at))).collect(), ..t })
 }
 
 fn parse(x: &Expanded, options: &naga::front::glsl::Options) -> Result<naga::Module, Vec<naga::front::glsl::Error>> {
@@ -292,9 +309,9 @@ mod name_tests {
         let text = "#version 450\nfloat saturate(float x) { return clamp(x, 0.0, 1.0); }\nfloat sqr(float x) { return x * x; }\nvec3 sqr(vec3 x) { return x * x; }\n";
         let t = translate(&[Source { name: "n.glsl".into(), text: text.into() }], &Composition::default()).unwrap();
         naga::front::wgsl::parse_str(&t.text).unwrap();
-        let call = super::super::call_names("--pdf", "saturate(p0) * d.z", &t.origins).unwrap();
+        let call = super::super::translate::call_names("--pdf", "saturate(p0) * d.z", &t.origins).unwrap();
         assert!(call.starts_with("saturate_(") && t.text.contains("fn saturate_("), "{call}\n{}", t.text);
-        let e = super::super::call_names("--pdf", "sqr(p0)", &t.origins).unwrap_err().to_string();
+        let e = super::super::translate::call_names("--pdf", "sqr(p0)", &t.origins).unwrap_err().to_string();
         assert!(e.contains("`sqr` is overloaded"), "{e}");
     }
 }

@@ -1,25 +1,47 @@
-//! Samplers in languages other than WGSL, read by naga's own front ends into a naga module and
-//! written out as WGSL, which `lobes check` then composes with its glue as it does a composed
-//! WGSL tree (`gpu::prepare`):
+//! The front ends of `lobes check`, one module per dialect, each a [`FrontEnd`]: how its files
+//! are told apart ([`sniff`]), composed into the WGSL that lobes' glue calls, and how a call
+//! expression (`--sample`, `--pdf`, `--eval`) names their functions.
+//!
+//! - plain WGSL ([`wgsl`]): the files, in order, as they are;
+//! - naga_oil ([`naga_oil`]): `#define_import_path`, `#import`, `#ifdef` shader defs, composed by
+//!   naga_oil's `Composer` over the modules under the shader roots ([`roots`]);
+//! - WESL ([`wesl`]): `import package::a::b;`, `@if` features, composed by the `wesl` crate
+//!   (feature "wesl") with lobes' resolver ([`wesl_resolver`]) and conditional blocks
+//!   ([`wesl_blocks`]);
 //! - GLSL ([`glsl`]): naga's GLSL front end (Vulkan GLSL 440–460), after lobes' `#include`
 //!   expansion, with errors at the user's file and line;
 //! - SPIR-V ([`spirv`]): naga's SPIR-V front end, functions named by their debug names (`OpName`).
 //!
-//! The translation keeps the user's function names where WGSL can spell them; where it cannot
-//! (a WGSL reserved word such as `saturate`, an overloaded GLSL function), the names written are
-//! recorded as origins, so that `--rand` and call expressions name the functions as the user's
-//! file does ([`call_names`]).
+//! GLSL and SPIR-V are translated to WGSL by naga ([`translate`]); where WGSL cannot spell a
+//! function's name (a WGSL reserved word such as `saturate`, an overloaded GLSL function), the
+//! names written are recorded as origins, so that `--rand` and call expressions name the
+//! functions as the user's file does. Composing a tree is slow ([`stage`] says what is being
+//! composed); `super::modules` keeps the trees composed and calls the front ends.
+//!
+//! A new dialect is a variant of [`Dialect`], a module here with its [`FrontEnd`], its arm in
+//! [`Dialect::front_end`] and its place in [`SNIFFED`].
 
 pub(super) mod callees_first;
+pub(super) mod front_end;
 mod gl_uniforms;
 pub mod glsl;
+pub(super) mod naga_oil;
 pub mod out_params;
+mod qualified;
+pub(super) mod roots;
 pub mod spirv;
+pub mod stage;
+mod translate;
+pub(super) mod wesl;
 pub mod wesl_blocks;
+#[cfg(feature = "wesl")]
+mod wesl_resolver;
+pub(super) mod wgsl;
 
 use super::CheckError;
 use super::compose::Source;
-use super::composition::{Composition, Dialect, Origin, UserCode};
+use super::composition::Dialect;
+use front_end::FrontEnd;
 
 // A file's dialect decides how it is read, so the reading is the front ends' (here), not the
 // type's (`compose`, below them).
@@ -37,177 +59,27 @@ impl Source {
     }
 }
 
-/// GLSL or SPIR-V, where the files are: a SPIR-V module by its `.spv` name, GLSL by its file
-/// extension or a `#version` line; else `None` (a WGSL dialect).
-pub(super) fn sniff(sources: &[Source]) -> Option<Dialect> {
-    if sources.iter().any(|s| spirv::is_spirv(std::path::Path::new(&s.name))) {
-        return Some(Dialect::Spirv);
-    }
-    sources.iter().any(glsl::is_glsl).then_some(Dialect::Glsl)
+/// The dialects in the order they are asked whether the files are theirs: a SPIR-V module by its
+/// `.spv` name, GLSL by its extension or a `#version` line, naga_oil by a directive, WESL by a
+/// `.wesl` file or an `import …;` statement; plain WGSL claims what is left.
+pub const SNIFFED: [Dialect; 5] = [Dialect::Spirv, Dialect::Glsl, Dialect::NagaOil, Dialect::Wesl, Dialect::Wgsl];
+
+/// The dialect of the files, from their names and text ([`SNIFFED`]).
+pub fn sniff(sources: &[Source]) -> Dialect {
+    SNIFFED.into_iter().find(|d| d.front_end().sniff(sources)).unwrap_or(Dialect::Wgsl)
 }
 
-/// The user's GLSL files (or SPIR-V module, already translated when read: [`spirv::read`]) as
-/// one translated WGSL part.
-pub(super) fn compose(dialect: Dialect, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
-    let files: Vec<String> = sources.iter().map(|s| s.name.clone()).collect();
-    if let Some((m, _)) = c.stubs.first() {
-        return Err(CheckError::Input(format!("--stub {m}: {} has no modules to stand in for ({} reads the files as they are)", files.join(", "), dialect.name())));
-    }
-    let (text, origins, uniforms) = match dialect {
-        Dialect::Spirv => {
-            if sources.len() > 1 {
-                return Err(CheckError::Input(format!("{}: give one SPIR-V module alone (it is a whole program; link several with spirv-link first)", files.join(", "))));
-            }
-            if !c.defines.is_empty() {
-                return Err(CheckError::Input("--define: a SPIR-V module is already compiled; give the defines to the compiler that made it".into()));
-            }
-            (sources[0].text.clone(), Vec::new(), Vec::new())
-        }
-        _ => {
-            let t = glsl::translate(sources, c)?;
-            (t.text, t.origins, t.uniforms)
-        }
-    };
-    let name = format!("<{} translated to WGSL by naga's {} front end>", files.join(", "), dialect.name());
-    Ok(UserCode { dialect, parts: vec![Source { name, text }], origins, files, decls: Vec::new(), renamed: Vec::new(), uniforms })
-}
-
-/// A module read from another language, as WGSL: its text and where renamed functions came from.
-pub(super) struct Translation {
-    pub text: String,
-    /// (name in `text`, the file, name in the file) of each function WGSL could not name as the
-    /// file does, and of every overload of an overloaded name.
-    pub origins: Vec<Origin>,
-    /// OpenGL's loose uniforms made module variables (GLSL only, [`gl_uniforms`]): each one's
-    /// name and `file:line`.
-    pub uniforms: Vec<(String, String)>,
-}
-
-/// `module` (from `file`, without its entry points: lobes calls the functions) validated and
-/// written as WGSL. `locate` turns a validation error into a message at the user's file.
-pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&naga::WithSpan<naga::valid::ValidationError>) -> String) -> Result<Translation, CheckError> {
-    module.entry_points.clear();
-    callees_first::callees_first(&mut module);
-    let caps = naga::valid::Capabilities::all();
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| CheckError::Wgsl(locate(&e)))?;
-    let text = free_writer_names(&super::compose::write_wgsl(&module, caps)?);
-    // naga's WGSL writer writes the functions in the module's order, each on a line `fn NAME(`
-    let written: Vec<&str> = text.lines().filter_map(|l| l.strip_prefix("fn ")).filter_map(|l| l.split_once('(')).map(|(n, _)| n).collect();
-    if written.len() != module.functions.len() {
-        return Err(CheckError::Internal(format!("{file}: {} functions translated, {} written", module.functions.len(), written.len())));
-    }
-    let names: Vec<&str> = module.functions.iter().map(|(_, f)| f.name.as_deref().unwrap_or("")).collect();
-    let mut origins = Vec::new();
-    for (i, (&name, &w)) in names.iter().zip(&written).enumerate() {
-        let overloaded = names.iter().enumerate().any(|(j, &n)| j != i && n == name);
-        if !name.is_empty() && (w != name || overloaded) {
-            origins.push((w.to_string(), file.to_string(), name.to_string()));
+impl Dialect {
+    /// The front end that reads files of this dialect.
+    pub(in crate::check) fn front_end(self) -> &'static dyn FrontEnd {
+        match self {
+            Dialect::Wgsl => &wgsl::Wgsl,
+            Dialect::NagaOil => &naga_oil::NagaOil,
+            Dialect::Wesl => &wesl::Wesl,
+            Dialect::Glsl => &glsl::Glsl,
+            Dialect::Spirv => &spirv::Spirv,
         }
     }
-    Ok(Translation { text, origins, uniforms: Vec::new() })
-}
-
-/// The `switch` cases of `module` that fall through into the next (naga's GLSL front end marks
-/// every case that does not end in `break` so) made plain cases where they end in a jump
-/// (`return`, `break`, `continue`, `discard`), since WGSL has no fall-through; the first that
-/// falls through with statements of its own (WGSL cannot write it): its span and function.
-pub(super) fn fall_through(module: &mut naga::Module) -> Option<(naga::Span, String)> {
-    let mut found = None;
-    for (_, f) in module.functions.iter_mut() {
-        let name = f.name.clone().unwrap_or_default();
-        if let Some(span) = cases(&mut f.body).filter(|_| found.is_none()) {
-            found = Some((span, name));
-        }
-    }
-    found
-}
-
-/// [`fall_through`] in one block, its nested blocks included.
-fn cases(block: &mut naga::Block) -> Option<naga::Span> {
-    use naga::Statement as S;
-    let mut found = None;
-    let spans: Vec<naga::Span> = block.span_iter().map(|(_, s)| *s).collect();
-    for (statement, span) in block.iter_mut().zip(spans) {
-        let inner = match statement {
-            S::Block(b) => cases(b),
-            S::If { accept, reject, .. } => cases(accept).or(cases(reject)),
-            S::Loop { body, continuing, .. } => cases(body).or(cases(continuing)),
-            S::Switch { cases: list, .. } => {
-                let mut bad = None;
-                for c in list.iter_mut().filter(|c| c.fall_through && !c.body.is_empty()) {
-                    c.fall_through = !ends_in_jump(&c.body);
-                    bad = bad.or(c.fall_through.then_some(span));
-                }
-                list.iter_mut().map(|c| cases(&mut c.body)).fold(bad, Option::or)
-            }
-            _ => None,
-        };
-        found = found.or(inner);
-    }
-    found
-}
-
-/// Whether `block` ends in a jump on every path (`return`, `break`, `continue`, `discard`).
-fn ends_in_jump(block: &naga::Block) -> bool {
-    use naga::Statement as S;
-    match block.last() {
-        Some(S::Return { .. } | S::Break | S::Continue | S::Kill) => true,
-        Some(S::Block(b)) => ends_in_jump(b),
-        Some(S::If { accept, reject, .. }) => ends_in_jump(accept) && ends_in_jump(reject),
-        _ => false,
-    }
-}
-
-/// A call expression (`--sample`, `--pdf`, `--eval`) over the functions as the user's file names
-/// them, with each name that the translation wrote differently replaced by the name written. An
-/// overloaded name is an error naming the translation's names of its overloads.
-pub(super) fn call_names(flag: &str, expr: &str, origins: &[Origin]) -> Result<String, CheckError> {
-    map_words(expr, |word| {
-        let written: Vec<&str> = origins.iter().filter(|o| o.2 == word).map(|o| o.0.as_str()).collect();
-        match written[..] {
-            [] => Ok(word.to_string()),
-            [w] => Ok(w.to_string()),
-            _ => Err(CheckError::Input(format!(
-                "{flag} '{expr}': `{word}` is overloaded in {}; in the translation its overloads are {} (in the order declared): call the one you mean by that name",
-                origins.iter().find(|o| o.2 == word).map_or("", |o| o.1.as_str()),
-                written.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ")
-            ))),
-        }
-    })
-}
-
-/// `text` with each identifier-like word (letters, digits, `_`) replaced by `f(word)`.
-fn map_words(text: &str, mut f: impl FnMut(&str) -> Result<String, CheckError>) -> Result<String, CheckError> {
-    let mut out = String::with_capacity(text.len());
-    let mut word = String::new();
-    for ch in text.chars() {
-        if ch.is_alphanumeric() || ch == '_' {
-            word.push(ch);
-            continue;
-        }
-        if !word.is_empty() {
-            out.push_str(&f(&word)?);
-            word.clear();
-        }
-        out.push(ch);
-    }
-    if !word.is_empty() {
-        out.push_str(&f(&word)?);
-    }
-    Ok(out)
-}
-
-/// naga's WGSL writer names the values it binds `_eN`, from the expression's index, whatever
-/// names the module holds: written again after naga reads them back as named values, two would
-/// be `_e8` in one function. The translation's are renamed `_glslN`.
-fn free_writer_names(text: &str) -> String {
-    let renamed = map_words(text, |w| {
-        Ok(match w.strip_prefix("_e").filter(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit())) {
-            Some(n) => format!("_glsl{n}"),
-            None => w.to_string(),
-        })
-    });
-    renamed.unwrap_or_else(|_| text.to_string())
 }
 
 #[cfg(test)]
@@ -215,14 +87,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn call_names_follow_the_translation() {
-        let origins = vec![
-            ("saturate_".to_string(), "a.glsl".to_string(), "saturate".to_string()),
-            ("rnd".to_string(), "a.glsl".to_string(), "rnd".to_string()),
-            ("rnd_1".to_string(), "a.glsl".to_string(), "rnd".to_string()),
-        ];
-        assert_eq!(call_names("--pdf", "saturate(d.z) * p0 + saturated", &origins).unwrap(), "saturate_(d.z) * p0 + saturated");
-        let e = call_names("--sample", "f(wi, rnd(u.x))", &origins).unwrap_err().to_string();
-        assert!(e.contains("`rnd` is overloaded in a.glsl") && e.contains("`rnd`, `rnd_1`"), "{e}");
+    fn dialects() {
+        let s = |name: &str, text: &str| vec![Source { name: name.into(), text: text.into() }];
+        assert_eq!(sniff(&s("a.wgsl", "fn f() {}")), Dialect::Wgsl);
+        assert_eq!(sniff(&s("a.wgsl", "#import a::b::{c}\nfn f() {}")), Dialect::NagaOil);
+        assert_eq!(sniff(&s("a.wgsl", "import package::maths::pi;\nfn f() {}")), Dialect::Wesl);
+        assert_eq!(sniff(&s("a.wesl", "fn f() {}")), Dialect::Wesl);
+        assert_eq!(sniff(&s("a.frag", "#import a::b\nvoid f() {}")), Dialect::Glsl);
+        assert_eq!(sniff(&s("a.spv", "")), Dialect::Spirv);
     }
 }

@@ -6,7 +6,34 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
+use super::super::composition::{Composition, Dialect, UserCode};
+use super::front_end::FrontEnd;
+use super::translate::{Translation, fall_through, to_wgsl, translated};
 use std::path::Path;
+
+/// The SPIR-V front end (the module is translated when it is read: [`read`]).
+pub(in crate::check) struct Spirv;
+
+impl FrontEnd for Spirv {
+    fn sniff(&self, sources: &[Source]) -> bool {
+        sources.iter().any(|s| is_spirv(Path::new(&s.name)))
+    }
+    fn compose(&self, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
+        translated(Dialect::Spirv, sources, c, || {
+            if sources.len() > 1 {
+                let files: Vec<&str> = sources.iter().map(|s| s.name.as_str()).collect();
+                return Err(CheckError::Input(format!("{}: give one SPIR-V module alone (it is a whole program; link several with spirv-link first)", files.join(", "))));
+            }
+            if !c.defines.is_empty() {
+                return Err(CheckError::Input("--define: a SPIR-V module is already compiled; give the defines to the compiler that made it".into()));
+            }
+            Ok(Translation { text: sources[0].text.clone(), origins: Vec::new(), uniforms: Vec::new() })
+        })
+    }
+    fn call(&self, code: &UserCode, flag: &str, expr: &str, _root_text: &str) -> Result<String, CheckError> {
+        super::translate::call(code, flag, expr)
+    }
+}
 
 /// SPIR-V's first word (the SPIR-V specification, 2.3 "Physical Layout").
 const MAGIC: u32 = 0x0723_0203;
@@ -30,7 +57,7 @@ pub(crate) fn read(path: &Path) -> Result<Source, CheckError> {
 
 /// A SPIR-V module's bytes as WGSL, named `name` in messages.
 pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Source, CheckError> {
-    if bytes.len() % 4 != 0 || !has_magic(bytes) {
+    if !bytes.len().is_multiple_of(4) || !has_magic(bytes) {
         return Err(CheckError::Input(format!(
             "{name}: not a SPIR-V module ({} bytes, first word {}; a module is 32-bit words starting with 0x07230203)",
             bytes.len(),
@@ -66,10 +93,10 @@ pub fn from_bytes(name: &str, bytes: &[u8]) -> Result<Source, CheckError> {
             "{name}: the module has no debug names (OpName), so lobes cannot find its functions; compile it with debug information (glslc -g, glslangValidator -g, dxc -Zi, slangc -g)"
         )));
     }
-    if let Some((_, f)) = super::fall_through(&mut module) {
+    if let Some((_, f)) = fall_through(&mut module) {
         return Err(CheckError::Input(format!("{name}: in `{f}`, a `switch` case falls through into the next one, which WGSL (what lobes runs) cannot express; end each case that has statements with `break` or `return` in the source")));
     }
-    let t = super::to_wgsl(module, name, |e| format!("{name}: error: naga translated the module into one it does not accept: {}", e.as_inner()))?;
+    let t = to_wgsl(module, name, |e| format!("{name}: error: naga translated the module into one it does not accept: {}", e.as_inner()))?;
     let wrappers: Vec<String> = wrapped.iter().filter_map(|n| by_value(&t.text, n)).collect();
     Ok(Source { name: name.to_string(), text: format!("{}\n{}", t.text, wrappers.join("\n")) })
 }

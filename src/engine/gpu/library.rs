@@ -38,6 +38,7 @@
 
 use super::context::GpuError;
 use super::precision::Precision;
+use crate::wgsl_tokens::{Kind, replace, tokens};
 use naga_oil::compose::{ComposableModuleDescriptor, Composer, NagaModuleDescriptor};
 use std::borrow::Cow;
 use std::collections::HashMap;
@@ -174,10 +175,10 @@ pub fn naga_oil_source(module: &str) -> Option<String> {
 }
 
 /// A file as naga_oil reads it (see the module doc): its `alias Real` line blanked and the word
-/// `Real` spelled `scalar` (`f32` or `f64`, padded to four columns) outside the directives.
+/// `Real` spelled `scalar` (`f32` or `f64`, padded to four columns) in the code outside the
+/// directives (comments are left as written).
 fn for_naga_oil(source: &str, scalar: &str) -> String {
     let scalar = format!("{scalar:<4}");
-    let word = |c: char| c.is_ascii_alphanumeric() || c == '_';
     let line = |l: &str| -> String {
         if l.trim_start().starts_with("alias Real") {
             return String::new();
@@ -185,16 +186,7 @@ fn for_naga_oil(source: &str, scalar: &str) -> String {
         if l.trim_start().starts_with('#') {
             return l.to_string();
         }
-        let mut out = String::with_capacity(l.len());
-        let mut rest = l;
-        while let Some(at) = rest.find("Real") {
-            let (before, after) = (&rest[..at], &rest[at + 4..]);
-            let whole = !before.ends_with(word) && !after.starts_with(word);
-            out.push_str(before);
-            out.push_str(if whole { &scalar } else { "Real" });
-            rest = after;
-        }
-        out + rest
+        replace(l, tokens(l), |t| t.is_name("Real").then(|| scalar.clone()))
     };
     source.lines().map(line).collect::<Vec<_>>().join("\n")
 }
@@ -359,7 +351,7 @@ use text::declared;
 /// The `#import` lines a generated file needs: for each module in the import closure of `from`,
 /// the names it declares that `code` uses.
 pub fn imports_for(code: &str, from: &[&str], chosen: &[File]) -> Result<String, GpuError> {
-    let used: Vec<&str> = code.split(|c: char| !(c.is_alphanumeric() || c == '_')).filter(|w| !w.is_empty()).collect();
+    let used: Vec<&str> = tokens(code).filter(|t| t.kind == Kind::Ident).map(|t| t.text).collect();
     let mut out = String::new();
     for file in in_import_order(from, chosen)? {
         let names: Vec<&str> = declared(&file.source).into_iter().filter(|n| used.contains(n)).collect();
