@@ -352,13 +352,13 @@ pub(super) fn write_wgsl(module: &naga::Module, caps: naga::valid::Capabilities)
 }
 
 /// `module` without what naga's WGSL writer cannot write (ray queries and their callers,
-/// `dialect::callees_first::drop_ray_queries`); itself where it has none.
+/// `call_graph::drop_ray_queries`); itself where it has none.
 pub(super) fn writable(module: &naga::Module) -> std::borrow::Cow<'_, naga::Module> {
-    if !super::dialect::callees_first::needs_cut(module) {
+    if !super::call_graph::needs_cut(module) {
         return std::borrow::Cow::Borrowed(module);
     }
     let mut m = module.clone();
-    super::dialect::callees_first::drop_ray_queries(&mut m);
+    super::call_graph::drop_ray_queries(&mut m);
     std::borrow::Cow::Owned(m)
 }
 

@@ -36,6 +36,7 @@
 
 pub mod budget;
 mod builtin;
+mod call_graph;
 pub mod compose;
 pub mod composition;
 pub mod conventions;

@@ -21,7 +21,6 @@
 //! A new dialect is a variant of [`Dialect`], a module here with its [`FrontEnd`], its arm in
 //! [`Dialect::front_end`] and its place in [`SNIFFED`].
 
-pub(super) mod callees_first;
 pub(super) mod front_end;
 mod gl_uniforms;
 pub mod glsl;

@@ -1,7 +1,7 @@
 //! Call expressions over a composed tree's modules (naga_oil's and WESL's): a name qualified by
 //! its module (`ggx::pdf`, `package::sampling::ggx::pdf`, an `#import … as` alias's
-//! `alias::pdf`), or a name the sampler's file imports, replaced by the name the composition
-//! gave it.
+//! `alias::pdf`), or a name the sampler's file imports (by that name, or as an `#import a::b::c
+//! as name` alias of an item), replaced by the name the composition gave it.
 
 use super::super::CheckError;
 use super::super::composition::UserCode;
@@ -18,7 +18,7 @@ pub(super) fn resolve(code: &UserCode, flag: &str, expr: &str, root_text: &str, 
         let member = previous.is_some_and(|p| p.is("."));
         previous = Some(*t);
         match t.kind {
-            Kind::Ident if !member => Ok(imported(code, t.text, root_text).map(str::to_string)),
+            Kind::Ident if !member => Ok(imported(code, t.text, root_text).or_else(|| item_alias(code, t.text, aliases)).map(str::to_string)),
             Kind::Path => qualified(code, flag, expr, &t.segments(), aliases).map(Some),
             _ => Ok(None),
         }
@@ -42,6 +42,14 @@ fn qualified(code: &UserCode, flag: &str, expr: &str, segments: &[&str], aliases
     )))
 }
 
+/// The composed name of the item an `#import a::b::item as name` names (Bevy's
+/// `tonemapping_luminance as luminance`): `aliases` holds (name, `a::b::item`).
+fn item_alias<'a>(code: &'a UserCode, name: &str, aliases: &[(String, String)]) -> Option<&'a str> {
+    let (_, target) = aliases.iter().find(|(a, _)| a == name)?;
+    let (module, item) = target.rsplit_once("::")?;
+    code.origins.iter().find(|(_, p, it)| it == item && p == module).map(|(composed, _, _)| composed.as_str())
+}
+
 /// The composed name of `name` where the sampler's file imports it by that name (naga_oil's
 /// `#import a::b::{name}`, WESL's `import package::a::name;`): an expression names it as the
 /// file does. `None` where no import line names it, or two modules hold an item of that name.
@@ -51,4 +59,24 @@ fn imported<'a>(code: &'a UserCode, name: &str, root_text: &str) -> Option<&'a s
     let mut held = code.origins.iter().filter(|(_, _, item)| item == name).map(|(composed, _, _)| composed.as_str());
     let first = held.next()?;
     (imports && held.all(|c| c == first)).then_some(first)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::compose::Source;
+    use crate::check::composition::Dialect;
+
+    /// Bevy's `#import bevy_core_pipeline::tonemapping::tonemapping_luminance as luminance`: a
+    /// call expression says `luminance(…)`, as the file does; a member `.luminance` stays.
+    #[test]
+    fn an_item_imported_under_an_alias_is_named_by_the_alias() {
+        let sources = [Source { name: "brdf.wgsl".into(), text: String::new() }];
+        let origins = vec![("tonemapping_luminanceX_mod_X".to_string(), "bevy_core_pipeline::tonemapping".to_string(), "tonemapping_luminance".to_string())];
+        let code = UserCode::tree(Dialect::NagaOil, &sources, "naga_oil", String::new(), origins);
+        let aliases = [("luminance".to_string(), "bevy_core_pipeline::tonemapping::tonemapping_luminance".to_string())];
+        let root = "#import bevy_core_pipeline::tonemapping::tonemapping_luminance as luminance\n";
+        let out = resolve(&code, "--pdf", "1.0 - luminance(c) + s.luminance", root, &aliases).unwrap();
+        assert_eq!(out, "1.0 - tonemapping_luminanceX_mod_X(c) + s.luminance");
+    }
 }

@@ -36,7 +36,7 @@ pub(super) struct Translation {
 /// written as WGSL. `locate` turns a validation error into a message at the user's file.
 pub(super) fn to_wgsl(mut module: naga::Module, file: &str, locate: impl Fn(&naga::WithSpan<naga::valid::ValidationError>) -> String) -> Result<Translation, CheckError> {
     module.entry_points.clear();
-    super::callees_first::callees_first(&mut module);
+    super::super::call_graph::callees_first(&mut module);
     let caps = naga::valid::Capabilities::all();
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), caps).validate(&module).map_err(|e| CheckError::Wgsl(locate(&e)))?;
     let text = free_writer_names(&super::super::compose::write_wgsl(&module, caps)?);

@@ -1,5 +1,7 @@
-//! A translated module's functions put callees first, as naga's validator requires of its
-//! function arena (a function may call only functions before it).
+//! The call graph of a user's module, for what naga itself cannot do with it: a translated
+//! module's functions put callees first, as naga's validator requires of its function arena (a
+//! function may call only functions before it), and a composed tree cut to what naga's WGSL
+//! writer can write.
 //!
 //! GLSL declares a function before its definition with a prototype (`vec3 Eval(State s);`, so
 //! that a function defined earlier can call it); naga's GLSL front end gives the function its
@@ -28,7 +30,7 @@ pub(super) fn callees_first(module: &mut Module) {
 /// `module`; their names. A renderer's tree holds them beside its samplers (Bevy Solari's
 /// `scene_bindings` traces shadow rays); a sampler cannot reach them in lobes' compute passes,
 /// which have no acceleration structure to trace.
-pub(in crate::check) fn drop_ray_queries(module: &mut Module) -> Vec<String> {
+pub(super) fn drop_ray_queries(module: &mut Module) -> Vec<String> {
     let uses = uses_ray_queries;
     let callees: Vec<Vec<usize>> = module.functions.iter().map(|(_, f)| calls(&f.body).iter().map(|h| h.index()).collect()).collect();
     let mut dropped: Vec<bool> = module.functions.iter().map(|(_, f)| uses(f)).collect();
@@ -47,7 +49,7 @@ pub(in crate::check) fn drop_ray_queries(module: &mut Module) -> Vec<String> {
 }
 
 /// Whether a function or entry point of `module` uses ray queries ([`drop_ray_queries`]).
-pub(in crate::check) fn needs_cut(module: &Module) -> bool {
+pub(super) fn needs_cut(module: &Module) -> bool {
     module.functions.iter().any(|(_, f)| uses_ray_queries(f)) || module.entry_points.iter().any(|e| uses_ray_queries(&e.function))
 }
 
