@@ -419,6 +419,20 @@ fn body_of(decl: &str) -> Result<(usize, usize), CheckError> {
 mod tests {
     use super::*;
 
+    /// Locals named as naga's writer names its own values (`_e4`, `_e5`: what a module written
+    /// by naga once, as naga_oil's headers are, holds) beside the values the writer names anew:
+    /// written, the suffix undone, and read back, no name is defined twice in a function (Bevy
+    /// 0.19.1's Solari BRDF gave "redefinition of `_e41`").
+    #[test]
+    fn locals_named_like_the_writers_values_stay_distinct() {
+        let text = "fn f(x: f32) -> f32 {\n    let _e4 = x * 2.0;\n    let _e5 = sin(x) + cos(_e4);\n    let _e6 = _e5 * _e5 + x;\n    return _e6 * x + sin(_e6 * 3.0) * cos(_e5);\n}\n";
+        let module = naga::front::wgsl::parse_str(text).unwrap();
+        let written = write_wgsl(&module, naga::valid::Capabilities::all()).unwrap();
+        if let Err(e) = naga::front::wgsl::parse_str(&written) {
+            panic!("{}\n{written}", e.emit_to_string(&written));
+        }
+    }
+
     #[test]
     fn digit_suffixes_are_undone() {
         assert_eq!(undo_digit_suffix("fn f0_(a: f32) -> f32 { let x_1 = a; return v2_ + b_; }"), "fn f0(a: f32) -> f32 { let x_1 = a; return v2 + b_; }");
