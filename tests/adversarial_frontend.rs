@@ -261,7 +261,7 @@ fn density_expressions_of_the_wrong_type_or_empty_are_named_in_the_flags_terms()
 }
 
 /// Item 16: `--define N=99999999999` is out of i32's range (said so); `X=false` vs `#ifdef X`
-/// behaves as docs/testing-your-own-sampler.md says (naga_oil's rule: `#ifdef` asks whether X is
+/// behaves as docs/samplers-in-repositories.md says (naga_oil's rule: `#ifdef` asks whether X is
 /// defined at all).
 #[test]
 fn define_values_out_of_range_are_named() {
@@ -269,7 +269,7 @@ fn define_values_out_of_range_are_named() {
     common::copy_dir(&root().join(OIL), &dir);
     bad_input(&oil_check(&dir, &["--define", "N=99999999999"]), &["--define N=99999999999", "out of the range of i32"]);
     bad_input(&oil_check(&dir, &["--define", "N=99999999999u"]), &["--define N=99999999999u", "out of the range of u32"]);
-    let docs = std::fs::read_to_string(root().join("docs/testing-your-own-sampler.md")).unwrap();
+    let docs = std::fs::read_to_string(root().join("docs/samplers-in-repositories.md")).unwrap();
     assert!(docs.contains("`--define X=false`") && docs.contains("`#ifdef X`"), "the docs say what X=false does to #ifdef X");
 }
 

@@ -8,7 +8,7 @@
 //! Block kinds, by the fence's info string:
 //! - `sh`: each line runs with bash in a temporary folder holding copies of `scenes/`,
 //!   `examples/` and `tests/fixtures/repository/` (the renderer trees of
-//!   docs/testing-your-own-sampler.md), `lobes` first on PATH and `cargo run --release -- ARGS` run as `lobes ARGS`;
+//!   docs/samplers-in-repositories.md), `lobes` first on PATH and `cargo run --release -- ARGS` run as `lobes ARGS`;
 //!   one folder per page, lines in order. Exit 0, or the code of a trailing `# exit N`. Not run:
 //!   `bash .ci/install &&` (apt; the rest of the line runs), `cargo test`, `cargo clippy`,
 //!   `duplicates` (the suite and the tools), `cargo run --example NAME` (its code runs in

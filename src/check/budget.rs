@@ -3,7 +3,7 @@
 //! compiling the passes, the quadrature of the pdf, the probe passes: independent of N) plus N
 //! times the time per sample of the histogram (and weights) passes; short pilot checks measure
 //! both on the adapter at hand, and the count is the largest whose predicted time
-//! t₀ + N · s is within the budget (docs/testing-your-own-sampler.md).
+//! t₀ + N · s is within the budget (docs/check-reference.md, `--budget`).
 
 use super::{CheckError, Settings, UserSampler, check};
 use crate::engine::gpu::Gpu;

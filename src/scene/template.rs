@@ -57,7 +57,7 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 # sampler = {{ wgsl = ["my_ggx.wgsl"], sample = "my_sample", pdf = "my_pdf", eval = "my_eval" }}
 #                         # files relative to the scene; eval is optional; sample, pdf and eval
 #                         # are function names or WGSL calls over wi, u, d, params, p0…p15, rng
-# (more keys of sampler, as the flags of lobes check; docs/testing-your-own-sampler.md):
+# (more keys of sampler, as the flags of lobes check; docs/check-reference.md):
 #   shader_root = ["shaders"], define = {{ NAME = true }}, stub = {{ "package::bindings" = "stub.wesl" }}
 #   package = {{ bevy_render = "bevy_render/src" }}   # another WESL package's folder
 #   texture = {{ env_radiance = "sky.hdr" }}, buffer = {{ env_marginal = "marginal.npy" }}   # the renderer's resources
