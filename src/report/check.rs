@@ -20,7 +20,7 @@ pub const POWER_JSON: &str = "power.json";
 
 /// Every file a check writes into its folder: an owner removes them all before it runs
 /// ([`super::folder::OutFolder::clean_files`]), so that none is left looking like this check's.
-pub const CHECK_FILES: [&str; 8] = [REPORT_JSON, POWER_JSON, COMPOSED_WGSL, MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, MARGINALS_PNG, super::compare::BARS_PNG];
+pub const CHECK_FILES: [&str; 9] = [REPORT_JSON, POWER_JSON, COMPOSED_WGSL, MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, super::compare::RESIDUAL_COARSE_PNG, MARGINALS_PNG, super::compare::BARS_PNG];
 
 /// Writes the heat maps, `composed.wgsl` (the module that ran) and then `report.json` into `dir`.
 pub fn write(dir: &Path, report: &Report, composed: &str) -> anyhow::Result<()> {
@@ -48,4 +48,28 @@ fn write_maps(dir: &Path, report: &Report) -> anyhow::Result<()> {
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
     let coarse = report.figures::<Chi2Figures>().and_then(|c| crate::stats::family::caught_grid(&c.chi2));
     compare::write(dir, &Comparison { bins, measured: &counts, expected: &report.expected, caption: &caption, note: &note, coarse })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::compare::{Bins, Comparison, write as draw};
+    use super::*;
+    use crate::stats::domain::Domain;
+
+    /// Every picture a check can draw (the coarse grid's residual among them) is one the next
+    /// check, or run, into the same folder removes first: none is left from an earlier failure.
+    #[test]
+    fn every_picture_drawn_is_cleaned_next_time() {
+        let dir = tempfile::tempdir().unwrap();
+        let lobe: Vec<f64> = (0..32).map(|i| if i / 8 >= 2 { 50.0 + (i % 8) as f64 } else { 0.0 }).collect();
+        let c = Comparison { bins: Bins::Grid(Domain::Sphere.grid(4, 8)), measured: &lobe, expected: &lobe, caption: "lobe", note: "", coarse: Some((2, 4)) };
+        draw(dir.path(), &c).unwrap();
+        let items = Comparison { bins: Bins::Items(3), measured: &[1.0, 2.0, 3.0], expected: &[1.0, 2.0, 3.0], caption: "d", note: "", coarse: None };
+        draw(dir.path(), &items).unwrap();
+        let names: Vec<String> = std::fs::read_dir(dir.path()).unwrap().map(|f| f.unwrap().file_name().into_string().unwrap()).collect();
+        assert!(names.len() >= 6, "{names:?}");
+        for name in &names {
+            assert!(CHECK_FILES.contains(&name.as_str()) && super::super::folder::CASE_FILES.contains(&name.as_str()), "{name} is drawn but not cleaned");
+        }
+    }
 }

@@ -24,7 +24,7 @@ pub use crate::folder_names::{JUNIT_XML, LOCK_FILE, SUMMARY_JSON, TOP_LEVEL_FILE
 /// The files of a case folder that `lobes run` and `lobes merge` write: only these are removed
 /// when the folder is cleaned (a user's own files there, and shard files, are kept). The first
 /// four mark a folder that a lobes case wrote.
-pub const CASE_FILES: [&str; 10] = [
+pub const CASE_FILES: [&str; 11] = [
     "histogram.json",
     "timing.json",
     "counts.npy",
@@ -32,6 +32,7 @@ pub const CASE_FILES: [&str; 10] = [
     super::compare::MEASURED_PNG,
     super::compare::EXPECTED_PNG,
     super::compare::RESIDUAL_PNG,
+    super::compare::RESIDUAL_COARSE_PNG,
     super::compare::MARGINALS_PNG,
     super::compare::BARS_PNG,
     "albedo.png",
