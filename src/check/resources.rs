@@ -306,6 +306,18 @@ mod tests {
     }
 
     #[test]
+    fn a_sampler_fits_a_sampler_only() {
+        let module = naga::front::wgsl::parse_str("@group(0) @binding(0) var s: sampler;\n@group(0) @binding(1) var c: sampler_comparison;\n@group(0) @binding(2) var t: texture_2d<f32>;").unwrap();
+        let fit = |name: &str| {
+            let (_, g) = module.global_variables.iter().find(|(_, g)| g.name.as_deref() == Some(name)).unwrap();
+            fits(name, &Data::Sampler(Filter::Linear), g, &module)
+        };
+        assert_eq!(fit("s"), Ok(()));
+        assert!(fit("c").unwrap_err().contains("`c` is a sampler_comparison (a depth comparison), which lobes does not bind"));
+        assert!(fit("t").unwrap_err().contains("--sampler t=linear: `t` is not declared as a `sampler`"));
+    }
+
+    #[test]
     fn a_sampler_is_a_filter_and_no_file() {
         assert_eq!(Filter::parse("linear"), Some(Filter::Linear));
         assert_eq!(Filter::parse("nearest"), Some(Filter::Nearest));

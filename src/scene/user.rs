@@ -140,8 +140,8 @@ fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneEr
 }
 
 /// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
-/// stub, package, texture, buffer, filter (`--sampler`), sample_returns, normal (the flags of `lobes check`), paths
-/// relative to the scene file.
+/// stub, package, texture, buffer, filter (`--sampler`), sample_returns, normal (the flags of
+/// `lobes check`), paths relative to the scene file.
 fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
     use crate::check::{Composition, Draw, SampleReturns};
     let mut c = Composition::default();

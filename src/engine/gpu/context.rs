@@ -158,7 +158,8 @@ impl Gpu {
             })?,
         };
         let info = adapter.get_info();
-        // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
+        // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it. FLOAT32_FILTERABLE
+        // where offered: `lobes check --texture` (rgba32float) read through a `--sampler`.
         #[cfg(feature = "check")]
         let cache_file = pipeline_cache::folder().filter(|_| !pipeline_cache::disabled()).and_then(|f| pipeline_cache::file(&f, &info));
         #[cfg(not(feature = "check"))]
