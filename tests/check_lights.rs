@@ -318,3 +318,39 @@ fn a_scene_binds_the_maps_texture_and_tables() {
     assert_eq!(passed("env"), Value::Bool(true));
     assert_eq!(passed("env-corners"), Value::Bool(false));
 }
+
+/// A renderer's `sampler` (`--sampler NAME=linear|nearest`): a cosine sampler whose pdf reads a
+/// lookup texture of 1s through `textureSampleLevel` with a sampler, both declared in a naga_oil
+/// module of their own (as Bevy Solari's `brdf_dfg_lut` and `brdf_dfg_lut_sampler`). It passes
+/// with either filter (lavapipe has FLOAT32_FILTERABLE, which a sampled rgba32float texture
+/// needs); without `--sampler`, or with `--sampler` naming the texture, it is exit 2, with the
+/// user's plain names, not naga_oil's decorated ones.
+#[test]
+fn a_renderers_sampler_is_bound_by_its_filter() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-sampler-lut");
+    std::fs::create_dir_all(&dir).unwrap();
+    let lut = "#define_import_path renderer::lut\n\n@group(0) @binding(0) var lut: texture_2d<f32>;\n@group(0) @binding(1) var lut_sampler: sampler;\n\nfn lut_factor(uv: vec2<f32>) -> f32 {\n    return textureSampleLevel(lut, lut_sampler, uv, 0.0).r;\n}\n";
+    let cosine = "#import renderer::lut::lut_factor\n\nfn cos_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n    let r = sqrt(u.x);\n    let phi = 6.2831853 * u.y;\n    let d = vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));\n    return vec4<f32>(d, cos_pdf(wi, d, params));\n}\n\nfn cos_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n    return max(d.z, 0.0) / 3.14159265 * lut_factor(vec2<f32>(0.5, d.z));\n}\n";
+    std::fs::write(dir.join("lut.wgsl"), lut).unwrap();
+    std::fs::write(dir.join("cosine.wgsl"), cosine).unwrap();
+    // a 4 × 2 Radiance image, flat RGBE (128, 128, 128, 129): every texel 1.0 exactly
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+    hdr.extend([128u8, 128, 128, 129].repeat(8));
+    std::fs::write(dir.join("one.hdr"), hdr).unwrap();
+    let (file, texture) = (dir.join("cosine.wgsl").display().to_string(), format!("lut={}", dir.join("one.hdr").display()));
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", &file, "--sample", "cos_sample", "--pdf", "cos_pdf", "--samples", "65536"];
+        args.extend_from_slice(extra);
+        lobes(&args)
+    };
+    for filter in ["lut_sampler=nearest", "lut_sampler=linear"] {
+        assert_eq!(check(&["--texture", &texture, "--sampler", filter]).status.code(), Some(0), "{filter}");
+    }
+    let unbound = check(&["--texture", &texture]);
+    assert_eq!(unbound.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&unbound.stderr);
+    assert!(stderr.contains("`lut_sampler` of module renderer::lut (@group(0) @binding(1), a sampler) is a resource of the renderer that the sampler reads, and nothing is bound to it") && stderr.contains("--sampler lut_sampler=linear or nearest"), "{stderr}");
+    let swapped = check(&["--sampler", "lut=nearest", "--texture", &format!("lut_sampler={}", dir.join("one.hdr").display())]);
+    assert_eq!(swapped.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&swapped.stderr).contains("--sampler lut=nearest: `lut` is not declared as a `sampler`"));
+}

@@ -73,18 +73,22 @@ impl Composition {
         self.resources.push((name.into(), super::resources::Resource::Buffer(file.into())));
         self
     }
-    /// `--texture` and `--buffer` flags, each NAME=FILE, named once each.
-    pub fn parse_resources(textures: &[String], buffers: &[String]) -> Result<Vec<(String, super::resources::Resource)>, String> {
-        use super::resources::Resource;
-        let mut out: Vec<(String, Resource)> = Vec::new();
-        let flags = textures.iter().map(|t| ("--texture", t)).chain(buffers.iter().map(|b| ("--buffer", b)));
+    /// A sampler bound as the sampler's `name: sampler` (`--sampler NAME=linear|nearest`).
+    pub fn sampler(mut self, name: &str, filter: super::resources::Filter) -> Self {
+        self.resources.push((name.into(), super::resources::Resource::Sampler(filter)));
+        self
+    }
+    /// `--texture` and `--buffer` flags, each NAME=FILE, and `--sampler` flags, each
+    /// NAME=linear|nearest; each NAME named once.
+    pub fn parse_resources(textures: &[String], buffers: &[String], samplers: &[String]) -> Result<Vec<(String, super::resources::Resource)>, String> {
+        let mut out: Vec<(String, super::resources::Resource)> = Vec::new();
+        let flags = textures.iter().map(|t| ("--texture", t)).chain(buffers.iter().map(|b| ("--buffer", b))).chain(samplers.iter().map(|s| ("--sampler", s)));
         for (flag, item) in flags {
-            let (name, file) = item.split_once('=').map(|(n, f)| (n.trim(), f.trim())).filter(|(n, f)| is_name(n) && !f.is_empty()).ok_or_else(|| format!("{flag} '{item}': give NAME=FILE, NAME the variable the sampler's files declare, e.g. {flag} env_map={}", if flag == "--texture" { "sky.hdr" } else { "cdf.npy" }))?;
+            let (name, resource) = parse_resource(flag, item)?;
             if out.iter().any(|(n, _)| n == name) {
                 return Err(format!("{flag} '{item}': {name} is bound twice"));
             }
-            let file = PathBuf::from(file);
-            out.push((name.to_string(), if flag == "--texture" { Resource::Texture(file) } else { Resource::Buffer(file) }));
+            out.push((name.to_string(), resource));
         }
         Ok(out)
     }
@@ -337,8 +341,27 @@ impl UserCode {
     }
 }
 
+/// One `--texture`/`--buffer` NAME=FILE or `--sampler` NAME=FILTER, as the name and what it binds.
+fn parse_resource<'a>(flag: &str, item: &'a str) -> Result<(&'a str, super::resources::Resource), String> {
+    use super::resources::{Filter, Resource};
+    let example = match flag {
+        "--texture" => "env_map=sky.hdr",
+        "--buffer" => "env_cdf=cdf.npy",
+        _ => "lut_sampler=linear",
+    };
+    let usage = || format!("{flag} '{item}': give NAME={}, NAME the variable the sampler's files declare, e.g. {flag} {example}", if flag == "--sampler" { "linear or nearest" } else { "FILE" });
+    let (name, value) = item.split_once('=').map(|(n, v)| (n.trim(), v.trim())).filter(|(n, v)| is_name(n) && !v.is_empty()).ok_or_else(usage)?;
+    let resource = match flag {
+        "--texture" => Resource::Texture(value.into()),
+        "--buffer" => Resource::Buffer(value.into()),
+        _ => Resource::Sampler(Filter::parse(value).ok_or_else(|| format!("{flag} '{item}': the filter '{value}' is unknown; give linear or nearest (the sampler clamps to the edge)"))?),
+    };
+    Ok((name, resource))
+}
+
 #[cfg(test)]
 mod tests {
+    use super::super::resources::{Filter, Resource};
     use super::*;
 
     #[test]
@@ -349,5 +372,21 @@ mod tests {
         assert_eq!(Draw::list(&[2, 0, 1, 3], 3), "event,x,y");
         assert!(Draw::parse_list("x,x").is_err());
         assert!(Draw::parse_list("z").unwrap_err().contains("'z' is not a draw"));
+    }
+
+    #[test]
+    fn a_sampler_flag_is_a_name_and_a_filter() {
+        let r = Composition::parse_resources(&["env=sky.hdr".into()], &[], &["lut_sampler=linear".into(), " s = nearest ".into()]).unwrap();
+        assert_eq!(r, vec![("env".into(), Resource::Texture("sky.hdr".into())), ("lut_sampler".into(), Resource::Sampler(Filter::Linear)), ("s".into(), Resource::Sampler(Filter::Nearest))]);
+    }
+
+    #[test]
+    fn a_bad_sampler_flag_says_what_to_give() {
+        let bad = |s: &str| Composition::parse_resources(&[], &[], &[s.into()]).unwrap_err();
+        assert!(bad("s=bilinear").contains("'bilinear' is unknown; give linear or nearest"), "{}", bad("s=bilinear"));
+        assert!(bad("s").contains("give NAME=linear or nearest"));
+        assert!(bad("1s=linear").contains("e.g. --sampler lut_sampler=linear"));
+        let twice = Composition::parse_resources(&["s=a.hdr".into()], &[], &["s=linear".into()]).unwrap_err();
+        assert!(twice.contains("s is bound twice"), "{twice}");
     }
 }

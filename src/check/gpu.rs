@@ -76,6 +76,7 @@ pub(super) struct Passes<'g> {
 enum GpuResource {
     Texture(wgpu::TextureView),
     Buffer(wgpu::Buffer),
+    Sampler(wgpu::Sampler),
 }
 
 impl GpuResource {
@@ -102,15 +103,59 @@ impl GpuResource {
                 bytes.resize(bytes.len().max(4), 0);
                 GpuResource::Buffer(gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(&b.name), contents: &bytes, usage: wgpu::BufferUsages::STORAGE }))
             }
+            Data::Sampler(f) => GpuResource::Sampler(sampler(gpu, &b.name, *f)),
         }
     }
     fn entry(&self, binding: u32) -> wgpu::BindGroupEntry<'_> {
         let resource = match self {
             GpuResource::Texture(v) => wgpu::BindingResource::TextureView(v),
             GpuResource::Buffer(b) => b.as_entire_binding(),
+            GpuResource::Sampler(s) => wgpu::BindingResource::Sampler(s),
         };
         wgpu::BindGroupEntry { binding, resource }
     }
+}
+
+/// A user's sampler (`--sampler NAME=FILTER`): `filter` for magnification and minification,
+/// nearest between mip levels, clamp-to-edge in every direction.
+fn sampler(gpu: &Gpu, name: &str, filter: super::resources::Filter) -> wgpu::Sampler {
+    let mode = match filter {
+        super::resources::Filter::Linear => wgpu::FilterMode::Linear,
+        super::resources::Filter::Nearest => wgpu::FilterMode::Nearest,
+    };
+    gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some(name),
+        address_mode_u: wgpu::AddressMode::ClampToEdge,
+        address_mode_v: wgpu::AddressMode::ClampToEdge,
+        address_mode_w: wgpu::AddressMode::ClampToEdge,
+        mag_filter: mode,
+        min_filter: mode,
+        mipmap_filter: wgpu::MipmapFilterMode::Nearest,
+        ..Default::default()
+    })
+}
+
+/// Bad input where a pass reads a `--texture` (rgba32float: lobes keeps the image's precision)
+/// through a `--sampler` and the adapter lacks wgpu's FLOAT32_FILTERABLE: wgpu's derived layout
+/// marks a texture that a pass samples as filterable, which rgba32float is only with that
+/// feature, so binding it would fail, whatever the sampler's filter.
+fn unfilterable(gpu: &Gpu, bound: &[super::resources::Bound]) -> Result<(), CheckError> {
+    use super::resources::Data;
+    if gpu.float32_filterable() {
+        return Ok(());
+    }
+    let reads = |b: &super::resources::Bound, other: &super::resources::Bound| b.entries.iter().any(|e| other.entries.contains(e));
+    for s in bound.iter().filter(|b| matches!(*b.data, Data::Sampler(_))) {
+        if let Some(t) = bound.iter().find(|t| matches!(*t.data, Data::Texture { .. }) && reads(t, s)) {
+            return Err(CheckError::Input(format!(
+                "--sampler {}: the sampler reads the texture `{}` (--texture, rgba32float) through it, and this adapter, {}, lacks wgpu's FLOAT32_FILTERABLE, without which wgpu binds no float32 texture to a pass that samples it (nearest or linear); lobes does not lower the image's precision: run the check on an adapter that has it (lavapipe and desktop Vulkan do), or give a stand-in that reads the texture with textureLoad (--stub MODULE=FILE)",
+                s.name,
+                t.name,
+                gpu.adapter_name()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// What the sample call returns.
@@ -667,11 +712,16 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
     Ok(())
 }
 
-/// Why a reached resource of the user's has nothing bound, and what to give.
+/// Why a reached resource of the user's has nothing bound, and what to give; a naga_oil name
+/// (`nameX_naga_oil_mod_X…X`) as the user's plain name and its module.
 fn unbound(g: &naga::GlobalVariable, b: &naga::ResourceBinding, module: &naga::Module) -> String {
-    let name = g.name.as_deref().unwrap_or("?");
+    let global = g.name.as_deref().unwrap_or("?");
+    let (name, from) = match super::resources::undecorated(global) {
+        Some((name, module)) => (name, format!(" of module {module}")),
+        None => (global, String::new()),
+    };
     format!(
-        "`{name}` (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture {name}=FILE.hdr for a texture_2d<f32>, --buffer {name}=FILE.npy for a storage array), or give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
+        "`{name}`{from} (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture {name}=FILE.hdr for a texture_2d<f32>, --buffer {name}=FILE.npy for a storage array, --sampler {name}=linear or nearest for a sampler), or give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
         b.group,
         b.binding,
         resource_kind(g, &module.types[g.ty].inner)
@@ -684,6 +734,7 @@ fn resource_kind(g: &naga::GlobalVariable, inner: &naga::TypeInner) -> &'static 
         (naga::AddressSpace::Storage { .. }, _) => "a storage buffer",
         (naga::AddressSpace::Uniform, _) => "a uniform buffer",
         (_, naga::TypeInner::Image { .. }) => "a texture",
+        (_, naga::TypeInner::Sampler { comparison: true }) => "a sampler_comparison",
         (_, naga::TypeInner::Sampler { .. }) => "a sampler",
         (_, naga::TypeInner::AccelerationStructure { .. }) => "an acceleration structure",
         _ => "a resource",
@@ -728,6 +779,7 @@ impl<'g> Passes<'g> {
         // `composed` is already validated with its errors mapped to the user's files
         let module = gpu.module_unvalidated("lobes check", &composed.text)?;
         gpu.check_errors()?;
+        unfilterable(gpu, &composed.bound)?;
         let resources = composed.bound.iter().map(|b| (b.binding, b.entries.clone(), GpuResource::upload(gpu, b))).collect();
         gpu.check_errors()?;
         Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default(), resources, group1: Default::default() })

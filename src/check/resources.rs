@@ -2,7 +2,9 @@
 //! radiance and its CDF tables, as the renderer builds them, instead of a stand-in. `--texture
 //! NAME=FILE` binds a Radiance `.hdr` image as `NAME: texture_2d<f32>` (rgba32float, read with
 //! `textureLoad`); `--buffer NAME=FILE` binds a `.npy` array of float32, uint32 or int32 (any
-//! shape, C order, read as flat) as `var<storage, read> NAME: array<f32>` (or `u32`, `i32`).
+//! shape, C order, read as flat) as `var<storage, read> NAME: array<f32>` (or `u32`, `i32`);
+//! `--sampler NAME=linear|nearest` binds `NAME: sampler` (clamp-to-edge, for
+//! `textureSampleLevel`).
 //! Each resource the passes reach is moved to `@group(1)`, binding 0, 1, … in declaration
 //! order (lobes' own are group 0), in the composed text only: the lines stay where they were.
 
@@ -16,18 +18,48 @@ pub enum Resource {
     Texture(PathBuf),
     /// A `.npy` array, bound as a read-only storage buffer.
     Buffer(PathBuf),
+    /// A `sampler` of this filter, clamp-to-edge.
+    Sampler(Filter),
 }
 
 impl Resource {
-    pub fn path(&self) -> &Path {
+    /// The file read for the resource; `None` for a sampler, which is made, not read.
+    pub fn path(&self) -> Option<&Path> {
         match self {
-            Resource::Texture(p) | Resource::Buffer(p) => p,
+            Resource::Texture(p) | Resource::Buffer(p) => Some(p),
+            Resource::Sampler(_) => None,
         }
     }
     fn flag(&self) -> &'static str {
         match self {
             Resource::Texture(_) => "--texture",
             Resource::Buffer(_) => "--buffer",
+            Resource::Sampler(_) => "--sampler",
+        }
+    }
+}
+
+/// How a bound sampler filters (`--sampler NAME=linear|nearest`), for magnification and
+/// minification alike; mipmaps are nearest (lobes' textures have one level).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    Linear,
+    Nearest,
+}
+
+impl Filter {
+    /// `linear` or `nearest`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "linear" => Some(Filter::Linear),
+            "nearest" => Some(Filter::Nearest),
+            _ => None,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Filter::Linear => "linear",
+            Filter::Nearest => "nearest",
         }
     }
 }
@@ -57,6 +89,8 @@ pub enum Data {
     Texture { width: u32, height: u32, texels: Vec<[f32; 4]> },
     /// The array's elements as 32-bit words, and their type.
     Buffer { scalar: Scalar, words: Vec<u32> },
+    /// A sampler's filter: nothing to read.
+    Sampler(Filter),
 }
 
 /// A user's resource bound at `@group(1) @binding(binding)`, and the passes that read it.
@@ -70,11 +104,18 @@ pub struct Bound {
 
 /// Reads `r`; the message says what is wrong with the file, after `{flag} NAME=FILE: `.
 pub fn load(name: &str, r: &Resource) -> Result<Data, String> {
-    let at = format!("{} {name}={}", r.flag(), r.path().display());
-    let bytes = std::fs::read(r.path()).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
+    let Some(path) = r.path() else {
+        return Ok(match r {
+            Resource::Sampler(f) => Data::Sampler(*f),
+            _ => unreachable!("only a sampler has no file"),
+        });
+    };
+    let at = format!("{} {name}={}", r.flag(), path.display());
+    let bytes = std::fs::read(path).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
     match r {
         Resource::Texture(_) => read_hdr(&bytes).map_err(|e| format!("{at}: {e}")),
         Resource::Buffer(_) => read_npy(&bytes).map(|(scalar, words)| Data::Buffer { scalar, words }).map_err(|e| format!("{at}: {e}")),
+        Resource::Sampler(_) => unreachable!("a sampler has no file"),
     }
 }
 
@@ -145,6 +186,9 @@ pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Mo
             }
         }
         (Data::Buffer { .. }, _) => Err(format!("--buffer {name}: `{name}` is not declared as var<storage, read> {name}: array<f32> (or u32, i32)")),
+        (Data::Sampler(_), TypeInner::Sampler { comparison: false }) => Ok(()),
+        (Data::Sampler(f), TypeInner::Sampler { comparison: true }) => Err(format!("--sampler {name}={}: `{name}` is a sampler_comparison (a depth comparison), which lobes does not bind: --sampler binds a filtering `sampler`; give the test a stand-in without it (--stub MODULE=FILE)", f.name())),
+        (Data::Sampler(f), _) => Err(format!("--sampler {name}={}: `{name}` is not declared as a `sampler`; --sampler binds one (var {name}: sampler;)", f.name())),
     }
 }
 
@@ -152,6 +196,30 @@ pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Mo
 /// (`nameX_naga_oil_mod_X…`) or the wesl crate (`…_1name`) renamed it.
 pub fn names(global: &str, name: &str) -> bool {
     global == name || global.strip_prefix(name).is_some_and(|r| r.starts_with("X_naga_oil_mod_X")) || global.ends_with(&format!("_1{name}"))
+}
+
+/// A naga_oil name `nameX_naga_oil_mod_X…X` as the user's plain name and the module that
+/// declares it (naga_oil's own `Composer::undecorate` is private); `None` for any other name.
+pub fn undecorated(global: &str) -> Option<(&str, String)> {
+    let (name, rest) = global.split_once("X_naga_oil_mod_X")?;
+    let module = base32(rest.strip_suffix('X')?)?;
+    Some((name, String::from_utf8(module).ok()?))
+}
+
+/// RFC 4648 base32 without padding (naga_oil's module decoration), decoded.
+fn base32(text: &str) -> Option<Vec<u8>> {
+    const ALPHABET: &[u8; 32] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZ234567";
+    let (mut bits, mut held, mut out) = (0u32, 0u32, Vec::new());
+    for c in text.bytes() {
+        bits = (bits << 5) | ALPHABET.iter().position(|&a| a == c)? as u32;
+        held += 5;
+        if held >= 8 {
+            held -= 8;
+            out.push((bits >> held) as u8);
+            bits &= (1 << held) - 1;
+        }
+    }
+    Some(out)
 }
 
 /// `text` with the `@group(…)` and `@binding(…)` attributes of the declaration that ends at
@@ -228,5 +296,32 @@ mod tests {
         assert!(names("env_cdfX_naga_oil_mod_XMJSXM6K7", "env_cdf"));
         assert!(names("_1bevy_pbr_1env_cdf", "env_cdf"));
         assert!(!names("env_cdf2", "env_cdf"));
+    }
+
+    #[test]
+    fn a_naga_oil_name_is_undecorated_to_its_name_and_module() {
+        // naga_oil's decoration of `bevy_pbr::utils` (BASE32_NOPAD of the module's path)
+        assert_eq!(undecorated("lutX_naga_oil_mod_XMJSXM6K7OBRHEOR2OV2GS3DTX"), Some(("lut", "bevy_pbr::utils".to_string())));
+        assert_eq!(undecorated("lut"), None);
+    }
+
+    #[test]
+    fn a_sampler_fits_a_sampler_only() {
+        let module = naga::front::wgsl::parse_str("@group(0) @binding(0) var s: sampler;\n@group(0) @binding(1) var c: sampler_comparison;\n@group(0) @binding(2) var t: texture_2d<f32>;").unwrap();
+        let fit = |name: &str| {
+            let (_, g) = module.global_variables.iter().find(|(_, g)| g.name.as_deref() == Some(name)).unwrap();
+            fits(name, &Data::Sampler(Filter::Linear), g, &module)
+        };
+        assert_eq!(fit("s"), Ok(()));
+        assert!(fit("c").unwrap_err().contains("`c` is a sampler_comparison (a depth comparison), which lobes does not bind"));
+        assert!(fit("t").unwrap_err().contains("--sampler t=linear: `t` is not declared as a `sampler`"));
+    }
+
+    #[test]
+    fn a_sampler_is_a_filter_and_no_file() {
+        assert_eq!(Filter::parse("linear"), Some(Filter::Linear));
+        assert_eq!(Filter::parse("nearest"), Some(Filter::Nearest));
+        assert_eq!(Filter::parse("bilinear"), None);
+        assert_eq!(load("s", &Resource::Sampler(Filter::Nearest)), Ok(Data::Sampler(Filter::Nearest)));
     }
 }

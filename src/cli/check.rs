@@ -81,6 +81,10 @@ pub struct CheckArgs {
     /// bound as the files' var<storage, read> NAME: array<f32> (or u32, i32).
     #[arg(long, value_name = "NAME=FILE")]
     pub buffer: Vec<String>,
+    /// A renderer's sampler the sampler reads (repeatable): bound as the files' NAME: sampler
+    /// with FILTER linear or nearest, clamp-to-edge (for textureSampleLevel over a --texture).
+    #[arg(long, value_name = "NAME=FILTER")]
+    pub sampler: Vec<String>,
     /// The sampler's random function (repeatable): its body becomes lobes' queue of u.x, u.y, u.z,
     /// u.w in call order (vec2/3/4 results take 2/3/4); at most four draws per sample.
     #[arg(long, value_name = "NAME")]
@@ -232,7 +236,7 @@ impl CheckArgs {
         )
         .map_err(usage)?;
         let packages = check::Composition::parse_packages(&self.package).map_err(usage)?;
-        let resources = check::Composition::parse_resources(&self.texture, &self.buffer).map_err(usage)?;
+        let resources = check::Composition::parse_resources(&self.texture, &self.buffer, &self.sampler).map_err(usage)?;
         let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
     }

@@ -61,6 +61,7 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 #   shader_root = ["shaders"], define = {{ NAME = true }}, stub = {{ "package::bindings" = "stub.wesl" }}
 #   package = {{ bevy_render = "bevy_render/src" }}   # another WESL package's folder
 #   texture = {{ env_radiance = "sky.hdr" }}, buffer = {{ env_marginal = "marginal.npy" }}   # the renderer's resources
+#   filter = {{ brdf_dfg_lut_sampler = "linear" }}   # a renderer's sampler (--sampler): "linear" or "nearest"
 #   rand = ["rand_f"], rand_order = "event,x,y", sample_returns = "half-vector"
 #   incident = "upper", reflection_only = true, u_open = true, measure = "projected", frame = "y-up"
 #   measure = "area", normal = "vec3<f32>(0.0, 0.0, -1.0)"   # a light sampled by area: (p, pdf_A)

@@ -35,6 +35,9 @@ pub(super) struct RawSampler {
     package: Option<Val>,
     texture: Option<Val>,
     buffer: Option<Val>,
+    /// The renderer's samplers, `NAME = "linear"` or `"nearest"` (`--sampler`; the key
+    /// `sampler` is this table's own).
+    filter: Option<Val>,
     sample_returns: Option<Val>,
     normal: Option<Val>,
 }
@@ -51,7 +54,7 @@ pub struct UserCase {
     pub budget: Option<Budget>,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, texture = { NAME = \"file.hdr\" }, buffer = { NAME = \"file.npy\" }, sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, texture = { NAME = \"file.hdr\" }, buffer = { NAME = \"file.npy\" }, filter = { NAME = \"linear\" or \"nearest\" } (a renderer's sampler), sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -137,8 +140,8 @@ fn strings<'v>(ctx: &Ctx, v: &'v Val, key: &str) -> Result<Vec<&'v str>, SceneEr
 }
 
 /// The keys of a sampler as it is in its repository: rand, rand_order, shader_root, define,
-/// stub, package, texture, buffer, sample_returns, normal (the flags of `lobes check`), paths
-/// relative to the scene file.
+/// stub, package, texture, buffer, filter (`--sampler`), sample_returns, normal (the flags of
+/// `lobes check`), paths relative to the scene file.
 fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::Composition, SceneError> {
     use crate::check::{Composition, Draw, SampleReturns};
     let mut c = Composition::default();
@@ -190,11 +193,7 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
         c.packages = paths(v, "package", "a folder name")?;
         Composition::parse_packages(&flags(&c.packages)).map_err(|e| ctx.err(v.span(), format!("sampler.package: {e}")))?;
     }
-    let (textures, buffers) = (r.texture.as_ref().map(|v| paths(v, "texture", "a file name")).transpose()?, r.buffer.as_ref().map(|v| paths(v, "buffer", "a file name")).transpose()?);
-    if textures.is_some() || buffers.is_some() {
-        let at = r.texture.as_ref().or(r.buffer.as_ref()).expect("one of them").span();
-        c.resources = Composition::parse_resources(&flags(&textures.unwrap_or_default()), &flags(&buffers.unwrap_or_default())).map_err(|e| ctx.err(at, format!("sampler.texture/buffer: {e}")))?;
-    }
+    c.resources = resources(ctx, r, base)?;
     if let Some(v) = &r.sample_returns {
         c.sample_returns = match string(ctx, v, "sampler.sample_returns", "use \"direction\" or \"half-vector\"")? {
             "direction" => SampleReturns::Direction,
@@ -206,6 +205,29 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
         c.normal = Some(string(ctx, v, "sampler.normal", "write normal = \"WGSL over p\", the light's unit normal at the sampled point (with measure = \"area\")")?.to_string());
     }
     Ok(c)
+}
+
+/// `texture = { NAME = "file.hdr" }`, `buffer = { NAME = "file.npy" }` and `filter = { NAME =
+/// "linear" }`: the renderer's resources (`--texture`, `--buffer`, `--sampler`), the files
+/// relative to `base`.
+fn resources(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<Vec<(String, crate::check::resources::Resource)>, SceneError> {
+    let keyed = [("texture", &r.texture), ("buffer", &r.buffer), ("filter", &r.filter)];
+    let Some(at) = keyed.iter().find_map(|(_, v)| v.as_ref()).map(|v| v.span()) else { return Ok(Vec::new()) };
+    let mut flags: [Vec<String>; 3] = Default::default();
+    for ((key, v), out) in keyed.iter().zip(&mut flags) {
+        let Some(v) = v else { continue };
+        let Value::Table(t) = v.get_ref() else {
+            return Err(ctx.err(v.span(), format!("sampler.{key} must be a table, got {}; {SAMPLER_ALLOWED}", kind_of(v.get_ref()))));
+        };
+        let what = if *key == "filter" { "\"linear\" or \"nearest\"" } else { "a file name" };
+        for (name, value) in t {
+            let Value::String(s) = value else {
+                return Err(ctx.err(v.span(), format!("sampler.{key}.\"{name}\" must be {what} (a string); {SAMPLER_ALLOWED}")));
+            };
+            out.push(if *key == "filter" { format!("{name}={s}") } else { format!("{name}={}", base.join(s).display()) });
+        }
+    }
+    crate::check::Composition::parse_resources(&flags[0], &flags[1], &flags[2]).map_err(|e| ctx.err(at, format!("sampler.texture/buffer/filter: {e}")))
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no

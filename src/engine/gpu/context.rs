@@ -158,13 +158,15 @@ impl Gpu {
             })?,
         };
         let info = adapter.get_info();
-        // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it.
+        // SHADER_F64 where offered: only `lobes tradeoff`'s f64 kernels use it. FLOAT32_FILTERABLE
+        // where offered: `lobes check --texture` (rgba32float) read through a `--sampler`.
         #[cfg(feature = "check")]
         let cache_file = pipeline_cache::folder().filter(|_| !pipeline_cache::disabled()).and_then(|f| pipeline_cache::file(&f, &info));
         #[cfg(not(feature = "check"))]
         let cache_file: Option<()> = None;
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::SHADER_F64
+            | wgpu::Features::FLOAT32_FILTERABLE
             | if cache_file.is_some() { wgpu::Features::PIPELINE_CACHE } else { wgpu::Features::empty() };
         let features = adapter.features() & wanted;
         let limits = shrink(adapter.limits());
@@ -214,6 +216,13 @@ impl Gpu {
 
     pub fn has_timestamps(&self) -> bool {
         self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Whether a float32 texture (`lobes check --texture`, rgba32float) may be read through a
+    /// sampler (the adapter has FLOAT32_FILTERABLE): wgpu's derived layouts mark a texture that
+    /// an entry point samples as filterable, which rgba32float is only with this feature.
+    pub fn float32_filterable(&self) -> bool {
+        self.features.contains(wgpu::Features::FLOAT32_FILTERABLE)
     }
 
     /// Whether the device runs WGSL `f64` (the adapter has SHADER_F64).
