@@ -1,6 +1,6 @@
 //! A renderer's textures and tables, bound where its sampler reads them: an environment map's
 //! radiance and its CDF tables, as the renderer builds them, instead of a stand-in. `--texture
-//! NAME=FILE` binds a Radiance `.hdr` image as `NAME: texture_2d<f32>` (rgba32float, read with
+//! NAME=FILE` binds a Radiance `.hdr` or a `.png` image (its stored values, no sRGB decoding) as `NAME: texture_2d<f32>` (rgba32float, read with
 //! `textureLoad`); `--buffer NAME=FILE` binds a `.npy` array of float32, uint32 or int32 (any
 //! shape, C order, read as flat) as `var<storage, read> NAME: array<f32>` (or `u32`, `i32`);
 //! `--sampler NAME=linear|nearest` binds `NAME: sampler` (clamp-to-edge, for
@@ -14,7 +14,7 @@ use std::sync::Arc;
 /// What a name is bound to.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resource {
-    /// A `.hdr` image, bound as a `texture_2d<f32>`.
+    /// A `.hdr` or `.png` image, bound as a `texture_2d<f32>`.
     Texture(PathBuf),
     /// A `.npy` array, bound as a read-only storage buffer.
     Buffer(PathBuf),
@@ -113,7 +113,7 @@ pub fn load(name: &str, r: &Resource) -> Result<Data, String> {
     let at = format!("{} {name}={}", r.flag(), path.display());
     let bytes = std::fs::read(path).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
     match r {
-        Resource::Texture(_) => read_hdr(&bytes).map_err(|e| format!("{at}: {e}")),
+        Resource::Texture(_) => read_image(path, &bytes).map_err(|e| format!("{at}: {e}")),
         Resource::Buffer(_) => read_npy(&bytes).map(|(scalar, words)| Data::Buffer { scalar, words }).map_err(|e| format!("{at}: {e}")),
         Resource::Sampler(_) => unreachable!("a sampler has no file"),
     }
@@ -124,6 +124,24 @@ fn read_hdr(bytes: &[u8]) -> Result<Data, String> {
     let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr).map_err(|e| format!("not a Radiance .hdr image: {e}"))?.into_rgb32f();
     let (width, height) = img.dimensions();
     let texels = img.pixels().map(|p| [p[0], p[1], p[2], 1.0]).collect();
+    Ok(Data::Texture { width, height, texels })
+}
+
+/// A texture file by its extension: a Radiance `.hdr` ([`read_hdr`]) or a `.png`, whose stored
+/// values are the texels (8-bit v as v / 255, 16-bit as v / 65535, alpha kept, no sRGB decoding:
+/// what a renderer's lookup table holds when it is loaded as a unorm texture).
+fn read_image(path: &Path, bytes: &[u8]) -> Result<Data, String> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("hdr") => read_hdr(bytes),
+        Some("png") => read_png(bytes),
+        _ => Err("a texture is a Radiance .hdr or a .png image (by its extension)".into()),
+    }
+}
+
+fn read_png(bytes: &[u8]) -> Result<Data, String> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| format!("not a PNG image: {e}"))?.into_rgba32f();
+    let (width, height) = img.dimensions();
+    let texels = img.pixels().map(|p| p.0).collect();
     Ok(Data::Texture { width, height, texels })
 }
 
@@ -323,5 +341,26 @@ mod tests {
         assert_eq!(Filter::parse("nearest"), Some(Filter::Nearest));
         assert_eq!(Filter::parse("bilinear"), None);
         assert_eq!(load("s", &Resource::Sampler(Filter::Nearest)), Ok(Data::Sampler(Filter::Nearest)));
+    }
+
+    /// A 16-bit and an 8-bit PNG written by the image crate read back as their stored values
+    /// over 65535 and 255 (a lookup table loaded as unorm), alpha kept; another extension is
+    /// refused naming the two formats.
+    #[test]
+    fn a_png_texture_holds_its_stored_values() {
+        let mut png = std::io::Cursor::new(Vec::new());
+        let wide = image::ImageBuffer::<image::Rgba<u16>, _>::from_raw(2, 1, vec![0, 65535, 32768, 65535, 13107, 0, 65535, 0]).unwrap();
+        image::DynamicImage::ImageRgba16(wide).write_to(&mut png, image::ImageFormat::Png).unwrap();
+        let Data::Texture { width, height, texels } = read_image(Path::new("lut.png"), png.get_ref()).unwrap() else { panic!("not a texture") };
+        assert_eq!((width, height), (2, 1));
+        assert_eq!(texels[0], [0.0, 1.0, 32768.0 / 65535.0, 1.0]);
+        assert_eq!(texels[1], [0.2, 0.0, 1.0, 0.0]);
+        let mut png = std::io::Cursor::new(Vec::new());
+        let narrow = image::ImageBuffer::<image::Rgba<u8>, _>::from_raw(1, 1, vec![51, 255, 0, 128]).unwrap();
+        image::DynamicImage::ImageRgba8(narrow).write_to(&mut png, image::ImageFormat::Png).unwrap();
+        let Data::Texture { texels, .. } = read_image(Path::new("LUT.PNG"), png.get_ref()).unwrap() else { panic!("not a texture") };
+        assert_eq!(texels[0], [0.2, 1.0, 0.0, 128.0 / 255.0]);
+        let e = read_image(Path::new("lut.exr"), png.get_ref()).unwrap_err();
+        assert!(e.contains(".hdr or a .png"), "{e}");
     }
 }
