@@ -292,20 +292,26 @@ fn bindings_without_the_right_file_are_exit_2() {
 }
 
 /// The same map as a case of a scene: `texture` and `buffer` are the flags' keys, paths relative
-/// to the scene file.
+/// to the scene file; its conditional table a raw file of little-endian f32 (`.bin`).
 #[test]
 fn a_scene_binds_the_maps_texture_and_tables() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-envmap-scene");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let maps = Path::new(env!("CARGO_MANIFEST_DIR")).join(ENVMAP);
+    // the conditional table as a renderer's fwrite leaves it: the .npy's data without its header
+    // (version 1: a 2-byte header length at byte 8), raw little-endian f32, typed by its declaration
+    let npy = std::fs::read(maps.join("conditional.npy")).unwrap();
+    assert_eq!(&npy[..8], b"\x93NUMPY\x01\x00");
+    let raw = dir.join("conditional.bin");
+    std::fs::write(&raw, &npy[10 + u16::from_le_bytes([npy[8], npy[9]]) as usize..]).unwrap();
     let case = |name: &str, sample: &str| {
         format!(
             "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"{sample}\", pdf = \"env_pdf\", texture = {{ env_radiance = {hdr:?} }}, buffer = {{ env_marginal = {m:?}, env_conditional = {c:?} }} }}\nparams = [{INTEGRAL}]\nsamples = 262144\n\n",
             wgsl = maps.join("envmap.wgsl"),
             hdr = maps.join("sky.hdr"),
             m = maps.join("marginal.npy"),
-            c = maps.join("conditional.npy"),
+            c = raw,
         )
     };
     let scene = dir.join("envmap.toml");

@@ -1,10 +1,11 @@
 //! A renderer's textures and tables, bound where its sampler reads them: an environment map's
 //! radiance and its CDF tables, as the renderer builds them, instead of a stand-in. `--texture
-//! NAME=FILE` binds a Radiance `.hdr` or a `.png` image (its stored values, no sRGB decoding) as `NAME: texture_2d<f32>` (rgba32float, read with
-//! `textureLoad`); `--buffer NAME=FILE` binds a `.npy` array of float32, uint32 or int32 (any
-//! shape, C order, read as flat) as `var<storage, read> NAME: array<f32>` (or `u32`, `i32`);
-//! `--sampler NAME=linear|nearest` binds `NAME: sampler` (clamp-to-edge, for
-//! `textureSampleLevel`).
+//! NAME=FILE` binds a Radiance `.hdr` or a `.png` image (its stored values, no sRGB decoding) as
+//! `NAME: texture_2d<f32>` (rgba32float, read with `textureLoad`); `--buffer NAME=FILE` binds a
+//! `.npy` array of float32, uint32 or int32 (any shape, C order, read as flat), or a raw file of
+//! little-endian 32-bit words (`.bin`, `.raw`, typed by the declaration), as
+//! `var<storage, read> NAME: array<f32>` (or `u32`, `i32`); `--sampler NAME=linear|nearest` binds
+//! `NAME: sampler` (clamp-to-edge, for `textureSampleLevel`).
 //! Each resource the passes reach is moved to `@group(1)`, binding 0, 1, … in declaration
 //! order (lobes' own are group 0), in the composed text only: the lines stay where they were.
 
@@ -16,7 +17,8 @@ use std::sync::Arc;
 pub enum Resource {
     /// A `.hdr` or `.png` image, bound as a `texture_2d<f32>`.
     Texture(PathBuf),
-    /// A `.npy` array, bound as a read-only storage buffer.
+    /// A `.npy` array or raw little-endian 32-bit words (`.bin`, `.raw`), bound as a read-only
+    /// storage buffer.
     Buffer(PathBuf),
     /// A `sampler` of this filter, clamp-to-edge.
     Sampler(Filter),
@@ -87,8 +89,9 @@ impl Scalar {
 pub enum Data {
     /// rgba texels, row-major from the image's top row, alpha 1.
     Texture { width: u32, height: u32, texels: Vec<[f32; 4]> },
-    /// The array's elements as 32-bit words, and their type.
-    Buffer { scalar: Scalar, words: Vec<u32> },
+    /// The array's elements as 32-bit words, and their type: `None` for raw words, whose type is
+    /// the declaration's.
+    Buffer { scalar: Option<Scalar>, words: Vec<u32> },
     /// A sampler's filter: nothing to read.
     Sampler(Filter),
 }
@@ -114,7 +117,7 @@ pub fn load(name: &str, r: &Resource) -> Result<Data, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
     match r {
         Resource::Texture(_) => read_image(path, &bytes).map_err(|e| format!("{at}: {e}")),
-        Resource::Buffer(_) => read_npy(&bytes).map(|(scalar, words)| Data::Buffer { scalar, words }).map_err(|e| format!("{at}: {e}")),
+        Resource::Buffer(_) => read_table(path, &bytes).map_err(|e| format!("{at}: {e}")),
         Resource::Sampler(_) => unreachable!("a sampler has no file"),
     }
 }
@@ -143,6 +146,25 @@ fn read_png(bytes: &[u8]) -> Result<Data, String> {
     let (width, height) = img.dimensions();
     let texels = img.pixels().map(|p| p.0).collect();
     Ok(Data::Texture { width, height, texels })
+}
+
+/// A table file by its extension: a NumPy `.npy` array ([`read_npy`]), or raw little-endian
+/// 32-bit words (`.bin`, `.raw`: what a renderer's `fwrite` of a `float` or `uint32_t` array
+/// writes), typed by the WGSL declaration it is bound to.
+fn read_table(path: &Path, bytes: &[u8]) -> Result<Data, String> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        Some("npy") => read_npy(bytes).map(|(scalar, words)| Data::Buffer { scalar: Some(scalar), words }),
+        Some("bin" | "raw") => read_raw(bytes).map(|words| Data::Buffer { scalar: None, words }),
+        _ => Err("a table is a NumPy .npy array or raw little-endian 32-bit words (.bin, .raw), by its extension".into()),
+    }
+}
+
+/// Raw little-endian 32-bit words: a whole, non-zero number of them.
+fn read_raw(bytes: &[u8]) -> Result<Vec<u32>, String> {
+    if bytes.is_empty() || bytes.len() % 4 != 0 {
+        return Err(format!("raw table of {} bytes: expected a non-zero multiple of 4 (32-bit little-endian words)", bytes.len()));
+    }
+    Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect())
 }
 
 /// A `.npy` file (NumPy's format, version 1–3: the magic, a header dict, the raw data) of
@@ -198,8 +220,8 @@ pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Mo
                 _ => None,
             };
             match want {
-                Some(w) if w == *scalar => Ok(()),
-                Some(w) => Err(format!("--buffer {name}: the file holds {} and `{name}` is an array<{}>", scalar.wgsl(), w.wgsl())),
+                Some(w) if scalar.is_none_or(|s| s == w) => Ok(()),
+                Some(w) => Err(format!("--buffer {name}: the file holds {} and `{name}` is an array<{}>", scalar.map_or("raw words", Scalar::wgsl), w.wgsl())),
                 None => Err(format!("--buffer {name}: `{name}` is not an array of f32, u32 or i32; --buffer binds a flat table")),
             }
         }
@@ -285,6 +307,22 @@ mod tests {
         assert_eq!(words.iter().map(|w| f32::from_bits(*w)).collect::<Vec<_>>(), vec![0.5, -2.0, 3.25, 1e-30]);
         let (s, words) = read_npy(&npy("<u4", "(3,)", &[1, 0, 0, 0, 2, 0, 0, 0, 255, 255, 255, 255])).unwrap();
         assert_eq!((s, words), (Scalar::U32, vec![1, 2, u32::MAX]));
+    }
+
+    #[test]
+    fn a_raw_table_is_little_endian_words_typed_by_its_declaration() {
+        let path = Path::new("cdf.bin");
+        let bytes: Vec<u8> = [0.25f32, 1.0].iter().flat_map(|x| x.to_le_bytes()).collect();
+        assert_eq!(read_table(path, &bytes).unwrap(), Data::Buffer { scalar: None, words: vec![0x3e80_0000, 0x3f80_0000] });
+        assert!(read_table(Path::new("cdf.raw"), &bytes[..7]).unwrap_err().contains("7 bytes"));
+        assert!(read_table(path, &[]).unwrap_err().contains("non-zero multiple of 4"));
+        assert!(read_table(Path::new("cdf.csv"), &bytes).unwrap_err().contains(".npy array or raw little-endian"));
+        // bound to a declaration of any 32-bit element type; a .npy's type must match it
+        let module = naga::front::wgsl::parse_str("@group(0) @binding(0) var<storage, read> t: array<u32>;").unwrap();
+        let (_, g) = module.global_variables.iter().next().unwrap();
+        assert_eq!(fits("t", &Data::Buffer { scalar: None, words: vec![1] }, g, &module), Ok(()));
+        let typed = fits("t", &Data::Buffer { scalar: Some(Scalar::F32), words: vec![1] }, g, &module).unwrap_err();
+        assert!(typed.contains("holds f32 and `t` is an array<u32>"), "{typed}");
     }
 
     #[test]

@@ -78,8 +78,9 @@ pub struct CheckArgs {
     /// texture_2d<f32> (rgba32float, for textureLoad or a --sampler).
     #[arg(long, value_name = "NAME=FILE")]
     pub texture: Vec<String>,
-    /// A renderer's table the sampler reads (repeatable): a .npy array of float32, uint32 or int32
-    /// bound as the files' var<storage, read> NAME: array<f32> (or u32, i32).
+    /// A renderer's table the sampler reads (repeatable): a .npy array of float32, uint32 or int32,
+    /// or raw little-endian 32-bit words (.bin, .raw), bound as the files' var<storage, read>
+    /// NAME: array<f32> (or u32, i32).
     #[arg(long, value_name = "NAME=FILE")]
     pub buffer: Vec<String>,
     /// A renderer's sampler the sampler reads (repeatable): bound as the files' NAME: sampler
