@@ -112,53 +112,81 @@ fn run(gpu: &Gpu, what: String, s: &UserSampler, settings: Settings) -> Run {
     Run { what, report }
 }
 
+/// One run of the sweep: what it is, the sampler, its settings.
+type Job<'a> = (String, &'a UserSampler, Settings);
+
+/// Runs the jobs on two threads, each with its own adapter (a check spends part of its time in
+/// one-threaded work: the driver's shader compiler, the host's quadrature), in their order.
+fn run_all(jobs: Vec<Job>) -> Vec<Run> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, Run)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..2)
+            .map(|_| {
+                scope.spawn(|| {
+                    let gpu = gpu();
+                    let mut mine = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some((what, s, settings)) = jobs.get(i) else { break mine };
+                        mine.push((i, run(&gpu, what.clone(), s, settings.clone())));
+                    }
+                })
+            })
+            .collect();
+        workers.into_iter().flat_map(|w| w.join().unwrap()).collect()
+    });
+    done.sort_by_key(|d| d.0);
+    done.into_iter().map(|d| d.1).collect()
+}
+
 #[test]
 fn correct_samplers_pass_over_their_documented_range() {
-    let gpu = gpu();
-    let mut runs = Vec::new();
+    let mut jobs: Vec<Job> = Vec::new();
     let ggx = sampler(&["ggx_vndf.wgsl"], "ggx_sample", "ggx_pdf", Some("ggx_eval"));
     let beckmann = sampler(&["beckmann_vndf.wgsl"], "beck_sample", "beck_pdf", None);
     let glass = sampler(&["ggx_vndf.wgsl", "rough_dielectric.wgsl"], "rd_sample", "rd_pdf", Some("rd_eval"));
     let mixture = sampler(&["ggx_vndf.wgsl", "ggx_diffuse_mixture.wgsl"], "mix_sample", "mix_pdf", None);
     for (i, &(ax, ay, theta)) in MICROFACET.iter().enumerate() {
         let at = |params: Vec<f64>| Settings { params, incident_theta: theta, incident_phi: 20.0, ..Settings::default() };
-        runs.push(run(&gpu, format!("ggx_vndf α ({ax}, {ay}) θi {theta}"), &ggx, at(vec![ax, ay])));
-        runs.push(run(&gpu, format!("beckmann_vndf α ({ax}, {ay}) θi {theta}"), &beckmann, at(vec![ax, ay])));
+        jobs.push((format!("ggx_vndf α ({ax}, {ay}) θi {theta}"), &ggx, at(vec![ax, ay])));
+        jobs.push((format!("beckmann_vndf α ({ax}, {ay}) θi {theta}"), &beckmann, at(vec![ax, ay])));
         // glass from outside and (every other α) from inside, η 1.5 and its inverse
         let eta = if i % 2 == 0 { 1.5 } else { 1.0 / 1.5 };
-        runs.push(run(&gpu, format!("rough_dielectric α ({ax}, {ay}) η {eta:.3} θi {theta}"), &glass, at(vec![ax, ay, eta])));
+        jobs.push((format!("rough_dielectric α ({ax}, {ay}) η {eta:.3} θi {theta}"), &glass, at(vec![ax, ay, eta])));
         let w = [0.5, 0.25, 0.9][i % 3];
-        runs.push(run(&gpu, format!("ggx_diffuse_mixture α ({ax}, {ay}) w {w} θi {theta}"), &mixture, at(vec![ax, ay, w])));
+        jobs.push((format!("ggx_diffuse_mixture α ({ax}, {ay}) w {w} θi {theta}"), &mixture, at(vec![ax, ay, w])));
     }
     let hg = sampler(&["henyey_greenstein.wgsl"], "hg_sample", "hg_pdf", Some("hg_eval"));
     for g in [-0.99, -0.95, -0.5, 0.0, 0.3, 0.9, 0.95, 0.99] {
-        runs.push(run(&gpu, format!("henyey_greenstein g {g}"), &hg, Settings { params: vec![g], ..Settings::default() }));
+        jobs.push((format!("henyey_greenstein g {g}"), &hg, Settings { params: vec![g], ..Settings::default() }));
     }
+    let ibl_sampler = ibl(IBL_PDF);
     for (roughness, theta) in [(0.1, 30.0), (0.3, 60.0), (0.7, 10.0)] {
         let settings = Settings { params: vec![roughness], incident_theta: theta, incident_phi: 20.0, ..Settings::default() };
-        runs.push(run(&gpu, format!("ibl_prefilter roughness {roughness} θi {theta}"), &ibl(IBL_PDF), settings));
+        jobs.push((format!("ibl_prefilter roughness {roughness} θi {theta}"), &ibl_sampler, settings));
     }
     let plane = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
     let env = UserSampler::from_files(&files(&["piecewise_2d.wgsl"]), "env_sample", "env_pdf", None, plane).unwrap();
     for seed in [1, 2] {
-        runs.push(run(&gpu, format!("piecewise_2d seed {seed}"), &env, Settings { seed, ..Settings::default() }));
+        jobs.push((format!("piecewise_2d seed {seed}"), &env, Settings { seed, ..Settings::default() }));
     }
     let light = rect_light("rect_sample", "rect_pdf");
     for params in RECT_LIGHTS {
-        runs.push(run(&gpu, format!("rect_light {params:?}"), &light, Settings { params: params.to_vec(), samples: LIGHT_SAMPLES, ..Settings::default() }));
+        jobs.push((format!("rect_light {params:?}"), &light, Settings { params: params.to_vec(), samples: LIGHT_SAMPLES, ..Settings::default() }));
     }
     let cone = sampler(&["cone_light.wgsl"], "cone_sample", "cone_pdf", None);
     for params in CONE_LIGHTS {
-        runs.push(run(&gpu, format!("cone_light {params:?}"), &cone, Settings { params: params.to_vec(), samples: LIGHT_SAMPLES, ..Settings::default() }));
+        jobs.push((format!("cone_light {params:?}"), &cone, Settings { params: params.to_vec(), samples: LIGHT_SAMPLES, ..Settings::default() }));
     }
     // lobes' own samplers as a user's: every other configuration of the grid each
-    for (j, spec) in REGISTRY.iter().enumerate() {
-        let s = UserSampler::builtin(spec);
+    let builtins: Vec<UserSampler> = REGISTRY.iter().map(UserSampler::builtin).collect();
+    for (j, (spec, s)) in REGISTRY.iter().zip(&builtins).enumerate() {
         for &(ax, ay, theta) in MICROFACET.iter().skip(j % 2).step_by(2) {
             let settings = Settings { params: vec![ax, ay], incident_theta: theta, incident_phi: 20.0, ..Settings::default() };
-            runs.push(run(&gpu, format!("builtin {} α ({ax}, {ay}) θi {theta}", spec.name()), &s, settings));
+            jobs.push((format!("builtin {} α ({ax}, {ay}) θi {theta}", spec.name()), s, settings));
         }
     }
+    let runs = run_all(jobs);
 
     let pointwise: Vec<String> = runs
         .iter()

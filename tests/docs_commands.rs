@@ -247,98 +247,125 @@ fn not_run_form(cmd: &str) -> Option<Result<(), String>> {
 fn every_documented_command_runs() {
     let tmp = tempfile::tempdir().unwrap();
     let bin = bin_dir(tmp.path());
+    // The pages run on two threads (each in its own folder, its lines in order): a lobes process
+    // spends much of its time in one-threaded work (start-up, the driver's shader compiler).
+    let pages = pages();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut results: Vec<(usize, Vec<String>, usize)> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..2)
+            .map(|_| {
+                s.spawn(|| {
+                    let mut done = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(page) = pages.get(i) else { break done };
+                        let (errors, ran) = run_page(page, tmp.path(), &bin);
+                        done.push((i, errors, ran));
+                    }
+                })
+            })
+            .collect();
+        workers.into_iter().flat_map(|w| w.join().unwrap()).collect()
+    });
+    results.sort_by_key(|r| r.0);
+    let ran: usize = results.iter().map(|r| r.2).sum();
+    let errors: Vec<String> = results.into_iter().flat_map(|r| r.1).collect();
+    assert!(errors.is_empty(), "{} documented command(s) failed:\n{}", errors.len(), errors.join("\n"));
+    assert!(ran >= 20, "only {ran} documented commands ran: are the pages there?");
+}
+
+/// Runs or checks every shell line of `page` in a folder of its own under `tmp`: the errors
+/// found and the number of commands run.
+fn run_page(page: &str, tmp: &Path, bin: &Path) -> (Vec<String>, usize) {
     let mut errors = Vec::new();
     let mut ran = 0;
-    for page in pages() {
-        let lines = shell_lines(&page, &read(&page), &mut errors);
-        let work = tmp.path().join(page.replace('/', "_"));
-        copy_tree(&Path::new(ROOT).join("scenes"), &work.join("scenes"));
-        copy_tree(&Path::new(ROOT).join("examples"), &work.join("examples"));
-        copy_tree(&Path::new(ROOT).join("tests/fixtures/repository"), &work.join("tests/fixtures/repository"));
-        for line in lines {
-            let at = format!("{page}:{}", line.number);
-            let text = line.text.as_str();
-            if text.starts_with('#') && !text.starts_with("#SBATCH") && !text.starts_with("#!") {
-                continue; // a comment line
+    let lines = shell_lines(page, &read(page), &mut errors);
+    let work = tmp.join(page.replace('/', "_"));
+    copy_tree(&Path::new(ROOT).join("scenes"), &work.join("scenes"));
+    copy_tree(&Path::new(ROOT).join("examples"), &work.join("examples"));
+    copy_tree(&Path::new(ROOT).join("tests/fixtures/repository"), &work.join("tests/fixtures/repository"));
+    for line in lines {
+        let at = format!("{page}:{}", line.number);
+        let text = line.text.as_str();
+        if text.starts_with('#') && !text.starts_with("#SBATCH") && !text.starts_with("#!") {
+            continue; // a comment line
+        }
+        match line.kind {
+            Kind::Run => {
+                let mut script = text.to_string();
+                if let Some(rest) = script.strip_prefix("bash .ci/install && ") {
+                    assert!(Path::new(ROOT).join(".ci/install").is_file(), "{at}: .ci/install is missing");
+                    script = rest.to_string();
+                }
+                match not_run_form(&script) {
+                    Some(Ok(())) => continue,
+                    Some(Err(why)) => {
+                        errors.push(format!("{at}: `{text}`: {why}"));
+                        continue;
+                    }
+                    None => {}
+                }
+                let script = script.replace("cargo run --release -- ", "lobes ");
+                let want = expected_exit(text);
+                let started = Instant::now();
+                ran += 1;
+                match bash(&script, &work, bin, &[]) {
+                    None => errors.push(format!("{at}: `{text}` ran past {} s", TIMEOUT.as_secs())),
+                    Some(out) if out.status.code() != Some(want) => errors.push(format!(
+                        "{at}: `{text}` exited with {:?}, expected {want} (annotate `# exit N` if meant)\n    {}",
+                        out.status.code(),
+                        tail(&out.stderr)
+                    )),
+                    Some(_) => eprintln!("{at}: ok in {:.1} s: {text}", started.elapsed().as_secs_f64()),
+                }
             }
-            match line.kind {
-                Kind::Run => {
-                    let mut script = text.to_string();
-                    if let Some(rest) = script.strip_prefix("bash .ci/install && ") {
-                        assert!(Path::new(ROOT).join(".ci/install").is_file(), "{at}: .ci/install is missing");
-                        script = rest.to_string();
-                    }
-                    match not_run_form(&script) {
-                        Some(Ok(())) => continue,
-                        Some(Err(why)) => {
-                            errors.push(format!("{at}: `{text}`: {why}"));
-                            continue;
-                        }
-                        None => {}
-                    }
-                    let script = script.replace("cargo run --release -- ", "lobes ");
-                    let want = expected_exit(text);
-                    let started = Instant::now();
+            Kind::Install => {
+                let cmd = command_of(text);
+                let cmd = cmd.strip_prefix("sudo ").unwrap_or(cmd);
+                // docs/install-mesa.md: the backports opt-in, its undoing, and a private copy
+                // of a driver for one process (extracted packages, the loader pointed at it)
+                let install = ["apt-get", "apt", "dnf", "pacman", "brew", "winget"].iter().any(|w| starts_with_word(cmd, w))
+                    || cmd.starts_with("cargo install ")
+                    || cmd == "bash .ci/install"
+                    || cmd.starts_with("bash .ci/install --")
+                    || cmd.starts_with("rm /etc/apt/sources.list.d/")
+                    || cmd.starts_with("for d in *.deb; do dpkg-deb -x ")
+                    || (text.trim_start().starts_with("VK_DRIVER_FILES=") && cmd.starts_with("target/release/lobes "));
+                if !install {
+                    errors.push(format!("{at}: `{text}` in a ```sh install block is not an install command"));
+                }
+            }
+            Kind::Dev => {
+                let cmd = command_of(text);
+                let cmd = cmd.strip_prefix("bash .ci/install && ").unwrap_or(cmd);
+                let dev = starts_with_word(cmd, "cargo") || starts_with_word(cmd, "duplicates") || cmd.starts_with("bash .ci/");
+                if !dev {
+                    errors.push(format!("{at}: `{text}` in a ```sh dev block is not a development command"));
+                }
+            }
+            Kind::Cluster => {
+                if starts_with_word(text, "lobes") {
+                    // The scheduler's variables at shard 0; the comment, if any, dropped.
+                    let command = text.split(" #").next().unwrap().trim_end();
+                    let env = [("SLURM_ARRAY_TASK_ID", "0"), ("JOB_COMPLETION_INDEX", "0")];
                     ran += 1;
-                    match bash(&script, &work, &bin, &[]) {
-                        None => errors.push(format!("{at}: `{text}` ran past {} s", TIMEOUT.as_secs())),
-                        Some(out) if out.status.code() != Some(want) => errors.push(format!(
-                            "{at}: `{text}` exited with {:?}, expected {want} (annotate `# exit N` if meant)\n    {}",
-                            out.status.code(),
-                            tail(&out.stderr)
+                    match bash(&format!("{command} --help"), &work, bin, &env) {
+                        Some(out) if out.status.success() && String::from_utf8_lossy(&out.stdout).contains("Usage: lobes ") => {}
+                        out => errors.push(format!(
+                            "{at}: `{text}`: clap rejects its arguments\n    {}",
+                            out.map_or("timed out".into(), |o| tail(&o.stderr))
                         )),
-                        Some(_) => eprintln!("{at}: ok in {:.1} s: {text}", started.elapsed().as_secs_f64()),
                     }
-                }
-                Kind::Install => {
-                    let cmd = command_of(text);
-                    let cmd = cmd.strip_prefix("sudo ").unwrap_or(cmd);
-                    // docs/install-mesa.md: the backports opt-in, its undoing, and a private copy
-                    // of a driver for one process (extracted packages, the loader pointed at it)
-                    let install = ["apt-get", "apt", "dnf", "pacman", "brew", "winget"].iter().any(|w| starts_with_word(cmd, w))
-                        || cmd.starts_with("cargo install ")
-                        || cmd == "bash .ci/install"
-                        || cmd.starts_with("bash .ci/install --")
-                        || cmd.starts_with("rm /etc/apt/sources.list.d/")
-                        || cmd.starts_with("for d in *.deb; do dpkg-deb -x ")
-                        || (text.trim_start().starts_with("VK_DRIVER_FILES=") && cmd.starts_with("target/release/lobes "));
-                    if !install {
-                        errors.push(format!("{at}: `{text}` in a ```sh install block is not an install command"));
-                    }
-                }
-                Kind::Dev => {
-                    let cmd = command_of(text);
-                    let cmd = cmd.strip_prefix("bash .ci/install && ").unwrap_or(cmd);
-                    let dev = starts_with_word(cmd, "cargo") || starts_with_word(cmd, "duplicates") || cmd.starts_with("bash .ci/");
-                    if !dev {
-                        errors.push(format!("{at}: `{text}` in a ```sh dev block is not a development command"));
-                    }
-                }
-                Kind::Cluster => {
-                    if starts_with_word(text, "lobes") {
-                        // The scheduler's variables at shard 0; the comment, if any, dropped.
-                        let command = text.split(" #").next().unwrap().trim_end();
-                        let env = [("SLURM_ARRAY_TASK_ID", "0"), ("JOB_COMPLETION_INDEX", "0")];
-                        ran += 1;
-                        match bash(&format!("{command} --help"), &work, &bin, &env) {
-                            Some(out) if out.status.success() && String::from_utf8_lossy(&out.stdout).contains("Usage: lobes ") => {}
-                            out => errors.push(format!(
-                                "{at}: `{text}`: clap rejects its arguments\n    {}",
-                                out.map_or("timed out".into(), |o| tail(&o.stderr))
-                            )),
-                        }
-                    } else {
-                        let scheduler = ["#!", "#SBATCH", "sbatch ", "jobid=$(sbatch ", "kubectl "].iter().any(|w| text.starts_with(w));
-                        if !scheduler {
-                            errors.push(format!("{at}: `{text}` in a ```sh cluster block is neither a lobes line nor a scheduler command"));
-                        }
+                } else {
+                    let scheduler = ["#!", "#SBATCH", "sbatch ", "jobid=$(sbatch ", "kubectl "].iter().any(|w| text.starts_with(w));
+                    if !scheduler {
+                        errors.push(format!("{at}: `{text}` in a ```sh cluster block is neither a lobes line nor a scheduler command"));
                     }
                 }
             }
         }
     }
-    assert!(errors.is_empty(), "{} documented command(s) failed:\n{}", errors.len(), errors.join("\n"));
-    assert!(ran >= 20, "only {ran} documented commands ran: are the pages there?");
+    (errors, ran)
 }
 
 /// The info strings of a page's fenced ```rust blocks and the lines of its ```LANG blocks.
