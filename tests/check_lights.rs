@@ -292,7 +292,8 @@ fn bindings_without_the_right_file_are_exit_2() {
 }
 
 /// The same map as a case of a scene: `texture` and `buffer` are the flags' keys, paths relative
-/// to the scene file; its conditional table a raw file of little-endian f32 (`.bin`).
+/// to the scene file; its radiance the OpenEXR copy of the map (`sky.exr`) and its conditional
+/// table a raw file of little-endian f32 (`.bin`).
 #[test]
 fn a_scene_binds_the_maps_texture_and_tables() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-envmap-scene");
@@ -309,7 +310,7 @@ fn a_scene_binds_the_maps_texture_and_tables() {
         format!(
             "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"{sample}\", pdf = \"env_pdf\", texture = {{ env_radiance = {hdr:?} }}, buffer = {{ env_marginal = {m:?}, env_conditional = {c:?} }} }}\nparams = [{INTEGRAL}]\nsamples = 262144\n\n",
             wgsl = maps.join("envmap.wgsl"),
-            hdr = maps.join("sky.hdr"),
+            hdr = maps.join("sky.exr"),
             m = maps.join("marginal.npy"),
             c = raw,
         )

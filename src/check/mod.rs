@@ -41,6 +41,7 @@ pub mod compose;
 pub mod composition;
 pub mod conventions;
 pub mod dialect;
+mod exr;
 mod gpu;
 pub mod hard;
 pub mod modules;

@@ -1,7 +1,8 @@
 //! A renderer's textures and tables, bound where its sampler reads them: an environment map's
 //! radiance and its CDF tables, as the renderer builds them, instead of a stand-in. `--texture
-//! NAME=FILE` binds a Radiance `.hdr` or a `.png` image (its stored values, no sRGB decoding) as
-//! `NAME: texture_2d<f32>` (rgba32float, read with `textureLoad`); `--buffer NAME=FILE` binds a
+//! NAME=FILE` binds a Radiance `.hdr`, an OpenEXR `.exr` (scanline, NONE/RLE/ZIPS/ZIP) or a
+//! `.png` image (its stored values, no sRGB decoding) as `NAME: texture_2d<f32>` (rgba32float,
+//! read with `textureLoad`); `--buffer NAME=FILE` binds a
 //! `.npy` array of float32, uint32 or int32 (any shape, C order, read as flat), or a raw file of
 //! little-endian 32-bit words (`.bin`, `.raw`, typed by the declaration), as
 //! `var<storage, read> NAME: array<f32>` (or `u32`, `i32`); `--sampler NAME=linear|nearest` binds
@@ -15,7 +16,7 @@ use std::sync::Arc;
 /// What a name is bound to.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resource {
-    /// A `.hdr` or `.png` image, bound as a `texture_2d<f32>`.
+    /// A `.hdr`, `.exr` or `.png` image, bound as a `texture_2d<f32>`.
     Texture(PathBuf),
     /// A `.npy` array or raw little-endian 32-bit words (`.bin`, `.raw`), bound as a read-only
     /// storage buffer.
@@ -130,14 +131,16 @@ fn read_hdr(bytes: &[u8]) -> Result<Data, String> {
     Ok(Data::Texture { width, height, texels })
 }
 
-/// A texture file by its extension: a Radiance `.hdr` ([`read_hdr`]) or a `.png`, whose stored
+/// A texture file by its extension: a Radiance `.hdr` ([`read_hdr`]), an OpenEXR `.exr` (its
+/// channels' values, [`super::exr`]) or a `.png`, whose stored
 /// values are the texels (8-bit v as v / 255, 16-bit as v / 65535, alpha kept, no sRGB decoding:
 /// what a renderer's lookup table holds when it is loaded as a unorm texture).
 fn read_image(path: &Path, bytes: &[u8]) -> Result<Data, String> {
     match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
         Some("hdr") => read_hdr(bytes),
         Some("png") => read_png(bytes),
-        _ => Err("a texture is a Radiance .hdr or a .png image (by its extension)".into()),
+        Some("exr") => super::exr::read(bytes).map(|(width, height, texels)| Data::Texture { width, height, texels }).map_err(|e| format!("OpenEXR: {e}")),
+        _ => Err("a texture is a Radiance .hdr, an OpenEXR .exr or a .png image (by its extension)".into()),
     }
 }
 
@@ -307,6 +310,19 @@ mod tests {
         assert_eq!(words.iter().map(|w| f32::from_bits(*w)).collect::<Vec<_>>(), vec![0.5, -2.0, 3.25, 1e-30]);
         let (s, words) = read_npy(&npy("<u4", "(3,)", &[1, 0, 0, 0, 2, 0, 0, 0, 255, 255, 255, 255])).unwrap();
         assert_eq!((s, words), (Scalar::U32, vec![1, 2, u32::MAX]));
+    }
+
+    /// examples/envmap's sky as an OpenEXR file (HALF, ZIP) and as Radiance RGBE, written from
+    /// the same texels by make.py (integers times powers of two, exact in both) and read by two
+    /// decoders (this crate's and the `image` crate's): the same texels, bit for bit.
+    #[test]
+    fn the_maps_exr_and_hdr_hold_the_same_texels() {
+        let map = |file: &str| load("env_radiance", &Resource::Texture(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/envmap").join(file))).unwrap();
+        let (exr, hdr) = (map("sky.exr"), map("sky.hdr"));
+        let Data::Texture { width: 64, height: 32, texels } = &exr else { panic!("a 64 × 32 texture: {exr:?}") };
+        assert_eq!(exr, hdr);
+        // the sun: 2 × 2 texels of (250, 230, 200) · 2⁶ at rows 8, 9 and columns 42, 43
+        assert_eq!(texels[8 * 64 + 42], [16000.0, 14720.0, 12800.0, 1.0]);
     }
 
     #[test]

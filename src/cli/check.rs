@@ -73,8 +73,9 @@ pub struct CheckArgs {
     /// .wgsl). Without it, lobes looks for NAME::a::b as a/b.wesl under the shader roots.
     #[arg(long, value_name = "NAME=DIR")]
     pub package: Vec<String>,
-    /// A renderer's texture the sampler reads (repeatable): a Radiance .hdr or a .png image (its
-    /// stored values: 8-bit v is v/255, no sRGB decoding) bound as the files' NAME:
+    /// A renderer's texture the sampler reads (repeatable): a Radiance .hdr, an OpenEXR .exr
+    /// (scanline; NONE, RLE, ZIPS or ZIP) or a .png image (its stored values: 8-bit v is v/255,
+    /// no sRGB decoding) bound as the files' NAME:
     /// texture_2d<f32> (rgba32float, for textureLoad or a --sampler).
     #[arg(long, value_name = "NAME=FILE")]
     pub texture: Vec<String>,
