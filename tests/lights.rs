@@ -9,6 +9,7 @@
 //! - the f64 twins against independent values: ∫pdf dω = 1 by the f64 sphere quadrature
 //!   (`check::quadrature::sphere_integral_f64`), and the map u → d preserves measure,
 //!   pdf(d) |∂d/∂u0 × ∂d/∂u1| = 1 by central differences.
+//!
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
 use glam::DVec3;

@@ -88,7 +88,7 @@ impl Rect {
     /// rectangle of no solid angle).
     pub fn sample(&self, u: [f64; 2]) -> LightSample {
         let omega = self.solid_angle();
-        if !(omega > 0.0) {
+        if omega.is_nan() || omega <= 0.0 {
             return LightSample { d: self.corner.normalize(), pdf: 0.0 };
         }
         let f = self.frame();

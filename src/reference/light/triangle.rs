@@ -37,7 +37,7 @@ impl Triangle {
     pub fn sample_spherical(&self, u: [f64; 2]) -> LightSample {
         let omega = self.solid_angle();
         let a = self.p[0].normalize();
-        if !(omega > 0.0) {
+        if omega.is_nan() || omega <= 0.0 {
             return LightSample { d: a, pdf: 0.0 };
         }
         let (b, c) = (self.p[1].normalize(), self.p[2].normalize());
