@@ -23,7 +23,7 @@ mod wgsl_tokens;
 /// lobes::embed's modules in dependency order (each after those it imports), with their files
 /// under `shaders/`: the order and names of `embed::Module::ALL` (a unit test holds the two
 /// together). A module is what a renderer imports as one: a lobe's sampler, densities and BRDF.
-const MODULES: [(&str, &[&str]); 11] = [
+const MODULES: [(&str, &[&str]); 17] = [
     ("rng", &["lib/rng.wgsl"]),
     ("math", &["math/f32.wgsl"]),
     ("reflect", &["lib/reflect.wgsl"]),
@@ -35,6 +35,12 @@ const MODULES: [(&str, &[&str]); 11] = [
     ("masking", &["lib/masking.wgsl"]),
     ("dielectric", &["lib/dielectric.wgsl", "lib/dielectric_eval.wgsl"]),
     ("discrete", &["lib/discrete.wgsl"]),
+    ("light", &["lib/light.wgsl"]),
+    ("sphere_light", &["lib/sphere_light.wgsl"]),
+    ("disk_light", &["lib/disk_light.wgsl"]),
+    ("triangle_light", &["lib/triangle_light.wgsl"]),
+    ("triangle_area_light", &["lib/triangle_area_light.wgsl"]),
+    ("rect_light", &["lib/rect_light.wgsl"]),
 ];
 
 /// The names each module offers a renderer, in `MODULES`' order: its API, which
@@ -42,7 +48,7 @@ const MODULES: [(&str, &[&str]); 11] = [
 /// the table to it). Every other name a module's files declare is an internal helper: the
 /// naga_oil and WESL forms put those in the submodule `lobes::NAME::internal` (neither module
 /// system hides names), so that `lobes::NAME` holds only these.
-const API: [&[&str]; 11] = [
+const API: [&[&str]; 17] = [
     &["rng_uniforms", "pcg4d", "rng_to_unit", "add64"],
     &["math_log", "math_exp", "math_sin", "math_cos", "math_atan2", "math_is_finite", "neg_ln", "UNDERFLOW_EXPONENT"],
     &[
@@ -67,6 +73,12 @@ const API: [&[&str]; 11] = [
         "dielectric_beckmann_vndf_weight",
     ],
     &["discrete_f", "discrete_u", "DISCRETE_BLOCK", "discrete_sample_cdf", "discrete_sample_cdf_blocks", "discrete_sample_alias", "discrete_search"],
+    &["LightSample", "LIGHT_PI", "light_to_world", "light_triangle_solid_angle", "light_area_to_solid_angle"],
+    &["sphere_light_sample", "sphere_light_pdf", "sphere_light_solid_angle"],
+    &["disk_light_sample", "disk_light_pdf"],
+    &["triangle_light_sample", "triangle_light_pdf", "triangle_light_solid_angle"],
+    &["triangle_area_light_sample", "triangle_area_light_pdf"],
+    &["rect_light_sample", "rect_light_pdf", "rect_light_solid_angle"],
 ];
 
 struct File {

@@ -49,7 +49,7 @@ fn an_unknown_module_is_a_usage_error_that_lists_the_modules() {
     assert!(out.stdout.is_empty());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown module 'beckman' (did you mean 'beckmann'?)"), "{err}");
-    assert!(err.contains("rng, math, reflect, microfacet, ward, ggx, beckmann, fresnel, masking, dielectric, discrete"), "{err}");
+    assert!(err.contains("rng, math, reflect, microfacet, ward, ggx, beckmann, fresnel, masking, dielectric, discrete, light, sphere_light, disk_light, triangle_light, triangle_area_light, rect_light"), "{err}");
     assert_eq!(lobes(&["wgsl"]).status.code(), Some(2), "at least one module");
 }
 
@@ -125,4 +125,25 @@ fn wgsl_out_dir_files_combine_and_bindings_move() {
     let out = lobes(&["wgsl", "ggx", "--binding", "2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("discrete"), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// Every built-in light (the light registry) is a module of `lobes wgsl` in each form: plain
+/// (prefixed, valid), naga_oil (composable with its import of `lobes::light`), GLSL (naga writes
+/// it).
+#[test]
+fn wgsl_exports_every_light_of_the_registry() {
+    use lobes::reference::light::registry::LIGHTS;
+    for l in &LIGHTS {
+        let name = l.module_name();
+        let out = lobes(&["wgsl", name]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        let sample = l.sample.split('(').next().unwrap();
+        assert!(text.contains(&format!("fn lobes_{sample}(")) && text.contains("struct LobesLightSample"), "{name}");
+        embed::validate(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let oil = String::from_utf8(lobes(&["wgsl", "--naga-oil", name]).stdout).unwrap();
+        assert!(oil.contains("#define_import_path lobes::light\n") && oil.contains(&format!("#define_import_path lobes::{name}\n")), "{name}");
+        let glsl = lobes(&["wgsl", "--glsl", name]);
+        assert!(glsl.status.success() && String::from_utf8_lossy(&glsl.stdout).contains(&format!("lobes_{sample}(")), "{name}: {}", String::from_utf8_lossy(&glsl.stderr));
+    }
 }

@@ -696,3 +696,32 @@ fn a_naga_oil_022_consumer_matches_the_f64_albedo() {
     println!("naga_oil 0.22, pdf 1 % high: albedo {mean:.6} ± {se:.2e}, z = {z:+.1}");
     assert!(z.abs() > 4.0, "a 1 % density error passed: z = {z}");
 }
+
+/// Every built-in light (the light registry) through the WESL package and the naga_oil modules:
+/// a renderer's shader importing the light's sample and pdf functions by their short names
+/// (`import lobes::sphere_light::{…};`, `#import lobes::sphere_light::{…}`) composes, and naga
+/// validates the result (the helpers in `NAME::internal` and `lobes::light` come along).
+#[test]
+fn every_light_composes_through_wesl_and_naga_oil() {
+    use lobes::reference::light::registry::LIGHTS;
+    for l in &LIGHTS {
+        let f = |call: &str| call.split('(').next().unwrap().to_string();
+        let (sample, pdf) = (f(l.sample), f(l.pdf));
+        let body = format!(
+            "@group(0) @binding(0) var<storage, read_write> o: array<vec4<f32>>;\n\
+             @compute @workgroup_size(1) fn main() {{\n    var params: array<vec4<f32>, 4>;\n    params[0] = o[0];\n    params[1] = o[1];\n    params[2] = o[2];\n    \
+             let u = o[3].xy;\n    let s = {};\n    let d = s.d;\n    o[4] = vec4<f32>(s.d, {});\n}}\n",
+            l.sample, l.pdf
+        );
+        let wesl = wesl_compile(&format!("import lobes::{}::{{{sample}, {pdf}}};\n{body}", l.module_name()));
+        embed::validate(&wesl).unwrap_or_else(|e| panic!("{} (WESL): {e}\n{wesl}", l.name));
+        use naga_oil::compose::{Composer, NagaModuleDescriptor};
+        let mut composer = Composer::default();
+        let module = Module::from_name(l.module_name()).unwrap();
+        embed::add_naga_oil_modules(&mut composer, &[module]).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&composer)));
+        let shader = format!("#import lobes::{}::{{{sample}, {pdf}}}\n{body}", l.module_name());
+        composer
+            .make_naga_module(NagaModuleDescriptor { source: &shader, file_path: "renderer.wgsl", ..Default::default() })
+            .unwrap_or_else(|e| panic!("{} (naga_oil): {}", l.name, e.emit_to_string(&composer)));
+    }
+}

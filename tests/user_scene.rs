@@ -195,6 +195,34 @@ fn a_budget_picks_the_cases_sample_count() {
     assert!(h.user_sampler.unwrap().budget.is_none());
 }
 
+/// lobes' built-in lights as cases (`sampler = { light = "NAME" }`, scenes/lights.toml): every
+/// case passes; a misspelt light is exit 2 naming the lights, and a light with WGSL keys too is
+/// exit 2 naming the key.
+#[test]
+fn built_in_light_cases_pass_and_bad_ones_are_refused() {
+    let dir = scratch("lights");
+    let out = lobes(&["run", "scenes/lights.toml", "--samples", "200000", "--out", dir.to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = summary(&out);
+    let names: Vec<&str> = s.cases.iter().map(|c| c.case.as_str()).collect();
+    assert_eq!(names, ["sphere-tiny", "rect-horizon", "triangle-overhead", "disk"]);
+    assert!(s.cases.iter().all(|c| c.passed), "{:?}", s.cases);
+    let cases: [(&str, &[&str]); 3] = [
+        ("sampler = { light = \"spere\" }\nparams = [0, 0, 1, 0.1]\n", &["bad.toml:6:", "unknown light 'spere' (did you mean 'sphere'?)", "sphere, disk, triangle, triangle-area, rect"]),
+        ("sampler = { light = \"disk\", pdf = \"p\" }\n", &["bad.toml:6:", "sampler.pdf does not apply to a built-in light", "params[0] = (centre x, y, z, radius)"]),
+        ("sampler = { light = 3 }\n", &["bad.toml:6:", "sampler.light must be a string", "sphere, disk"]),
+    ];
+    for (lines, want) in cases {
+        let scene = bad_scene(&dir, lines);
+        let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{lines}: {stderr}");
+        for w in want {
+            assert!(stderr.contains(w), "{lines}: want {w:?} in: {stderr}");
+        }
+    }
+}
+
 /// Writes a scene whose case uses ggx_vndf.wgsl through a path relative to the scene file.
 fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
     let scene = dir.join("bad.toml");

@@ -47,6 +47,7 @@ pub mod hard;
 pub mod modules;
 pub mod jacobian;
 mod judge;
+pub mod light;
 pub mod power;
 pub mod probe;
 pub mod quadrature;

@@ -1,9 +1,10 @@
 //! `lobes stress`: the stability suite by hand, a table of case, kernel, worst errors and
-//! verdict; exits non-zero if any row fails.
+//! verdict, then the light samplers' table (`experiments::light_stress`); exits non-zero if any
+//! row fails.
 
 use super::{OutputArgs, emit, emit_json};
 use crate::engine::gpu::GpuEngine;
-use crate::experiments::stress;
+use crate::experiments::{light_stress, stress};
 use crate::report::table;
 use clap::Args;
 
@@ -32,9 +33,10 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     let rows = stress::run_all(engine.as_mut())?;
-    let failed = rows.iter().filter(|r| !r.passed).count();
+    let lights = light_stress::run_all_lights(engine.as_ref().map(|e| &e.gpu))?;
+    let failed = rows.iter().filter(|r| !r.passed).count() + lights.iter().filter(|r| !r.passed).count();
     if args.output.json {
-        emit_json(&serde_json::json!({"rows": rows, "failed": failed,
+        emit_json(&serde_json::json!({"rows": rows, "lights": lights, "failed": failed,
             "direction_bound_rad": stress::DIRECTION_BOUND, "unit_bound_f32": stress::UNIT_BOUND_F32}))?;
     } else {
         let shown = rows.iter().filter(|r| !args.failures || !r.passed);
@@ -55,11 +57,33 @@ pub fn run(args: &StressArgs) -> anyhow::Result<()> {
                 ]
             }),
         );
-        t += &format!("\n{} rows, {failed} failed\n", rows.len());
+        t += "\n";
+        t += &light_table(lights.iter().filter(|r| !args.failures || !r.passed));
+        t += &format!("\n{} rows, {failed} failed\n", rows.len() + lights.len());
         emit(&t)?;
     }
     if failed > 0 {
         return Err(super::ChecksFailed(format!("{failed} stress rows failed")).into());
     }
     Ok(())
+}
+
+/// The light samplers' rows: case, kernel, samples, valid, bad values, unit error, interior
+/// samples whose pdf function disagrees with the reported pdf, verdict.
+fn light_table<'a>(rows: impl Iterator<Item = &'a light_stress::LightRow>) -> String {
+    table::render(
+        &["light case", "kernel", "n", "valid", "bad", "unit err", "pdf ≠ pdf(d)", "verdict"],
+        rows.map(|r| {
+            vec![
+                r.case.clone(),
+                r.kernel.clone(),
+                r.samples.to_string(),
+                r.valid.to_string(),
+                r.bad_values.to_string(),
+                format!("{:.2e}", r.worst_unit_error),
+                format!("{}/{}", r.inconsistent, r.interior),
+                if r.passed { "pass" } else { "FAIL" }.to_string(),
+            ]
+        }),
+    )
 }

@@ -14,7 +14,8 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, Args)]
 pub struct WgslArgs {
     /// Modules to print, with the modules they use: rng, math, reflect, microfacet, ward, ggx,
-    /// beckmann, fresnel, masking, dielectric, discrete.
+    /// beckmann, fresnel, masking, dielectric, discrete, and the lights: light, sphere_light,
+    /// disk_light, triangle_light, triangle_area_light, rect_light.
     #[arg(required = true, value_name = "MODULE")]
     pub modules: Vec<String>,
     /// The files as naga_oil modules (`#define_import_path lobes::ggx`, `#import`s, short

@@ -210,11 +210,37 @@ pub enum Module {
     /// - `discrete_search(u: f32, first: u32, n: u32) -> u32`: the first i < n whose entry
     ///   `discrete_f[first + i]` is ≥ u (binary search), and `DISCRETE_BLOCK` = [`BLOCK`].
     Discrete,
+    /// `shaders/lib/light.wgsl`: what the light samplers share (CPU twin:
+    /// `lobes::reference::light`). The shading point is the origin; a light sampler returns
+    /// `struct LightSample { d: vec3<f32>, pdf: f32 }`, a unit direction toward the light and its
+    /// density per unit solid angle (0: no sample). Also `light_to_world(n, v)` (an orthonormal
+    /// basis about n, Duff et al. 2017), `light_triangle_solid_angle(p0, e1, e2)` (Van Oosterom &
+    /// Strackee 1983), `light_area_to_solid_angle(pdf_area, t, n, d)` and `LIGHT_PI`.
+    Light,
+    /// `shaders/lib/sphere_light.wgsl`: a sphere light (centre c, radius r) uniform in the cone it
+    /// subtends: `sphere_light_sample(c, r, u: vec2<f32>) -> LightSample`,
+    /// `sphere_light_pdf(c, r, d) -> f32`, `sphere_light_solid_angle(c, r)`.
+    SphereLight,
+    /// `shaders/lib/disk_light.wgsl`: a disk light (centre, unit normal, radius) uniform by area:
+    /// `disk_light_sample(c, n, r, u) -> LightSample`, `disk_light_pdf(c, n, r, d)`.
+    DiskLight,
+    /// `shaders/lib/triangle_light.wgsl`: a triangle light uniform over its spherical triangle
+    /// (Arvo 1995): `triangle_light_sample(p0, p1, p2, u) -> LightSample`,
+    /// `triangle_light_pdf(p0, p1, p2, d)`, `triangle_light_solid_angle(p0, p1, p2)`.
+    TriangleLight,
+    /// `shaders/lib/triangle_area_light.wgsl`: a triangle light uniform by area:
+    /// `triangle_area_light_sample(p0, p1, p2, u) -> LightSample`, `triangle_area_light_pdf(p0, p1, p2, d)`.
+    TriangleAreaLight,
+    /// `shaders/lib/rect_light.wgsl`: a rectangle light (corner s, perpendicular edges ex, ey)
+    /// uniform over its spherical rectangle (Ureña, Fajardo & King 2013):
+    /// `rect_light_sample(s, ex, ey, u) -> LightSample`, `rect_light_pdf(s, ex, ey, d)`,
+    /// `rect_light_solid_angle(s, ex, ey)`.
+    RectLight,
 }
 
 impl Module {
     /// Every module, in dependency order.
-    pub const ALL: [Module; 11] = [
+    pub const ALL: [Module; 17] = [
         Module::Rng,
         Module::Math,
         Module::Reflect,
@@ -226,6 +252,12 @@ impl Module {
         Module::Masking,
         Module::Dielectric,
         Module::Discrete,
+        Module::Light,
+        Module::SphereLight,
+        Module::DiskLight,
+        Module::TriangleLight,
+        Module::TriangleAreaLight,
+        Module::RectLight,
     ];
 
     /// The module's name: its import path under `lobes` (`lobes::ggx`), its file in the WESL
@@ -746,7 +778,9 @@ mod tests {
     fn the_generated_table_is_the_enum() {
         for (i, m) in Module::ALL.into_iter().enumerate() {
             assert_eq!(m as usize, i);
-            assert_eq!(format!("{m:?}").to_lowercase(), m.name());
+            // the variant's name in snake case: SphereLight is sphere_light
+            let snake: String = format!("{m:?}").chars().enumerate().flat_map(|(k, c)| (k > 0 && c.is_uppercase()).then_some('_').into_iter().chain(c.to_lowercase())).collect();
+            assert_eq!(snake, m.name());
         }
     }
 

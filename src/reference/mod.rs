@@ -9,6 +9,7 @@ pub mod dielectric;
 pub mod discrete;
 pub mod effects;
 pub mod frame;
+pub mod light;
 pub mod fresnel;
 pub mod ggx;
 pub mod masking;

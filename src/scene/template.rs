@@ -65,6 +65,8 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
 #   rand = ["rand_f"], rand_order = "event,x,y", sample_returns = "half-vector"
 #   incident = "upper", reflection_only = true, u_open = true, measure = "projected", frame = "y-up"
 #   measure = "area", normal = "vec3<f32>(0.0, 0.0, -1.0)"   # a light sampled by area: (p, pdf_A)
+# sampler = {{ light = "sphere" }}   # instead: one of lobes' built-in lights ({lights}),
+#                         # its geometry in params (docs/lights-and-environment-maps.md)
 # params = [0.3, 0.3]     # up to {max_params} numbers, params[i / 4][i % 4] in WGSL; default none
 # domain = "sphere"       # sphere | plane (then bounds = [x0, y0, x1, y1])
 # incident_theta = {user_theta:?}   # degrees, 0 ≤ θ ≤ 180 (a user sampler's default)
@@ -84,6 +86,7 @@ weights = [15, 5, 25, 0]  # finite numbers ≥ 0, not all zero; one bin per weig
         angle = DEFAULT_ALPHA_ANGLE,
         discrete = DEFAULT_DISCRETE_METHOD.name(),
         max_params = MAX_PARAMS,
+        lights = crate::reference::light::registry::names(),
         user_theta = user.incident_theta,
         srows = sphere.0,
         scols = sphere.1,

@@ -17,6 +17,9 @@ use toml::{Spanned, Value};
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawSampler {
+    /// One of lobes' built-in lights (`crate::reference::light::registry::LIGHTS`), instead of
+    /// WGSL files: `sampler = { light = "sphere" }`, the geometry in the case's `params`.
+    light: Option<Val>,
     wgsl: Option<Val>,
     sample: Option<Val>,
     pdf: Option<Val>,
@@ -54,7 +57,7 @@ pub struct UserCase {
     pub budget: Option<Budget>,
 }
 
-const SAMPLER_ALLOWED: &str = "write sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, texture = { NAME = \"file.hdr\" }, buffer = { NAME = \"file.npy\" }, filter = { NAME = \"linear\" or \"nearest\" } (a renderer's sampler), sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
+const SAMPLER_ALLOWED: &str = "write sampler = { light = \"NAME\" } (one of lobes' built-in lights, its geometry in params), or sampler = { wgsl = [\"file.wgsl\", ...], sample = \"fn name or call\", pdf = \"fn name or call\", eval = \"fn name or call\" } (eval optional; also rand = [\"fn\", ...], rand_order = \"event,x,y\", shader_root = [\"dir\", ...], define = { NAME = true }, stub = { \"module\" = \"file\" }, package = { NAME = \"dir\" }, texture = { NAME = \"file.hdr\" }, buffer = { NAME = \"file.npy\" }, filter = { NAME = \"linear\" or \"nearest\" } (a renderer's sampler), sample_returns = \"half-vector\", and the conventions incident = \"upper\", reflection_only = true, u_open = true, measure = \"projected\" or \"area\" (with normal = \"WGSL over p\"), frame = \"y-up\"; paths relative to the scene file)";
 const GRID_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows × cols ≤ 2^24 (16777216)";
 const BOUNDS_ALLOWED: &str = "give bounds = [x0, y0, x1, y1], finite numbers with x0 < x1 and y0 < y1";
 
@@ -68,6 +71,9 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
     }
     reject_keys(ctx, &effect_keys(c, p), "does not apply to a user sampler (give an eval function for the weight and albedo checks); remove it")?;
     let r = raw.get_ref();
+    if let Some(light) = &r.light {
+        return builtin_light(ctx, r, light);
+    }
     let name = |v: &Option<Val>, key: &str| -> Result<Option<String>, SceneError> {
         v.as_ref().map(|v| string(ctx, v, &format!("sampler.{key}"), SAMPLER_ALLOWED).map(String::from)).transpose()
     };
@@ -96,6 +102,23 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
         .and_then(|s| s.with_conventions(conventions))
         .map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
         .map(Arc::new)
+}
+
+/// `sampler = { light = "NAME" }`: lobes' built-in light of that name (the case's `params` its
+/// geometry), alone in the table.
+fn builtin_light(ctx: &Ctx, r: &RawSampler, light: &Val) -> Result<Arc<UserSampler>, SceneError> {
+    use crate::reference::light::registry::{LIGHTS, by_name, names};
+    let allowed = format!("sampler.light is one of {} (lobes' built-in lights, their geometry in params)", names());
+    let name = string(ctx, light, "sampler.light", &allowed)?;
+    let Some(spec) = by_name(name) else {
+        let hint = crate::scene::suggest::did_you_mean(name, LIGHTS.iter().map(|l| l.name));
+        return Err(ctx.err(light.span(), format!("sampler.light: unknown light '{name}'{hint}; {allowed}")));
+    };
+    let others = [("wgsl", &r.wgsl), ("sample", &r.sample), ("pdf", &r.pdf), ("eval", &r.eval), ("measure", &r.measure), ("normal", &r.normal), ("rand", &r.rand), ("texture", &r.texture), ("buffer", &r.buffer)];
+    if let Some((key, v)) = others.iter().find_map(|(k, v)| v.as_ref().map(|v| (k, v))) {
+        return Err(ctx.err(v.span(), format!("sampler.{key} does not apply to a built-in light (light = \"{name}\" is the whole sampler: {}); remove it", spec.layout)));
+    }
+    Ok(Arc::new(UserSampler::light(spec)))
 }
 
 /// `incident = "upper"`, `reflection_only = true`, `u_open = true`, `measure = "projected"`,

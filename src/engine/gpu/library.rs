@@ -76,7 +76,7 @@ macro_rules! shader {
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 33] = [
+static FILES: [File; 39] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -92,6 +92,12 @@ static FILES: [File; 33] = [
     shader!("lib/fresnel.wgsl"),
     shader!("lib/masking.wgsl"),
     shader!("lib/discrete.wgsl"),
+    shader!("lib/light.wgsl"),
+    shader!("lib/sphere_light.wgsl"),
+    shader!("lib/disk_light.wgsl"),
+    shader!("lib/triangle_light.wgsl"),
+    shader!("lib/triangle_area_light.wgsl"),
+    shader!("lib/rect_light.wgsl"),
     shader!("lib/bins.wgsl"),
     shader!("lib/histogram.wgsl"),
     shader!("math/f32.wgsl"),
