@@ -1,25 +1,24 @@
-//! Expected bin probabilities: each bin's integral of p(ωr) in f64, by adaptive Gauss–Legendre
-//! quadrature over (cos θ, φ), where the solid-angle element is simply d(cos θ) dφ.
+//! Expected bin probabilities: each bin's integral of p(ωr) in f64, by the adaptive
+//! Gauss–Legendre quadrature of [`crate::stats::quadrature`] over (a = 1 − |cos θ|, φ), whose
+//! area element is the solid angle's.
 //!
-//! How we know the quadrature is accurate enough: every bin is integrated with a 5 × 5 rule and
+//! How we know the quadrature is accurate enough: every part is integrated with a 5 × 5 rule and
 //! a 3 × 3 rule; where they agree within a tolerance of 1e-2 of the bin's statistical standard
-//! deviation at 10⁸ samples (√(p/10⁸)) the 5 × 5 value is taken. Otherwise the bin is also
+//! deviation at 10⁸ samples (√(p/10⁸)) the 5 × 5 value is taken. Otherwise the part is also
 //! integrated with the 5 × 5 rule on its four quarters, and accepted only when that agrees with
-//! the whole-bin rule within the same tolerance, else split again. The summed |fine − coarse| differences are returned as an error
-//! estimate, and tests check it against quadrature at a finer setting and against the closed-
-//! form total mass.
+//! the whole-part rule within the same tolerance, else split again. The summed |fine − coarse|
+//! differences are returned as an error estimate, and tests check it against quadrature at a
+//! finer setting and against the closed-form total mass.
 
 use crate::reference::Lobe;
 use crate::reference::dielectric::RoughDielectric;
+use crate::stats::domain::Domain;
 use crate::stats::gauss_legendre::GaussLegendre;
 use crate::stats::histogram::SphereGrid;
+pub use crate::stats::quadrature::Peak;
+use crate::stats::quadrature::{CpuPdf, Jumps, Part, Settings, Tolerance, peak_parts, refine, row_zones, split};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::LazyLock;
-
-/// The 5-point rule of every part, and the 3-point rule it is checked against.
-static GL5: LazyLock<GaussLegendre> = LazyLock::new(|| GaussLegendre::new(5));
-static GL3: LazyLock<GaussLegendre> = LazyLock::new(|| GaussLegendre::new(3));
 
 /// The smallest roughness α whose expected histogram this quadrature resolves at every θi:
 /// scenes refuse a narrower lobe (exit 2). The bins about a lobe's peak are cut down to a
@@ -97,25 +96,6 @@ impl Expected {
     }
 }
 
-#[derive(Clone, Copy)]
-struct Rect {
-    z: (f64, f64),
-    phi: (f64, f64),
-}
-
-impl Rect {
-    fn quarters(&self) -> [Rect; 4] {
-        let zm = 0.5 * (self.z.0 + self.z.1);
-        let pm = 0.5 * (self.phi.0 + self.phi.1);
-        [
-            Rect { z: (self.z.0, zm), phi: (self.phi.0, pm) },
-            Rect { z: (zm, self.z.1), phi: (self.phi.0, pm) },
-            Rect { z: (self.z.0, zm), phi: (pm, self.phi.1) },
-            Rect { z: (zm, self.z.1), phi: (pm, self.phi.1) },
-        ]
-    }
-}
-
 /// sin θ from cos θ as √((1 − z)(1 + z)): 1 − z is exact near the poles (Sterbenz), where
 /// 1 − z² loses the digits a narrow lobe there is made of.
 fn sin_from_cos(z: f64) -> f64 {
@@ -139,136 +119,6 @@ pub fn integrate_rect(rule: &GaussLegendre, z: (f64, f64), phi: (f64, f64), f: &
             wz * trig.iter().map(|&(wp, c, s)| wp * f(DVec3::new(st * c, st * s, zk))).sum::<f64>()
         })
         .sum()
-}
-
-fn gauss(f: &impl Fn(DVec3) -> f64, r: Rect) -> f64 {
-    integrate_rect(&GL5, r.z, r.phi, f)
-}
-
-/// The tolerance on a part whose integral is about `value`.
-fn tolerance(value: f64, q: &Quadrature) -> f64 {
-    q.sigma_fraction * (value.abs() / REFERENCE_SAMPLES).sqrt() + q.abs_floor
-}
-
-/// An integral, its error estimate (the accepted |fine − coarse| differences) and the parts
-/// accepted at the depth limit without agreeing.
-#[derive(Clone, Copy, Default)]
-struct Part {
-    value: f64,
-    error: f64,
-    unconverged: u64,
-}
-
-impl std::ops::Add for Part {
-    type Output = Part;
-    fn add(self, o: Part) -> Part {
-        Part { value: self.value + o.value, error: self.error + o.error, unconverged: self.unconverged + o.unconverged }
-    }
-}
-
-/// Adaptive integral of `f` over `r`, given its coarse estimate.
-fn adapt(f: &impl Fn(DVec3) -> f64, r: Rect, coarse: f64, q: &Quadrature, depth: u32) -> Part {
-    let parts = r.quarters().map(|p| (p, gauss(f, p)));
-    let fine: f64 = parts.iter().map(|p| p.1).sum();
-    let diff = (fine - coarse).abs();
-    let agree = diff <= tolerance(fine, q);
-    if agree || depth >= q.max_depth {
-        return Part { value: fine, error: diff, unconverged: u64::from(!agree) };
-    }
-    parts.iter().fold(Part::default(), |acc, &(p, c)| acc + adapt(f, p, c, q, depth + 1))
-}
-
-/// Integrates `f` over `r` as one part: where the 5 × 5 rule agrees with the 3 × 3 one within
-/// the tolerance, it is taken as it is (the difference estimates the 3-point rule's error, exact
-/// to degree 5, which bounds the 5-point rule's, exact to degree 9, for a smooth integrand);
-/// where they disagree, the part is refined by [`adapt`].
-fn integrate_part(f: &impl Fn(DVec3) -> f64, r: Rect, q: &Quadrature) -> Part {
-    let g5 = gauss(f, r);
-    let g3 = integrate_rect(&GL3, r.z, r.phi, f);
-    if (g5 - g3).abs() <= tolerance(g5, q) { Part { value: g5, error: (g5 - g3).abs(), unconverged: 0 } } else { adapt(f, r, g5, q, 0) }
-}
-
-/// Integrates `f(cos θ, φ)` over one bin, first split per axis into `m` parts.
-fn integrate_bin(f: &impl Fn(DVec3) -> f64, bin: Rect, m: u32, q: &Quadrature) -> Part {
-    let (dz, dp) = ((bin.z.1 - bin.z.0) / m as f64, (bin.phi.1 - bin.phi.0) / m as f64);
-    let mut acc = Part::default();
-    for i in 0..m {
-        for j in 0..m {
-            let r = Rect {
-                z: (bin.z.0 + i as f64 * dz, bin.z.0 + (i + 1) as f64 * dz),
-                phi: (bin.phi.0 + j as f64 * dp, bin.phi.0 + (j + 1) as f64 * dp),
-            };
-            acc = acc + integrate_part(f, r, q);
-        }
-    }
-    acc
-}
-
-/// Edges of `range` graded toward `at` (clamped into it): `at` ± 4⁻ᵏ of the range, k = 1, 2, …
-/// while the step is above `finest`, with the range's ends and `at`.
-fn graded_edges(range: (f64, f64), at: f64, finest: f64) -> Vec<f64> {
-    let at = at.clamp(range.0, range.1);
-    let extent = range.1 - range.0;
-    let mut edges = vec![range.0, at, range.1];
-    let mut d = extent / 4.0;
-    while d > finest {
-        edges.extend([at - d, at + d]);
-        d /= 4.0;
-    }
-    edges.retain(|x| (range.0..=range.1).contains(x));
-    edges.sort_by(f64::total_cmp);
-    edges.dedup();
-    edges
-}
-
-/// A narrow peak of the density: its direction and its angular width (radians).
-#[derive(Debug, Clone, Copy)]
-pub struct Peak {
-    pub direction: DVec3,
-    pub width: f64,
-}
-
-/// The parts of `bin` graded toward `peak`, where the peak lies within the bin's own extent of
-/// it and is narrower than a part of the width-based split could resolve; else `None`.
-///
-/// A peak narrower than the finest part of [`adapt`] slips between the rules' nodes, and then
-/// the rules agree on a wrong value (GGX VNDF at α 1e-8, θi 30°: 84 % of the mass missed). Its
-/// direction is known (a reflection lobe's mirror direction, where h = n): the bin is cut at
-/// edges graded toward it by factors of 4 in cos θ and φ, down to a quarter of its width there
-/// (in cos θ: sin θ · w, or w²/2 at a pole; in φ: w cos θ / sin θ), so that the parts next to it are
-/// smaller than the peak and those away from it no larger than their distance from it.
-fn graded_parts(bin: Rect, peak: Peak, q: &Quadrature) -> Option<Vec<Rect>> {
-    let (zp, mut pp) = (peak.direction.z.clamp(-1.0, 1.0), peak.direction.y.atan2(peak.direction.x));
-    // the turn of φ closest to the bin
-    let mid = 0.5 * (bin.phi.0 + bin.phi.1);
-    pp += std::f64::consts::TAU * ((mid - pp) / std::f64::consts::TAU).round();
-    let (zc, pc) = (zp.clamp(bin.z.0, bin.z.1), pp.clamp(bin.phi.0, bin.phi.1));
-    let (a, b) = (direction(zc, pc), direction(zp, pp));
-    let nearest = a.cross(b).length().atan2(a.dot(b));
-    let extent = bin_extent(bin);
-    let w = peak.width.max(nearest);
-    // Across the plane of incidence the mirror lobe is narrower by cos θ: a tilt δ of h there
-    // turns ωr = 2(ωi·h)h − ωi by 2 cos θi δ, against 2δ within the plane (at θi 89°, 57 times).
-    let across = w * zp.abs().max(w);
-    if nearest > extent || across * q.max_initial_split as f64 >= extent {
-        return None;
-    }
-    let sin_p = sin_from_cos(zp);
-    let zs = graded_edges(bin.z, zc, 0.25 * (sin_p * w).max(0.5 * w * w));
-    let ps = if w < sin_p { graded_edges(bin.phi, pc, 0.25 * across / sin_p) } else { vec![bin.phi.0, bin.phi.1] };
-    Some(zs.windows(2).flat_map(|z| ps.windows(2).map(move |p| Rect { z: (z[0], z[1]), phi: (p[0], p[1]) })).collect())
-}
-
-/// A bin's angular extent: the larger of its span in θ and its widest span in φ.
-fn bin_extent(bin: Rect) -> f64 {
-    let dtheta = bin.z.0.clamp(-1.0, 1.0).acos() - bin.z.1.clamp(-1.0, 1.0).acos();
-    let smax = if bin.z.0 < 0.0 && bin.z.1 > 0.0 { 1.0 } else { (1.0 - bin.z.0.abs().min(bin.z.1.abs()).powi(2)).sqrt() };
-    dtheta.max((bin.phi.1 - bin.phi.0) * smax)
-}
-
-/// The initial split of a bin: its angular extent over the lobe's narrowest width α.
-fn initial_split(bin: Rect, width: f64, q: &Quadrature) -> u32 {
-    ((bin_extent(bin) / width).ceil() as u32).clamp(1, q.max_initial_split)
 }
 
 /// The narrow peak of `lobe`'s reflected density seen from `wi`: the mirror direction (h = n,
@@ -302,39 +152,51 @@ pub fn sphere_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGri
     bin_probabilities(pdf, grid, width, None, q, true)
 }
 
+/// The settings of the engine for `q`: its tolerance at 10⁸ samples (`q` comes scaled to the
+/// run's N by [`Quadrature::for_samples`]), its depth counted from a bin's initial parts (`q`'s
+/// from their first quarters), no edges looked for (lobes' densities have none inside a bin), and
+/// no budget of parts.
+fn settings(q: &Quadrature) -> Settings {
+    let tolerance = Tolerance { sigma_fraction: q.sigma_fraction, samples: REFERENCE_SAMPLES, floor: q.abs_floor };
+    Settings { tolerance, max_depth: q.max_depth + 1, jumps: Jumps::Trust, max_parts: usize::MAX, keep_leaves: false }
+}
+
+/// The initial parts of every bin of `grid` (the upper hemisphere's, or the sphere's where
+/// `sphere`): graded toward `peak` where it is given and narrow there ([`peak_parts`]), else split
+/// per axis by the bin's angular extent over `width`, at most `q.max_initial_split` times.
+fn initial_parts(grid: SphereGrid, width: f64, peak: Option<Peak>, q: &Quadrature, sphere: bool) -> Vec<Part> {
+    let phis = grid.phi_edges();
+    let mut parts = Vec::new();
+    for row in 0..grid.rows {
+        for zone in row_zones(grid.rows, row).into_iter().filter(|z| sphere || z.h > 0.0) {
+            for c in 0..grid.cols as usize {
+                let (phi, bin) = ((phis[c], phis[c + 1]), row * grid.cols + c as u32);
+                match peak.and_then(|p| peak_parts(&zone, phi, bin, p, q.max_initial_split)) {
+                    Some(graded) => parts.extend(graded),
+                    None => parts.extend(split(zone.a, phi, zone.h, ((zone.extent(phi) / width).ceil() as u32).clamp(1, q.max_initial_split), bin)),
+                }
+            }
+        }
+    }
+    parts
+}
+
 fn bin_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, peak: Option<Peak>, q: &Quadrature, sphere: bool) -> Expected {
-    let zs = grid.cos_theta_edges();
-    let ps = grid.phi_edges();
-    let f = |w: DVec3| pdf(w);
-    let rows: Vec<Vec<(Part, f64)>> = (0..grid.rows as usize)
-        .into_par_iter()
-        .map(|r| {
-            (0..grid.cols as usize)
-                .map(|c| {
-                    let bin = Rect { z: (zs[r], zs[r + 1]), phi: (ps[c], ps[c + 1]) };
-                    if bin.z.1 <= 0.0 && !sphere {
-                        return (Part::default(), 0.0); // p(ωr) = 0 below the horizon
-                    }
-                    let part = match peak.and_then(|p| graded_parts(bin, p, q)) {
-                        Some(parts) => parts.into_iter().fold(Part::default(), |acc, r| acc + integrate_part(&f, r, q)),
-                        None => integrate_bin(&f, bin, initial_split(bin, width, q), q),
-                    };
-                    let sigma = (part.value.max(1e-300) / REFERENCE_SAMPLES).sqrt();
-                    (part, part.error / sigma)
-                })
-                .collect()
-        })
-        .collect();
-    let cells: Vec<(Part, f64)> = rows.into_iter().flatten().collect();
-    let probabilities: Vec<f64> = cells.iter().map(|c| c.0.value).collect();
-    let total: f64 = probabilities.iter().sum();
+    let cpu = CpuPdf::new(pdf, Domain::Sphere, Jumps::Trust);
+    let parts = initial_parts(grid, width, peak, q, sphere);
+    let r = match refine::<std::convert::Infallible>(&cpu, parts, grid.bins(), &settings(q)) {
+        Ok(r) => r,
+        Err(never) => match never {},
+    };
+    let total: f64 = r.pdf.iter().sum();
+    let sigma = |p: f64| (p.max(1e-300) / REFERENCE_SAMPLES).sqrt();
     Expected {
-        probabilities,
         below_horizon: (1.0 - total).max(0.0),
-        error_estimate: cells.iter().map(|c| c.0.error).sum(),
-        max_error_sigma: cells.iter().map(|c| c.1).fold(0.0, f64::max),
-        bin_errors: cells.iter().map(|c| c.0.error).collect(),
-        unconverged_parts: cells.iter().map(|c| c.0.unconverged).sum(),
+        error_estimate: r.linear.iter().sum(),
+        max_error_sigma: r.linear.iter().zip(&r.pdf).map(|(e, p)| e / sigma(*p)).fold(0.0, f64::max),
+        unconverged_parts: r.unconverged.iter().sum(),
+        bin_errors: r.linear,
+        probabilities: r.pdf,
     }
 }
 
@@ -409,14 +271,6 @@ pub fn dielectric_wrong_side(glass: &RoughDielectric, wi: DVec3, q: &Quadrature)
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn uniform_density_gives_equal_bins() {
-        let f = |_w: DVec3| 1.0 / (4.0 * std::f64::consts::PI);
-        let bin = Rect { z: (0.5, 0.75), phi: (0.0, 1.0) };
-        let v = integrate_bin(&f, bin, 1, &Quadrature::default()).value;
-        assert!((v - 0.25 / (4.0 * std::f64::consts::PI)).abs() < 1e-16);
-    }
 
     /// The trig-hoisted product rule is the plain tensor-product rule of `direction(z, φ)`.
     #[test]

@@ -76,12 +76,12 @@ impl<'a, 'g> Run<'a, 'g> {
     }
     /// What integrates the pdf, handed to `f`: the f64 reference on the CPU where the settings
     /// give one, else the WGSL pdf on the GPU.
-    pub fn with_integrand<R>(&self, f: impl FnOnce(&dyn Integrand) -> R) -> R {
+    pub fn with_integrand<R>(&self, f: impl FnOnce(&dyn Integrand<CheckError>) -> R) -> R {
         let wi = glam::DVec3::new(self.wi[0] as f64, self.wi[1] as f64, self.wi[2] as f64);
         match &self.settings.reference {
             Some(r) => {
                 let pdf = move |d: glam::DVec3| (r.0)(wi, d);
-                f(&quadrature::CpuPdf { pdf: &pdf, domain: self.sampler.domain, jumps: quadrature::Jumps::Locate })
+                f(&quadrature::CpuPdf::new(&pdf, self.sampler.domain, quadrature::Jumps::Locate))
             }
             None => f(&(&self.passes, &self.params)),
         }
