@@ -270,7 +270,7 @@ fn bindings_without_the_right_file_are_exit_2() {
     let cases: [(&str, String, &str); 4] = [
         ("env_marginal", String::new(), "`env_marginal` (@group(0) @binding(1), a storage buffer) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture env_marginal=FILE.hdr"),
         ("env_marginal", npy_of_u32.display().to_string(), "--buffer env_marginal: the file holds u32 and `env_marginal` is an array<f32>"),
-        ("env_conditional", format!("{ENVMAP}/sky.hdr"), "not a .npy file"),
+        ("env_conditional", format!("{ENVMAP}/sky.hdr"), "a table is a NumPy .npy array or raw little-endian 32-bit words (.bin, .raw), by its extension"),
         ("env_radiance", format!("{ENVMAP}/missing.hdr"), "--texture env_radiance=examples/envmap/missing.hdr: cannot read the file"),
     ];
     for (name, file, message) in cases {
