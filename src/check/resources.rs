@@ -414,7 +414,9 @@ mod tests {
         image::DynamicImage::ImageRgba8(narrow).write_to(&mut png, image::ImageFormat::Png).unwrap();
         let Data::Texture { texels, .. } = read_image(Path::new("LUT.PNG"), png.get_ref()).unwrap() else { panic!("not a texture") };
         assert_eq!(texels[0], [0.2, 1.0, 0.0, 128.0 / 255.0]);
+        let e = read_image(Path::new("lut.tga"), png.get_ref()).unwrap_err();
+        assert!(e.contains("a Radiance .hdr, an OpenEXR .exr or a .png image"), "{e}");
         let e = read_image(Path::new("lut.exr"), png.get_ref()).unwrap_err();
-        assert!(e.contains(".hdr or a .png"), "{e}");
+        assert!(e.contains("not an OpenEXR image"), "{e}");
     }
 }
