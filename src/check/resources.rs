@@ -399,7 +399,7 @@ mod tests {
 
     /// A 16-bit and an 8-bit PNG written by the image crate read back as their stored values
     /// over 65535 and 255 (a lookup table loaded as unorm), alpha kept; another extension is
-    /// refused naming the two formats.
+    /// refused naming the three formats, and PNG bytes named .exr are refused as not OpenEXR.
     #[test]
     fn a_png_texture_holds_its_stored_values() {
         let mut png = std::io::Cursor::new(Vec::new());
