@@ -133,7 +133,7 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
     let around: Vec<[f32; 4]> = probe_u.iter().flat_map(|u| map::around(*u)).collect();
     let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
     let p_max = probes.iter().filter(|p| p.valid()).map(|p| p.reported_pdf() as f64).fold(0.0, f64::max);
-    let width = quadrature::initial_width(p_max, run.sampler.domain);
+    let width = quadrature::initial_width(p_max, run.sampler.domain, run.rows);
     let (integrals, f32_moved) = integrate(run, &totals[..run.bins()], width)?;
     let jump = map_jump(run, &probes, &probe_u)?;
     Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
