@@ -17,7 +17,7 @@ pub mod weights;
 use super::gpu::{CHUNK, Params, Passes, histogram};
 use super::probe::Probe;
 use super::quadrature::{self, Integrals, Integrand};
-use super::{CheckError, Settings, UserSampler, jacobian as map};
+use super::{CheckError, Domain, Settings, UserSampler, jacobian as map};
 use crate::stats::domain::Grid;
 use crate::engine::gpu::Gpu;
 use crate::reference::rng;
@@ -104,7 +104,8 @@ pub(crate) struct Measured {
     /// The quadrature's first part width, from the largest reported pdf.
     pub width: f64,
     /// How far ∫pdf moves on the quadrature's parts when the WGSL pdf's inputs move by an ulp
-    /// ([`quadrature::sensitivity`]; 0 for an f64 reference).
+    /// ([`quadrature::sensitivity`]; on a cap, the direction too:
+    /// [`quadrature::direction_sensitivity`]; 0 for an f64 reference).
     pub f32_moved: f64,
     /// A jump of the sample map along u.x or u.y ([`map::find_jump`]).
     pub jump: Option<map::Jump>,
@@ -160,15 +161,19 @@ fn probe_uniforms(settings: &Settings) -> Vec<[f32; 4]> {
 }
 
 /// The quadrature of the pdf per bin (and of eval, which has no f64 twin: always the GPU's), and
-/// how far the WGSL pdf's f32 evaluation moves ∫pdf ([`quadrature::f32_sensitivity`]; 0 for an
-/// f64 reference).
+/// how far the WGSL pdf's f32 evaluation moves ∫pdf ([`quadrature::f32_sensitivity`], and on a
+/// cap fitted to a small support [`quadrature::direction_sensitivity`]; 0 for an f64 reference).
 fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64), CheckError> {
     let (domain, rows, cols, samples) = (&run.sampler.domain, run.rows, run.cols, run.settings.samples);
     let (mut integrals, leaves) = run.with_integrand(|f| quadrature::integrate_leaves(f, domain, rows, cols, width, samples, Some(observed)))?;
     if run.settings.reference.is_some() && run.sampler.eval.is_some() {
         integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(observed))?.eval;
     }
-    let moved = if run.settings.reference.is_some() { 0.0 } else { quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? };
+    let moved = match (&run.settings.reference, domain) {
+        (Some(_), _) => 0.0,
+        (None, Domain::Cap { .. }) => quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? + quadrature::direction_sensitivity(&(&run.passes, &run.params), &leaves)?,
+        (None, _) => quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)?,
+    };
     Ok((integrals, moved))
 }
 
