@@ -85,9 +85,9 @@ fn a_corner_in_the_caps_outer_row_keeps_its_mass() {
 
 /// A rectangle light of 10⁻⁴ sr overhead: its f32 pdf integrates to 1.00002, its f32 solid angle
 /// being within 2·10⁻⁷ of the f64 one and the rest where f32 places its edges (an ulp of a unit
-/// vector, 1.2·10⁻⁷ rad, against sides of 10⁻² rad); `normalization` failed it at 2²⁰ samples,
-/// seeds 1 and 2, until its tolerance held that (`direction_sensitivity`). Its pdf made 10⁻³ too
-/// large still fails.
+/// vector, 1.2·10⁻⁷ rad, against sides of 10⁻² rad); `normalization` failed it at 2¹⁸ samples,
+/// seed 7 (and at 2²⁰, seeds 1 and 2), until its tolerance held that (`direction_sensitivity`).
+/// Its pdf made 10⁻³ too large still fails.
 #[test]
 fn a_small_lights_edges_in_f32_are_in_the_tolerance_and_a_wrong_pdf_is_not() {
     let gpu = gpu();
@@ -95,7 +95,7 @@ fn a_small_lights_edges_in_f32_are_in_the_tolerance_and_a_wrong_pdf_is_not() {
     let p = spec.sized(1e-4, 90.0);
     let run = |pdf: &str| {
         let sampler = UserSampler::light_with(spec, &wrapper(spec, spec.sample, pdf));
-        check(&gpu, &sampler, &Settings { seed: 1, ..settings(&p, 1 << 20) }).unwrap_or_else(|e| panic!("{e}"))
+        check(&gpu, &sampler, &settings(&p, 1 << 18)).unwrap_or_else(|e| panic!("{e}"))
     };
     let r = run(spec.pdf);
     let n = r.figures::<NormalizationFigures>().expect("a normalization check");
