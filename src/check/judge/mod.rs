@@ -169,12 +169,12 @@ fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64)
     if run.settings.reference.is_some() && run.sampler.eval.is_some() {
         integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(observed))?.eval;
     }
-    let moved = match (&run.settings.reference, domain) {
-        (Some(_), _) => 0.0,
-        (None, Domain::Cap { .. }) => quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)? + quadrature::direction_sensitivity(&(&run.passes, &run.params), &leaves)?,
-        (None, _) => quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)?,
-    };
-    Ok((integrals, moved))
+    if run.settings.reference.is_some() {
+        return Ok((integrals, 0.0));
+    }
+    let inputs = quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)?;
+    let direction = if matches!(domain, Domain::Cap { .. }) { quadrature::direction_sensitivity(&(&run.passes, &run.params), &leaves)? } else { 0.0 };
+    Ok((integrals, inputs + direction))
 }
 
 /// A pdf that returned NaN, ∞ or a negative value fails `pdf_values` whatever else; otherwise
