@@ -337,11 +337,15 @@ pub const DIRECTION_RESOLUTION: f64 = 1.0 / 8_388_608.0;
 /// angle is the same at every scale). A rectangle light of 10⁻⁴ sr overhead: its f32 pdf
 /// integrates to 1.000020 (its f32 solid angle is within 2·10⁻⁷ of the f64 one: the rest is
 /// where its edges are), a false `normalization` FAIL at 2²⁰ samples without this. Parts about
-/// the axis (in s = √a) hold no edge of a support the cap was fitted around, and stay.
+/// the axis (in s = √a) hold no edge of a support the cap was fitted around, and stay; so do
+/// parts in which the edge detector saw no jump (the mass moved is the edge's: moving the parts
+/// inside a support only moves its smooth pdf, and those were 84 % of the leaves of the
+/// rectangle above, for 6 % of its figure).
 pub(super) fn direction_sensitivity(f: &dyn Integrand<CheckError>, leaves: &[Leaf]) -> Result<f64, CheckError> {
     let moved = |delta: f64| -> Vec<Leaf> {
         leaves
             .iter()
+            .filter(|l| l.edge)
             .map(|l| {
                 let [a0, a1, ..] = l.rect.r;
                 let da = if l.rect.radial == Radial::A { (0.5 * (a0 + a1) * (2.0 - 0.5 * (a0 + a1))).max(0.0).sqrt() * delta } else { 0.0 };

@@ -167,6 +167,8 @@ pub struct Leaf {
     pub rect: Rect,
     pub bin: u32,
     pub value: f64,
+    /// Whether the edge detector saw a jump of the pdf in it (a support's edge crosses it).
+    pub edge: bool,
 }
 
 /// What [`refine`] gives per bin, and in all.
@@ -252,7 +254,7 @@ impl Round<'_> {
         } else if (!self.edged(i) && self.agree(p5, p3) && self.agree(e5, e3)) || next.len() + 4 > self.settings.max_parts {
             out.accept(part.bin, p5, e5, (p5 - p3).abs(), self.agree(p5, p3), squares);
             if self.settings.keep_leaves {
-                out.leaves.push(Leaf { rect: part.rect(), bin: part.bin, value: p5 });
+                out.leaves.push(Leaf { rect: part.rect(), bin: part.bin, value: p5, edge: self.edges[i].is_some() });
             }
         } else {
             next.extend(part.quarters((p5, e5)));
@@ -274,7 +276,8 @@ impl Round<'_> {
         if (agree && !edge) || (part.depth >= self.settings.max_depth && !edge) || next.len() + 16 > self.settings.max_parts {
             out.accept(part.bin, fine, fine_e, (fine - cp).abs(), agree, squares);
             if self.settings.keep_leaves {
-                out.leaves.extend(self.pending[i..i + 4].iter().zip(group).map(|(q, v)| Leaf { rect: q.rect(), bin: q.bin, value: v[0] }));
+                let edges = &self.edges[i..i + 4];
+                out.leaves.extend(self.pending[i..i + 4].iter().zip(group).zip(edges).map(|((q, v), e)| Leaf { rect: q.rect(), bin: q.bin, value: v[0], edge: e.is_some() }));
             }
         } else {
             for (q, v) in self.pending[i..i + 4].iter().zip(group) {
@@ -474,6 +477,9 @@ pub fn peak_parts(zone: &Zone, phi: (f64, f64), bin: u32, peak: Peak, max_split:
     let point = |a: f64, b: f64| DVec3::from(Domain::Sphere.part_point(a, b, zone.h as f64));
     // the peak's a in this hemisphere, and the turn of φ closest to the zone
     let zp = peak.direction.z.clamp(-1.0, 1.0);
+    if zp * (zone.h as f64) < 0.0 {
+        return None; // in the other hemisphere
+    }
     let ap = 1.0 - zone.h as f64 * zp;
     let mut pp = peak.direction.y.atan2(peak.direction.x);
     pp += std::f64::consts::TAU * ((0.5 * (phi.0 + phi.1) - pp) / std::f64::consts::TAU).round();
