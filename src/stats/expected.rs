@@ -136,20 +136,26 @@ pub fn lobe_probabilities(lobe: &Lobe, wi: DVec3, grid: SphereGrid, q: &Quadratu
 /// The probability of each upper-hemisphere bin of `grid` under the density `pdf` (per unit
 /// solid angle, zero below the horizon) whose narrowest feature is about `width` radians.
 pub fn probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature) -> Expected {
-    bin_probabilities(pdf, grid, width, None, q, false)
+    bin_probabilities(pdf, grid, width, &[], q, false)
 }
 
 /// As [`probabilities`], for a density with a narrow peak at a known direction: the bins about
 /// it are cut into parts graded toward it ([`Peak`]).
 pub fn peaked_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, peak: Peak, q: &Quadrature) -> Expected {
-    bin_probabilities(pdf, grid, peak.width, Some(peak), q, false)
+    bin_probabilities(pdf, grid, peak.width, &[peak], q, false)
 }
 
 /// As [`probabilities`], over every bin of the sphere: for a density that also lives below the
 /// horizon (a rough dielectric's transmission, [`crate::reference::dielectric`]).
 /// `below_horizon` is then the mass of no bin, 1 − Σ probabilities.
 pub fn sphere_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, q: &Quadrature) -> Expected {
-    bin_probabilities(pdf, grid, width, None, q, true)
+    bin_probabilities(pdf, grid, width, &[], q, true)
+}
+
+/// As [`sphere_probabilities`], for a density with narrow peaks at known directions (a smooth
+/// dielectric's reflected and transmitted ones): the bins about each are graded toward it.
+pub fn peaked_sphere_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, peaks: &[Peak], q: &Quadrature) -> Expected {
+    bin_probabilities(pdf, grid, width, peaks, q, true)
 }
 
 /// The settings of the engine for `q`: its tolerance at 10⁸ samples (`q` comes scaled to the
@@ -162,16 +168,17 @@ fn settings(q: &Quadrature) -> Settings {
 }
 
 /// The initial parts of every bin of `grid` (the upper hemisphere's, or the sphere's where
-/// `sphere`): graded toward `peak` where it is given and narrow there ([`peak_parts`]), else split
-/// per axis by the bin's angular extent over `width`, at most `q.max_initial_split` times.
-fn initial_parts(grid: SphereGrid, width: f64, peak: Option<Peak>, q: &Quadrature, sphere: bool) -> Vec<Part> {
+/// `sphere`): graded toward the first of `peaks` that is in the bin's reach and narrow there
+/// ([`peak_parts`]), else split per axis by the bin's angular extent over `width`, at most
+/// `q.max_initial_split` times.
+fn initial_parts(grid: SphereGrid, width: f64, peaks: &[Peak], q: &Quadrature, sphere: bool) -> Vec<Part> {
     let phis = grid.phi_edges();
     let mut parts = Vec::new();
     for row in 0..grid.rows {
         for zone in row_zones(grid.rows, row).into_iter().filter(|z| sphere || z.h > 0.0) {
             for c in 0..grid.cols as usize {
                 let (phi, bin) = ((phis[c], phis[c + 1]), row * grid.cols + c as u32);
-                match peak.and_then(|p| peak_parts(&zone, phi, bin, p, q.max_initial_split)) {
+                match peaks.iter().find_map(|p| peak_parts(&zone, phi, bin, *p, q.max_initial_split)) {
                     Some(graded) => parts.extend(graded),
                     None => parts.extend(split(zone.a, phi, zone.h, ((zone.extent(phi) / width).ceil() as u32).clamp(1, q.max_initial_split), bin)),
                 }
@@ -181,9 +188,9 @@ fn initial_parts(grid: SphereGrid, width: f64, peak: Option<Peak>, q: &Quadratur
     parts
 }
 
-fn bin_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, peak: Option<Peak>, q: &Quadrature, sphere: bool) -> Expected {
+fn bin_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: SphereGrid, width: f64, peaks: &[Peak], q: &Quadrature, sphere: bool) -> Expected {
     let cpu = CpuPdf::new(pdf, Domain::Sphere, Jumps::Trust);
-    let parts = initial_parts(grid, width, peak, q, sphere);
+    let parts = initial_parts(grid, width, peaks, q, sphere);
     let r = match refine::<std::convert::Infallible>(&cpu, parts, grid.bins(), &settings(q)) {
         Ok(r) => r,
         Err(never) => match never {},
