@@ -2,7 +2,7 @@
 //! without the command line, what a renderer's `cargo test` uses with `lobes::check`) pulls in
 //! none of the command line's crates; no features at all (`lobes::embed` alone) none of the GPU
 //! crates; each of the embed's features (naga, glsl, naga-oil, wgpu, wesl) only its own. `.ci/run`
-//! compiles them (`cargo check --release --no-default-features [--features F]`).
+//! compiles the embed alone (`cargo check --release --no-default-features`).
 
 use std::process::Command;
 
