@@ -240,7 +240,7 @@ fn the_density_integrates_to_the_mass_of_valid_samples_and_the_furnace_to_one() 
 
 /// The expected shares of the two wrong-side reasons (`expected::dielectric_wrong_side`, a
 /// quadrature about ωi with the sets' edges as breakpoints) against the f64 sampler's own
-/// counts: reflections through the surface (`below_horizon`) and refractions back to the
+/// counts: reflections through the surface (`outside_domain`) and refractions back to the
 /// incident side (`refracted_near_side`), each a binomial z-test. The cases include TIR from
 /// inside and the one a 2-D rule over (cos θh, φh) cells got wrong, θi 125°, η 1.33, where that
 /// rule's refracted_near_side share is shown to fail the same test.
@@ -270,7 +270,7 @@ fn the_wrong_side_shares_match_the_sampler_reason_by_reason() {
             let (below_share, near_share) = lobes::stats::expected::dielectric_wrong_side(&d, wi, &Quadrature::default());
             let (below, near) = count(&d, wi, M, 40 + k as u64);
             let what = format!("{kind:?} {method:?} α {alpha} η {eta} θi {theta}°");
-            assert!(z(below, below_share, M).abs() < 4.5, "{what}: below_horizon {below} of {M}, expected share {below_share:.6}");
+            assert!(z(below, below_share, M).abs() < 4.5, "{what}: outside_domain {below} of {M}, expected share {below_share:.6}");
             assert!(z(near, near_share, M).abs() < 4.5, "{what}: refracted_near_side {near} of {M}, expected share {near_share:.6}");
         }
     }

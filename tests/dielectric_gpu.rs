@@ -44,7 +44,7 @@ fn job(g: &RoughDielectric, theta_deg: f64) -> Job {
 }
 
 /// The reasons of a sample on the wrong side of its event.
-const WRONG_SIDE: [Invalid; 2] = [Invalid::BelowHorizon, Invalid::RefractedNearSide];
+const WRONG_SIDE: [Invalid; 2] = [Invalid::OutsideDomain, Invalid::RefractedNearSide];
 
 /// The GPU's counts: every sample a bin hit or a sample on the wrong side of its event
 /// (a reflection through the surface, a refraction that stayed on the incident side).

@@ -167,7 +167,7 @@ fn reflected_mass_above(l: &Lobe, wi: DVec3, cuts: &Cuts) -> f64 {
 /// Reflected densities of the NDF and VNDF methods: ∫ pdf_r over the upper hemisphere of ωr
 /// equals 1 − P(below), where P(below) is the mass of the half-vector density `pdf_h` over
 /// those h whose reflection of ωi is at or below the horizon, i.e. the probability that a sample
-/// is flagged `BelowHorizon`.
+/// is flagged `OutsideDomain`.
 #[test]
 fn reflected_densities_integrate_to_the_mass_above_the_horizon() {
     let mut worst = Worst::default();

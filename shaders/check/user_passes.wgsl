@@ -3,6 +3,7 @@
 #import lobes::check_params::lobes_check
 #import lobes::domain::{LOBES_DOMAIN_OUTSIDE, lobes_domain_point, lobes_domain_coordinates, lobes_domain_cell}
 #import lobes::user::{lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
+#import lobes::invalid::{LOBES_REASON_COUNT, LOBES_REASON_NON_FINITE_POINT, LOBES_REASON_OUTSIDE_DOMAIN, LOBES_REASON_NON_FINITE_PDF, LOBES_REASON_ZERO_PDF}
 
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
 // functions through three wrappers of `lobes::user`, the module that the composing host
@@ -429,53 +430,49 @@ fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
     lobes_out[i] = vec4<f32>(pdf, k, 0.0, 0.0);
 }
 
-// Reason codes of invalid samples (src/check/mod.rs: REASONS), counted after the bins.
-const LOBES_NON_FINITE_POINT: u32 = 1u;
-const LOBES_OUTSIDE_DOMAIN: u32 = 2u;
-const LOBES_NON_FINITE_PDF: u32 = 3u;
-const LOBES_ZERO_PDF: u32 = 4u;
-
 fn lobes_finite3(d: vec3<f32>) -> bool {
     let b = bitcast<vec3<u32>>(d) & vec3<u32>(0x7f800000u);
     return all(b != vec3<u32>(0x7f800000u));
 }
 
-// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1 (a rejection,
+// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1, the reasons' codes
+// those of `lobes::invalid` (src/reference/invalid.rs, generated; a user's sampler has no
+// refracted_near_side, whose cell stays 0) (a rejection,
 // pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`); the bin is the domain's
 // (lobes_domain_cell).
 fn lobes_cell(s: vec4<f32>) -> u32 {
     let bins = lobes_check.rows * lobes_check.cols;
     if (!lobes_finite3(s.xyz)) {
-        return bins + LOBES_NON_FINITE_POINT - 1u;
+        return bins + LOBES_REASON_NON_FINITE_POINT - 1u;
     }
     // pdf exactly 0 at a finite point, (0, 0, 0) or any other: the rejection the contract allows,
     // whatever the point (as the hard cases read it), not a point outside the domain
     if (s.w == 0.0) {
-        return bins + LOBES_ZERO_PDF - 1u;
+        return bins + LOBES_REASON_ZERO_PDF - 1u;
     }
     let cell = lobes_domain_cell(s.xyz);
     if (cell == LOBES_DOMAIN_OUTSIDE) {
-        return bins + LOBES_OUTSIDE_DOMAIN - 1u;
+        return bins + LOBES_REASON_OUTSIDE_DOMAIN - 1u;
     }
     let bits = bitcast<u32>(s.w);
     if ((bits & 0x7f800000u) == 0x7f800000u) {
-        return bins + LOBES_NON_FINITE_PDF - 1u;
+        return bins + LOBES_REASON_NON_FINITE_PDF - 1u;
     }
     if (!(s.w > 0.0)) {
-        return bins + LOBES_ZERO_PDF - 1u;
+        return bins + LOBES_REASON_ZERO_PDF - 1u;
     }
     return cell;
 }
 
-// The cells of the histogram: the bins, the 4 reasons, then the two draw counters of the
+// The cells of the histogram: the bins, the reasons, then the two draw counters of the
 // --rand queue: the samples that drew more than the four uniforms it holds, and the most draws
 // one sample took (src/check/gpu.rs: Counted). Counted on every sample, not on a probe: a lobe
 // of a mixture that draws a fifth number in 0.2 % of its samples is found at any seed.
 fn lobes_cells() -> u32 {
-    return lobes_check.rows * lobes_check.cols + 6u;
+    return lobes_check.rows * lobes_check.cols + LOBES_REASON_COUNT + 2u;
 }
-const LOBES_OVER_DRAWN: u32 = 4u;
-const LOBES_MOST_DRAWS: u32 = 5u;
+const LOBES_OVER_DRAWN: u32 = LOBES_REASON_COUNT;
+const LOBES_MOST_DRAWS: u32 = LOBES_REASON_COUNT + 1u;
 
 // Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
 // keeps each dispatch under 2^32 samples and adds into 64-bit totals), one storage atomic per

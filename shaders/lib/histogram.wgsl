@@ -1,14 +1,14 @@
 #define_import_path lobes::histogram
-#import lobes::job::{ROWS, COLS, REASON_NON_FINITE_DIRECTION, REASON_BELOW_HORIZON, REASON_NON_FINITE_PDF, REASON_ZERO_PDF, REASON_REFRACTED_NEAR_SIDE}
+#import lobes::job::{ROWS, COLS, REASON_NON_FINITE_POINT, REASON_OUTSIDE_DOMAIN, REASON_NON_FINITE_PDF, REASON_ZERO_PDF, REASON_REFRACTED_NEAR_SIDE}
 #import lobes::math::{Real, math_atan2, math_is_finite}
 #import lobes::reflect::PI
 #import lobes::bins::lobes_axis_column
 
 // Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
-// grid and REASON_* the codes of src/engine/gpu/layout.rs, from the generated `lobes::job`.
-// Cell layout: BINS bins, then one counter per invalid reason (codes 1..N_REASONS, in the order of
-// reference::Invalid::ALL): non-finite direction, below horizon, non-finite pdf, zero pdf,
-// refracted near side.
+// grid and REASON_* the codes of src/reference/invalid.rs, from the generated `lobes::job`.
+// Cell layout: BINS bins, then one counter per invalid reason (codes 1..REASON_COUNT, in the
+// order of reference::Invalid::ALL): non-finite point, outside the domain (for a lobe: below
+// the horizon), non-finite pdf, zero pdf, refracted near side.
 const F32_MAX: f32 = 3.40282347e38;
 
 // 0 for a valid sample, else the reason code: the first that applies in the order of
@@ -29,9 +29,9 @@ fn classify_scattered(wi: vec3<Real>, wo: vec3<Real>, pdf: Real, reflected: bool
     var reason = select(0u, REASON_ZERO_PDF, pdf <= 0.0);
     reason = select(reason, REASON_NON_FINITE_PDF, !math_is_finite(pdf));
     reason = select(reason, REASON_REFRACTED_NEAR_SIDE, !reflected && side >= 0.0);
-    reason = select(reason, REASON_BELOW_HORIZON, reflected && side <= 0.0);
+    reason = select(reason, REASON_OUTSIDE_DOMAIN, reflected && side <= 0.0);
     let finite = math_is_finite(wo.x) && math_is_finite(wo.y) && math_is_finite(wo.z);
-    return select(reason, REASON_NON_FINITE_DIRECTION, !finite);
+    return select(reason, REASON_NON_FINITE_POINT, !finite);
 }
 
 // Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over

@@ -6,6 +6,7 @@ use super::composition::{Draw, UserCode, is_name};
 use super::modules::compose_user;
 use super::probe::Probe;
 use super::{CheckError, Domain, UserSampler};
+use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::counting::SLAB_WORKGROUP;
 use crate::engine::gpu::{Counting, Gpu, GpuError, Strategy};
@@ -175,7 +176,7 @@ const DRAW_CELLS: usize = 2;
 /// What the histogram pass counted in one dispatch.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(super) struct Counted {
-    /// Per cell: the bins, then the 4 reasons.
+    /// Per cell: the bins, then the reasons of [`Invalid::ALL`].
     pub counts: Vec<u32>,
     /// Samples that drew more than the four numbers of the --rand queue, and the most draws one
     /// of them took (0 where none did).
@@ -196,12 +197,12 @@ pub(super) const CHUNK: u64 = 1 << 26;
 /// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
 /// numbers, counted on every sample, are bad input ([`too_many_draws`]).
 pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
-    let mut totals = vec![0u64; bins + 4];
+    let mut totals = vec![0u64; bins + Invalid::COUNT];
     let (mut over, mut most) = (0u64, 0u32);
     let mut first = 0;
     while first < samples {
         let n = CHUNK.min(samples - first) as u32;
-        let counted = passes.histogram(params, first, n, bins + 4, None)?;
+        let counted = passes.histogram(params, first, n, bins + Invalid::COUNT, None)?;
         for (t, c) in totals.iter_mut().zip(counted.counts) {
             *t += c as u64;
         }
@@ -641,7 +642,8 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
     let glue = contract_glue(sampler);
     let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
     let module = format!("#define_import_path lobes::user\n#import lobes::check_params::lobes_check\n{user}{glue}");
-    let chosen = [File::generated(USER_MODULE, module), domain_file(sampler.domain)];
+    let reasons = format!("#define_import_path lobes::invalid\n{}", Invalid::wgsl_consts("LOBES_REASON"));
+    let chosen = [File::generated(USER_MODULE, module), domain_file(sampler.domain), File::generated("lobes::invalid", reasons)];
     match library::validate_files(&["lobes::check"], &chosen) {
         Err(GpuError::Shader { what, .. }) if what == USER_MODULE => {}
         other => other?,
@@ -876,7 +878,7 @@ impl<'g> Passes<'g> {
         Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the 4 reasons
+    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the reasons
     /// (`cells` in all), and the --rand draws past the queue's four; in per-invocation slabs on a
     /// CPU adapter, else in storage atomics ([`Counting::choose`]; `force` asks for one, as
     /// tests do).
@@ -1108,7 +1110,7 @@ mod tests {
         let passes = Passes::new(&gpu, &compose(&sampler(text)).unwrap()).unwrap();
         let (rows, cols) = (32, 64);
         let params = Params { wi: [0.0, 0.0, 1.0, 0.0], seed: [7, 0], rows, cols, ..Zeroable::zeroed() };
-        let cells = (rows * cols + 4) as usize;
+        let cells = (rows * cols) as usize + Invalid::COUNT;
         for (first, count) in [(0u64, 1_000_003u32), (5_000_000_000, 77)] {
             let atomics = passes.histogram(&params, first, count, cells, Some(Strategy::Atomics)).unwrap().counts;
             let slabs = passes.histogram(&params, first, count, cells, Some(Strategy::Slabs)).unwrap().counts;
@@ -1117,7 +1119,8 @@ mod tests {
         }
         // about 1 % each outside the domain and with pdf 0 (10 000 ± 100)
         let counts = passes.histogram(&params, 0, 1_000_003, cells, Some(Strategy::Slabs)).unwrap().counts;
-        let (outside, zero) = (counts[cells - 4 + 1], counts[cells - 4 + 3]);
+        let bins = (rows * cols) as usize;
+        let (outside, zero) = (counts[bins + Invalid::OutsideDomain.index()], counts[bins + Invalid::ZeroPdf.index()]);
         assert!((9_500..10_500).contains(&outside) && (9_500..10_500).contains(&zero), "{outside} {zero}");
     }
 }

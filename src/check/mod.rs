@@ -60,7 +60,7 @@ pub use conventions::{Conventions, Frame, Incident, Measure};
 /// glam, whose `DVec3` [`Reference`] takes: a renderer's tests need no glam of their own.
 pub use glam;
 pub use composition::{Composition, Dialect, Draw, SampleReturns};
-pub use report::{Check, Figures, REASONS, Report};
+pub use report::{Check, Figures, InvalidCounts, Report};
 
 use crate::engine::gpu::{Gpu, GpuError};
 use report::REPORT_VERSION;
@@ -470,7 +470,7 @@ fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, 
 }
 
 /// The histograms alone (none of the other checks) of `sampler` at each (samples, seed) of
-/// `runs`, the passes composed once: counts per bin then per reason of [`REASONS`], and the
+/// `runs`, the passes composed once: counts per bin then per reason of [`crate::reference::Invalid::ALL`], and the
 /// wall seconds of each histogram. For measurements over many seeds and counts (`lobes
 /// tradeoff`'s detection table), judged against the expected counts of one [`check`] of the
 /// same settings, on the sampler's own domain: a grid fitted to the samples

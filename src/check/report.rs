@@ -6,19 +6,20 @@ use super::Domain;
 use super::hard::HardRow;
 use super::jacobian::JacobianCheck;
 use super::quadrature::Integrals;
+use crate::reference::Invalid;
 use crate::stats::chi2::Chi2;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The version of the layout of [`Report`] (and of [`super::power::PowerSweep`]): 2 since a
-/// report's `domain` may be a fitted cap (`{"kind": "cap", "axis", "height"}`).
-pub const REPORT_VERSION: u32 = 2;
+/// report's `domain` may be a fitted cap (`{"kind": "cap", "axis", "height"}`); 3: `invalid` holds
+/// the five reasons of [`Invalid::ALL`], shared with `lobes run`, `refracted_near_side` last).
+pub const REPORT_VERSION: u32 = 3;
 
-/// Names of the invalid-sample reasons, in the order of their cells after the bins.
-pub const REASONS: [&str; 4] = ["non_finite_point", "outside_domain", "non_finite_pdf", "zero_pdf"];
-/// The index of `outside_domain` in [`REASONS`].
-pub const OUTSIDE_DOMAIN: usize = 1;
+/// Invalid samples per reason, in the order of [`Invalid::ALL`] (a user's sampler never has a
+/// `refracted_near_side`).
+pub type InvalidCounts = [u64; Invalid::COUNT];
 
 /// Everything a check of a user's sampler found.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -40,9 +41,9 @@ pub struct Report {
     /// none), and the wall time of the whole check.
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
-    /// Counts per bin (row-major), and per reason of [`REASONS`].
+    /// Counts per bin (row-major), and per reason of [`Invalid::ALL`].
     pub counts: Vec<u64>,
-    pub invalid: [u64; 4],
+    pub invalid: InvalidCounts,
     /// Expected counts per bin from the quadrature of the pdf: N ∫pdf, signed (below 0 in a bin
     /// where the pdf is negative, which `pdf_values` fails; the χ² counts those parts as 0).
     pub expected: Vec<f64>,
@@ -112,8 +113,8 @@ pub struct Chi2Figures {
     pub chi2: Chi2,
     /// Σ over bins of ∫ pdf: 1 for a pdf that is normalised over the domain.
     pub pdf_integral: f64,
-    /// Invalid samples by reason (the order of [`REASONS`]), and the invalid cell's expectation.
-    pub invalid: [u64; 4],
+    /// Invalid samples by reason (the order of [`Invalid::ALL`]), and the invalid cell's expectation.
+    pub invalid: InvalidCounts,
     pub expected_invalid: f64,
     pub quadrature: Integrals,
     /// Column edges off the axes closer to the lobe than f32 binning places them
@@ -145,7 +146,7 @@ pub fn grouped(n: u64) -> String {
 
 /// When the invalid cell holds most of the χ² statistic (or any count where none was expected):
 /// "34 739 invalid samples where 33 were expected (zero_pdf 34 000, outside_domain 739)".
-pub fn invalid_dominates(invalid: &[u64; 4], expected: f64, statistic: f64) -> Option<String> {
+pub fn invalid_dominates(invalid: &InvalidCounts, expected: f64, statistic: f64) -> Option<String> {
     let observed: u64 = invalid.iter().sum();
     let o = observed as f64;
     let share = if expected > 0.0 { (o - expected).powi(2) / expected } else if observed > 0 { f64::INFINITY } else { 0.0 };
@@ -153,7 +154,7 @@ pub fn invalid_dominates(invalid: &[u64; 4], expected: f64, statistic: f64) -> O
     if observed == 0 || share.partial_cmp(&(0.5 * statistic)) != Some(std::cmp::Ordering::Greater) || o <= expected {
         return None;
     }
-    let reasons: Vec<String> = REASONS.iter().zip(invalid).filter(|(_, n)| **n > 0).map(|(r, n)| format!("{r} {}", grouped(*n))).collect();
+    let reasons: Vec<String> = Invalid::ALL.iter().zip(invalid).filter(|(_, n)| **n > 0).map(|(r, n)| format!("{} {}", r.name(), grouped(*n))).collect();
     Some(format!("{} invalid samples where {} were expected ({})", grouped(observed), grouped(expected.round() as u64), reasons.join(", ")))
 }
 
@@ -303,14 +304,14 @@ mod tests {
     /// The invalid cell is named when it holds most of χ², not when the bins do.
     #[test]
     fn a_dominating_invalid_cell_is_named() {
-        let m = invalid_dominates(&[0, 739, 0, 34_000], 33.0, 3.7e7).unwrap();
+        let m = invalid_dominates(&[0, 739, 0, 34_000, 0], 33.0, 3.7e7).unwrap();
         assert_eq!(m, "34 739 invalid samples where 33 were expected (outside_domain 739, zero_pdf 34 000)");
         // (34 739 − 33)² / 33 ≈ 3.65e7: less than half of a statistic of 1e8
-        assert!(invalid_dominates(&[0, 739, 0, 34_000], 33.0, 1e8).is_none());
-        assert!(invalid_dominates(&[0, 0, 0, 10], 0.0, 5.0).is_some());
-        assert!(invalid_dominates(&[0, 0, 0, 0], 3.0, 5.0).is_none());
+        assert!(invalid_dominates(&[0, 739, 0, 34_000, 0], 33.0, 1e8).is_none());
+        assert!(invalid_dominates(&[0, 0, 0, 10, 0], 0.0, 5.0).is_some());
+        assert!(invalid_dominates(&[0, 0, 0, 0, 0], 3.0, 5.0).is_none());
         // fewer than expected: the pdf allows more rejections than happen; not "invalid samples"
-        assert!(invalid_dominates(&[0, 0, 0, 10], 1000.0, 1000.0).is_none());
+        assert!(invalid_dominates(&[0, 0, 0, 10, 0], 1000.0, 1000.0).is_none());
     }
 
     #[test]

@@ -19,6 +19,7 @@
 use super::gpu::Passes;
 use super::{CheckError, Domain, Settings, UserSampler};
 use crate::check::probe::Probe;
+use crate::reference::Invalid;
 use glam::DVec3;
 
 /// Whether to fit the grid to a small support.
@@ -87,7 +88,7 @@ pub fn probed_cap(probes: &[Probe], limit: f64) -> Option<([f64; 3], f64)> {
 /// about `axis`, then the reasons), or `None` where a sample fell outside it.
 pub fn fitted(axis: [f64; 3], height: f64, counts: &[u64]) -> Option<Domain> {
     let rows = FIT_ROWS as usize;
-    let outside = counts[rows + super::report::OUTSIDE_DOMAIN];
+    let outside = counts[rows + Invalid::OutsideDomain.index()];
     let top = counts[..rows].iter().rposition(|&c| c > 0)?;
     (outside == 0).then(|| Domain::cap(axis, height * ((top + 2).min(rows) as f64) / rows as f64)).flatten()
 }
@@ -156,12 +157,12 @@ mod tests {
 
     #[test]
     fn the_fitted_cap_ends_a_row_past_the_farthest_sample() {
-        let mut counts = vec![0u64; FIT_ROWS as usize + 4];
+        let mut counts = vec![0u64; FIT_ROWS as usize + Invalid::COUNT];
         counts[10] = 5;
         counts[99] = 1;
         let Some(Domain::Cap { height, .. }) = fitted([0.0, 0.0, 1.0], 1.0, &counts) else { panic!() };
         assert_eq!(height, (101.0f64 / FIT_ROWS as f64) as f32 as f64);
-        counts[FIT_ROWS as usize + crate::check::report::OUTSIDE_DOMAIN] = 1;
+        counts[FIT_ROWS as usize + Invalid::OutsideDomain.index()] = 1;
         assert_eq!(fitted([0.0, 0.0, 1.0], 1.0, &counts), None, "a sample outside");
     }
 }

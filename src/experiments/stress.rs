@@ -287,7 +287,7 @@ fn cpu_sample(case: &StressCase, glass: Option<&RoughDielectric>, u: [f64; 3]) -
             // the sampler's own verdict, with the reason check_scattered gives (an invalid sample
             // that check_scattered finds valid gets one it cannot match, so `bad` counts it)
             let reason = Invalid::check_scattered(case.incident, s.omega_o, s.pdf_o, reflected);
-            let invalid = if s.valid { None } else { Some(reason.unwrap_or(Invalid::NonFiniteDirection)) };
+            let invalid = if s.valid { None } else { Some(reason.unwrap_or(Invalid::NonFinitePoint)) };
             Drawn { h: s.h, wo: s.omega_o, pdf: s.pdf_o, invalid, reflected, unknown_reason: false, grazing_h: case.incident.dot(s.h).abs() < COS_ROUNDING }
         }
     }
@@ -306,7 +306,7 @@ fn gpu_sample(case: &StressCase, g: &[[f32; 4]; 3]) -> Drawn {
     let invalid = Invalid::ALL.into_iter().find(|r| r.code() as f32 == code);
     let wi = case.incident;
     let reflected = match (case.scatter, invalid) {
-        (Scatter::Reflect, _) | (_, Some(Invalid::BelowHorizon)) => true,
+        (Scatter::Reflect, _) | (_, Some(Invalid::OutsideDomain)) => true,
         (_, Some(Invalid::RefractedNearSide)) => false,
         (_, None) => wo.z * wi.z > 0.0,
         _ => wi.dot(h) * wo.dot(h) >= 0.0,

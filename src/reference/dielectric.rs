@@ -193,7 +193,7 @@ impl RoughDielectric {
     /// kinds of wrong-side samples of [`sample`](Self::sample): a reflection that leaves
     /// through the surface (p(h) F, or p(h) where refraction is impossible) and a refraction
     /// that stays on the incident side (p(h) (1 − F)). Their integrals are the expected shares
-    /// of [`Invalid::BelowHorizon`](super::Invalid) and [`Invalid::RefractedNearSide`](super::Invalid).
+    /// of [`Invalid::OutsideDomain`](super::Invalid) and [`Invalid::RefractedNearSide`](super::Invalid).
     pub fn wrong_side_h(&self, wi: DVec3, h: DVec3) -> (f64, f64) {
         let (wi, eta) = self.upper_side(wi);
         let pdf_h = self.lobe.pdf_h(wi, h);

@@ -9,6 +9,7 @@ pub mod dielectric;
 pub mod discrete;
 pub mod effects;
 pub mod frame;
+pub mod invalid;
 pub mod light;
 pub mod fresnel;
 pub mod ggx;
@@ -69,75 +70,8 @@ impl Method {
     }
 }
 
+pub use invalid::{ByReason, Invalid};
 pub use sampler::SAMPLERS;
-
-/// Why a sample is not a usable reflected direction. Every invalid sample is counted under
-/// exactly one reason, checked in this order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Invalid {
-    /// ωr has a NaN or infinite component.
-    NonFiniteDirection,
-    /// ωr.z ≤ 0: the reflection left the upper hemisphere (for a rough dielectric: a reflection
-    /// that left through the surface, to the far side from ωi).
-    BelowHorizon,
-    /// p(ωr) is NaN or infinite.
-    NonFinitePdf,
-    /// p(ωr) ≤ 0.
-    ZeroPdf,
-    /// A rough dielectric's refraction that stayed on the incident side (a microfacet tilted
-    /// past the macro surface, [`dielectric`]).
-    RefractedNearSide,
-}
-
-impl Invalid {
-    pub const ALL: [Invalid; 5] =
-        [Invalid::NonFiniteDirection, Invalid::BelowHorizon, Invalid::NonFinitePdf, Invalid::ZeroPdf, Invalid::RefractedNearSide];
-    /// The number of reasons.
-    pub const COUNT: usize = Invalid::ALL.len();
-    pub fn name(self) -> &'static str {
-        match self {
-            Invalid::NonFiniteDirection => "non_finite_direction",
-            Invalid::BelowHorizon => "below_horizon",
-            Invalid::NonFinitePdf => "non_finite_pdf",
-            Invalid::ZeroPdf => "zero_pdf",
-            Invalid::RefractedNearSide => "refracted_near_side",
-        }
-    }
-    /// The code the GPU kernels use for this reason (`shaders/lib/histogram.wgsl`).
-    pub fn code(self) -> u32 {
-        self as u32 + 1
-    }
-
-    /// Classifies a sampled direction and its density.
-    pub fn check(wr: DVec3, pdf_r: f64) -> Option<Invalid> {
-        Invalid::check_scattered(DVec3::Z, wr, pdf_r, true)
-    }
-
-    /// Classifies a direction that may leave on either side of the surface, a rough
-    /// dielectric's ([`dielectric`]) seen from ωi: `reflected` says its event. A reflection is
-    /// valid on the side of ωi, a refraction on the other (ωo on the surface is on neither); a
-    /// sample on the wrong side of its event is [`Invalid::BelowHorizon`] (a reflection) or
-    /// [`Invalid::RefractedNearSide`], before its density is looked at. With ωi = +z and a
-    /// reflection, this is [`Invalid::check`].
-    pub fn check_scattered(wi: DVec3, wo: DVec3, pdf_o: f64, reflected: bool) -> Option<Invalid> {
-        // ωo.z on ωi's side taken positive (light from inside is mirrored, dielectric.rs)
-        let side = if wi.z < 0.0 { -wo.z } else { wo.z };
-        if !wo.is_finite() {
-            Some(Invalid::NonFiniteDirection)
-        } else if reflected && side <= 0.0 {
-            Some(Invalid::BelowHorizon)
-        } else if !reflected && side >= 0.0 {
-            Some(Invalid::RefractedNearSide)
-        } else if !pdf_o.is_finite() {
-            Some(Invalid::NonFinitePdf)
-        } else if pdf_o <= 0.0 {
-            Some(Invalid::ZeroPdf)
-        } else {
-            None
-        }
-    }
-}
 
 /// A reflectance lobe with its roughness and sampling method.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -70,6 +70,14 @@ impl<'a> Outcome<'a> {
         }
     }
 
+    /// Invalid samples per reason, in the order of [`crate::reference::Invalid::ALL`].
+    pub fn invalid(self) -> [u64; crate::reference::Invalid::COUNT] {
+        match self {
+            Outcome::Lobe(r) => r.counts.invalid,
+            Outcome::User(r) => r.report.invalid,
+        }
+    }
+
     /// Counts and expected counts per bin, row-major.
     pub fn counts(self) -> &'a [u64] {
         match self {

@@ -21,7 +21,8 @@ use super::npy;
 use super::outcome::Outcome;
 use crate::stats::weighted::AlbedoTest;
 use crate::reference::effects::Effects;
-use crate::run::record::{ByReason, CaseDescription, Timing, WeightedTiming};
+use crate::reference::ByReason;
+use crate::run::record::{CaseDescription, Timing, WeightedTiming};
 use crate::run::shard::ShardFile;
 use crate::run::user::UserResult;
 use crate::run::{CaseResult, WeightedResult};
@@ -35,8 +36,10 @@ use std::path::{Path, PathBuf};
 
 /// The version of the layout of `histogram.json` (2: the times moved to `timing.json`; 3:
 /// `counting` in place of `workgroup_counting`; 4: a user's case may be binned on a fitted cap,
-/// `domain = "cap"` with `cap_axis` and `cap_height`).
-pub const HISTOGRAM_VERSION: u32 = 4;
+/// `domain = "cap"` with `cap_axis` and `cap_height`; 5: one list of invalid reasons for lobes and
+/// user's samplers, `invalid` filled for both, its first two keys `non_finite_point` and
+/// `outside_domain` (were `non_finite_direction`, `below_horizon`), `user_sampler.invalid` gone).
+pub const HISTOGRAM_VERSION: u32 = 5;
 /// The version of the layout of `timing.json`.
 pub const TIMING_VERSION: u32 = 1;
 /// The version of the layout of the summaries of `lobes run` and `lobes merge` (`summary.json`,
@@ -66,8 +69,10 @@ pub struct HistogramFile {
     pub counts: Vec<Vec<u64>>,
     /// Expected counts, rows × cols.
     pub expected: Vec<Vec<f64>>,
-    /// Invalid samples by reason (null for a user's sampler: see `user_sampler.invalid`).
+    /// Invalid samples by reason (for a user's sampler, `refracted_near_side` is always 0).
     pub invalid: Option<ByReason<u64>>,
+    /// The expected count of each reason's cell (lobe cases; a user's sampler's invalid samples
+    /// are one pooled cell: `user_sampler.expected_invalid`).
     pub expected_invalid: Option<ByReason<f64>>,
     pub chi2: Chi2,
     /// GPU directions of the first samples against f64 (GPU lobe cases).
@@ -118,30 +123,20 @@ impl TimingFile {
     }
 }
 
-/// The `user_sampler` section: every check of `lobes check` and the invalid samples by the
-/// check's reasons ([`crate::check::REASONS`]), pooled into one cell of the χ² test.
+/// The `user_sampler` section: every check of `lobes check`, and the expectation of the one cell
+/// of the χ² test that pools the invalid samples of every reason (the case's `invalid`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct UserSamplerRecord {
     /// Whether every check passed (the case's verdict).
     pub passed: bool,
     /// Every check, as in `lobes check`'s report: `{"name", "figures", "passed", "summary"}`.
     pub checks: Vec<crate::check::Check>,
-    pub invalid: UserInvalid,
     /// The expected count of the pooled invalid cell.
     pub expected_invalid: f64,
     /// With the case's `budget`: the pilot checks, the fitted time model and the count picked
     /// (the `samples` above).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub budget: Option<crate::check::budget::BudgetPick>,
-}
-
-/// Invalid samples of a user's sampler by reason.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct UserInvalid {
-    pub non_finite_point: u64,
-    pub outside_domain: u64,
-    pub non_finite_pdf: u64,
-    pub zero_pdf: u64,
 }
 
 /// The accuracy and time of the expected histogram's quadrature.
@@ -188,7 +183,7 @@ impl HistogramFile {
             phi_edges: grid.map(|g| g.phi_edges()),
             counts: nested(r.counts(), cols),
             expected: nested(r.expected(), cols),
-            invalid: lobe.map(|l| l.counts.invalid.into()),
+            invalid: Some(r.invalid().into()),
             expected_invalid: lobe.map(|l| l.expected.invalid.into()),
             chi2: r.chi2().clone(),
             per_sample_check: lobe.and_then(|l| l.angle.clone()),
@@ -227,11 +222,9 @@ impl WeightedRecord {
 
 impl UserSamplerRecord {
     fn of(r: &UserResult) -> Self {
-        let [non_finite_point, outside_domain, non_finite_pdf, zero_pdf] = r.report.invalid;
         UserSamplerRecord {
             passed: r.report.passed,
             checks: r.report.checks.to_vec(),
-            invalid: UserInvalid { non_finite_point, outside_domain, non_finite_pdf, zero_pdf },
             expected_invalid: r.expected_invalid,
             budget: r.budget.clone(),
         }
@@ -302,7 +295,7 @@ pub fn write_case(dir: &Path, r: Outcome, adapter: &str, backend: &str, style: J
     }
     let caption = format!("{} ({}): {verdict}", r.name(), caption::parameters(&doc.description));
     // a lobe's invalid samples (a user's sampler's are in its report)
-    let invalid: u64 = lobe.map_or(0, |l| l.counts.invalid.iter().sum());
+    let invalid: u64 = r.invalid().iter().sum();
     let note = if invalid > 0 { format!("{invalid} invalid samples not shown") } else { String::new() };
     let coarse = family::caught_grid(r.chi2());
     compare::write(&folder, &Comparison { bins: r.bins(), measured: &measured, expected: r.expected(), caption: &caption, note: &note, coarse })?;

@@ -53,7 +53,7 @@ pub fn expected_counts(job: &Job, samples: u64, q: &Quadrature) -> ExpectedCount
         Job::Lobe { lobe, incident, grid, .. } => {
             let e = expected::lobe_probabilities(lobe, *incident, *grid, q);
             let mut invalid = [0.0; Invalid::COUNT];
-            invalid[Invalid::BelowHorizon.code() as usize - 1] = n * e.below_horizon;
+            invalid[Invalid::OutsideDomain.code() as usize - 1] = n * e.below_horizon;
             ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Domain::Sphere.grid(grid.rows, grid.cols) }
         }
         Job::Discrete { dist, .. } => {
@@ -123,7 +123,7 @@ fn dielectric_expected(glass: &RoughDielectric, wi: DVec3, grid: crate::stats::h
     // inside at θi 125°, η 1.33, refracted_near_side came out at 91 % of its count.
     let (below, near) = expected::dielectric_wrong_side(glass, wi, q);
     let mut invalid = [0.0; Invalid::COUNT];
-    invalid[Invalid::BelowHorizon.code() as usize - 1] = n * below;
+    invalid[Invalid::OutsideDomain.code() as usize - 1] = n * below;
     invalid[Invalid::RefractedNearSide.code() as usize - 1] = n * near;
     ExpectedCounts { bins: e.probabilities.iter().map(|p| n * p).collect(), invalid, quadrature: Some(e), grid: Domain::Sphere.grid(grid.rows, grid.cols) }
 }

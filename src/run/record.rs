@@ -4,7 +4,6 @@
 //! structs; `docs/schema/` holds their JSON Schema ([`crate::report::schema`]).
 
 use crate::engine::job::{Job, Scatter};
-use crate::reference::Invalid;
 use crate::scene::{Case, UserCase};
 use crate::stats::domain::{Domain, Grid};
 use schemars::JsonSchema;
@@ -142,46 +141,6 @@ impl Params {
     }
 }
 
-/// One value per invalid reason ([`Invalid::ALL`], whose names are the keys).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[schemars(bound = "T: JsonSchema + Default")]
-pub struct ByReason<T> {
-    pub non_finite_direction: T,
-    pub below_horizon: T,
-    pub non_finite_pdf: T,
-    pub zero_pdf: T,
-    /// Absent in records written before the rough dielectric (read as 0).
-    #[serde(default)]
-    pub refracted_near_side: T,
-}
-
-impl<T: Copy> From<[T; Invalid::COUNT]> for ByReason<T> {
-    /// From values in the order of [`Invalid::ALL`].
-    fn from([non_finite_direction, below_horizon, non_finite_pdf, zero_pdf, refracted_near_side]: [T; Invalid::COUNT]) -> Self {
-        ByReason { non_finite_direction, below_horizon, non_finite_pdf, zero_pdf, refracted_near_side }
-    }
-}
-
-impl<T: Copy> From<ByReason<T>> for [T; Invalid::COUNT] {
-    /// To values in the order of [`Invalid::ALL`].
-    fn from(r: ByReason<T>) -> Self {
-        [r.non_finite_direction, r.below_horizon, r.non_finite_pdf, r.zero_pdf, r.refracted_near_side]
-    }
-}
-
-impl<T> ByReason<T> {
-    /// The value for `reason`.
-    pub fn get(&self, reason: Invalid) -> &T {
-        match reason {
-            Invalid::NonFiniteDirection => &self.non_finite_direction,
-            Invalid::BelowHorizon => &self.below_horizon,
-            Invalid::NonFinitePdf => &self.non_finite_pdf,
-            Invalid::ZeroPdf => &self.zero_pdf,
-            Invalid::RefractedNearSide => &self.refracted_near_side,
-        }
-    }
-}
-
 /// The histogram pass's time.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Timing {
@@ -195,24 +154,4 @@ pub struct Timing {
 pub struct WeightedTiming {
     pub gpu_seconds: Option<f64>,
     pub wall_seconds: f64,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reasons_are_keyed_by_their_names_in_order() {
-        let v = serde_json::to_value(ByReason::from([10u64, 11, 12, 13, 14])).unwrap();
-        for (i, r) in Invalid::ALL.into_iter().enumerate() {
-            assert_eq!(v[r.name()], 10 + i as u64, "{}", r.name());
-            assert_eq!(*ByReason::from([10u64, 11, 12, 13, 14]).get(r), 10 + i as u64);
-        }
-        assert_eq!(v.as_object().unwrap().len(), 5);
-        let back: [u64; 5] = serde_json::from_value::<ByReason<u64>>(v).unwrap().into();
-        assert_eq!(back, [10, 11, 12, 13, 14]);
-        // a record from before the rough dielectric has four reasons
-        let old = serde_json::json!({"non_finite_direction": 1, "below_horizon": 2, "non_finite_pdf": 3, "zero_pdf": 4});
-        assert_eq!(<[u64; 5]>::from(serde_json::from_value::<ByReason<u64>>(old).unwrap()), [1, 2, 3, 4, 0]);
-    }
 }

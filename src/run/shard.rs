@@ -18,7 +18,8 @@
 //! another) changes the checksum. Both are refused as bad input. (The checksum finds edits and
 //! damage, not an attacker: anyone can recompute it.)
 
-use super::record::{ByReason, CaseDescription, Subject, Timing, WeightedTiming};
+use super::record::{CaseDescription, Subject, Timing, WeightedTiming};
+use crate::reference::ByReason;
 use super::Sampled;
 use crate::engine::gpu::WeightedRun;
 use crate::engine::job::Counts;
@@ -35,8 +36,10 @@ use std::path::{Path, PathBuf};
 pub const SHARD_FORMAT: &str = "lobes-shard";
 /// The version of the shard file layout (1: the layout before `format_version`, with the
 /// exact bits of the per-sample check in a side field; 3: `counts_fnv1a64`; 4: `counting` in
-/// place of `workgroup_counting`).
-pub const SHARD_VERSION: u32 = 4;
+/// place of `workgroup_counting`; 5: `invalid`'s first two keys `non_finite_point` and
+/// `outside_domain`, the names `lobes check` gives them, were `non_finite_direction` and
+/// `below_horizon`).
+pub const SHARD_VERSION: u32 = 5;
 /// The lobes that writes (and alone reads) shard files.
 pub const LOBES_VERSION: &str = env!("CARGO_PKG_VERSION");
 

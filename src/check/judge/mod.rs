@@ -90,7 +90,7 @@ impl<'a, 'g> Run<'a, 'g> {
 
 /// Everything the checks judge, measured once.
 pub(crate) struct Measured {
-    /// Counts per bin, then per invalid reason ([`super::REASONS`]).
+    /// Counts per bin, then per invalid reason ([`crate::reference::Invalid::ALL`]).
     pub totals: Vec<u64>,
     /// The probed uniforms and what the probe pass found at each.
     pub probe_u: Vec<[f32; 4]>,
@@ -115,8 +115,8 @@ impl Measured {
     pub fn counts(&self, bins: usize) -> &[u64] {
         &self.totals[..bins]
     }
-    pub fn invalid(&self, bins: usize) -> [u64; 4] {
-        self.totals[bins..].try_into().expect("four reasons")
+    pub fn invalid(&self, bins: usize) -> super::InvalidCounts {
+        self.totals[bins..].try_into().expect("a count per reason")
     }
     /// ∫pdf over the domain.
     pub fn pdf_total(&self) -> f64 {

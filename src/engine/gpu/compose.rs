@@ -304,7 +304,7 @@ fn counting_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Pre
     let mut job_module = JobModule::new(describe(job));
     job_module.push(&format!(
         "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
-         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + N_REASONS;\nconst WG_WORDS: u32 = {wg_words}u;\n\
+         const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + REASON_COUNT;\nconst WG_WORDS: u32 = {wg_words}u;\n\
          const WG_BINS_PER_WORD: u32 = {bins_per_word}u;\nconst COUNT_WG: u32 = {count_wg}u;\nconst SLABS: u32 = {slabs}u;\n{slabs_used}{}",
         layout::consts_wgsl()
     ));

@@ -123,7 +123,7 @@ impl GpuEngine {
     }
 
     /// How `job`'s histogram is split to fit this adapter's limits: a tile's cells (its bins and
-    /// the four invalid reasons) must fit one storage binding as 64-bit totals, and the fold
+    /// the invalid reasons) must fit one storage binding as 64-bit totals, and the fold
     /// kernel's grid (one invocation per cell) the per-dimension dispatch limit. An error if
     /// the job cannot run here at all (a discrete table larger than a storage binding).
     pub fn tiling(&self, job: &Job) -> Result<Tiling, GpuError> {

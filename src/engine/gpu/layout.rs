@@ -38,11 +38,9 @@ fn constant_name(prefix: &str, name: &str) -> String {
 /// fixed-point scales of the weighted sums (`src/stats/weighted.rs`).
 pub fn consts_wgsl() -> String {
     let mut src = format!(
-        "const WG_SIZE: u32 = {WG_SIZE}u;\nconst SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\nconst N_REASONS: u32 = {N_REASONS}u;\n"
+        "const WG_SIZE: u32 = {WG_SIZE}u;\nconst SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;\n"
     );
-    for reason in Invalid::ALL {
-        src += &format!("const {}: u32 = {}u;\n", constant_name("REASON", reason.name()), reason.code());
-    }
+    src += &Invalid::wgsl_consts("REASON");
     let fresnels = [Fresnel::Schlick { f0: 0.0 }, Fresnel::Conductor { eta: 1.0, k: 0.0 }, Fresnel::Dielectric { eta: 1.0 }];
     for f in fresnels {
         src += &format!("const {}: u32 = {}u;\n", constant_name("FRESNEL", f.name()), f.mode());

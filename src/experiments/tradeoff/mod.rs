@@ -403,7 +403,7 @@ pub fn albedo_estimator(lobe: &Lobe, wi: DVec3, seed: u64, n: u64) -> (f64, f64,
                     let w = lobe.eval(wi, s.omega_r) * s.omega_r.z / s.pdf_r;
                     (w, w * w, 0u64)
                 }
-                Some(Invalid::BelowHorizon) => (0.0, 0.0, 1),
+                Some(Invalid::OutsideDomain) => (0.0, 0.0, 1),
                 Some(_) => (0.0, 0.0, 0),
             }
         })
