@@ -35,7 +35,7 @@ pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::domain::Cell;
 use crate::stats::histogram::SphereGrid;
 pub use crate::stats::quadrature::{CpuPdf, EDGE_DEPTH, Integrand, Jumps, Leaf, Rect, SphereIntegral, sphere_integral_f64};
-use crate::stats::quadrature::{Part, Radial, Refined, Rules, Settings, Tolerance, refine, row_zones, sphere_integral, split};
+use crate::stats::quadrature::{Part, Radial, Refined, Rules, Settings, Tolerance, refine, row_zones, sphere_integral, split, z_zones};
 use serde::{Deserialize, Serialize};
 
 /// Deepest split of a part (a quarter per level).
@@ -366,78 +366,123 @@ pub(super) fn direction_sensitivity(f: &dyn Integrand<CheckError>, leaves: &[Lea
 }
 
 
-/// How far from a column edge off the axes `lobes check`'s f32 binning may put it (radians): the
-/// column ⌊(atan2(y, x) + π)/2π · cols⌋ rounds atan2 (whose result near ±π steps by 2.4·10⁻⁷)
-/// and t; measured within about 2·10⁻⁷ on lavapipe, taken as 2 ulps of π. Edges on an axis are
-/// exact (`lobes_axis_column`).
+/// How far from a bin edge f32 may put a sample: from a column edge off the axes, the binning
+/// (radians: the column ⌊(atan2(y, x) + π)/2π · cols⌋ rounds atan2, whose result near ±π steps
+/// by 2.4·10⁻⁷, and t; measured within about 2·10⁻⁷ on lavapipe, taken as 2 ulps of π; edges
+/// on an axis are exact, `lobes_axis_column`); from a row edge, the sampler's own rounding of
+/// cos θ = d.z, a few ulps of 1 (a light whose edge lies in the plane of a row edge, as one lying
+/// on the surface's plane does at cos θ = 0: its samples on that edge land on either side).
 pub const EDGE_RESOLUTION: f64 = 5e-7;
-/// A column edge whose strip of ±[`EDGE_RESOLUTION`] holds more than this many standard
-/// deviations of the smaller of its two bins' counts (what f32 may move across it, at worst)
-/// cannot be placed by the binning as the quadrature places it; the χ² judges its two bins as
-/// one cell.
+/// An edge whose strip of ±[`EDGE_RESOLUTION`] holds more than this many standard deviations of
+/// the smaller of its two bins' counts (what f32 may move across it, at worst) cannot be placed
+/// by the binning as the quadrature places it; the χ² judges its two bins as one cell.
 pub const EDGE_SIGMA: f64 = 0.3;
 
+/// Per bin of the sphere grid, the pdf's integral over the strips within [`EDGE_RESOLUTION`] of
+/// its left and lower edges: the samples that f32 may put on the other side of the edge than
+/// the quadrature does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EdgeStrips {
+    /// Of its left column edge, where that edge is off the axes (0 elsewhere).
+    pub column: Vec<f64>,
+    /// Of its lower row edge (0 in the bottom row).
+    pub row: Vec<f64>,
+}
 
-/// Per bin of the sphere grid, the pdf's integral over the strip within [`EDGE_RESOLUTION`] of
-/// its left column edge, where that edge is off the axes and the bins beside it hold a count at
-/// N = `samples` (0 elsewhere): the samples whose column f32 may decide otherwise than the
-/// quadrature's edge. By the same adaptive rules, each strip split along θ like a bin.
-pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, width: f64, samples: u64, probabilities: &[f64]) -> Result<Vec<f64>, CheckError> {
+/// The [`EdgeStrips`] of the sphere grid, where the bins beside an edge hold a count at N =
+/// `samples` (0 elsewhere). By the same adaptive rules, each strip split along its edge like a
+/// bin; the row strips' parts accumulate after the column strips' (bin + rows · cols).
+pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, width: f64, samples: u64, probabilities: &[f64]) -> Result<EdgeStrips, CheckError> {
     let bins = (rows * cols) as usize;
     let n = samples.max(1) as f64;
+    let held = |i: u32, j: u32| n * (probabilities[i as usize] + probabilities[j as usize]) >= 1.0;
     let grid = SphereGrid { rows, cols };
-    let phi = grid.phi_edges();
+    let (phi, z) = (grid.phi_edges(), grid.cos_theta_edges());
     let mut parts = Vec::new();
     for r in 0..rows {
-        for c in (0..cols).filter(|&c| !grid.exact_phi_edge(c)) {
-            let bin = r * cols + c;
-            if n * (probabilities[bin as usize] + probabilities[bin as usize - 1]) < 1.0 {
-                continue;
-            }
+        for c in (0..cols).filter(|&c| !grid.exact_phi_edge(c)).filter(|&c| held(r * cols + c, r * cols + c - 1)) {
             let b = (phi[c as usize] - EDGE_RESOLUTION, phi[c as usize] + EDGE_RESOLUTION);
-            for z in row_zones(rows, r) {
-                let m = ((z.dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
-                let da = (z.a.1 - z.a.0) / m as f64;
+            for zone in row_zones(rows, r) {
+                let m = ((zone.dtheta / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
+                let da = (zone.a.1 - zone.a.0) / m as f64;
                 for i in 0..m {
-                    parts.push(Part { a: (z.a.0 + i as f64 * da, z.a.0 + (i + 1) as f64 * da), b, h: z.h, radial: Radial::A, bin, depth: 0, coarse: None });
+                    let a = (zone.a.0 + i as f64 * da, zone.a.0 + (i + 1) as f64 * da);
+                    parts.push(Part { a, b, h: zone.h, radial: Radial::A, bin: r * cols + c, depth: 0, coarse: None });
+                }
+            }
+        }
+    }
+    for r in 1..rows {
+        let band = z_zones(z[r as usize] - EDGE_RESOLUTION, z[r as usize] + EDGE_RESOLUTION);
+        for c in (0..cols).filter(|&c| held(r * cols + c, (r - 1) * cols + c)) {
+            for zone in &band {
+                let (b0, b1) = (phi[c as usize], phi[c as usize + 1]);
+                let m = (((b1 - b0) * zone.smax / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
+                let db = (b1 - b0) / m as f64;
+                for i in 0..m {
+                    let b = (b0 + i as f64 * db, b0 + (i + 1) as f64 * db);
+                    parts.push(Part { a: zone.a, b, h: zone.h, radial: Radial::A, bin: bins as u32 + r * cols + c, depth: 0, coarse: None });
                 }
             }
         }
     }
     if parts.is_empty() {
-        return Ok(vec![0.0; bins]);
+        return Ok(EdgeStrips { column: vec![0.0; bins], row: vec![0.0; bins] });
     }
-    Ok(refine(f, parts, bins, &settings(samples, MAX_DEPTH, false))?.pdf)
+    let mut column = refine(f, parts, 2 * bins, &settings(samples, MAX_DEPTH, false))?.pdf;
+    let row = column.split_off(bins);
+    Ok(EdgeStrips { column, row })
 }
 
-/// The counts and expected counts the χ² judges: where an off-axis column edge is closer to the
-/// lobe than f32 binning resolves ([`EDGE_SIGMA`] of `strips`), the bins beside it as one cell
-/// (the right one's count and expectation moved into the left one, and on along a run of such
-/// edges), with the number of edges so joined. The choice depends on the pdf alone, never on the
-/// counts, so the test stays a χ² test of a fixed partition.
-pub fn join_unresolved_edges(counts: &[u64], expected: &[f64], strips: &[f64], rows: u32, cols: u32, samples: u64) -> (Vec<u64>, Vec<f64>, usize) {
-    let original = expected;
-    let (mut counts, mut expected) = (counts.to_vec(), expected.to_vec());
+/// The edges joined by [`join_unresolved_edges`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Joined {
+    pub columns: usize,
+    pub rows: usize,
+}
+
+/// The counts and expected counts the χ² judges: where an edge is closer to the pdf's mass than
+/// f32 resolves ([`EDGE_SIGMA`] of its strip), the bins beside it as one cell (every bin of a
+/// set so linked moved into its first), with the edges so joined. The choice depends on the pdf
+/// alone, never on the counts, so the test stays a χ² test of a fixed partition.
+pub fn join_unresolved_edges(counts: &[u64], expected: &[f64], strips: &EdgeStrips, rows: u32, cols: u32, samples: u64) -> (Vec<u64>, Vec<f64>, Joined) {
     let n = samples.max(1) as f64;
-    let mut joined = 0;
-    for r in 0..rows as usize {
-        let row = r * cols as usize;
-        let mut target = row;
-        for c in 0..cols as usize {
-            let i = row + c;
-            let unresolved = c > 0 && strips[i] > 0.0 && n * strips[i] > EDGE_SIGMA * original[i].min(original[i - 1]).max(1.0).sqrt();
-            if unresolved {
-                counts[target] += counts[i];
-                expected[target] += expected[i];
-                counts[i] = 0;
-                expected[i] = 0.0;
-                joined += 1;
-            } else {
-                target = i;
-            }
+    let cols = cols as usize;
+    let unresolved = |i: usize, j: usize, strip: f64| strip > 0.0 && n * strip > EDGE_SIGMA * expected[i].min(expected[j]).max(1.0).sqrt();
+    let mut first: Vec<usize> = (0..counts.len()).collect();
+    let mut joined = Joined::default();
+    for i in 0..(rows as usize * cols) {
+        if i % cols > 0 && unresolved(i, i - 1, strips.column[i]) {
+            link(&mut first, i, i - 1);
+            joined.columns += 1;
+        }
+        if i >= cols && unresolved(i, i - cols, strips.row[i]) {
+            link(&mut first, i, i - cols);
+            joined.rows += 1;
         }
     }
-    (counts, expected, joined)
+    let (mut judged_counts, mut judged_expected) = (vec![0; counts.len()], vec![0.0; counts.len()]);
+    for i in 0..counts.len() {
+        let k = root(&mut first, i);
+        judged_counts[k] += counts[i];
+        judged_expected[k] += expected[i];
+    }
+    (judged_counts, judged_expected, joined)
+}
+
+/// The first bin of the set `i` is in (a union–find forest whose roots are each set's least bin).
+fn root(first: &mut [usize], mut i: usize) -> usize {
+    while first[i] != i {
+        first[i] = first[first[i]];
+        i = first[i];
+    }
+    i
+}
+
+/// Puts the sets of bins `i` and `j` together.
+fn link(first: &mut [usize], i: usize, j: usize) {
+    let (a, b) = (root(first, i), root(first, j));
+    first[a.max(b)] = a.min(b);
 }
 
 /// A bin's error `e` in units of its count's standard deviation √(N p) at N = `samples`, taken
@@ -538,4 +583,28 @@ pub(super) fn f32_sensitivity(passes: &Passes, params: &Params, leaves: &[Leaf])
     let integrands: Vec<(&Passes, &Params)> = perturbed.iter().map(|q| (passes, q)).collect();
     let dynamic: Vec<&dyn Integrand<CheckError>> = integrands.iter().map(|i| i as &dyn Integrand<CheckError>).collect();
     sensitivity(&dynamic, leaves)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bins joined across a column edge and a row edge form one cell in the first bin of the
+    /// set, sums kept; an edge whose strip holds less than its bins' spread is left alone.
+    #[test]
+    fn unresolved_edges_join_their_bins() {
+        // 3 × 3 bins; the edge left of bin 4 and the one below bin 7 unresolved, the one left of
+        // bin 2 resolved (its strip under 0.3 σ of the smaller of bins 1 and 2)
+        let counts: Vec<u64> = (1..=9).collect();
+        let expected: Vec<f64> = vec![100.0; 9];
+        let (mut column, mut row) = (vec![0.0; 9], vec![0.0; 9]);
+        column[4] = 1e-2;
+        row[7] = 1e-2;
+        column[2] = 1e-6;
+        let (c, e, joined) = join_unresolved_edges(&counts, &expected, &EdgeStrips { column, row }, 3, 3, 1000);
+        assert_eq!(joined, Joined { columns: 1, rows: 1 });
+        assert_eq!(c, vec![1, 2, 3, 4 + 5 + 8, 0, 6, 7, 0, 9]);
+        assert_eq!(e.iter().sum::<f64>(), 900.0);
+        assert_eq!((e[3], e[4], e[7]), (300.0, 0.0, 0.0));
+    }
 }

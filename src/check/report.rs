@@ -122,6 +122,10 @@ pub struct Chi2Figures {
     /// the χ² (the counts and `expected` of the report stay per bin).
     #[serde(default)]
     pub joined_edges: u64,
+    /// Row edges within [`crate::check::quadrature::EDGE_RESOLUTION`] in cos θ of the pdf's mass
+    /// (a light's edge in the plane of a row edge, as on the surface's plane): judged likewise.
+    #[serde(default)]
+    pub joined_row_edges: u64,
 }
 
 impl Chi2Figures {

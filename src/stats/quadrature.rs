@@ -407,7 +407,7 @@ impl<E> Integrand<E> for CpuPdf<'_> {
     }
 }
 
-/// The part of row `r` of a sphere grid in each hemisphere it touches, in the quadrature's
+/// The part of a band of cos θ (a row of a sphere grid) in one hemisphere, in the quadrature's
 /// coordinate a = 1 − |cos θ| ([`Domain::part_point`]): its a range, the hemisphere's sign, its
 /// extent in θ and the largest sin θ in it.
 pub struct Zone {
@@ -424,9 +424,14 @@ impl Zone {
     }
 }
 
+/// The zones of row `r` of a sphere grid of `rows` rows.
 pub fn row_zones(rows: u32, r: u32) -> Vec<Zone> {
     let z = SphereGrid { rows, cols: 1 }.cos_theta_edges();
-    let (z0, z1) = (z[r as usize], z[r as usize + 1]);
+    z_zones(z[r as usize], z[r as usize + 1])
+}
+
+/// The zones of the band cos θ ∈ [z0, z1]: its parts in each hemisphere (as [`row_zones`]).
+pub fn z_zones(z0: f64, z1: f64) -> Vec<Zone> {
     [(z0.max(0.0), z1.max(0.0), 1.0f32), (z0.min(0.0), z1.min(0.0), -1.0)]
         .into_iter()
         .filter(|(lo, hi, _)| hi > lo)

@@ -17,7 +17,7 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     let chi2 = family::judge(grid, (&counts, &expected), (&[invalid.iter().sum()], &[expected_invalid]), run.settings.significance);
     let summary = summary(run, m, &chi2, expected_invalid, joined);
     let passed = chi2.passed;
-    let figures = Chi2Figures { chi2, pdf_integral: m.pdf_total(), invalid, expected_invalid, quadrature: m.integrals.clone(), joined_edges: joined as u64 };
+    let figures = Chi2Figures { chi2, pdf_integral: m.pdf_total(), invalid, expected_invalid, quadrature: m.integrals.clone(), joined_edges: joined.columns as u64, joined_row_edges: joined.rows as u64 };
     Ok(Check { passed, summary, figures: Figures::Chi2(figures) })
 }
 
@@ -26,26 +26,28 @@ pub(crate) fn expected(run: &Run, m: &Measured) -> Vec<f64> {
     m.integrals.probabilities.iter().map(|p| run.samples() * p).collect()
 }
 
-/// The cells the χ² judges: the bins, but where a column edge off the axes lies closer to the
-/// lobe than f32 binning places it, the two bins beside it as one cell.
-fn judged_cells(run: &Run, m: &Measured) -> Result<(Vec<u64>, Vec<f64>, usize), CheckError> {
+/// The cells the χ² judges: the bins, but where a column edge off the axes or a row edge lies
+/// closer to the pdf's mass than f32 places samples and bins, the two bins beside it as one cell.
+fn judged_cells(run: &Run, m: &Measured) -> Result<(Vec<u64>, Vec<f64>, quadrature::Joined), CheckError> {
     let (counts, expected) = (m.counts(run.bins()), expected(run, m));
     if !run.sampler.domain.rounds_phi_edges() {
-        return Ok((counts.to_vec(), expected, 0));
+        return Ok((counts.to_vec(), expected, quadrature::Joined::default()));
     }
     let (rows, cols, samples) = (run.rows, run.cols, run.settings.samples);
     let strips = run.with_integrand(|f| quadrature::edge_strips(f, rows, cols, m.width, samples, &m.integrals.probabilities))?;
     Ok(quadrature::join_unresolved_edges(counts, &expected, &strips, rows, cols, samples))
 }
 
-fn summary(run: &Run, m: &Measured, chi2: &Chi2, expected_invalid: f64, joined: usize) -> String {
+fn summary(run: &Run, m: &Measured, chi2: &Chi2, expected_invalid: f64, joined: quadrature::Joined) -> String {
     let (significance, seed) = (run.settings.significance, run.settings.seed);
     let family_p = chi2.family_p_value.unwrap_or(chi2.p_value);
     let invalid = m.invalid(run.bins());
-    let joined = if joined > 0 {
-        format!("; {joined} column edges off the axes lie closer to the lobe than f32 binning places them (±{:.0e} rad): the bins beside each judged as one", quadrature::EDGE_RESOLUTION)
-    } else {
-        String::new()
+    let joined = match (joined.columns, joined.rows) {
+        (0, 0) => String::new(),
+        (c, r) => format!(
+            "; {c} column edges off the axes and {r} row edges lie closer to the pdf's mass than f32 places samples and bins (±{:.0e}): the bins beside each judged as one",
+            quadrature::EDGE_RESOLUTION
+        ),
     };
     format!(
         "{}{}χ² = {:.1} on {} dof, p = {:.3e}; over {} grids and marginals (Holm) p = {:.3e} (significance {significance}){}{}; ∫pdf = {:.6}; {} samples in cells of zero probability; quadrature error ≤ {:.2}σ{joined}",
