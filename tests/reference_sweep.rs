@@ -84,6 +84,11 @@ fn the_reference_converges_and_judges_over_the_documented_range() {
                 let t = compare::chi2_test(&counts, &exp, level);
                 assert!(t.passed || t.untested == Some(Untested::OneCell), "{tag}: a correct sampler failed: {t:?}");
                 correct.add(&t);
+                if t.untested.is_some() {
+                    // a lobe in one cell: the same cells judge no lobe, rougher or not
+                    broken.untested += 1;
+                    continue;
+                }
                 let rough = Lobe { alpha_x: 1.2 * alpha, alpha_y: 1.2 * alpha, ..lobe };
                 let wrong = compare::expected_counts(&Job::Lobe { lobe: rough, incident: wi, grid: GRID, scatter: Scatter::Reflect }, SAMPLES, &Quadrature::default());
                 let t = compare::chi2_test(&counts, &wrong, level);

@@ -30,6 +30,8 @@ fn renderer_example_passes_its_own_tests() {
         .arg(&manifest)
         .env("CARGO_TARGET_DIR", target_dir(root))
         .env("CARGO_PROFILE_DEV_DEBUG", "0")
+        // built once from nothing: incremental compilation's bookkeeping would buy nothing
+        .env("CARGO_INCREMENTAL", "0")
         .current_dir(root)
         .output()
         .unwrap_or_else(|e| panic!("cannot run {}: {e}", Path::new(&cargo).display()));

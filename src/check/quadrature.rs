@@ -385,7 +385,8 @@ pub const EDGE_SIGMA: f64 = 0.3;
 pub struct EdgeStrips {
     /// Of its left column edge, where that edge is off the axes (0 elsewhere).
     pub column: Vec<f64>,
-    /// Of its lower row edge (0 in the bottom row).
+    /// Of its lower row edge, where one bin beside it holds a count and the other none (0
+    /// elsewhere, and in the bottom row).
     pub row: Vec<f64>,
 }
 
@@ -412,9 +413,13 @@ pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, w
             }
         }
     }
+    // a row edge between a bin with a count and one without: where a support's edge lies on it
+    // (f32 moving samples between two bins that both hold counts is the column edges' case, of
+    // the binning's atan2; the rows' cos θ = d.z is binned as the sampler rounded it)
+    let bare = |i: u32| n * probabilities[i as usize] < 1.0;
     for r in 1..rows {
         let band = z_zones(z[r as usize] - EDGE_RESOLUTION, z[r as usize] + EDGE_RESOLUTION);
-        for c in (0..cols).filter(|&c| held(r * cols + c, (r - 1) * cols + c)) {
+        for c in (0..cols).filter(|&c| held(r * cols + c, (r - 1) * cols + c) && bare(r * cols + c) != bare((r - 1) * cols + c)) {
             for zone in &band {
                 let (b0, b1) = (phi[c as usize], phi[c as usize + 1]);
                 let m = (((b1 - b0) * zone.smax / width).ceil() as u32).clamp(1, MAX_INITIAL_SPLIT);
