@@ -35,6 +35,7 @@ pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::domain::Cell;
 use crate::stats::histogram::SphereGrid;
 pub use crate::stats::quadrature::{CpuPdf, EDGE_DEPTH, Integrand, Jumps, Leaf, Rect, SphereIntegral, sphere_integral_f64};
+pub use crate::stats::quadrature::Witnesses;
 use crate::stats::quadrature::{Part, Radial, Refined, Rules, Settings, Tolerance, refine, row_zones, sphere_integral, split, z_zones};
 use serde::{Deserialize, Serialize};
 
@@ -217,21 +218,30 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
 /// integrates to 74.1, by a 8000 × 8000 midpoint rule and by 6000 × 6000 slopes of h, and 68–77
 /// were observed at seeds 1–4). A finer integral tends to the pdf's, not to the histogram's: a
 /// sampler that puts samples where its pdf does not fails as before.
+/// Parts whose rules both give 0 where a probed sample fell are split too ([`Witnesses`]).
 /// [`Integrals::converged`] says whether any bin is left beyond the limit.
-pub(super) fn integrate(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<Integrals, CheckError> {
-    Ok(integrate_leaves(f, domain, rows, cols, width, samples, observed)?.0)
+pub(super) fn integrate(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, evidence: Option<&Evidence>) -> Result<Integrals, CheckError> {
+    Ok(integrate_leaves(f, domain, rows, cols, width, samples, evidence)?.0)
+}
+
+/// What the run's samples say of where the pdf's mass lies: the histogram's counts per bin, and
+/// the points of samples drawn for the purpose ([`Witnesses`]).
+pub struct Evidence<'a> {
+    pub observed: &'a [u64],
+    pub witnesses: Witnesses,
 }
 
 /// [`integrate`], with the parts its integrals are the sum of ([`Leaf`]).
-pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, observed: Option<&[u64]>) -> Result<(Integrals, Vec<Leaf>), CheckError> {
+pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, evidence: Option<&Evidence>) -> Result<(Integrals, Vec<Leaf>), CheckError> {
     let bins = (rows * cols) as usize;
-    let mut out = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, &settings(samples, MAX_DEPTH, true))?;
+    let (observed, witnesses) = (evidence.map(|e| e.observed), evidence.map(|e| &e.witnesses));
+    let mut out = refine(f, initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, None), bins, &settings(samples, MAX_DEPTH, witnesses))?;
     for retry in 1..=RETRIES {
         let factor = REFINE_FACTOR.pow(retry);
         let cap = MAX_INITIAL_SPLIT * factor;
         let Some(over) = again(&out, domain.grid(rows, cols), cap, samples, observed) else { break };
         let parts = initial_parts(domain, rows, cols, width / factor as f64, cap, Some(&over));
-        let again = refine(f, parts, bins, &settings(samples, MAX_DEPTH + 2 * retry, true))?;
+        let again = refine(f, parts, bins, &settings(samples, MAX_DEPTH + 2 * retry, witnesses))?;
         for i in (0..bins).filter(|&i| over[i]) {
             out.pdf[i] = again.pdf[i];
             out.eval[i] = again.eval[i];
@@ -251,10 +261,10 @@ pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, r
 }
 
 /// The settings of a histogram's parts at `samples` samples (the module doc's tolerance), to
-/// `max_depth`, keeping the accepted parts where `keep_leaves`.
-fn settings(samples: u64, max_depth: u32, keep_leaves: bool) -> Settings {
+/// `max_depth`, keeping the accepted parts, with the run's `witnesses`.
+fn settings(samples: u64, max_depth: u32, witnesses: Option<&Witnesses>) -> Settings<'_> {
     let n = samples.max(1) as f64;
-    Settings { tolerance: Tolerance { sigma_fraction: 0.01, samples: n, floor: 1e-3 / n }, max_depth, jumps: Jumps::Locate, max_parts: MAX_PARTS, keep_leaves }
+    Settings { tolerance: Tolerance { sigma_fraction: 0.01, samples: n, floor: 1e-3 / n }, max_depth, jumps: Jumps::Locate, max_parts: MAX_PARTS, keep_leaves: true, witnesses }
 }
 
 /// The bins to integrate again from an initial split of at most `cap` per axis: those beyond
@@ -434,7 +444,7 @@ pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, w
     if parts.is_empty() {
         return Ok(EdgeStrips { column: vec![0.0; bins], row: vec![0.0; bins] });
     }
-    let mut column = refine(f, parts, 2 * bins, &settings(samples, MAX_DEPTH, false))?.pdf;
+    let mut column = refine(f, parts, 2 * bins, &Settings { keep_leaves: false, ..settings(samples, MAX_DEPTH, None) })?.pdf;
     let row = column.split_off(bins);
     Ok(EdgeStrips { column, row })
 }

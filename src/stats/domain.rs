@@ -213,6 +213,27 @@ impl Domain {
         }
     }
 
+    /// The coordinates (a, b, hemisphere) of a quadrature part at point `p`: the inverse of
+    /// [`Domain::part_point`], b in [−π, π] as the grid's columns.
+    ///
+    /// ```
+    /// use lobes::stats::domain::Domain;
+    /// let (a, b, h) = Domain::Sphere.part_coordinates([0.0, -0.6, -0.8]);
+    /// assert!((a - 0.2).abs() < 1e-15 && (b + std::f64::consts::FRAC_PI_2).abs() < 1e-15 && h == -1.0);
+    /// let p = Domain::Sphere.part_point(a, b, h as f64);
+    /// assert!((p[1] + 0.6).abs() < 1e-15 && (p[2] + 0.8).abs() < 1e-15);
+    /// ```
+    pub fn part_coordinates(&self, p: [f64; 3]) -> (f64, f64, f32) {
+        match self {
+            Domain::Sphere => (1.0 - p[2].abs(), p[1].atan2(p[0]), if p[2] < 0.0 { -1.0 } else { 1.0 }),
+            Domain::Cap { axis, .. } => {
+                let (a, x, y) = Frame::of(*axis).local(DVec3::from(p));
+                (a, y.atan2(x), 1.0)
+            }
+            Domain::Plane { .. } => (p[0], p[1], 0.0),
+        }
+    }
+
     /// The box of a plane.
     pub fn bounds(&self) -> Option<[f64; 4]> {
         match *self {

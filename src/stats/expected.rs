@@ -162,9 +162,9 @@ pub fn peaked_sphere_probabilities(pdf: &(dyn Fn(DVec3) -> f64 + Sync), grid: Sp
 /// run's N by [`Quadrature::for_samples`]), its depth counted from a bin's initial parts (`q`'s
 /// from their first quarters), no edges looked for (lobes' densities have none inside a bin), and
 /// no budget of parts.
-fn settings(q: &Quadrature) -> Settings {
+fn settings(q: &Quadrature) -> Settings<'static> {
     let tolerance = Tolerance { sigma_fraction: q.sigma_fraction, samples: REFERENCE_SAMPLES, floor: q.abs_floor };
-    Settings { tolerance, max_depth: q.max_depth + 1, jumps: Jumps::Trust, max_parts: usize::MAX, keep_leaves: false }
+    Settings { tolerance, max_depth: q.max_depth + 1, jumps: Jumps::Trust, max_parts: usize::MAX, keep_leaves: false, witnesses: None }
 }
 
 /// The initial parts of every bin of `grid` (the upper hemisphere's, or the sphere's where

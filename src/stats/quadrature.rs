@@ -21,6 +21,11 @@
 //! part is split [`EDGE_DEPTH`] levels past the depth limit while its jump holds more than the
 //! tolerance.
 //!
+//! **Witnesses** ([`Witnesses`]): a support narrower than the nodes' spacing (a light seen as a
+//! sliver) can pass between every node of a part, where both rules give 0 and agree. A part
+//! whose rules both give 0 and that holds a sample of the run is split as a part with an edge is:
+//! a correct sampler's samples lie where its pdf has mass.
+//!
 //! **Peaks** ([`Peak`]): a peak narrower than the finest part slips between the rules' nodes,
 //! and then the rules agree on a wrong value; where its direction is known, the parts about it
 //! start graded toward it ([`peak_parts`]).
@@ -148,7 +153,7 @@ pub enum Jumps {
 
 /// How [`refine`] refines.
 #[derive(Clone, Copy, Debug)]
-pub struct Settings {
+pub struct Settings<'w> {
     pub tolerance: Tolerance,
     /// Deepest split of a part (a quarter per level; a bin's initial parts are depth 0).
     pub max_depth: u32,
@@ -157,6 +162,56 @@ pub struct Settings {
     pub max_parts: usize,
     /// Whether the accepted parts are kept ([`Refined::leaves`]).
     pub keep_leaves: bool,
+    /// Samples of the run, where a part's zero is not trusted ([`Witnesses`]).
+    pub witnesses: Option<&'w Witnesses>,
+}
+
+/// Points where samples of the run fell, per bin, in the parts' coordinates (a, b, hemisphere:
+/// [`Domain::part_coordinates`]): a part whose two rules both give 0 and that holds one is split
+/// as far as a part with an edge of the support ([`EDGE_DEPTH`]). A triangle light 0.6 × 3·10⁻⁴
+/// rad lying along a row of the sphere's grid passes between the nodes of most of the parts it
+/// crosses, and its bins' first integrals held 0.70 of its mass. Where the pdf is truly 0 at a
+/// sample, the split parts stay 0 and the sample still fails the test.
+#[derive(Clone, Debug, Default)]
+pub struct Witnesses {
+    by_bin: Vec<Vec<(f64, f64, f32)>>,
+}
+
+impl Witnesses {
+    /// The witnesses of `points` on `grid`, each in the bin [`super::domain::Grid::cell_of`]
+    /// gives it (points outside the domain are left out).
+    ///
+    /// ```
+    /// use lobes::stats::domain::Domain;
+    /// use lobes::stats::quadrature::Witnesses;
+    /// let w = Witnesses::new(&Domain::Sphere.grid(8, 16), [[0.0, 0.6, 0.8], [0.0, 0.0, 2.0]]);
+    /// assert_eq!(w.len(), 1);
+    /// ```
+    pub fn new(grid: &super::domain::Grid, points: impl IntoIterator<Item = [f64; 3]>) -> Self {
+        let mut by_bin = vec![Vec::new(); grid.bins()];
+        for p in points {
+            if let Some(bin) = grid.cell_of(p) {
+                by_bin[bin].push(grid.domain.part_coordinates(p));
+            }
+        }
+        Witnesses { by_bin }
+    }
+
+    /// How many points are held.
+    pub fn len(&self) -> usize {
+        self.by_bin.iter().map(Vec::len).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether `part` holds one (its bounds included; a part at a pole is in s = √a).
+    fn hold(&self, part: &Part) -> bool {
+        let inside = |x: f64, r: (f64, f64)| r.0 <= x && x <= r.1;
+        let a = |a: f64| if part.radial == Radial::RootA { a.sqrt() } else { a };
+        self.by_bin.get(part.bin as usize).is_some_and(|w| w.iter().any(|&(x, b, h)| h == part.h && inside(a(x), part.a) && inside(b, part.b)))
+    }
 }
 
 /// A part whose 5 × 5 value was summed into its bin's integral (an accepted initial part, or each
@@ -226,7 +281,7 @@ struct Round<'a> {
     pending: &'a [Part],
     values: Vec<[f64; 4]>,
     edges: Vec<Option<f64>>,
-    settings: &'a Settings,
+    settings: &'a Settings<'a>,
     rounding: f64,
 }
 
@@ -243,6 +298,12 @@ impl Round<'_> {
         let s = self.settings;
         s.jumps == Jumps::Locate && self.pending[k].depth < s.max_depth + EDGE_DEPTH && self.edges[k].is_some_and(|scale| scale > self.tolerance(scale))
     }
+    /// Whether part `k`'s rules both give the pdf 0 where a sample fell ([`Witnesses`]), and it
+    /// may be split on (as an edge).
+    fn witnessed(&self, k: usize) -> bool {
+        let (s, [p5, p3, ..]) = (self.settings, self.values[k]);
+        p5 == 0.0 && p3 == 0.0 && self.pending[k].depth < s.max_depth + EDGE_DEPTH && s.witnesses.is_some_and(|w| w.hold(&self.pending[k]))
+    }
 
     /// Initial part `i`: accepted where its two rules agree (pdf and eval) and no edge is in it,
     /// or where the budget is spent; else quartered into `next`.
@@ -251,7 +312,7 @@ impl Round<'_> {
         let [p5, p3, e5, e3] = v;
         if bad(&v) {
             out.drop_bad(part.bin, &[v]);
-        } else if (!self.edged(i) && self.agree(p5, p3) && self.agree(e5, e3)) || next.len() + 4 > self.settings.max_parts {
+        } else if (!self.edged(i) && !self.witnessed(i) && self.agree(p5, p3) && self.agree(e5, e3)) || next.len() + 4 > self.settings.max_parts {
             out.accept(part.bin, p5, e5, (p5 - p3).abs(), self.agree(p5, p3), squares);
             if self.settings.keep_leaves {
                 out.leaves.push(Leaf { rect: part.rect(), bin: part.bin, value: p5, edge: self.edges[i].is_some() });
@@ -272,7 +333,7 @@ impl Round<'_> {
         let fine: f64 = group.iter().map(|v| v[0]).sum();
         let fine_e: f64 = group.iter().map(|v| v[2]).sum();
         let agree = self.agree(fine, cp) && self.agree(fine_e, ce);
-        let edge = (i..i + 4).any(|k| self.edged(k));
+        let edge = (i..i + 4).any(|k| self.edged(k) || self.witnessed(k));
         if (agree && !edge) || (part.depth >= self.settings.max_depth && !edge) || next.len() + 16 > self.settings.max_parts {
             out.accept(part.bin, fine, fine_e, (fine - cp).abs(), agree, squares);
             if self.settings.keep_leaves {
@@ -294,7 +355,7 @@ fn bad(v: &[f64; 4]) -> bool {
 
 /// Integrates `pending`, the initial parts of `bins` bins, refining each as the module doc says,
 /// a round of parts at a time (one call of [`Integrand::rules`] per round).
-pub fn refine<E>(f: &dyn Integrand<E>, mut pending: Vec<Part>, bins: usize, settings: &Settings) -> Result<Refined, E> {
+pub fn refine<E>(f: &dyn Integrand<E>, mut pending: Vec<Part>, bins: usize, settings: &Settings<'_>) -> Result<Refined, E> {
     let mut out = Refined::zero(bins);
     let mut squares = vec![0.0; bins];
     let rounding = f.rounding();
@@ -532,8 +593,14 @@ const AZIMUTH_PARTS: u32 = 64;
 /// The tolerance of a sphere integral: as a histogram's at 10¹² samples, a part's tolerance
 /// 10⁻⁸ √(its integral) plus a thousandth of a count plus the rounding of its sum (f32's 2·10⁻⁶ on the GPU), to
 /// 8 levels.
-pub const SPHERE_SETTINGS: Settings =
-    Settings { tolerance: Tolerance { sigma_fraction: 0.01, samples: 1e12, floor: 1e-3 / 1e12 }, max_depth: 8, jumps: Jumps::Trust, max_parts: 1 << 22, keep_leaves: false };
+pub const SPHERE_SETTINGS: Settings<'static> = Settings {
+    tolerance: Tolerance { sigma_fraction: 0.01, samples: 1e12, floor: 1e-3 / 1e12 },
+    max_depth: 8,
+    jumps: Jumps::Trust,
+    max_parts: 1 << 22,
+    keep_leaves: false,
+    witnesses: None,
+};
 
 fn sphere_parts() -> Vec<Part> {
     let step = 2f64.powi(-EVEN_BANDS);
@@ -619,5 +686,28 @@ mod tests {
         let parts = peak_parts(zone, phi, 0, Peak { direction: at, width: w }, 16).expect("a narrow peak inside the bin");
         let v = cpu_refine(&f, parts, 1, &SPHERE_SETTINGS).pdf[0];
         assert!((v - 1.0).abs() < 1e-6, "{v}");
+    }
+
+    /// A strip narrower than the nodes' spacing: density 1/w on x ∈ [179/512, 179/512 + w) of the
+    /// unit square, w = 2⁻¹⁰, whose integral is 1 (its edges on the parts' edges at depth 10, where
+    /// the edges' parts hold the strip whole or not at all). No node of the square's rules, nor of
+    /// its quarters' to depth 4, falls on it, so both rules give 0 and agree; with samples of it
+    /// as witnesses the parts holding them are split until the strip is found and its edges
+    /// located.
+    #[test]
+    fn witnesses_find_a_strip_between_the_nodes() {
+        let (x0, w) = (179.0 / 512.0, 1.0 / 1024.0);
+        let f = |p: DVec3| if (x0..x0 + w).contains(&p.x) { 1.0 / w } else { 0.0 };
+        let domain = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
+        let cpu = CpuPdf::new(&f, domain, Jumps::Locate);
+        let settings = Settings { tolerance: Tolerance { sigma_fraction: 0.01, samples: 1e6, floor: 1e-9 }, jumps: Jumps::Locate, ..SPHERE_SETTINGS };
+        let integral = |settings: &Settings| match refine::<std::convert::Infallible>(&cpu, split((0.0, 1.0), (0.0, 1.0), 0.0, 1, 0), 1, settings) {
+            Ok(r) => r.pdf[0],
+            Err(never) => match never {},
+        };
+        assert_eq!(integral(&settings), 0.0);
+        let witnesses = Witnesses::new(&domain.grid(1, 1), (0..256).map(|k| [x0 + 0.5 * w, (k as f64 + 0.5) / 256.0, 0.0]));
+        let seen = integral(&Settings { witnesses: Some(&witnesses), ..settings });
+        assert!((seen - 1.0).abs() < 1e-9, "{seen}");
     }
 }

@@ -135,9 +135,27 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
     let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
     let p_max = probes.iter().filter(|p| p.valid()).map(|p| p.reported_pdf() as f64).fold(0.0, f64::max);
     let width = quadrature::initial_width(p_max, run.sampler.domain, run.rows);
-    let (integrals, f32_moved) = integrate(run, &totals[..run.bins()], width)?;
+    let evidence = quadrature::Evidence { observed: &totals[..run.bins()], witnesses: witnesses(run, &probes)? };
+    let (integrals, f32_moved) = integrate(run, &evidence, width)?;
     let jump = map_jump(run, &probes, &probe_u)?;
     Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
+}
+
+/// Samples drawn for the quadrature's [`quadrature::Witnesses`], besides the probes': at
+/// 2¹⁶, a region of the support holding 10⁻⁴ of the mass is missed by all of them with
+/// probability e^(−6.6).
+pub const WITNESSES: u64 = 1 << 16;
+
+/// The valid samples of the probes and of [`WITNESSES`] more uniforms (a stream of their own),
+/// as the quadrature's witnesses.
+fn witnesses(run: &Run, probes: &[Probe]) -> Result<quadrature::Witnesses, CheckError> {
+    // the largest f32 below 1: u stays in [0, 1)
+    let below_one = 1.0 - f32::EPSILON / 2.0;
+    let us: Vec<[f32; 4]> = (0..WITNESSES).map(|i| rng::uniforms(run.settings.seed ^ 0x5851_f42d_4c95_7f2d, i).map(|x| (x as f32).min(below_one))).collect();
+    let samples = run.passes.map(&run.params, &us)?;
+    let valid = |s: &[f32; 4]| s[3] > 0.0 && s.iter().all(|x| x.is_finite());
+    let points = probes.iter().map(|p| p.sample).chain(samples).filter(valid).map(|s| [s[0], s[1], s[2]].map(f64::from));
+    Ok(quadrature::Witnesses::new(&run.grid(), points))
 }
 
 /// A jump of the sample map along u.x or u.y ([`map::find_jump`]) on the lines through the first
@@ -163,11 +181,11 @@ fn probe_uniforms(settings: &Settings) -> Vec<[f32; 4]> {
 /// The quadrature of the pdf per bin (and of eval, which has no f64 twin: always the GPU's), and
 /// how far the WGSL pdf's f32 evaluation moves ∫pdf ([`quadrature::f32_sensitivity`], and on a
 /// cap fitted to a small support [`quadrature::direction_sensitivity`]; 0 for an f64 reference).
-fn integrate(run: &Run, observed: &[u64], width: f64) -> Result<(Integrals, f64), CheckError> {
+fn integrate(run: &Run, evidence: &quadrature::Evidence, width: f64) -> Result<(Integrals, f64), CheckError> {
     let (domain, rows, cols, samples) = (&run.sampler.domain, run.rows, run.cols, run.settings.samples);
-    let (mut integrals, leaves) = run.with_integrand(|f| quadrature::integrate_leaves(f, domain, rows, cols, width, samples, Some(observed)))?;
+    let (mut integrals, leaves) = run.with_integrand(|f| quadrature::integrate_leaves(f, domain, rows, cols, width, samples, Some(evidence)))?;
     if run.settings.reference.is_some() && run.sampler.eval.is_some() {
-        integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(observed))?.eval;
+        integrals.eval = quadrature::integrate(&(&run.passes, &run.params), domain, rows, cols, width, samples, Some(evidence))?.eval;
     }
     if run.settings.reference.is_some() {
         return Ok((integrals, 0.0));
