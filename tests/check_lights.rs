@@ -258,6 +258,55 @@ fn a_broken_environment_map_sampler_fails() {
     }
 }
 
+/// A `.npy` of float32 (version 1, C order) as f64: the tables make.py wrote.
+fn read_npy_f32(path: &str) -> Vec<f64> {
+    let bytes = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("the table");
+    assert_eq!(&bytes[..6], b"\x93NUMPY", "{path}");
+    let header = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    assert!(String::from_utf8_lossy(&bytes[10..10 + header]).contains("'<f4'"), "{path}: float32");
+    bytes[10 + header..].chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64).collect()
+}
+
+/// Texel space (`--domain latlong`, item 3): on the map's own 32 × 64 texels, every bin's
+/// expected count is N times the texel's probability, which the tables make.py built give
+/// independently of lobes (the marginal CDF's step of the row times the conditional CDF's step of
+/// the column: the sampler picks the texel that way), within the tables' f32 rounding; the
+/// correct sampler passes and the one searching the next row's CDF fails χ² there.
+#[test]
+fn the_environment_map_is_judged_texel_by_texel() {
+    let texels = [("--domain", "latlong".to_string()), ("--bins", "32,64".to_string())];
+    let check_texels = |sample: &str| {
+        let file = format!("{ENVMAP}/envmap.wgsl");
+        let mut args: Vec<String> = ["check", &file, "--sample", sample, "--pdf", "env_pdf", "--params", INTEGRAL, "--samples", "262144", "--json"].map(String::from).to_vec();
+        args.extend(env_bindings(&[]));
+        args.extend(texels.iter().flat_map(|(f, v)| [f.to_string(), v.clone()]));
+        lobes(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let out = check_texels("env_sample");
+    assert_eq!(out.status.code(), Some(0), "{:?}", failed(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report");
+    assert_eq!((v["domain"]["kind"].as_str(), v["rows"].as_u64(), v["cols"].as_u64()), (Some("latlong"), Some(32), Some(64)));
+    let (marginal, conditional) = (read_npy_f32("examples/envmap/marginal.npy"), read_npy_f32("examples/envmap/conditional.npy"));
+    let expected: Vec<f64> = v["expected"].as_array().expect("expected").iter().map(|e| e.as_f64().unwrap()).collect();
+    let n = v["samples"].as_f64().unwrap();
+    let mut worst: f64 = 0.0;
+    for (bin, e) in expected.iter().enumerate() {
+        let (j, i) = (bin / 64, bin % 64);
+        let p = (marginal[j + 1] - marginal[j]) * (conditional[j * 65 + i + 1] - conditional[j * 65 + i]);
+        worst = worst.max((e / (n * p) - 1.0).abs());
+    }
+    // the tables' f32 rounding: half an ulp of 1 (6·10⁻⁸) on each of a column's two CDF values
+    // against its share of about 1/64 is 8·10⁻⁶, and the pdf is f32 too (1.4·10⁻⁵ measured)
+    assert!(worst < 5e-5, "a texel's expected count is off its tables' probability by {worst:e} (relative)");
+    let out = check_texels("env_sample_wrong_row");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(failed(&out).contains(&"chi2".to_string()), "{:?}", failed(&out));
+    // a map's texels are not fitted to a cap
+    let out = lobes(&["check", "examples/envmap/envmap.wgsl", "--sample", "env_sample", "--pdf", "env_pdf", "--domain", "latlong", "--fit", "always"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--fit always: only with --domain sphere"));
+}
+
 #[test]
 fn bindings_without_the_right_file_are_exit_2() {
     let npy_of_u32 = std::env::temp_dir().join(format!("lobes-envmap-u32-{}.npy", std::process::id()));
@@ -306,9 +355,9 @@ fn a_scene_binds_the_maps_texture_and_tables() {
     assert_eq!(&npy[..8], b"\x93NUMPY\x01\x00");
     let raw = dir.join("conditional.bin");
     std::fs::write(&raw, &npy[10 + u16::from_le_bytes([npy[8], npy[9]]) as usize..]).unwrap();
-    let case = |name: &str, sample: &str| {
+    let case = |name: &str, sample: &str, extra: &str| {
         format!(
-            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"{sample}\", pdf = \"env_pdf\", texture = {{ env_radiance = {hdr:?} }}, buffer = {{ env_marginal = {m:?}, env_conditional = {c:?} }} }}\nparams = [{INTEGRAL}]\nsamples = 262144\n\n",
+            "[[case]]\nname = \"{name}\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"{sample}\", pdf = \"env_pdf\", texture = {{ env_radiance = {hdr:?} }}, buffer = {{ env_marginal = {m:?}, env_conditional = {c:?} }} }}\nparams = [{INTEGRAL}]\nsamples = 262144\n{extra}\n",
             wgsl = maps.join("envmap.wgsl"),
             hdr = maps.join("sky.exr"),
             m = maps.join("marginal.npy"),
@@ -316,7 +365,9 @@ fn a_scene_binds_the_maps_texture_and_tables() {
         )
     };
     let scene = dir.join("envmap.toml");
-    std::fs::write(&scene, format!("{}{}", case("env", "env_sample"), case("env-corners", "env_sample_corners"))).unwrap();
+    // and judged texel by texel on the map's 32 × 64 texels (domain = "latlong")
+    let texels = case("env-texels", "env_sample", "domain = \"latlong\"\nbins = [32, 64]\n");
+    std::fs::write(&scene, format!("{}{}{texels}", case("env", "env_sample", ""), case("env-corners", "env_sample_corners", ""))).unwrap();
     let out_dir = dir.join("out");
     let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap(), "--json"]);
     assert_eq!(out.status.code(), Some(1), "one case passes, the other fails");
@@ -324,6 +375,9 @@ fn a_scene_binds_the_maps_texture_and_tables() {
     let passed = |name: &str| summary["cases"].as_array().unwrap().iter().find(|c| c["case"] == name).unwrap_or_else(|| panic!("{name} in {summary}"))["passed"].clone();
     assert_eq!(passed("env"), Value::Bool(true));
     assert_eq!(passed("env-corners"), Value::Bool(false));
+    assert_eq!(passed("env-texels"), Value::Bool(true));
+    let histogram: Value = serde_json::from_str(&std::fs::read_to_string(out_dir.join("env-texels/histogram.json")).unwrap()).unwrap();
+    assert_eq!((histogram["params"]["domain"].as_str(), histogram["rows"].as_u64(), histogram["cols"].as_u64()), (Some("latlong"), Some(32), Some(64)), "{}", histogram["params"]);
 }
 
 /// A renderer's `sampler` (`--sampler NAME=linear|nearest`): a cosine sampler whose pdf reads a

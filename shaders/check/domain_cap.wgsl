@@ -1,6 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::check_params::lobes_check
-#import lobes::bins::lobes_axis_column
+#import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
 
 // A spherical cap fitted around a small support as the domain of `lobes check`'s passes
 // (src/stats/domain.rs, Domain::Cap: the CPU twin of each function here; domain_sphere.wgsl says
@@ -22,13 +22,7 @@ fn lobes_cap_frame(n: vec3<f32>) -> mat3x3<f32> {
 // cap's frame: the local direction's components across n keep their f32 resolution, so a cap of
 // 10⁻³ rad is resolved to an ulp of its radius, not of 1.
 fn lobes_domain_point(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
-    let s = sqrt(max(0.0, a * (2.0 - a)));
-    let e = vec2<f32>(cos(b), sin(b));
-    var t = e;
-    t = select(t, vec2<f32>(-e.y, e.x), k == 1u);
-    t = select(t, -e, k == 2u);
-    t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
-    return lobes_cap_frame(lobes_check.bounds.xyz) * vec3<f32>(s * t.x, s * t.y, 1.0 - a);
+    return lobes_cap_frame(lobes_check.bounds.xyz) * lobes_quadrant_direction(a, b, 1.0, k);
 }
 
 // A sample's point as the domain reads it: a direction, all three components.
@@ -56,11 +50,7 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     let row = min(u32(a / height * f32(lobes_check.rows)), lobes_check.rows - 1u);
     let x = dot(p, f[0]);
     let y = dot(p, f[1]);
-    var t = 0.5;
-    if (x != 0.0 || y != 0.0) {
-        t = (atan2(y, x) + 3.14159265358979) * (0.5 / 3.14159265358979);
-    }
-    let col = lobes_axis_column(u32(max(t, 0.0) * f32(lobes_check.cols)), lobes_check.cols, x, y);
+    let col = lobes_phi_column(x, y, lobes_check.cols);
     return row * lobes_check.cols + col;
 }
 

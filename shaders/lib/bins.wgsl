@@ -41,3 +41,34 @@ fn lobes_axis_column(col_t: u32, cols: u32, x: f32, y: f32) -> u32 {
     }
     return clamp(col, lo, hi);
 }
+
+// The direction at coordinates (a, b) of a quadrature rectangle of a sphere grid in hemisphere
+// `h` (±1) and quadrant `k`: a = 1 − |cos θ| (the distance from the nearer pole, exact in f32
+// where a peak sits at a pole) and b = φ − k π/2, φ measured from the axis nearest the rectangle
+// (the host chooses k), so the direction is (s cos φ, s sin φ, h (1 − a)) with s = √(a (2 − a)),
+// (cos φ, sin φ) being (cos b, sin b) turned by k quarter turns, which is exact; and the
+// solid-angle element is da dφ: a rectangle's integral needs no Jacobian. So an edge on an axis
+// is exactly where the binning puts it (f32(π) is 8.7·10⁻⁸ past π: with φ itself in f32 the two
+// columns of the seam overlapped by twice that, 2.5 % of a grazing lobe of α 10⁻⁴ counted twice),
+// and one off the axes within an ulp of b (≤ 4.7·10⁻⁸ rad) rather than of φ (2.4·10⁻⁷ near ±π).
+// CPU twin: Domain::part_point (src/stats/domain.rs).
+fn lobes_quadrant_direction(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
+    let s = sqrt(max(0.0, a * (2.0 - a)));
+    let e = vec2<f32>(cos(b), sin(b));
+    var t = e;
+    t = select(t, vec2<f32>(-e.y, e.x), k == 1u);
+    t = select(t, -e, k == 2u);
+    t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
+    return vec3<f32>(s * t.x, s * t.y, h * (1.0 - a));
+}
+
+// The column of a direction whose components across the grid's axis are (x, y): ⌊(φ + π)/2π ·
+// cols⌋ with φ = atan2(y, x), φ = 0 at x = y = 0 (a pole), made exact on the axes' edges.
+// CPU twin: SphereGrid::column_of (src/stats/histogram.rs).
+fn lobes_phi_column(x: f32, y: f32, cols: u32) -> u32 {
+    var t = 0.5;
+    if (x != 0.0 || y != 0.0) {
+        t = (atan2(y, x) + 3.14159265358979) * (0.5 / 3.14159265358979);
+    }
+    return lobes_axis_column(u32(max(t, 0.0) * f32(cols)), cols, x, y);
+}

@@ -163,7 +163,7 @@ pub(super) fn initial_width(p_max: f64, domain: Domain, rows: u32) -> f64 {
     match domain {
         // θmax of a cap of height 1 − cos θmax, as 2 asin √(height/2) (no cancellation)
         Domain::Cap { height, .. } => width.min(MAX_SPHERE_WIDTH).min(2.0 * (0.5 * height).sqrt().asin() / (CAP_PARTS_PER_ROW * rows as f64)),
-        Domain::Sphere => width.min(MAX_SPHERE_WIDTH),
+        Domain::Sphere | Domain::LatLong => width.min(MAX_SPHERE_WIDTH),
         Domain::Plane { .. } => width,
     }
 }
@@ -185,6 +185,13 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
             Cell::Plane { x, y } => pieces.push((x, y, 0.0, m((x.1 - x.0).max(y.1 - y.0)))),
             Cell::Sphere { row, phi } => {
                 for z in row_zones(rows, row) {
+                    pieces.push((z.a, phi, z.h, m(z.extent(phi))));
+                }
+            }
+            // a texel's band of θ per hemisphere it touches, cos θ as sin(π/2 − θ) (0 at the equator)
+            Cell::LatLong { theta, phi } => {
+                let z = |t: f64| (std::f64::consts::FRAC_PI_2 - t).sin();
+                for z in z_zones(z(theta.1), z(theta.0)) {
                     pieces.push((z.a, phi, z.h, m(z.extent(phi))));
                 }
             }

@@ -18,6 +18,9 @@ pub enum DomainChoice {
     Sphere,
     /// Points (d.x, d.y) of the box given by --bounds.
     Plane,
+    /// Unit directions binned on the texels of a latitude–longitude map (--bins ROWS,COLS its
+    /// texels): rows uniform in θ from +z (v = θ/π), columns in φ = atan2(y, x) (u = (φ + π)/2π).
+    Latlong,
 }
 
 /// What a sample expression returns.
@@ -218,13 +221,17 @@ impl CheckArgs {
     fn sampler_parts(&self) -> anyhow::Result<(Domain, Conventions, check::Composition)> {
         let domain = match (self.domain, &self.bounds) {
             (DomainChoice::Sphere, None) => Domain::Sphere,
-            (DomainChoice::Sphere, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
+            (DomainChoice::Latlong, None) => Domain::LatLong,
+            (DomainChoice::Sphere | DomainChoice::Latlong, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
             (DomainChoice::Plane, None) => return Err(usage("--domain plane needs --bounds X0,Y0,X1,Y1")),
             (DomainChoice::Plane, Some(b)) => match b.0[..] {
                 [x0, y0, x1, y1] => Domain::Plane { bounds: [x0, y0, x1, y1] },
                 _ => return Err(usage(format!("--bounds: expected 4 numbers X0,Y0,X1,Y1, got {}", b.0.len()))),
             },
         };
+        if self.fit == check::support::Fit::Always && domain != Domain::Sphere {
+            return Err(usage(format!("--fit always: only with --domain sphere (a cap is fitted on the sphere; --domain {} keeps its own grid)", domain.name())));
+        }
         let conventions = Conventions { incident: self.incident, reflection_only: self.reflection_only, u_open: self.u_open, measure: self.measure, frame: self.frame };
         let composition = check::Composition::from_flags(
             &self.shader_root,

@@ -187,7 +187,7 @@ fn draw(dir: &Path, c: &Comparison, grid: Grid, residual_only: Option<&str>) -> 
     );
     let drawn = drawn_rows(c.measured, c.expected, rows, cols);
     // columns that wrap around (φ) start where the lobe is not cut in two
-    let first = if grid.domain.columns_wrap() { first_column(c.expected, cols) } else { 0 };
+    let first = if grid.domain.pictures_turn_columns() { first_column(c.expected, cols) } else { 0 };
     // the drawn rows, each from column `first` round to the one before it
     let cells = |values: &[f64]| -> Vec<f64> {
         drawn.clone().flat_map(|r| (0..cols).map(move |k| values[r * cols + (k + first) % cols])).collect()

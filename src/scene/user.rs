@@ -254,20 +254,21 @@ fn resources(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<Vec<(String, crat
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no
-/// incident direction.
+/// incident direction, or `domain = "latlong"` (the sphere binned on a lat-long map's texels).
 fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
-    let allowed = "use sphere (unit directions) or plane (points of the box given by bounds)";
-    let plane = match &c.domain {
-        None => false,
+    let allowed = "use sphere (unit directions), latlong (unit directions binned on the texels of a lat-long map) or plane (points of the box given by bounds)";
+    let directions = match &c.domain {
+        None => Some(Domain::Sphere),
         Some(v) => match string(ctx, v, "domain", allowed)? {
-            "sphere" => false,
-            "plane" => true,
+            "sphere" => Some(Domain::Sphere),
+            "latlong" => Some(Domain::LatLong),
+            "plane" => None,
             other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, Domain::NAMES)))),
         },
     };
-    if !plane {
+    if let Some(directions) = directions {
         reject_keys(ctx, &[("bounds", c.bounds.as_ref())], "only applies to domain = \"plane\"; remove it (or set domain = \"plane\")")?;
-        return Ok(Domain::Sphere);
+        return Ok(directions);
     }
     let angles = [("incident_theta", c.incident_theta.as_ref().map(|s| s.whole())), ("incident_phi", c.incident_phi.as_ref().map(|s| s.whole()))];
     let angles: Vec<(&str, Option<&Val>)> = angles.iter().map(|(k, v)| (*k, v.as_ref())).collect();

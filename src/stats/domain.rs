@@ -27,6 +27,12 @@ pub enum Domain {
     /// light seen from afar), binned in (1 − cos θ′, φ′) about the axis ([`Frame`]). Both are
     /// f32 values, as the GPU's binning reads them.
     Cap { axis: [f64; 3], height: f64 },
+    /// Unit directions binned on the texels of a latitude–longitude map: rows uniform in θ ∈
+    /// [0, π] from +z (row 0 at θ = 0, a map's first row v = 0, v = θ/π), columns in φ =
+    /// atan2(y, x) over [−π, π) as the sphere's (u = (φ + π)/2π). With `rows` × `cols` the
+    /// map's texels, each cell is one texel: the histogram in texel space.
+    #[serde(rename = "latlong")]
+    LatLong,
 }
 
 /// The orthonormal frame (t, b, axis) of a cap: Duff et al. 2017, "Building an Orthonormal
@@ -113,7 +119,7 @@ impl Domain {
     pub fn validate(&self) -> Result<(), NotABox> {
         match *self {
             Domain::Plane { bounds } => Domain::plane(bounds).map(|_| ()),
-            Domain::Sphere | Domain::Cap { .. } => Ok(()),
+            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong => Ok(()),
         }
     }
 
@@ -128,19 +134,20 @@ impl Domain {
     /// The solid angle it spans (sr): 4π, a cap's 2π h; `None` on the plane.
     pub fn solid_angle(&self) -> Option<f64> {
         match *self {
-            Domain::Sphere => Some(4.0 * std::f64::consts::PI),
+            Domain::Sphere | Domain::LatLong => Some(4.0 * std::f64::consts::PI),
             Domain::Cap { height, .. } => Some(2.0 * std::f64::consts::PI * height),
             Domain::Plane { .. } => None,
         }
     }
 
-    /// Its name in scene files, flags and output files: `sphere`, `plane` or `cap` (a cap is
-    /// fitted, not named by users: [`Self::NAMES`] leaves it out).
+    /// Its name in scene files, flags and output files: `sphere`, `plane`, `latlong` or `cap` (a
+    /// cap is fitted, not named by users: [`Self::NAMES`] leaves it out).
     pub fn name(&self) -> &'static str {
         match self {
             Domain::Sphere => "sphere",
             Domain::Plane { .. } => "plane",
             Domain::Cap { .. } => "cap",
+            Domain::LatLong => "latlong",
         }
     }
 
@@ -148,12 +155,13 @@ impl Domain {
     pub const UNIT_SQUARE: Domain = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
 
     /// The names of a grid's axes, rows' then columns': `["cos θ", "φ"]` on the sphere, `["y",
-    /// "x"]` on the plane.
+    /// "x"]` on the plane, `["θ", "φ"]` on a lat-long map.
     pub fn axes(&self) -> [&'static str; 2] {
         match self {
             Domain::Sphere => ["cos θ", "φ"],
             Domain::Plane { .. } => ["y", "x"],
             Domain::Cap { .. } => ["1 − cos θ′", "φ′"],
+            Domain::LatLong => ["θ", "φ"],
         }
     }
 
@@ -163,6 +171,12 @@ impl Domain {
         self.directions()
     }
 
+    /// Whether a picture may start its wrapping columns where the density is not cut in two (a
+    /// lobe about φ = ±π drawn whole); a lat-long map is drawn as its texture lies, from u = 0.
+    pub fn pictures_turn_columns(&self) -> bool {
+        matches!(self, Domain::Sphere | Domain::Cap { .. })
+    }
+
     /// A picture's axes, rows' then columns': each label and the range it spans (cos θ over
     /// [−1, 1] and φ in degrees over [−180, 180) on the sphere; y and x over the box).
     pub fn picture_axes(&self) -> [(&'static str, (f64, f64)); 2] {
@@ -170,16 +184,17 @@ impl Domain {
             Domain::Sphere => [("cos θ", (-1.0, 1.0)), ("φ (degrees)", (-180.0, 180.0))],
             Domain::Plane { bounds: [x0, y0, x1, y1] } => [("y", (y0, y1)), ("x", (x0, x1))],
             Domain::Cap { height, .. } => [("1 − cos θ′ (θ′ from the cap's axis)", (0.0, height)), ("φ′ (degrees)", (-180.0, 180.0))],
+            Domain::LatLong => [("θ (degrees; texel row v = θ/180°)", (0.0, 180.0)), ("φ (degrees; u = (φ + 180°)/360°)", (-180.0, 180.0))],
         }
     }
 
     /// The names [`Domain::name`] gives, for messages that list them.
-    pub const NAMES: [&'static str; 2] = ["sphere", "plane"];
+    pub const NAMES: [&'static str; 3] = ["sphere", "plane", "latlong"];
 
     /// Whether a point is a direction from a shading point lit from an incident direction, so
     /// that incidence, frames, half vectors and solid angle apply to it.
     pub fn directions(&self) -> bool {
-        matches!(self, Domain::Sphere | Domain::Cap { .. })
+        matches!(self, Domain::Sphere | Domain::Cap { .. } | Domain::LatLong)
     }
 
     /// Whether f32 binning places its column edges off the axes coarser than a sample's own
@@ -204,7 +219,7 @@ impl Domain {
     /// The f64 twin of `lobes_domain_point` ([`Domain::binning_wgsl`]).
     pub fn part_point(&self, a: f64, b: f64, h: f64) -> [f64; 3] {
         match self {
-            Domain::Sphere => {
+            Domain::Sphere | Domain::LatLong => {
                 let s = (a * (2.0 - a)).max(0.0).sqrt();
                 [s * b.cos(), s * b.sin(), h * (1.0 - a)]
             }
@@ -225,7 +240,7 @@ impl Domain {
     /// ```
     pub fn part_coordinates(&self, p: [f64; 3]) -> (f64, f64, f32) {
         match self {
-            Domain::Sphere => (1.0 - p[2].abs(), p[1].atan2(p[0]), if p[2] < 0.0 { -1.0 } else { 1.0 }),
+            Domain::Sphere | Domain::LatLong => (1.0 - p[2].abs(), p[1].atan2(p[0]), if p[2] < 0.0 { -1.0 } else { 1.0 }),
             Domain::Cap { axis, .. } => {
                 let (a, x, y) = Frame::of(*axis).local(DVec3::from(p));
                 (a, y.atan2(x), 1.0)
@@ -238,7 +253,7 @@ impl Domain {
     pub fn bounds(&self) -> Option<[f64; 4]> {
         match *self {
             Domain::Plane { bounds } => Some(bounds),
-            Domain::Sphere | Domain::Cap { .. } => None,
+            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong => None,
         }
     }
 
@@ -260,6 +275,7 @@ impl Domain {
             Domain::Sphere => (64, 128),
             Domain::Plane { .. } => (64, 64),
             Domain::Cap { .. } => (16, 32),
+            Domain::LatLong => (32, 64),
         }
     }
 
@@ -275,6 +291,7 @@ impl Domain {
             Domain::Sphere => "shaders/check/domain_sphere.wgsl",
             Domain::Plane { .. } => "shaders/check/domain_plane.wgsl",
             Domain::Cap { .. } => "shaders/check/domain_cap.wgsl",
+            Domain::LatLong => "shaders/check/domain_latlong.wgsl",
         }
     }
 }
@@ -297,6 +314,8 @@ pub enum Cell {
     Plane { x: (f64, f64), y: (f64, f64) },
     /// The 1 − cos θ′ and φ′ ranges of a cell of a cap.
     Cap { a: (f64, f64), phi: (f64, f64) },
+    /// The θ and φ ranges of a texel of a lat-long map.
+    LatLong { theta: (f64, f64), phi: (f64, f64) },
 }
 
 impl Grid {
@@ -322,6 +341,11 @@ impl Grid {
                 let da = height / self.rows as f64;
                 Cell::Cap { a: (r as f64 * da, (r + 1) as f64 * da), phi: (phi[c as usize], phi[c as usize + 1]) }
             }
+            Domain::LatLong => {
+                let phi = SphereGrid { rows: self.rows, cols: self.cols }.phi_edges();
+                let theta = latlong_theta_edges(self.rows);
+                Cell::LatLong { theta: (theta[r as usize], theta[r as usize + 1]), phi: (phi[c as usize], phi[c as usize + 1]) }
+            }
         }
     }
 
@@ -343,6 +367,10 @@ impl Grid {
                     Domain::Cap { height, .. } => {
                         let phi = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * c / cols as f64;
                         self.domain.part_point(height * r / rows as f64, phi, 1.0)
+                    }
+                    Domain::LatLong => {
+                        let (theta, phi) = (std::f64::consts::PI * r / rows as f64, -std::f64::consts::PI + 2.0 * std::f64::consts::PI * c / cols as f64);
+                        [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
                     }
                 }
             })
@@ -393,8 +421,31 @@ impl Grid {
                 let row = ((a / height * self.rows as f64) as u32).min(self.rows - 1);
                 Some((row * self.cols + SphereGrid { rows: self.rows, cols: self.cols }.column_of(x, y)) as usize)
             }
+            Domain::LatLong => {
+                let d = DVec3::from(p);
+                ((d.length() - 1.0).abs() <= 1e-3).then(|| (latlong_row(d, self.rows) * self.cols + SphereGrid { rows: self.rows, cols: self.cols }.column_of(d.x, d.y)) as usize)
+            }
         }
     }
+}
+
+/// The θ edges of a lat-long map's `rows` rows, from 0 to π.
+pub fn latlong_theta_edges(rows: u32) -> Vec<f64> {
+    (0..=rows).map(|i| std::f64::consts::PI * i as f64 / rows as f64).collect()
+}
+
+/// The row of direction `d` on a lat-long map of `rows` rows: ⌊θ/π · rows⌋ with θ =
+/// atan2(√(x² + y²), z) (accurate at the poles, where acos(z) loses half its digits), in the
+/// northern half of the rows for z ≥ 0 and the southern for z < 0 where `rows` is even (the
+/// equator, a row edge, placed by the sign of z as the sphere's axis columns are by signs).
+/// The CPU twin of `lobes_domain_cell` (shaders/check/domain_latlong.wgsl).
+pub fn latlong_row(d: DVec3, rows: u32) -> u32 {
+    let theta = d.x.hypot(d.y).atan2(d.z);
+    let row = ((theta / std::f64::consts::PI * rows as f64) as u32).min(rows - 1);
+    if !rows.is_multiple_of(2) {
+        return row;
+    }
+    if d.z >= 0.0 { row.min(rows / 2 - 1) } else { row.max(rows / 2) }
 }
 
 #[cfg(test)]
@@ -411,6 +462,31 @@ mod tests {
             let area = (z[row as usize + 1] - z[row as usize]) * (phi.1 - phi.0);
             assert!((area - 4.0 * std::f64::consts::PI / 128.0).abs() < 1e-12, "cell {bin}: {area}");
         }
+    }
+
+    #[test]
+    fn a_texel_of_a_latlong_map_is_its_cell() {
+        // 4 × 8 texels: the direction at texel (row j, column i)'s centre, θ = π (j + ½)/4 and
+        // φ = 2π (i + ½)/8 − π, falls in cell 8 j + i; the texels' solid angles (cos θ0 − cos θ1)
+        // Δφ add to 4π
+        let g = Domain::LatLong.grid(4, 8);
+        let mut total = 0.0;
+        for bin in 0..g.bins() {
+            let (j, i) = ((bin / 8) as f64, (bin % 8) as f64);
+            let (theta, phi) = (std::f64::consts::PI * (j + 0.5) / 4.0, std::f64::consts::TAU * (i + 0.5) / 8.0 - std::f64::consts::PI);
+            let d = [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()];
+            assert_eq!(g.cell_of(d), Some(bin), "texel {j}, {i}");
+            let Cell::LatLong { theta, phi } = g.cell(bin) else { panic!("a texel") };
+            assert!((theta.0 - std::f64::consts::PI * j / 4.0).abs() < 1e-15 && (phi.1 - phi.0 - std::f64::consts::TAU / 8.0).abs() < 1e-15);
+            total += (theta.0.cos() - theta.1.cos()) * (phi.1 - phi.0);
+        }
+        assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12, "{total}");
+        // the equator (a row edge of an even grid) by the sign of z, the poles in the first and last rows
+        assert_eq!(g.cell_of([1.0, 0.0, 0.0]).map(|c| c / 8), Some(1));
+        assert_eq!(g.cell_of([1.0, 0.0, -1e-300]).map(|c| c / 8), Some(2));
+        assert_eq!(g.cell_of([0.0, 0.0, 1.0]).map(|c| c / 8), Some(0));
+        assert_eq!(g.cell_of([1e-9, 0.0, -1.0]).map(|c| c / 8), Some(3));
+        assert_eq!(g.cell_of([0.0, 0.0, 2.0]), None, "not a direction");
     }
 
     #[test]
@@ -458,7 +534,7 @@ mod tests {
 
     #[test]
     fn every_centre_falls_in_its_own_cell() {
-        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9), Domain::cap([0.0, 1.0, 0.1], 3e-6).unwrap().grid(5, 12)] {
+        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9), Domain::cap([0.0, 1.0, 0.1], 3e-6).unwrap().grid(5, 12), Domain::LatLong.grid(7, 12), Domain::LatLong.grid(6, 10)] {
             for (bin, c) in g.centres().into_iter().enumerate() {
                 assert_eq!(g.cell_of(c), Some(bin), "{g:?}: the centre {c:?}");
             }
@@ -490,6 +566,6 @@ mod tests {
             assert!(Domain::plane(b).is_err(), "{b:?}");
         }
         assert_eq!(Domain::plane([0.0, 0.0, 1.0, 1.0]).unwrap().name(), "plane");
-        assert_eq!(Domain::NAMES, [Domain::Sphere.name(), Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }.name()]);
+        assert_eq!(Domain::NAMES, [Domain::Sphere.name(), Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }.name(), Domain::LatLong.name()]);
     }
 }
