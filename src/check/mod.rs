@@ -503,17 +503,17 @@ pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Re
     let run = judge::Run::new(gpu, sampler, settings)?;
     let m = judge::measure(&run)?;
     judge::require_converged(&run, &m)?;
-    let mut checks = vec![
-        judge::pdf_consistency::check(&run, &m),
-        judge::jacobian::check(&run, &m),
-        judge::pdf_values::check(&run, &m)?,
-        judge::normalization::check(&run, &m),
-        judge::chi2::check(&run, &m)?,
-    ];
+    let pointwise = vec![judge::pdf_consistency::check(&run, &m), judge::jacobian::check(&run, &m), judge::pdf_values::check(&run, &m)?];
+    let mut integral = vec![judge::normalization::check(&run, &m), judge::chi2::check(&run, &m)?];
     if sampler.eval.is_some() {
-        checks.extend(judge::weights::check(&run, &m)?);
+        integral.extend(judge::weights::check(&run, &m)?);
     }
-    checks.push(judge::hard_cases::check(&run)?);
+    let hard = judge::hard_cases::check(&run)?;
+    // a support narrower than the nodes decides nothing by its integrals; a failing point does
+    if pointwise.iter().chain([&hard]).all(|c| c.passed) {
+        m.integrals.support_seen().map_err(CheckError::NoVerdict)?;
+    }
+    let checks = pointwise.into_iter().chain(integral).chain([hard]).collect();
     Ok(report(&run, &m, checks, gpu.adapter_name(), started))
 }
 

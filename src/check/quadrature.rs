@@ -83,7 +83,23 @@ pub struct Integrals {
     /// Parts evaluated in all, and refinement rounds.
     pub parts: u64,
     pub rounds: u32,
+    /// Bins where the pdf's support proved narrower than their parts' nodes (it was found only
+    /// below parts split for a witness, [`Witnesses`]) and whose observed count exceeds the
+    /// integral by more than [`HIDDEN_SIGMA`] standard deviations: the parts that held no
+    /// witness may hide mass that no rule sees (the tapering tip of a sliver of a light), so such
+    /// a bin gives no verdict ([`Integrals::converged`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub hidden_support_bins: u64,
 }
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
+/// How many standard deviations of its count a bin whose support is narrower than its parts'
+/// nodes may hold above its integral before it gives no verdict: past the largest excess that
+/// chance gives a correct sampler on a grid of 10⁵ bins (P(Z > 5) = 2.9·10⁻⁷ a bin).
+pub const HIDDEN_SIGMA: f64 = 5.0;
 
 impl Integrals {
     /// `Err` with what is wrong where a bin's error estimate is beyond [`MAX_QUADRATURE_SIGMA`] of
@@ -93,7 +109,7 @@ impl Integrals {
     /// ```
     /// use lobes::check::quadrature::Integrals;
     /// let mut i = Integrals { probabilities: vec![0.5, 0.5], eval: vec![0.0; 2], error_estimate: 0.0, max_error_sigma: 0.05,
-    ///     unconverged_parts: 0, bad_parts: 0, dropped: vec![], parts: 2, rounds: 1 };
+    ///     unconverged_parts: 0, bad_parts: 0, dropped: vec![], parts: 2, rounds: 1, hidden_support_bins: 0 };
     /// assert!(i.converged(1_000_000).is_ok());
     /// i.max_error_sigma = 2.0;
     /// assert!(i.converged(1_000_000).unwrap_err().contains("no verdict"));
@@ -105,6 +121,30 @@ impl Integrals {
         Err(format!(
             "the quadrature of the pdf did not converge: a bin's error estimate is {:.3}σ of its count at {samples} samples (at most {MAX_QUADRATURE_SIGMA}σ gives a verdict; {} parts accepted at the depth limit or the parts' budget after {RETRIES} finer retries), so no verdict is drawn; a pdf with an edge or a peak narrower than the quadrature resolves (a small cone, a near-delta lobe) needs fewer --samples or more --bins",
             self.max_error_sigma, self.unconverged_parts
+        ))
+    }
+}
+
+impl Integrals {
+    /// `Err` with what is wrong where [`Integrals::hidden_support_bins`] holds a bin: its
+    /// expected count may lack mass that the nodes did not see, and its excess decides nothing.
+    ///
+    /// ```
+    /// use lobes::check::quadrature::Integrals;
+    /// let mut i = Integrals { probabilities: vec![1.0], eval: vec![0.0], error_estimate: 0.0, max_error_sigma: 0.0,
+    ///     unconverged_parts: 0, bad_parts: 0, dropped: vec![], parts: 1, rounds: 1, hidden_support_bins: 0 };
+    /// assert!(i.support_seen().is_ok());
+    /// i.hidden_support_bins = 2;
+    /// assert!(i.support_seen().unwrap_err().contains("no verdict"));
+    /// ```
+    pub fn support_seen(&self) -> Result<(), String> {
+        if self.hidden_support_bins == 0 {
+            return Ok(());
+        }
+        Err(format!(
+            "the quadrature cannot see all of the pdf's support: in {} bin{} it is narrower than the quadrature's nodes (found only about the samples, as a sliver of a light and its tapering tips are) and there the samples exceed the integral by over {HIDDEN_SIGMA}σ, mass the nodes may have missed; the checks that read no integral pass, so no verdict is drawn; fewer --bins or fewer --samples",
+            self.hidden_support_bins,
+            if self.hidden_support_bins == 1 { "" } else { "s" }
         ))
     }
 }
@@ -256,6 +296,7 @@ pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, r
             out.linear[i] = again.linear[i];
             out.unconverged[i] = again.unconverged[i];
             out.dropped[i] = again.dropped[i];
+            out.hidden[i] = again.hidden[i];
         }
         out.leaves.retain(|l| !over[l.bin as usize]);
         out.leaves.extend(again.leaves.into_iter().filter(|l| over[l.bin as usize]));
@@ -264,7 +305,7 @@ pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, r
         out.rounds += again.rounds;
     }
     let leaves = std::mem::take(&mut out.leaves);
-    Ok((integrals(out, samples), leaves))
+    Ok((integrals(out, samples, observed), leaves))
 }
 
 /// The settings of a histogram's parts at `samples` samples (the module doc's tolerance), to
@@ -307,10 +348,15 @@ fn again(out: &Refined, grid: crate::stats::domain::Grid, cap: u32, samples: u64
     over.contains(&true).then_some(over)
 }
 
-/// The integrals per bin of `r` and what their accuracy is at `samples` samples.
-fn integrals(r: Refined, samples: u64) -> Integrals {
+/// The integrals per bin of `r` and what their accuracy is at `samples` samples, against the
+/// histogram's counts `observed` where given.
+fn integrals(r: Refined, samples: u64, observed: Option<&[u64]>) -> Integrals {
     let dropped = if r.dropped.iter().all(|d| *d == 0.0) { Vec::new() } else { r.dropped };
+    let n = samples.max(1) as f64;
+    let excess = |i: usize| observed.map_or(0.0, |o| (o[i] as f64 - n * r.pdf[i]) / (n * r.pdf[i]).max(1.0).sqrt());
+    let hidden_support_bins = (0..r.pdf.len()).filter(|&i| r.hidden[i] > 0.0 && excess(i) > HIDDEN_SIGMA).count() as u64;
     Integrals {
+        hidden_support_bins,
         max_error_sigma: r.error.iter().zip(&r.pdf).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max),
         error_estimate: r.linear.iter().sum(),
         unconverged_parts: r.unconverged.iter().sum(),
@@ -425,7 +471,7 @@ pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, w
                 let da = (zone.a.1 - zone.a.0) / m as f64;
                 for i in 0..m {
                     let a = (zone.a.0 + i as f64 * da, zone.a.0 + (i + 1) as f64 * da);
-                    parts.push(Part { a, b, h: zone.h, radial: Radial::A, bin: r * cols + c, depth: 0, coarse: None });
+                    parts.push(Part { a, b, h: zone.h, radial: Radial::A, bin: r * cols + c, depth: 0, coarse: None, hidden: false });
                 }
             }
         }
@@ -443,7 +489,7 @@ pub(super) fn edge_strips(f: &dyn Integrand<CheckError>, rows: u32, cols: u32, w
                 let db = (b1 - b0) / m as f64;
                 for i in 0..m {
                     let b = (b0 + i as f64 * db, b0 + (i + 1) as f64 * db);
-                    parts.push(Part { a: zone.a, b, h: zone.h, radial: Radial::A, bin: bins as u32 + r * cols + c, depth: 0, coarse: None });
+                    parts.push(Part { a: zone.a, b, h: zone.h, radial: Radial::A, bin: bins as u32 + r * cols + c, depth: 0, coarse: None, hidden: false });
                 }
             }
         }

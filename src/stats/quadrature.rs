@@ -80,6 +80,9 @@ pub struct Part {
     pub depth: u32,
     /// the parent's 5 × 5 estimates (pdf, eval), none for a bin's initial parts
     pub coarse: Option<(f64, f64)>,
+    /// Whether an ancestor was split for a witness ([`Witnesses`]): its rules gave 0 where a
+    /// sample fell, so the support there is narrower than that ancestor's nodes.
+    pub hidden: bool,
 }
 
 impl Part {
@@ -88,13 +91,14 @@ impl Part {
     pub fn initial(a: (f64, f64), b: (f64, f64), h: f32, bin: u32) -> Part {
         let radial = if h != 0.0 && a.0 == 0.0 { Radial::RootA } else { Radial::A };
         let a = if radial == Radial::RootA { (0.0, a.1.sqrt()) } else { a };
-        Part { a, b, h, radial, bin, depth: 0, coarse: None }
+        Part { a, b, h, radial, bin, depth: 0, coarse: None, hidden: false }
     }
 
-    fn quarters(&self, coarse: (f64, f64)) -> [Part; 4] {
+    /// Its quarters, carrying its 5 × 5 estimates; `witnessed` where it is split for a witness.
+    fn quarters(&self, coarse: (f64, f64), witnessed: bool) -> [Part; 4] {
         let am = 0.5 * (self.a.0 + self.a.1);
         let bm = 0.5 * (self.b.0 + self.b.1);
-        let q = |a, b| Part { a, b, depth: self.depth + 1, coarse: Some(coarse), ..*self };
+        let q = |a, b| Part { a, b, depth: self.depth + 1, coarse: Some(coarse), hidden: self.hidden || witnessed, ..*self };
         [q((self.a.0, am), (self.b.0, bm)), q((am, self.a.1), (self.b.0, bm)), q((self.a.0, am), (bm, self.b.1)), q((am, self.a.1), (bm, self.b.1))]
     }
 
@@ -243,6 +247,10 @@ pub struct Refined {
     pub unconverged: Vec<u64>,
     /// The pdf's integral over the parts left out as bad (NaN, infinite or negative) where finite.
     pub dropped: Vec<f64>,
+    /// The pdf's integral over parts found below a witnessed part ([`Part::hidden`]): mass of a
+    /// support narrower than the nodes of the parts the bin started as, where the parts that
+    /// held no witness may hide more, which no rule estimates.
+    pub hidden: Vec<f64>,
     pub bad_parts: u64,
     /// Parts evaluated in all, and rounds.
     pub parts: u64,
@@ -252,13 +260,16 @@ pub struct Refined {
 
 impl Refined {
     fn zero(bins: usize) -> Self {
-        Refined { pdf: vec![0.0; bins], eval: vec![0.0; bins], error: vec![0.0; bins], linear: vec![0.0; bins], unconverged: vec![0; bins], dropped: vec![0.0; bins], ..Default::default() }
+        Refined { pdf: vec![0.0; bins], eval: vec![0.0; bins], error: vec![0.0; bins], linear: vec![0.0; bins], unconverged: vec![0; bins], dropped: vec![0.0; bins], hidden: vec![0.0; bins], ..Default::default() }
     }
 
     /// Adds an accepted value to its bin; `converged` errors go into the bin's sum of squares
     /// (`error` holds those until [`refine`] ends).
-    fn accept(&mut self, bin: u32, pdf: f64, eval: f64, err: f64, converged: bool, squares: &mut [f64]) {
-        let b = bin as usize;
+    fn accept(&mut self, part: &Part, pdf: f64, eval: f64, err: f64, converged: bool, squares: &mut [f64]) {
+        let b = part.bin as usize;
+        if part.hidden {
+            self.hidden[b] += pdf;
+        }
         self.pdf[b] += pdf;
         self.eval[b] += eval;
         self.linear[b] += err;
@@ -313,12 +324,12 @@ impl Round<'_> {
         if bad(&v) {
             out.drop_bad(part.bin, &[v]);
         } else if (!self.edged(i) && !self.witnessed(i) && self.agree(p5, p3) && self.agree(e5, e3)) || next.len() + 4 > self.settings.max_parts {
-            out.accept(part.bin, p5, e5, (p5 - p3).abs(), self.agree(p5, p3), squares);
+            out.accept(&part, p5, e5, (p5 - p3).abs(), self.agree(p5, p3), squares);
             if self.settings.keep_leaves {
                 out.leaves.push(Leaf { rect: part.rect(), bin: part.bin, value: p5, edge: self.edges[i].is_some() });
             }
         } else {
-            next.extend(part.quarters((p5, e5)));
+            next.extend(part.quarters((p5, e5), self.witnessed(i)));
         }
     }
 
@@ -335,14 +346,14 @@ impl Round<'_> {
         let agree = self.agree(fine, cp) && self.agree(fine_e, ce);
         let edge = (i..i + 4).any(|k| self.edged(k) || self.witnessed(k));
         if (agree && !edge) || (part.depth >= self.settings.max_depth && !edge) || next.len() + 16 > self.settings.max_parts {
-            out.accept(part.bin, fine, fine_e, (fine - cp).abs(), agree, squares);
+            out.accept(&part, fine, fine_e, (fine - cp).abs(), agree, squares);
             if self.settings.keep_leaves {
                 let edges = &self.edges[i..i + 4];
                 out.leaves.extend(self.pending[i..i + 4].iter().zip(group).zip(edges).map(|((q, v), e)| Leaf { rect: q.rect(), bin: q.bin, value: v[0], edge: e.is_some() }));
             }
         } else {
-            for (q, v) in self.pending[i..i + 4].iter().zip(group) {
-                next.extend(q.quarters((v[0], v[2])));
+            for (k, (q, v)) in self.pending[i..i + 4].iter().zip(group).enumerate() {
+                next.extend(q.quarters((v[0], v[2]), self.witnessed(i + k)));
             }
         }
     }
@@ -613,7 +624,7 @@ fn sphere_parts() -> Vec<Part> {
         for band in edges.windows(2) {
             for j in 0..AZIMUTH_PARTS {
                 let b = (-std::f64::consts::PI + j as f64 * dphi, -std::f64::consts::PI + (j + 1) as f64 * dphi);
-                parts.push(Part { a: (band[0], band[1]), b, h, radial: Radial::A, bin: 0, depth: 0, coarse: None });
+                parts.push(Part { a: (band[0], band[1]), b, h, radial: Radial::A, bin: 0, depth: 0, coarse: None, hidden: false });
             }
         }
     }
@@ -701,13 +712,26 @@ mod tests {
         let domain = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
         let cpu = CpuPdf::new(&f, domain, Jumps::Locate);
         let settings = Settings { tolerance: Tolerance { sigma_fraction: 0.01, samples: 1e6, floor: 1e-9 }, jumps: Jumps::Locate, ..SPHERE_SETTINGS };
-        let integral = |settings: &Settings| match refine::<std::convert::Infallible>(&cpu, split((0.0, 1.0), (0.0, 1.0), 0.0, 1, 0), 1, settings) {
-            Ok(r) => r.pdf[0],
+        let refined = |settings: &Settings| match refine::<std::convert::Infallible>(&cpu, split((0.0, 1.0), (0.0, 1.0), 0.0, 64, 0), 1, settings) {
+            Ok(r) => r,
             Err(never) => match never {},
         };
-        assert_eq!(integral(&settings), 0.0);
+        let unseen = refined(&settings);
+        assert_eq!((unseen.pdf[0], unseen.hidden[0]), (0.0, 0.0));
         let witnesses = Witnesses::new(&domain.grid(1, 1), (0..256).map(|k| [x0 + 0.5 * w, (k as f64 + 0.5) / 256.0, 0.0]));
-        let seen = integral(&Settings { witnesses: Some(&witnesses), ..settings });
-        assert!((seen - 1.0).abs() < 1e-9, "{seen}");
+        let seen = refined(&Settings { witnesses: Some(&witnesses), ..settings });
+        assert!((seen.pdf[0] - 1.0).abs() < 1e-9, "{}", seen.pdf[0]);
+        // all of it found below the witnessed part: a support narrower than the first nodes
+        assert_eq!(seen.hidden[0], seen.pdf[0]);
+        // a strip 8 times wider, which the nodes of the first parts (1/64 wide) see: witnesses on
+        // it split nothing that gave 0
+        let wide = |p: DVec3| if (0.25..0.25 + 8.0 * w).contains(&p.x) { 1.0 / (8.0 * w) } else { 0.0 };
+        let cpu = CpuPdf::new(&wide, domain, Jumps::Locate);
+        let witnesses = Witnesses::new(&domain.grid(1, 1), (0..256).map(|k| [0.25 + 4.0 * w, (k as f64 + 0.5) / 256.0, 0.0]));
+        let r = match refine::<std::convert::Infallible>(&cpu, split((0.0, 1.0), (0.0, 1.0), 0.0, 64, 0), 1, &Settings { witnesses: Some(&witnesses), ..settings }) {
+            Ok(r) => r,
+            Err(never) => match never {},
+        };
+        assert!((r.pdf[0] - 1.0).abs() < 1e-6 && r.hidden[0] == 0.0, "{} {}", r.pdf[0], r.hidden[0]);
     }
 }
