@@ -258,6 +258,53 @@ fn a_broken_environment_map_sampler_fails() {
     }
 }
 
+/// A uniform cone of half-angle 0.3 rad about +z whose pdf counts its rim out (d.z > cos ρ).
+/// `rim_sample` puts every sample exactly on the rim, where the pdf function says 0 and a move of
+/// d by an ulp inward gives 1/Ω: a sample within f32 of the support's edge. `far_sample` puts
+/// them 10⁻³ rad outside it, far beyond any rounding.
+const EDGE_CONE: &str = "const COS_RHO: f32 = 0.95533649;
+
+fn cone_pdf(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {
+    return select(0.0, 1.0 / (6.2831853 * (1.0 - COS_RHO)), d.z > COS_RHO);
+}
+
+fn on_circle(z: f32, u: f32) -> vec3<f32> {
+    let s = sqrt(1.0 - z * z);
+    let phi = 6.2831853 * u;
+    return vec3<f32>(s * cos(phi), s * sin(phi), z);
+}
+
+fn rim_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {
+    return vec4<f32>(on_circle(COS_RHO, u.x), 1.0 / (6.2831853 * (1.0 - COS_RHO)));
+}
+
+fn far_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {
+    return vec4<f32>(on_circle(cos(0.301), u.x), 1.0 / (6.2831853 * (1.0 - COS_RHO)));
+}
+";
+
+/// `pdf_consistency` allows a sample where the pdf function says 0 when its support's edge lies
+/// within the sample's own rounding (issue 33 item 1: the pdf's conditioning there is infinite),
+/// and says so; a sample 10⁻³ rad outside still fails it.
+#[test]
+fn a_sample_within_f32_of_the_supports_edge_is_consistent() {
+    let file = std::env::temp_dir().join(format!("lobes-edge-cone-{}.wgsl", std::process::id()));
+    std::fs::write(&file, EDGE_CONE).unwrap();
+    let consistency = |sample: &str| -> Value {
+        let out = lobes(&["check", file.to_str().unwrap(), "--sample", sample, "--pdf", "cone_pdf", "--samples", "16384", "--json"]);
+        let v: Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|_| panic!("{sample}: a JSON report, exit {:?}", out.status.code()));
+        v["checks"].as_array().unwrap().iter().find(|c| c["name"] == "pdf_consistency").expect("pdf_consistency").clone()
+    };
+    let rim = consistency("rim_sample");
+    assert_eq!(rim["passed"], Value::Bool(true), "{rim}");
+    assert!(rim["figures"]["at_edge"].as_u64() > Some(4000), "{rim}");
+    assert!(rim["summary"].as_str().unwrap().contains("support's edge within the sample's f32 rounding"), "{rim}");
+    let far = consistency("far_sample");
+    assert_eq!(far["passed"], Value::Bool(false), "{far}");
+    assert_eq!(far["figures"]["at_edge"].as_u64(), Some(0), "{far}");
+    let _ = std::fs::remove_file(&file);
+}
+
 /// A `.npy` of float32 (version 1, C order) as f64: the tables make.py wrote.
 fn read_npy_f32(path: &str) -> Vec<f64> {
     let bytes = std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("the table");

@@ -411,9 +411,24 @@ fn lobes_map(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     lobes_out[i] = lobes_user_sample(lobes_check.wi.xyz, lobes_in[i]);
 }
 
+// At a d where the pdf is 0 (outside its support by the pdf function): infinite (1e30) where a
+// component of d moved by LOBES_CONDITIONING_ULPS ulps (the rounding a sampler's d carries) gives
+// a pdf > 0, the support's edge being within d's own rounding; 0 farther out.
+fn lobes_edge_within_rounding(wi: vec3<f32>, d: vec3<f32>) -> f32 {
+    let delta = LOBES_CONDITIONING_ULPS * 1.1920929e-7 * max(max(abs(d.x), abs(d.y)), abs(d.z));
+    for (var c = 0u; c < 6u; c++) {
+        var e = vec3<f32>(0.0);
+        e[c / 2u] = select(-delta, delta, (c & 1u) == 0u);
+        if (lobes_positive(lobes_user_pdf(wi, d + e))) {
+            return 1e30;
+        }
+    }
+    return 0.0;
+}
+
 // The pdf's f32 conditioning at the host's points: item i of lobes_in is d, and lobes_out[i] =
-// (pdf(d), its conditioning lobes_conditioning_at, 0, 0) at the incident lobes_check.wi; the
-// conditioning is 0 where pdf(d) is not finite and > 0.
+// (pdf(d), its conditioning, 0, 0) at the incident lobes_check.wi: lobes_conditioning_at where
+// pdf(d) > 0, lobes_edge_within_rounding where it is 0, and 0 where it is not finite or < 0.
 @compute @workgroup_size(64)
 fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
@@ -426,6 +441,8 @@ fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
     var k = 0.0;
     if (lobes_positive(pdf)) {
         k = lobes_conditioning_at(wi, d, pdf);
+    } else if (pdf == 0.0) {
+        k = lobes_edge_within_rounding(wi, d);
     }
     lobes_out[i] = vec4<f32>(pdf, k, 0.0, 0.0);
 }

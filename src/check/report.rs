@@ -84,6 +84,10 @@ pub struct ConsistencyFigures {
     pub widened: u64,
     #[serde(default)]
     pub over_limit: u64,
+    /// Of the `widened`, samples where pdf(d) is 0 and the support's edge lies within d's own
+    /// rounding ([`super::CONDITIONING_ULPS`] ulps): the pdf's conditioning there is infinite.
+    #[serde(default)]
+    pub at_edge: u64,
 }
 
 /// The pdf function's values at the quadrature's nodes.

@@ -28,7 +28,11 @@ pub fn parameters(d: &CaseDescription) -> String {
                 (Some(t), Some(p)) => format!(", {}", angles(*t, *p)),
                 _ => String::new(),
             };
-            let on = if domain == "cap" { "a cap fitted to its samples".to_string() } else { format!("the {domain}") };
+            let on = match domain.as_str() {
+                "cap" => "a cap fitted to its samples".to_string(),
+                "latlong" => "a lat-long map's texels".to_string(),
+                other => format!("the {other}"),
+            };
             format!("WGSL sampler {sample} on {on}{at}")
         }
     }

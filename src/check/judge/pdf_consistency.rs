@@ -30,6 +30,7 @@ fn figures(m: &Measured) -> ConsistencyFigures {
         worst_limit: PDF_CONSISTENCY_LIMIT,
         widened: 0,
         over_limit: 0,
+        at_edge: 0,
     };
     let mut worst = 0.0;
     for ((p, u), k) in m.probes.iter().zip(&m.probe_u).zip(&m.kappa).filter(|((p, _), _)| p.valid()) {
@@ -47,6 +48,7 @@ fn figures(m: &Measured) -> ConsistencyFigures {
         let limit = PDF_CONSISTENCY_LIMIT + CONDITIONING_ULPS * k;
         c.max_relative_difference = c.max_relative_difference.max(diff);
         c.widened += u64::from(diff > PDF_CONSISTENCY_LIMIT && diff <= limit);
+        c.at_edge += u64::from(fun == 0.0 && diff <= limit);
         c.over_limit += u64::from(diff > limit);
         if diff / limit > worst {
             worst = diff / limit;
@@ -59,6 +61,15 @@ fn figures(m: &Measured) -> ConsistencyFigures {
     c
 }
 
+/// What the summary says of samples on the support's edge: where `pdf(d)` is 0 and a move of d
+/// within its rounding gives a pdf > 0.
+fn at_edge(n: u64) -> String {
+    match n {
+        0 => String::new(),
+        n => format!(" ({n} where the pdf function says 0 with its support's edge within the sample's f32 rounding)"),
+    }
+}
+
 fn summary(c: &ConsistencyFigures, pdf: &str) -> String {
     let not_finite = match c.pdf_function_not_finite {
         0 => String::new(),
@@ -66,7 +77,7 @@ fn summary(c: &ConsistencyFigures, pdf: &str) -> String {
     };
     let widened = match (c.widened, c.over_limit) {
         (0, 0) => String::new(),
-        (w, 0) => format!("; {w} beyond {PDF_CONSISTENCY_LIMIT:.0e} but within the pdf's f32 conditioning there"),
+        (w, 0) => format!("; {w} beyond {PDF_CONSISTENCY_LIMIT:.0e} but within the pdf's f32 conditioning there{}", at_edge(c.at_edge)),
         (_, o) => format!("; {o} beyond the limit widened by the pdf's f32 conditioning (worst: {:.2e} allowed there)", c.worst_limit),
     };
     format!(
