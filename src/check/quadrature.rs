@@ -87,7 +87,7 @@ pub struct Integrals {
     /// integral was found only below parts split for a witness, [`Witnesses`]) and whose observed count exceeds the
     /// integral by more than [`HIDDEN_SIGMA`] standard deviations: the parts that held no
     /// witness may hide mass that no rule sees (the tapering tip of a sliver of a light), so such
-    /// a bin gives no verdict ([`Integrals::converged`]).
+    /// a bin gives no verdict ([`Integrals::support_seen`]).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub hidden_support_bins: u64,
 }
@@ -123,9 +123,7 @@ impl Integrals {
             self.max_error_sigma, self.unconverged_parts
         ))
     }
-}
 
-impl Integrals {
     /// `Err` with what is wrong where [`Integrals::hidden_support_bins`] holds a bin: its
     /// expected count may lack mass that the nodes did not see, and its excess decides nothing.
     ///
