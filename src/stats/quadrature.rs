@@ -194,9 +194,15 @@ impl Witnesses {
     pub fn new(grid: &super::domain::Grid, points: impl IntoIterator<Item = [f64; 3]>) -> Self {
         let mut by_bin = vec![Vec::new(); grid.bins()];
         for p in points {
-            if let Some(bin) = grid.cell_of(p) {
-                by_bin[bin].push(grid.domain.part_coordinates(p));
+            let c = grid.domain.part_coordinates(p);
+            // a coordinate that is not a number is inside no part
+            if let Some(bin) = grid.cell_of(p).filter(|_| c.0.is_finite() && c.1.is_finite()) {
+                by_bin[bin].push(c);
             }
+        }
+        // by their first coordinate, which `hold` searches
+        for w in &mut by_bin {
+            w.sort_by(|p, q| p.0.total_cmp(&q.0));
         }
         Witnesses { by_bin }
     }
@@ -210,11 +216,16 @@ impl Witnesses {
         self.len() == 0
     }
 
-    /// Whether `part` holds one (its bounds included; a part at a pole is in s = √a).
+    /// Whether `part` holds one (its bounds included; a part at a pole is in s = √a). The bin's
+    /// witnesses are sorted by a, and s = √a keeps that order: only those from the first with a
+    /// coordinate ≥ the part's lower bound to the last ≤ its upper bound are looked at (a narrow
+    /// lobe's 2¹⁶ witnesses share one bin with millions of parts).
     fn hold(&self, part: &Part) -> bool {
-        let inside = |x: f64, r: (f64, f64)| r.0 <= x && x <= r.1;
-        let a = |a: f64| if part.radial == Radial::RootA { a.sqrt() } else { a };
-        self.by_bin.get(part.bin as usize).is_some_and(|w| w.iter().any(|&(x, b, h)| h == part.h && inside(a(x), part.a) && inside(b, part.b)))
+        // √a below 0 is no number, inside no part: placed before every bound, the order holds
+        let a = |a: f64| if part.radial != Radial::RootA { a } else if a < 0.0 { f64::NEG_INFINITY } else { a.sqrt() };
+        let Some(w) = self.by_bin.get(part.bin as usize) else { return false };
+        let first = w.partition_point(|&(x, ..)| a(x) < part.a.0);
+        w[first..].iter().take_while(|&&(x, ..)| a(x) <= part.a.1).any(|&(_, b, h)| h == part.h && part.b.0 <= b && b <= part.b.1)
     }
 }
 
