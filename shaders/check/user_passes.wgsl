@@ -86,6 +86,27 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     lobes_out[lobes_check.count + i] = lobes_support_edge(seen, c, hw, h, quadrant, root, wi);
 }
 
+// Rectangle i of lobes_in (as lobes_integrate_rects reads it), ∫ pdf by the 5 × 5 rule alone,
+// four rectangles to a vec4 of lobes_out: the first number of lobes_integrate_rects' by the very
+// same arithmetic, for the sums over fixed parts at moved inputs (src/check/quadrature.rs:
+// sensitivity), where only the differences of those numbers count.
+@compute @workgroup_size(64)
+fn lobes_integrate_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = gid.x + gid.y * nwg.x * 64u;
+    if (i >= lobes_check.count) {
+        return;
+    }
+    let r = lobes_in[i];
+    let h = lobes_in[lobes_check.count + i].x;
+    let quadrant = u32(lobes_in[lobes_check.count + i].y);
+    let root = lobes_in[lobes_check.count + i].z != 0.0;
+    let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
+    let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
+    var seen = vec3<f32>(0.0, 0.0, 3.4e38);
+    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, root, lobes_check.wi.xyz, &seen);
+    lobes_out[i / 4u][i % 4u] = r5.x * (hw.x * hw.y);
+}
+
 // What the pdf's values at a rectangle's points say of its support: (any 0, any > 0, the
 // smallest value > 0) so far, updated with the value p (z starts at the largest f32).
 fn lobes_seen(seen: ptr<function, vec3<f32>>, p: f32) {

@@ -853,6 +853,19 @@ impl<'g> Passes<'g> {
         Ok(out)
     }
 
+    /// Per rectangle as [`Self::integrate`] reads it, ∫pdf by the 5 × 5 rule alone: the first
+    /// number `integrate` gives, by the same arithmetic (`lobes_integrate_pdf`).
+    pub fn integrate_pdf(&self, params: &Params, rects: &[([f32; 4], [f32; 3])]) -> Result<Vec<f32>, CheckError> {
+        let mut out = Vec::with_capacity(rects.len());
+        for chunk in rects.chunks(1 << 20) {
+            let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], r.1[2], 0.0])).collect();
+            let p = Params { count: chunk.len() as u32, ..*params };
+            let bytes = self.run("lobes_integrate_pdf", &p, &input, chunk.len() as u32, chunk.len().div_ceil(4) as u64 * 16, Output::Values)?;
+            out.extend_from_slice(&bytemuck::cast_slice::<u8, f32>(&bytes)[..chunk.len()]);
+        }
+        Ok(out)
+    }
+
     /// The probe of the sample map at each (u, wi).
     pub fn probe(&self, params: &Params, items: &[([f32; 4], [f32; 3])]) -> Result<Vec<Probe>, CheckError> {
         let input: Vec<[f32; 4]> = items.iter().flat_map(|(u, w)| [*u, [w[0], w[1], w[2], 0.0]]).collect();
@@ -1092,6 +1105,35 @@ mod tests {
         for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn lobes_rng_uniforms(", "fn lobes_user_sample("] {
             assert!(c.text.contains(entry), "{entry}");
         }
+    }
+
+    /// `lobes_integrate_pdf` gives the first number of `lobes_integrate_rects` bit for bit (the
+    /// sensitivity of ∫pdf to an ulp subtracts the one from the other): a pdf with an eval, on
+    /// rectangles in both hemispheres, every quadrant, in a and in s = √a, wide and narrow.
+    #[test]
+    fn the_pdf_pass_repeats_the_quadrature_pass_bit_for_bit() {
+        let text = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { return vec4<f32>(0.0, 0.0, 1.0, 1.0); }\n\
+                    fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {\n\
+                        let a2 = params[0].x * params[0].x; let h = normalize(wi + d); let t = (a2 - 1.0) * h.z * h.z + 1.0;\n\
+                        return max(h.z, 0.0) * a2 / (3.14159265 * t * t) / (4.0 * abs(dot(wi, h)) + 1e-3); }\n\
+                    fn e(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return exp(-d.x * d.y); }\n";
+        let mut s = sampler(text);
+        s.eval = Some("e".into());
+        let gpu = Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
+        let passes = Passes::new(&gpu, &compose(&s).unwrap()).unwrap();
+        let wi = crate::check::incident(40.0, 20.0);
+        let params = Params { user: [[0.05, 0.0, 0.0, 0.0], [0.0; 4], [0.0; 4], [0.0; 4]], wi: [wi[0], wi[1], wi[2], 0.0], ..Zeroable::zeroed() };
+        let mut rects = Vec::new();
+        for i in 0..4096u32 {
+            let (x, y) = ((i % 64) as f32 / 64.0, (i / 64) as f32 / 64.0);
+            let w = if i % 3 == 0 { 1e-4 } else { 1.0 / 64.0 };
+            rects.push(([x, x + w, -0.78 + 1.5 * y, -0.78 + 1.5 * y + w], [if i % 2 == 0 { 1.0 } else { -1.0 }, (i % 4) as f32, (i % 5 == 0) as u32 as f32]));
+        }
+        let full = passes.integrate(&params, &rects).unwrap();
+        let pdf = passes.integrate_pdf(&params, &rects).unwrap();
+        assert!(full.iter().any(|r| r[0][0] > 0.0) && full.iter().any(|r| r[0][2] != 0.0));
+        let differ = full.iter().zip(&pdf).filter(|(f, p)| f[0][0].to_bits() != p.to_bits()).count();
+        assert_eq!(differ, 0, "{differ} of {} rectangles' ∫pdf differ", rects.len());
     }
 
     /// The histogram pass counts alike in per-invocation slabs (CPU adapters) and in storage

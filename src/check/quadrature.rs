@@ -174,6 +174,10 @@ impl Integrand<CheckError> for (&Passes<'_>, &Params) {
     fn rounding(&self) -> f64 {
         GPU_ROUNDING
     }
+    fn fine_pdf(&self, rects: &[Rect]) -> Result<Vec<f64>, CheckError> {
+        let rects32: Vec<([f32; 4], [f32; 3])> = rects.iter().map(rect_f32).collect();
+        Ok(self.0.integrate_pdf(self.1, &rects32)?.into_iter().map(f64::from).collect())
+    }
 }
 
 
@@ -381,8 +385,8 @@ pub(super) fn sensitivity(perturbed: &[&dyn Integrand<CheckError>], leaves: &[Le
     let rects: Vec<Rect> = leaves.iter().map(|l| l.rect).collect();
     let mut worst: f64 = 0.0;
     for f in perturbed {
-        let values: Vec<[f64; 4]> = f.rules(&rects)?.into_iter().map(|(v, _)| v).collect();
-        let shift: f64 = leaves.iter().zip(&values).filter(|(l, v)| v[0].is_finite() && v[0] >= 0.0 && l.value.is_finite() && l.value >= 0.0).map(|(l, v)| v[0] - l.value).sum();
+        let values = f.fine_pdf(&rects)?;
+        let shift: f64 = leaves.iter().zip(&values).filter(|(l, v)| v.is_finite() && **v >= 0.0 && l.value.is_finite() && l.value >= 0.0).map(|(l, v)| v - l.value).sum();
         worst = worst.max(shift.abs());
     }
     Ok(worst)

@@ -128,6 +128,11 @@ pub type Rules = ([f64; 4], Option<f64>);
 pub trait Integrand<E> {
     fn rules(&self, rects: &[Rect]) -> Result<Vec<Rules>, E>;
     fn rounding(&self) -> f64;
+    /// The first number of each part's [`Rules`] (∫pdf by the fine rule), the same value
+    /// `rules` gives, where an integrand can give it alone for less.
+    fn fine_pdf(&self, rects: &[Rect]) -> Result<Vec<f64>, E> {
+        Ok(self.rules(rects)?.into_iter().map(|(v, _)| v[0]).collect())
+    }
 }
 
 /// The tolerance on a part whose integral is about p: `sigma_fraction` of a count's standard
