@@ -58,6 +58,13 @@ impl Output {
     }
 }
 
+/// Quadrature rectangles per dispatch of `lobes_integrate_rects` or `lobes_integrate_pdf`: 2¹⁸,
+/// whose buffers (8 MiB of input) stay under glibc's 32 MiB mmap threshold, so each call reuses
+/// the heap the last one freed. At 2²⁰ each call's buffers were fresh pages from the kernel:
+/// tests/check_sweep.rs's correct samplers spent 25 s of system time faulting them in (81 s of
+/// wall time; 2¹⁸: 15 s, 77 s).
+const RECTS_PER_CALL: usize = 1 << 18;
+
 /// The compiled passes of one user sampler.
 pub(super) struct Passes<'g> {
     gpu: &'g Gpu,
@@ -841,8 +848,7 @@ impl<'g> Passes<'g> {
     /// pdf > 0 seen times the area, 0, 0; `lobes_support_edge`).
     pub fn integrate(&self, params: &Params, rects: &[([f32; 4], [f32; 3])]) -> Result<Vec<[[f32; 4]; 2]>, CheckError> {
         let mut out = Vec::with_capacity(rects.len());
-        let per_call = 1 << 20;
-        for chunk in rects.chunks(per_call) {
+        for chunk in rects.chunks(RECTS_PER_CALL) {
             let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], r.1[2], 0.0])).collect();
             let p = Params { count: chunk.len() as u32, ..*params };
             let bytes = self.run("lobes_integrate_rects", &p, &input, chunk.len() as u32, chunk.len() as u64 * 32, Output::Values)?;
@@ -857,7 +863,7 @@ impl<'g> Passes<'g> {
     /// number `integrate` gives, by the same arithmetic (`lobes_integrate_pdf`).
     pub fn integrate_pdf(&self, params: &Params, rects: &[([f32; 4], [f32; 3])]) -> Result<Vec<f32>, CheckError> {
         let mut out = Vec::with_capacity(rects.len());
-        for chunk in rects.chunks(1 << 20) {
+        for chunk in rects.chunks(RECTS_PER_CALL) {
             let input: Vec<[f32; 4]> = chunk.iter().map(|r| r.0).chain(chunk.iter().map(|r| [r.1[0], r.1[1], r.1[2], 0.0])).collect();
             let p = Params { count: chunk.len() as u32, ..*params };
             let bytes = self.run("lobes_integrate_pdf", &p, &input, chunk.len() as u32, chunk.len().div_ceil(4) as u64 * 16, Output::Values)?;
