@@ -13,7 +13,7 @@
 //! are widest.
 //!
 //! The grid is a fixed selection (each α with one incident angle, every angle met), to keep
-//! the test to about three minutes on two CPU cores with lavapipe.
+//! the test to about two minutes on two CPU cores with lavapipe.
 
 use statrs::distribution::{Binomial, DiscreteCDF};
 use lobes::check::{Domain, Report, Settings, UserSampler, check};
