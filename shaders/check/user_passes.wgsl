@@ -61,9 +61,26 @@ fn lobes_rule(first: u32, n: u32, c: vec2<f32>, hw: vec2<f32>, h: f32, quadrant:
     return sum;
 }
 
-// Rectangle i of lobes_in, (a0, a1, b0, b1) with its hemisphere sign, quadrant and root flag in
-// lobes_in[count + i].xyz (b measured from the quadrant's axis, lobes_domain_point),
-// integrated with the 5 × 5 and the 3 × 3 tensor
+// A quadrature rectangle: centre c and half-widths hw of its (a, b) ranges, b measured from the
+// axis of its quadrant (lobes_domain_point), in hemisphere h, its first coordinate s = √a where
+// `root` (src/check/quadrature.rs: Rect).
+struct LobesRect {
+    c: vec2<f32>,
+    hw: vec2<f32>,
+    h: f32,
+    quadrant: u32,
+    root: bool,
+}
+
+// Rectangle i of lobes_in: (a0, a1, b0, b1) at i, its hemisphere sign, quadrant and root flag at
+// lobes_in[count + i].xyz.
+fn lobes_rect(i: u32) -> LobesRect {
+    let r = lobes_in[i];
+    let more = lobes_in[lobes_check.count + i];
+    return LobesRect(0.5 * vec2<f32>(r.y + r.x, r.w + r.z), 0.5 * vec2<f32>(r.y - r.x, r.w - r.z), more.x, u32(more.y), more.z != 0.0);
+}
+
+// Rectangle i of lobes_in (lobes_rect) integrated with the 5 × 5 and the 3 × 3 tensor
 // Gauss–Legendre rules: (∫ pdf by 5 × 5, by 3 × 3, ∫ eval by 5 × 5, by 3 × 3). A pdf that is
 // NaN, infinite or negative at a node is returned as such: the host reports it.
 @compute @workgroup_size(64)
@@ -72,39 +89,29 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
     if (i >= lobes_check.count) {
         return;
     }
-    let r = lobes_in[i];
-    let h = lobes_in[lobes_check.count + i].x;
-    let quadrant = u32(lobes_in[lobes_check.count + i].y);
-    let root = lobes_in[lobes_check.count + i].z != 0.0;
-    let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
-    let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
+    let q = lobes_rect(i);
     let wi = lobes_check.wi.xyz;
     var seen = vec3<f32>(0.0, 0.0, 3.4e38);
-    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, root, wi, &seen);
-    let r3 = lobes_rule(5u, 3u, c, hw, h, quadrant, root, wi, &seen);
-    lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (hw.x * hw.y);
-    lobes_out[lobes_check.count + i] = lobes_support_edge(seen, c, hw, h, quadrant, root, wi);
+    let r5 = lobes_rule(0u, 5u, q.c, q.hw, q.h, q.quadrant, q.root, wi, &seen);
+    let r3 = lobes_rule(5u, 3u, q.c, q.hw, q.h, q.quadrant, q.root, wi, &seen);
+    lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (q.hw.x * q.hw.y);
+    lobes_out[lobes_check.count + i] = lobes_support_edge(seen, q.c, q.hw, q.h, q.quadrant, q.root, wi);
 }
 
-// Rectangle i of lobes_in (as lobes_integrate_rects reads it), ∫ pdf by the 5 × 5 rule alone,
-// four rectangles to a vec4 of lobes_out: the first number of lobes_integrate_rects' by the very
-// same arithmetic, for the sums over fixed parts at moved inputs (src/check/quadrature.rs:
-// sensitivity), where only the differences of those numbers count.
+// Rectangle i of lobes_in (lobes_rect), ∫ pdf by the 5 × 5 rule alone, four rectangles to a
+// vec4 of lobes_out: the first number of lobes_integrate_rects' by the very same arithmetic, for
+// the sums over fixed parts at moved inputs (src/check/quadrature.rs: sensitivity), where only
+// the differences of those numbers count.
 @compute @workgroup_size(64)
 fn lobes_integrate_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
     if (i >= lobes_check.count) {
         return;
     }
-    let r = lobes_in[i];
-    let h = lobes_in[lobes_check.count + i].x;
-    let quadrant = u32(lobes_in[lobes_check.count + i].y);
-    let root = lobes_in[lobes_check.count + i].z != 0.0;
-    let hw = 0.5 * vec2<f32>(r.y - r.x, r.w - r.z);
-    let c = 0.5 * vec2<f32>(r.y + r.x, r.w + r.z);
+    let q = lobes_rect(i);
     var seen = vec3<f32>(0.0, 0.0, 3.4e38);
-    let r5 = lobes_rule(0u, 5u, c, hw, h, quadrant, root, lobes_check.wi.xyz, &seen);
-    lobes_out[i / 4u][i % 4u] = r5.x * (hw.x * hw.y);
+    let r5 = lobes_rule(0u, 5u, q.c, q.hw, q.h, q.quadrant, q.root, lobes_check.wi.xyz, &seen);
+    lobes_out[i / 4u][i % 4u] = r5.x * (q.hw.x * q.hw.y);
 }
 
 // What the pdf's values at a rectangle's points say of its support: (any 0, any > 0, the
