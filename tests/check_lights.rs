@@ -354,6 +354,67 @@ fn the_environment_map_is_judged_texel_by_texel() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--fit always: only with --domain sphere"));
 }
 
+/// The equal-area environment map of examples/envmap/equal_area.wgsl: 16 × 16 texels of an
+/// octahedral equal-area square, its weights the file's closed form, their sum Σw = 825.
+const EQUAL_AREA: &str = "examples/envmap/equal_area.wgsl";
+
+/// The weight of texel (column i, row j) of equal_area.wgsl, as its `ea_weight` defines it: 40 at
+/// the sun (row 5, columns 11 and 12), else 1–3 by the L¹ distance of the texel's centre from the
+/// horizon |s| + |t| = 1, plus 1 on every other texel.
+fn equal_area_weight(i: usize, j: usize) -> f64 {
+    if j == 5 && (i == 11 || i == 12) {
+        return 40.0;
+    }
+    let c = |k: usize| (k as f64 + 0.5 - 8.0).abs() / 8.0;
+    (3 - ((c(i) + c(j) - 1.0).abs() * 3.0).min(2.0) as usize + (i + 2 * j) % 2) as f64
+}
+
+/// `--domain equal-area` (item 3's texel space for an octahedral equal-area map, pbrt-v4's
+/// layout): on the map's own 16 × 16 texels every bin's expected count is N w/Σw, the texel's
+/// weight over the sum of the file's closed form; the correct sampler passes there and on the
+/// sphere; one mapping its texels by the octahedral normal encoding (not equal-area) and one
+/// placing a texel's point transposed each fail χ² and the Jacobian in texel space.
+#[test]
+fn an_equal_area_map_is_judged_texel_by_texel() {
+    let sum: f64 = (0..16).flat_map(|j| (0..16).map(move |i| equal_area_weight(i, j))).sum();
+    assert_eq!(sum, 825.0, "the weights' sum the sampler is given");
+    let check = |sample: &str, texels: bool| {
+        let mut args = vec!["check", EQUAL_AREA, "--sample", sample, "--pdf", "ea_pdf", "--params", "825", "--samples", "262144", "--json"];
+        if texels {
+            args.extend(["--domain", "equal-area", "--bins", "16,16"]);
+        }
+        lobes(&args)
+    };
+    let out = check("ea_sample", true);
+    assert_eq!(out.status.code(), Some(0), "{:?}", failed(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).expect("a JSON report");
+    assert_eq!((v["domain"]["kind"].as_str(), v["rows"].as_u64(), v["cols"].as_u64()), (Some("equal-area"), Some(16), Some(16)));
+    let n = v["samples"].as_f64().unwrap();
+    let expected: Vec<f64> = v["expected"].as_array().expect("expected").iter().map(|e| e.as_f64().unwrap()).collect();
+    let worst = expected.iter().enumerate().map(|(bin, e)| (e / (n * equal_area_weight(bin % 16, bin / 16) / sum) - 1.0).abs()).fold(0.0, f64::max);
+    // the pdf is f32 (w/Σw · 256/4π rounded: 6·10⁻⁸) and constant on each texel (6.9·10⁻⁷ measured)
+    assert!(worst < 1e-5, "a texel's expected count is off w/Σw by {worst:e} (relative)");
+    let out = check("ea_sample", false);
+    assert_eq!(out.status.code(), Some(0), "on the sphere: {:?}", failed(&out));
+    for sample in ["ea_sample_octahedral", "ea_sample_transposed"] {
+        let out = check(sample, true);
+        assert_eq!(out.status.code(), Some(1), "{sample}");
+        let f = failed(&out);
+        assert!(f.contains(&"chi2".to_string()) && f.contains(&"jacobian".to_string()), "{sample}: failed {f:?}");
+    }
+    // the same as a scene's case (domain = "equal-area"), its histogram on the map's texels
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("check-equal-area-scene");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let wgsl = Path::new(env!("CARGO_MANIFEST_DIR")).join(EQUAL_AREA);
+    let scene = dir.join("map.toml");
+    std::fs::write(&scene, format!("[[case]]\nname = \"map\"\nsampler = {{ wgsl = [{wgsl:?}], sample = \"ea_sample\", pdf = \"ea_pdf\" }}\nparams = [825]\nsamples = 65536\ndomain = \"equal-area\"\nbins = [16, 16]\n")).unwrap();
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0));
+    let histogram: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("out/map/histogram.json")).unwrap()).unwrap();
+    assert_eq!((histogram["params"]["domain"].as_str(), histogram["rows"].as_u64(), histogram["cols"].as_u64()), (Some("equal-area"), Some(16), Some(16)), "{}", histogram["params"]);
+}
+
 #[test]
 fn bindings_without_the_right_file_are_exit_2() {
     let npy_of_u32 = std::env::temp_dir().join(format!("lobes-envmap-u32-{}.npy", std::process::id()));

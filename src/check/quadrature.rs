@@ -32,7 +32,7 @@ use super::gpu::{self, Params, Passes};
 use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
 use crate::engine::gpu::Gpu;
 pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
-use crate::stats::domain::Cell;
+use crate::stats::domain::{Cell, SQRT_PI};
 use crate::stats::histogram::SphereGrid;
 pub use crate::stats::quadrature::{CpuPdf, EDGE_DEPTH, Integrand, Jumps, Leaf, Rect, SphereIntegral, sphere_integral_f64};
 pub use crate::stats::quadrature::Witnesses;
@@ -205,7 +205,7 @@ pub(super) fn initial_width(p_max: f64, domain: Domain, rows: u32) -> f64 {
     match domain {
         // θmax of a cap of height 1 − cos θmax, as 2 asin √(height/2) (no cancellation)
         Domain::Cap { height, .. } => width.min(MAX_SPHERE_WIDTH).min(2.0 * (0.5 * height).sqrt().asin() / (CAP_PARTS_PER_ROW * rows as f64)),
-        Domain::Sphere | Domain::LatLong => width.min(MAX_SPHERE_WIDTH),
+        Domain::Sphere | Domain::LatLong | Domain::EqualArea => width.min(MAX_SPHERE_WIDTH),
         Domain::Plane { .. } => width,
     }
 }
@@ -235,6 +235,16 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
                 let z = |t: f64| (std::f64::consts::FRAC_PI_2 - t).sin();
                 for z in z_zones(z(theta.1), z(theta.0)) {
                     pieces.push((z.a, phi, z.h, m(z.extent(phi))));
+                }
+            }
+            // a texel of an equal-area map in (a, b) = √π (s, t), whose area is its solid angle,
+            // cut where it straddles an axis (the map's derivative jumps there)
+            Cell::EqualArea { s, t } => {
+                let cut = |(lo, hi): (f64, f64)| if lo < 0.0 && hi > 0.0 { vec![(lo, 0.0), (0.0, hi)] } else { vec![(lo, hi)] };
+                let scaled = |(lo, hi): (f64, f64)| (SQRT_PI * lo, SQRT_PI * hi);
+                for (s, t) in cut(s).into_iter().flat_map(|s| cut(t).into_iter().map(move |t| (s, t))) {
+                    let (a, b) = (scaled(s), scaled(t));
+                    pieces.push((a, b, 0.0, m((a.1 - a.0).max(b.1 - b.0))));
                 }
             }
             // a cap's cell is one piece about its axis, as a sphere's row about the pole (h = 1)

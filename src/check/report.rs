@@ -15,8 +15,9 @@ use std::path::Path;
 /// The version of the layout of [`Report`] (and of [`super::power::PowerSweep`]): 2 since a
 /// report's `domain` may be a fitted cap (`{"kind": "cap", "axis", "height"}`); 3: `invalid` holds
 /// the five reasons of [`Invalid::ALL`], shared with `lobes run`, `refracted_near_side` last); 4:
-/// `domain` may be a lat-long map's texels (`{"kind": "latlong"}`).
-pub const REPORT_VERSION: u32 = 4;
+/// `domain` may be a lat-long map's texels (`{"kind": "latlong"}`); 5: or an octahedral
+/// equal-area map's (`{"kind": "equal-area"}`).
+pub const REPORT_VERSION: u32 = 5;
 
 /// Invalid samples per reason, in the order of [`Invalid::ALL`] (a user's sampler never has a
 /// `refracted_near_side`).

@@ -21,6 +21,10 @@ pub enum DomainChoice {
     /// Unit directions binned on the texels of a latitude–longitude map (--bins ROWS,COLS its
     /// texels): rows uniform in θ from +z (v = θ/π), columns in φ = atan2(y, x) (u = (φ + π)/2π).
     Latlong,
+    /// Unit directions binned on the texels of an octahedral equal-area map (--bins ROWS,COLS
+    /// its texels; pbrt-v4's environment maps): +z at the square's centre, −z at its corners,
+    /// columns along u, rows along v.
+    EqualArea,
 }
 
 /// What a sample expression returns.
@@ -222,7 +226,8 @@ impl CheckArgs {
         let domain = match (self.domain, &self.bounds) {
             (DomainChoice::Sphere, None) => Domain::Sphere,
             (DomainChoice::Latlong, None) => Domain::LatLong,
-            (DomainChoice::Sphere | DomainChoice::Latlong, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
+            (DomainChoice::EqualArea, None) => Domain::EqualArea,
+            (DomainChoice::Sphere | DomainChoice::Latlong | DomainChoice::EqualArea, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
             (DomainChoice::Plane, None) => return Err(usage("--domain plane needs --bounds X0,Y0,X1,Y1")),
             (DomainChoice::Plane, Some(b)) => match b.0[..] {
                 [x0, y0, x1, y1] => Domain::Plane { bounds: [x0, y0, x1, y1] },

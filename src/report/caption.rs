@@ -31,6 +31,7 @@ pub fn parameters(d: &CaseDescription) -> String {
             let on = match domain.as_str() {
                 "cap" => "a cap fitted to its samples".to_string(),
                 "latlong" => "a lat-long map's texels".to_string(),
+                "equal-area" => "an equal-area map's texels".to_string(),
                 other => format!("the {other}"),
             };
             format!("WGSL sampler {sample} on {on}{at}")

@@ -254,14 +254,16 @@ fn resources(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<Vec<(String, crat
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no
-/// incident direction, or `domain = "latlong"` (the sphere binned on a lat-long map's texels).
+/// incident direction, or `domain = "latlong"` or `"equal-area"` (the sphere binned on an
+/// environment map's texels).
 fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
-    let allowed = "use sphere (unit directions), latlong (unit directions binned on the texels of a lat-long map) or plane (points of the box given by bounds)";
+    let allowed = "use sphere (unit directions), latlong or equal-area (unit directions binned on the texels of a lat-long or an octahedral equal-area map) or plane (points of the box given by bounds)";
     let directions = match &c.domain {
         None => Some(Domain::Sphere),
         Some(v) => match string(ctx, v, "domain", allowed)? {
             "sphere" => Some(Domain::Sphere),
             "latlong" => Some(Domain::LatLong),
+            "equal-area" => Some(Domain::EqualArea),
             "plane" => None,
             other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, Domain::NAMES)))),
         },

@@ -8,8 +8,11 @@
 //! spans 4π / (rows · cols) sr (Archimedes' hat-box theorem; [`SphereGrid`]); on a cap about an
 //! axis, rows are uniform in 1 − cos θ′ ∈ [0, h] and columns in φ′, θ′ and φ′ measured about the
 //! axis, so every cell spans 2π h / (rows · cols) sr by the same theorem; on the plane, rows are
-//! uniform in y and columns in x over the box.
+//! uniform in y and columns in x over the box; on an environment map's texels, rows uniform in θ
+//! (lat-long) or in v of the octahedral equal-area square ([`super::equal_area`]), whose cells
+//! again span equal solid angles.
 
+use super::equal_area;
 use super::histogram::SphereGrid;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -33,7 +36,17 @@ pub enum Domain {
     /// map's texels, each cell is one texel: the histogram in texel space.
     #[serde(rename = "latlong")]
     LatLong,
+    /// Unit directions binned on the texels of an octahedral equal-area map (Clarberg 2008, as
+    /// pbrt-v4's environment maps): the unit square, columns along u and rows along v, +z at its
+    /// centre and −z at its corners ([`super::equal_area`]). Every texel spans 4π / (rows · cols)
+    /// sr; with `rows` × `cols` the map's texels, the histogram in texel space.
+    #[serde(rename = "equal-area")]
+    EqualArea,
 }
+
+/// √π: an equal-area map's quadrature coordinates are its centred square coordinates times it,
+/// so that their area is the solid angle ([`Domain::part_point`]).
+pub const SQRT_PI: f64 = 1.772_453_850_905_516;
 
 /// The orthonormal frame (t, b, axis) of a cap: Duff et al. 2017, "Building an Orthonormal
 /// Basis, Revisited" (JCGT 6(1)), listing 3, whose branchless form the WGSL twin
@@ -119,7 +132,7 @@ impl Domain {
     pub fn validate(&self) -> Result<(), NotABox> {
         match *self {
             Domain::Plane { bounds } => Domain::plane(bounds).map(|_| ()),
-            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong => Ok(()),
+            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong | Domain::EqualArea => Ok(()),
         }
     }
 
@@ -134,20 +147,21 @@ impl Domain {
     /// The solid angle it spans (sr): 4π, a cap's 2π h; `None` on the plane.
     pub fn solid_angle(&self) -> Option<f64> {
         match *self {
-            Domain::Sphere | Domain::LatLong => Some(4.0 * std::f64::consts::PI),
+            Domain::Sphere | Domain::LatLong | Domain::EqualArea => Some(4.0 * std::f64::consts::PI),
             Domain::Cap { height, .. } => Some(2.0 * std::f64::consts::PI * height),
             Domain::Plane { .. } => None,
         }
     }
 
-    /// Its name in scene files, flags and output files: `sphere`, `plane`, `latlong` or `cap` (a
-    /// cap is fitted, not named by users: [`Self::NAMES`] leaves it out).
+    /// Its name in scene files, flags and output files: `sphere`, `plane`, `latlong`,
+    /// `equal-area` or `cap` (a cap is fitted, not named by users: [`Self::NAMES`] leaves it out).
     pub fn name(&self) -> &'static str {
         match self {
             Domain::Sphere => "sphere",
             Domain::Plane { .. } => "plane",
             Domain::Cap { .. } => "cap",
             Domain::LatLong => "latlong",
+            Domain::EqualArea => "equal-area",
         }
     }
 
@@ -155,20 +169,21 @@ impl Domain {
     pub const UNIT_SQUARE: Domain = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
 
     /// The names of a grid's axes, rows' then columns': `["cos θ", "φ"]` on the sphere, `["y",
-    /// "x"]` on the plane, `["θ", "φ"]` on a lat-long map.
+    /// "x"]` on the plane, `["θ", "φ"]` on a lat-long map, `["v", "u"]` on an equal-area one.
     pub fn axes(&self) -> [&'static str; 2] {
         match self {
             Domain::Sphere => ["cos θ", "φ"],
             Domain::Plane { .. } => ["y", "x"],
             Domain::Cap { .. } => ["1 − cos θ′", "φ′"],
             Domain::LatLong => ["θ", "φ"],
+            Domain::EqualArea => ["v", "u"],
         }
     }
 
     /// Whether a grid's columns wrap around (φ = −π is φ = π), so the first column neighbours
-    /// the last.
+    /// the last (an equal-area map's edges fold onto themselves instead, across their midpoints).
     pub fn columns_wrap(&self) -> bool {
-        self.directions()
+        matches!(self, Domain::Sphere | Domain::Cap { .. } | Domain::LatLong)
     }
 
     /// Whether a picture may start its wrapping columns where the density is not cut in two (a
@@ -185,16 +200,17 @@ impl Domain {
             Domain::Plane { bounds: [x0, y0, x1, y1] } => [("y", (y0, y1)), ("x", (x0, x1))],
             Domain::Cap { height, .. } => [("1 − cos θ′ (θ′ from the cap's axis)", (0.0, height)), ("φ′ (degrees)", (-180.0, 180.0))],
             Domain::LatLong => [("θ (degrees; texel row v = θ/180°)", (0.0, 180.0)), ("φ (degrees; u = (φ + 180°)/360°)", (-180.0, 180.0))],
+            Domain::EqualArea => [("v (texel row; +z at the centre, −z at the corners)", (0.0, 1.0)), ("u (texel column)", (0.0, 1.0))],
         }
     }
 
     /// The names [`Domain::name`] gives, for messages that list them.
-    pub const NAMES: [&'static str; 3] = ["sphere", "plane", "latlong"];
+    pub const NAMES: [&'static str; 4] = ["sphere", "plane", "latlong", "equal-area"];
 
     /// Whether a point is a direction from a shading point lit from an incident direction, so
     /// that incidence, frames, half vectors and solid angle apply to it.
     pub fn directions(&self) -> bool {
-        matches!(self, Domain::Sphere | Domain::Cap { .. } | Domain::LatLong)
+        matches!(self, Domain::Sphere | Domain::Cap { .. } | Domain::LatLong | Domain::EqualArea)
     }
 
     /// Whether f32 binning places its column edges off the axes coarser than a sample's own
@@ -215,7 +231,9 @@ impl Domain {
     /// The point at coordinates (a, b) of a quadrature part: on the sphere in hemisphere `h`
     /// (±1), with a = 1 − |cos θ| and b = φ, the direction (s cos φ, s sin φ, h (1 − a)),
     /// s = √(a (2 − a)), whose solid-angle element is da dφ; on a cap the same about its axis
-    /// ([`Frame::direction`], h = 1); on the plane the point (a, b, 0).
+    /// ([`Frame::direction`], h = 1); on the plane the point (a, b, 0); on an equal-area map
+    /// (h = 0) the direction at centred square coordinates (s, t) = (a, b)/√π
+    /// ([`super::equal_area::square_to_sphere`]), so that da db = π ds dt is the solid angle.
     /// The f64 twin of `lobes_domain_point` ([`Domain::binning_wgsl`]).
     pub fn part_point(&self, a: f64, b: f64, h: f64) -> [f64; 3] {
         match self {
@@ -225,6 +243,7 @@ impl Domain {
             }
             Domain::Cap { axis, .. } => Frame::of(*axis).direction(a, b).into(),
             Domain::Plane { .. } => [a, b, 0.0],
+            Domain::EqualArea => equal_area::square_to_sphere(a / SQRT_PI, b / SQRT_PI).into(),
         }
     }
 
@@ -246,6 +265,10 @@ impl Domain {
                 (a, y.atan2(x), 1.0)
             }
             Domain::Plane { .. } => (p[0], p[1], 0.0),
+            Domain::EqualArea => {
+                let (s, t) = equal_area::sphere_to_square(DVec3::from(p));
+                (SQRT_PI * s, SQRT_PI * t, 0.0)
+            }
         }
     }
 
@@ -253,7 +276,7 @@ impl Domain {
     pub fn bounds(&self) -> Option<[f64; 4]> {
         match *self {
             Domain::Plane { bounds } => Some(bounds),
-            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong => None,
+            Domain::Sphere | Domain::Cap { .. } | Domain::LatLong | Domain::EqualArea => None,
         }
     }
 
@@ -276,6 +299,7 @@ impl Domain {
             Domain::Plane { .. } => (64, 64),
             Domain::Cap { .. } => (16, 32),
             Domain::LatLong => (32, 64),
+            Domain::EqualArea => (64, 64),
         }
     }
 
@@ -292,6 +316,7 @@ impl Domain {
             Domain::Plane { .. } => "shaders/check/domain_plane.wgsl",
             Domain::Cap { .. } => "shaders/check/domain_cap.wgsl",
             Domain::LatLong => "shaders/check/domain_latlong.wgsl",
+            Domain::EqualArea => "shaders/check/domain_equal_area.wgsl",
         }
     }
 }
@@ -316,6 +341,9 @@ pub enum Cell {
     Cap { a: (f64, f64), phi: (f64, f64) },
     /// The θ and φ ranges of a texel of a lat-long map.
     LatLong { theta: (f64, f64), phi: (f64, f64) },
+    /// The ranges of centred square coordinates s = 2u − 1 and t = 2v − 1 of a texel of an
+    /// equal-area map ([`super::equal_area`]).
+    EqualArea { s: (f64, f64), t: (f64, f64) },
 }
 
 impl Grid {
@@ -346,6 +374,10 @@ impl Grid {
                 let theta = latlong_theta_edges(self.rows);
                 Cell::LatLong { theta: (theta[r as usize], theta[r as usize + 1]), phi: (phi[c as usize], phi[c as usize + 1]) }
             }
+            Domain::EqualArea => {
+                let edge = |i: u32, n: u32| 2.0 * i as f64 / n as f64 - 1.0;
+                Cell::EqualArea { s: (edge(c, self.cols), edge(c + 1, self.cols)), t: (edge(r, self.rows), edge(r + 1, self.rows)) }
+            }
         }
     }
 
@@ -372,13 +404,14 @@ impl Grid {
                         let (theta, phi) = (std::f64::consts::PI * r / rows as f64, -std::f64::consts::PI + 2.0 * std::f64::consts::PI * c / cols as f64);
                         [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()]
                     }
+                    Domain::EqualArea => equal_area::square_to_sphere(2.0 * c / cols as f64 - 1.0, 2.0 * r / rows as f64 - 1.0).into(),
                 }
             })
             .collect()
     }
 
     /// Cell `bin` and its (up to) eight neighbours, the cell first; columns wrap around on the
-    /// sphere (φ = −π is φ = π), not on the plane.
+    /// sphere (φ = −π is φ = π), not on the plane or an equal-area map.
     pub fn neighbourhood(&self, bin: usize) -> Vec<usize> {
         let (rows, cols) = (self.rows as i64, self.cols as i64);
         let (r, c) = (bin as i64 / cols, bin as i64 % cols);
@@ -424,6 +457,12 @@ impl Grid {
             Domain::LatLong => {
                 let d = DVec3::from(p);
                 ((d.length() - 1.0).abs() <= 1e-3).then(|| (latlong_row(d, self.rows) * self.cols + SphereGrid { rows: self.rows, cols: self.cols }.column_of(d.x, d.y)) as usize)
+            }
+            Domain::EqualArea => {
+                let d = DVec3::from(p);
+                let (s, t) = equal_area::sphere_to_square(d);
+                let (row, col) = (equal_area::index(t, self.rows, d.y < 0.0), equal_area::index(s, self.cols, d.x < 0.0));
+                ((d.length() - 1.0).abs() <= 1e-3).then_some((row * self.cols + col) as usize)
             }
         }
     }
@@ -490,6 +529,34 @@ mod tests {
     }
 
     #[test]
+    fn a_texel_of_an_equal_area_map_is_its_cell() {
+        // 6 × 4 texels (rows × columns): points of a 9 × 9 grid inside each texel, mapped to the
+        // sphere, fall in that texel, and their quadrature coordinates are √π times the centred
+        // square's; the texels' areas in those coordinates add to 4π
+        let g = Domain::EqualArea.grid(6, 4);
+        let mut total = 0.0;
+        for bin in 0..g.bins() {
+            let Cell::EqualArea { s, t } = g.cell(bin) else { panic!("a texel") };
+            total += SQRT_PI * (s.1 - s.0) * SQRT_PI * (t.1 - t.0);
+            for (x, y) in (0..9).flat_map(|i| (0..9).map(move |j| ((i as f64 + 0.5) / 9.0, (j as f64 + 0.5) / 9.0))) {
+                let (sx, ty) = (s.0 + x * (s.1 - s.0), t.0 + y * (t.1 - t.0));
+                let d = Domain::EqualArea.part_point(SQRT_PI * sx, SQRT_PI * ty, 0.0);
+                assert_eq!(g.cell_of(d), Some(bin), "({sx}, {ty})");
+                let (a, b, h) = Domain::EqualArea.part_coordinates(d);
+                assert!((a - SQRT_PI * sx).abs() < 1e-13 && (b - SQRT_PI * ty).abs() < 1e-13 && h == 0.0, "({sx}, {ty})");
+            }
+        }
+        assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-12, "{total}");
+        // +z at the centre (an axis of an even grid: by the signs), −z at a corner, the sign of
+        // a component deciding the middle edge
+        let g = Domain::EqualArea.grid(4, 4);
+        assert_eq!(g.cell_of([0.0, 0.0, 1.0]), Some(2 * 4 + 2));
+        assert_eq!(g.cell_of([-1e-9, -1e-9, 1.0]), Some(4 + 1));
+        assert_eq!(g.cell_of([1e-9, 1e-9, -1.0]), Some(15));
+        assert_eq!(g.cell_of([0.0, 0.0, 1.1]), None, "not a direction");
+    }
+
+    #[test]
     fn a_cell_of_a_cap_spans_its_solid_angle_over_the_cells() {
         // a cap of ρ = 10⁻³ rad: a Monte Carlo of directions uniform in the cone (the cos θ′
         // uniform on [cos ρ, 1]: Archimedes again) falls in each of the 4 × 8 cells equally, and
@@ -534,7 +601,7 @@ mod tests {
 
     #[test]
     fn every_centre_falls_in_its_own_cell() {
-        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9), Domain::cap([0.0, 1.0, 0.1], 3e-6).unwrap().grid(5, 12), Domain::LatLong.grid(7, 12), Domain::LatLong.grid(6, 10)] {
+        for g in [Domain::Sphere.grid(7, 12), Domain::plane([-1.0, 2.0, 3.0, 2.5]).unwrap().grid(5, 9), Domain::cap([0.0, 1.0, 0.1], 3e-6).unwrap().grid(5, 12), Domain::LatLong.grid(7, 12), Domain::LatLong.grid(6, 10), Domain::EqualArea.grid(8, 8), Domain::EqualArea.grid(5, 7)] {
             for (bin, c) in g.centres().into_iter().enumerate() {
                 assert_eq!(g.cell_of(c), Some(bin), "{g:?}: the centre {c:?}");
             }
@@ -566,6 +633,6 @@ mod tests {
             assert!(Domain::plane(b).is_err(), "{b:?}");
         }
         assert_eq!(Domain::plane([0.0, 0.0, 1.0, 1.0]).unwrap().name(), "plane");
-        assert_eq!(Domain::NAMES, [Domain::Sphere.name(), Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }.name(), Domain::LatLong.name()]);
+        assert_eq!(Domain::NAMES, [Domain::Sphere.name(), Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }.name(), Domain::LatLong.name(), Domain::EqualArea.name()]);
     }
 }

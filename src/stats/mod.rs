@@ -4,6 +4,7 @@
 
 pub mod chi2;
 pub mod domain;
+pub mod equal_area;
 pub mod expected;
 pub mod family;
 pub mod gauss_legendre;

@@ -434,6 +434,7 @@ impl<'a> CpuPdf<'a> {
         let (b, cos, sin) = b;
         match (self.domain, &self.frame) {
             (Domain::Plane { .. }, _) => DVec3::new(a, b, 0.0),
+            (Domain::EqualArea, _) => DVec3::from(self.domain.part_point(a, b, 0.0)),
             (_, Some(frame)) => {
                 let s = (a * (2.0 - a)).max(0.0).sqrt();
                 s * cos * frame.t + s * sin * frame.b + (1.0 - a) * frame.axis

@@ -120,7 +120,13 @@ static FILES: [File; 39] = [
 
 /// `lobes::domain` of each domain `lobes check` bins on, by the path its
 /// [`crate::stats::domain::Domain::binning_wgsl`] names (the sphere's is also the built-in one).
-pub const DOMAINS: [File; 4] = [shader!("check/domain_sphere.wgsl"), shader!("check/domain_plane.wgsl"), shader!("check/domain_cap.wgsl"), shader!("check/domain_latlong.wgsl")];
+pub const DOMAINS: [File; 5] = [
+    shader!("check/domain_sphere.wgsl"),
+    shader!("check/domain_plane.wgsl"),
+    shader!("check/domain_cap.wgsl"),
+    shader!("check/domain_latlong.wgsl"),
+    shader!("check/domain_equal_area.wgsl"),
+];
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
 pub const MATH_F32_FAST: File = shader!("math/f32_fast.wgsl");
