@@ -87,7 +87,8 @@ pub struct Integrals {
     /// integral was found only below parts split for a witness, [`Witnesses`]) and whose observed count exceeds the
     /// integral by more than [`HIDDEN_SIGMA`] standard deviations: the parts that held no
     /// witness may hide mass that no rule sees (the tapering tip of a sliver of a light), so such
-    /// a bin gives no verdict ([`Integrals::support_seen`]).
+    /// a bin, left after the bins of such a support were integrated again with denser witnesses
+    /// ([`Evidence::denser`]), gives no verdict ([`Integrals::support_seen`]).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub hidden_support_bins: u64,
 }
@@ -284,11 +285,16 @@ pub(super) fn integrate(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u3
 }
 
 /// What the run's samples say of where the pdf's mass lies: the histogram's counts per bin, and
-/// the points of samples drawn for the purpose ([`Witnesses`]).
+/// the points of samples drawn for the purpose ([`Witnesses`]); and, where given, denser
+/// witnesses drawn for the bins it is asked for.
 pub struct Evidence<'a> {
     pub observed: &'a [u64],
     pub witnesses: Witnesses,
+    pub denser: Option<Denser<'a>>,
 }
+
+/// What draws denser witnesses for the bins a mask marks ([`Evidence::denser`]).
+pub type Denser<'a> = &'a dyn Fn(&[bool]) -> Result<Witnesses, CheckError>;
 
 /// [`integrate`], with the parts its integrals are the sum of ([`Leaf`]).
 pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, rows: u32, cols: u32, width: f64, samples: u64, evidence: Option<&Evidence>) -> Result<(Integrals, Vec<Leaf>), CheckError> {
@@ -301,23 +307,49 @@ pub(super) fn integrate_leaves(f: &dyn Integrand<CheckError>, domain: &Domain, r
         let Some(over) = again(&out, domain.grid(rows, cols), cap, samples, observed) else { break };
         let parts = initial_parts(domain, rows, cols, width / factor as f64, cap, Some(&over));
         let again = refine(f, parts, bins, &settings(samples, MAX_DEPTH + 2 * retry, witnesses))?;
-        for i in (0..bins).filter(|&i| over[i]) {
-            out.pdf[i] = again.pdf[i];
-            out.eval[i] = again.eval[i];
-            out.error[i] = again.error[i];
-            out.linear[i] = again.linear[i];
-            out.unconverged[i] = again.unconverged[i];
-            out.dropped[i] = again.dropped[i];
-            out.hidden[i] = again.hidden[i];
-        }
-        out.leaves.retain(|l| !over[l.bin as usize]);
-        out.leaves.extend(again.leaves.into_iter().filter(|l| over[l.bin as usize]));
-        out.parts += again.parts;
-        out.bad_parts = out.bad_parts.max(again.bad_parts);
-        out.rounds += again.rounds;
+        replace_bins(&mut out, again, &over);
+    }
+    // a support narrower than the nodes whose samples exceed its integral: every bin where such
+    // a support was found integrated again, as far as witnesses 64 times denser lead (the tip of
+    // a tapering sliver, which 2¹⁶ of them miss)
+    if let Some((denser, observed)) = evidence.and_then(|e| e.denser.map(|d| (d, e.observed)))
+        && (0..bins).any(|i| hides_support(&out, i, samples, Some(observed)))
+    {
+        let hidden: Vec<bool> = out.hidden.iter().map(|&h| h > 0.0).collect();
+        let dense = denser(&hidden)?;
+        let parts = initial_parts(domain, rows, cols, width, MAX_INITIAL_SPLIT, Some(&hidden));
+        let again = refine(f, parts, bins, &settings(samples, MAX_DEPTH + 2 * RETRIES, Some(&dense)))?;
+        replace_bins(&mut out, again, &hidden);
     }
     let leaves = std::mem::take(&mut out.leaves);
     Ok((integrals(out, samples, observed), leaves))
+}
+
+/// `out` with the bins `over` marks (their integrals and leaves) taken from `again`.
+fn replace_bins(out: &mut Refined, again: Refined, over: &[bool]) {
+    for i in (0..over.len()).filter(|&i| over[i]) {
+        out.pdf[i] = again.pdf[i];
+        out.eval[i] = again.eval[i];
+        out.error[i] = again.error[i];
+        out.linear[i] = again.linear[i];
+        out.unconverged[i] = again.unconverged[i];
+        out.dropped[i] = again.dropped[i];
+        out.hidden[i] = again.hidden[i];
+    }
+    out.leaves.retain(|l| !over[l.bin as usize]);
+    out.leaves.extend(again.leaves.into_iter().filter(|l| over[l.bin as usize]));
+    out.parts += again.parts;
+    out.bad_parts = out.bad_parts.max(again.bad_parts);
+    out.rounds += again.rounds;
+}
+
+/// Whether bin `i` found most of its integral only below witnessed parts (its support is
+/// narrower than the nodes it started with; a part just outside a wide support's edge finds a
+/// little) and its count exceeds the integral by more than [`HIDDEN_SIGMA`] standard deviations.
+fn hides_support(r: &Refined, i: usize, samples: u64, observed: Option<&[u64]>) -> bool {
+    let n = samples.max(1) as f64;
+    let excess = observed.map_or(0.0, |o| (o[i] as f64 - n * r.pdf[i]) / (n * r.pdf[i]).max(1.0).sqrt());
+    r.hidden[i] > 0.5 * r.pdf[i] && excess > HIDDEN_SIGMA
 }
 
 /// The settings of a histogram's parts at `samples` samples (the module doc's tolerance), to
@@ -363,13 +395,8 @@ fn again(out: &Refined, grid: crate::stats::domain::Grid, cap: u32, samples: u64
 /// The integrals per bin of `r` and what their accuracy is at `samples` samples, against the
 /// histogram's counts `observed` where given.
 fn integrals(r: Refined, samples: u64, observed: Option<&[u64]>) -> Integrals {
+    let hidden_support_bins = (0..r.pdf.len()).filter(|&i| hides_support(&r, i, samples, observed)).count() as u64;
     let dropped = if r.dropped.iter().all(|d| *d == 0.0) { Vec::new() } else { r.dropped };
-    let n = samples.max(1) as f64;
-    let excess = |i: usize| observed.map_or(0.0, |o| (o[i] as f64 - n * r.pdf[i]) / (n * r.pdf[i]).max(1.0).sqrt());
-    // most of the bin's integral found only below witnessed parts: its support is narrower than
-    // the nodes it started with (a part just outside a wide support's edge finds a little)
-    let narrow = |i: usize| r.hidden[i] > 0.5 * r.pdf[i];
-    let hidden_support_bins = (0..r.pdf.len()).filter(|&i| narrow(i) && excess(i) > HIDDEN_SIGMA).count() as u64;
     Integrals {
         hidden_support_bins,
         max_error_sigma: r.error.iter().zip(&r.pdf).map(|(e, p)| sigmas(*e, *p, samples)).fold(0.0, f64::max),

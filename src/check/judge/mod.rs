@@ -135,7 +135,8 @@ pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
     let at = run.passes.map(&run.params, &around)?.chunks(map::AROUND).map(|c| c.try_into().expect("AROUND per probe")).collect();
     let p_max = probes.iter().filter(|p| p.valid()).map(|p| p.reported_pdf() as f64).fold(0.0, f64::max);
     let width = quadrature::initial_width(p_max, run.sampler.domain, run.rows);
-    let evidence = quadrature::Evidence { observed: &totals[..run.bins()], witnesses: witnesses(run, &probes)? };
+    let denser = |bins: &[bool]| denser_witnesses(run, bins);
+    let evidence = quadrature::Evidence { observed: &totals[..run.bins()], witnesses: witnesses(run, &probes)?, denser: Some(&denser) };
     let (integrals, f32_moved) = integrate(run, &evidence, width)?;
     let jump = map_jump(run, &probes, &probe_u)?;
     Ok(Measured { totals, probe_u, probes, kappa, at, integrals, width, f32_moved, jump })
@@ -153,9 +154,33 @@ fn witnesses(run: &Run, probes: &[Probe]) -> Result<quadrature::Witnesses, Check
     let below_one = 1.0 - f32::EPSILON / 2.0;
     let us: Vec<[f32; 4]> = (0..WITNESSES).map(|i| rng::uniforms(run.settings.seed ^ 0x5851_f42d_4c95_7f2d, i).map(|x| (x as f32).min(below_one))).collect();
     let samples = run.passes.map(&run.params, &us)?;
-    let valid = |s: &[f32; 4]| s[3] > 0.0 && s.iter().all(|x| x.is_finite());
-    let points = probes.iter().map(|p| p.sample).chain(samples).filter(valid).map(|s| [s[0], s[1], s[2]].map(f64::from));
+    let points = probes.iter().map(|p| p.sample).chain(samples).filter(valid_witness).map(|s| [s[0], s[1], s[2]].map(f64::from));
     Ok(quadrature::Witnesses::new(&run.grid(), points))
+}
+
+/// Whether a sample can witness the support: a pdf > 0, every component finite.
+fn valid_witness(s: &[f32; 4]) -> bool {
+    s[3] > 0.0 && s.iter().all(|x| x.is_finite())
+}
+
+/// Samples drawn for [`denser_witnesses`]: 2²², 64 times [`WITNESSES`], in dispatches of 2²⁰.
+pub const DENSE_WITNESSES: u64 = 1 << 22;
+
+/// The valid samples of [`DENSE_WITNESSES`] more uniforms (a stream of their own) that fall in
+/// the bins `bins` marks: where a bin's support is narrower than the quadrature's nodes and its
+/// count exceeds its integral, the tip of a tapering sliver that the first witnesses missed.
+fn denser_witnesses(run: &Run, bins: &[bool]) -> Result<quadrature::Witnesses, CheckError> {
+    const BATCH: u64 = 1 << 20;
+    let below_one = 1.0 - f32::EPSILON / 2.0;
+    let grid = run.grid();
+    let mut points = Vec::new();
+    for first in (0..DENSE_WITNESSES).step_by(BATCH as usize) {
+        let us: Vec<[f32; 4]> = (first..first + BATCH).map(|i| rng::uniforms(run.settings.seed ^ 0x2545_f491_4f6c_dd1d, i).map(|x| (x as f32).min(below_one))).collect();
+        let samples = run.passes.map(&run.params, &us)?;
+        let kept = samples.into_iter().filter(valid_witness).map(|s| [s[0], s[1], s[2]].map(f64::from));
+        points.extend(kept.filter(|p| grid.cell_of(*p).is_some_and(|b| bins[b])));
+    }
+    Ok(quadrature::Witnesses::new(&grid, points))
 }
 
 /// A jump of the sample map along u.x or u.y ([`map::find_jump`]) on the lines through the first
