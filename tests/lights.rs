@@ -132,6 +132,20 @@ fn a_sliver_on_the_surfaces_plane_is_judged_across_the_horizon() {
     assert!(f.contains(&"jacobian"), "{f:?}");
 }
 
+/// A spherical triangle along the row of the sphere's grid at 45° elevation, azimuth 30°: its
+/// long edge 2 `half` rad, its third vertex `width` rad across from the edge's middle.
+fn sliver(half: f64, width: f64) -> LightParams {
+    let (e, az) = (45f64.to_radians(), 30f64.to_radians());
+    let axis = DVec3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
+    let along = axis.cross(DVec3::Z).normalize();
+    let across = axis.cross(along);
+    let mut p: LightParams = [0.0; 16];
+    for (k, v) in [axis + half * along, axis - half * along, axis + width * across].into_iter().enumerate() {
+        p[4 * k..4 * k + 3].copy_from_slice(&v.to_array());
+    }
+    p
+}
+
 /// A sliver of a triangle, 0.6 × 3·10⁻⁴ rad, at 45° elevation, lying along a row of the sphere's
 /// grid: it passes between every node of most of the quadrature's parts it crosses, and its
 /// bins' integrals summed to 0.970 (0.70 before the retries), where the pdf 1/Ω integrates to 1 over
@@ -141,14 +155,7 @@ fn a_sliver_on_the_surfaces_plane_is_judged_across_the_horizon() {
 fn a_sliver_between_the_quadratures_nodes_keeps_its_mass() {
     let gpu = gpu();
     let spec = by_name("triangle").unwrap();
-    let (e, az) = (45f64.to_radians(), 30f64.to_radians());
-    let axis = DVec3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
-    let along = axis.cross(DVec3::Z).normalize();
-    let across = axis.cross(along);
-    let mut p: LightParams = [0.0; 16];
-    for (k, v) in [axis + 0.3 * along, axis - 0.3 * along, axis + 3e-4 * across].into_iter().enumerate() {
-        p[4 * k..4 * k + 3].copy_from_slice(&v.to_array());
-    }
+    let p = sliver(0.3, 3e-4);
     let r = check(&gpu, &UserSampler::light(spec), &Settings { seed: 1, ..settings(&p, 1 << 16) }).unwrap_or_else(|e| panic!("{e}"));
     let n = r.figures::<NormalizationFigures>().expect("a normalization check");
     assert!(r.passed, "{:?}: {n:?}", r.failed());
@@ -167,14 +174,7 @@ fn a_sliver_between_the_quadratures_nodes_keeps_its_mass() {
 fn a_tapering_sliver_gets_a_verdict() {
     let gpu = gpu();
     let spec = by_name("triangle").unwrap();
-    let (e, az) = (45f64.to_radians(), 30f64.to_radians());
-    let axis = DVec3::new(e.cos() * az.cos(), e.cos() * az.sin(), e.sin());
-    let along = axis.cross(DVec3::Z).normalize();
-    let across = axis.cross(along);
-    let mut p: LightParams = [0.0; 16];
-    for (k, v) in [axis + 0.1 * along, axis - 0.1 * along, axis + 3e-4 * across].into_iter().enumerate() {
-        p[4 * k..4 * k + 3].copy_from_slice(&v.to_array());
-    }
+    let p = sliver(0.1, 3e-4);
     let r = check(&gpu, &UserSampler::light(spec), &Settings { seed: 1, ..settings(&p, 1 << 16) }).unwrap_or_else(|e| panic!("{e}"));
     let n = r.figures::<NormalizationFigures>().expect("a normalization check");
     assert!(r.passed, "{:?}: {n:?}", r.failed());
