@@ -1,5 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::check_params::lobes_check
+#import lobes::bins::lobes_half_by_sign
 
 // The texels of an octahedral equal-area map (Clarberg 2008; pbrt-v4's environment maps) as the
 // domain of `lobes check`'s passes (src/stats/domain.rs, Domain::EqualArea; the CPU twin of each
@@ -50,10 +51,7 @@ fn lobes_domain_coordinates(p: vec3<f32>) -> vec3<f32> {
 // equal_area::index.
 fn lobes_equal_area_index(c: f32, n: u32, negative: bool) -> u32 {
     let i = min(u32(max((c + 1.0) * 0.5 * f32(n), 0.0)), n - 1u);
-    if (n % 2u != 0u) {
-        return i;
-    }
-    return select(max(i, n / 2u), min(i, n / 2u - 1u), negative);
+    return lobes_half_by_sign(i, n, negative);
 }
 
 // The texel of a finite sample point, or LOBES_DOMAIN_OUTSIDE where it is not a unit direction

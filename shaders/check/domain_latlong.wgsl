@@ -1,6 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::check_params::lobes_check
-#import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
+#import lobes::bins::{lobes_half_by_sign, lobes_phi_column, lobes_quadrant_direction}
 
 // The texels of a latitude–longitude map as the domain of `lobes check`'s passes
 // (src/stats/domain.rs, Domain::LatLong: the CPU twin of each function here;
@@ -29,10 +29,8 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     }
     let rows = lobes_check.rows;
     let theta = atan2(length(p.xy), p.z);
-    var row = min(u32(max(theta, 0.0) * (1.0 / 3.14159265358979) * f32(rows)), rows - 1u);
-    if (rows % 2u == 0u) {
-        row = select(max(row, rows / 2u), min(row, rows / 2u - 1u), p.z >= 0.0);
-    }
+    let row_t = min(u32(max(theta, 0.0) * (1.0 / 3.14159265358979) * f32(rows)), rows - 1u);
+    let row = lobes_half_by_sign(row_t, rows, p.z >= 0.0);
     let col = lobes_phi_column(p.x, p.y, lobes_check.cols);
     return row * lobes_check.cols + col;
 }

@@ -42,6 +42,17 @@ fn lobes_axis_column(col_t: u32, cols: u32, x: f32, y: f32) -> u32 {
     return clamp(col, lo, hi);
 }
 
+// Index i of n equal intervals whose middle edge, where n is even, lies on an axis (a lat-long
+// map's equator, an equal-area map's u = 1/2 or v = 1/2): kept in the first half where `first`,
+// else in the second, so a sign places a point on that edge, not the coordinate's rounding. CPU
+// twin: histogram::half_by_sign.
+fn lobes_half_by_sign(i: u32, n: u32, first: bool) -> u32 {
+    if (n % 2u != 0u) {
+        return i;
+    }
+    return select(max(i, n / 2u), min(i, n / 2u - 1u), first);
+}
+
 // The direction at coordinates (a, b) of a quadrature rectangle of a sphere grid in hemisphere
 // `h` (±1) and quadrant `k`: a = 1 − |cos θ| (the distance from the nearer pole, exact in f32
 // where a peak sits at a pole) and b = φ − k π/2, φ measured from the axis nearest the rectangle

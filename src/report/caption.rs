@@ -4,6 +4,7 @@
 use super::label::compact;
 use crate::run::record::{CaseDescription, Params};
 use crate::stats::chi2::Chi2;
+use crate::stats::domain::Domain;
 use crate::stats::family;
 
 /// The lobe, method and parameters, e.g. `ggx vndf, α 0.3 × 0.1, θi 40°, φi 60°`.
@@ -28,12 +29,7 @@ pub fn parameters(d: &CaseDescription) -> String {
                 (Some(t), Some(p)) => format!(", {}", angles(*t, *p)),
                 _ => String::new(),
             };
-            let on = match domain.as_str() {
-                "cap" => "a cap fitted to its samples".to_string(),
-                "latlong" => "a lat-long map's texels".to_string(),
-                "equal-area" => "an equal-area map's texels".to_string(),
-                other => format!("the {other}"),
-            };
+            let on = Domain::words_for_name(domain).map_or_else(|| format!("the {domain}"), str::to_string);
             format!("WGSL sampler {sample} on {on}{at}")
         }
     }

@@ -165,6 +165,25 @@ impl Domain {
         }
     }
 
+    /// What its grid bins, in words for captions: `the sphere`, `the plane`, `a cap fitted to its
+    /// samples`, `a lat-long map's texels`, `an equal-area map's texels`.
+    pub fn in_words(&self) -> &'static str {
+        match self {
+            Domain::Sphere => "the sphere",
+            Domain::Plane { .. } => "the plane",
+            Domain::Cap { .. } => "a cap fitted to its samples",
+            Domain::LatLong => "a lat-long map's texels",
+            Domain::EqualArea => "an equal-area map's texels",
+        }
+    }
+
+    /// [`Self::in_words`] of the domain called `name` ([`Self::name`]), for a record that keeps
+    /// only its name; `None` for a name no domain has.
+    pub fn words_for_name(name: &str) -> Option<&'static str> {
+        let cap = Domain::Cap { axis: [0.0, 0.0, 1.0], height: 1.0 };
+        [Domain::Sphere, Domain::UNIT_SQUARE, cap, Domain::LatLong, Domain::EqualArea].into_iter().find(|d| d.name() == name).map(|d| d.in_words())
+    }
+
     /// The plane over the unit square `[0, 0, 1, 1]`.
     pub const UNIT_SQUARE: Domain = Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] };
 
@@ -481,10 +500,7 @@ pub fn latlong_theta_edges(rows: u32) -> Vec<f64> {
 pub fn latlong_row(d: DVec3, rows: u32) -> u32 {
     let theta = d.x.hypot(d.y).atan2(d.z);
     let row = ((theta / std::f64::consts::PI * rows as f64) as u32).min(rows - 1);
-    if !rows.is_multiple_of(2) {
-        return row;
-    }
-    if d.z >= 0.0 { row.min(rows / 2 - 1) } else { row.max(rows / 2) }
+    super::histogram::half_by_sign(row, rows, d.z >= 0.0)
 }
 
 #[cfg(test)]
@@ -634,5 +650,14 @@ mod tests {
         }
         assert_eq!(Domain::plane([0.0, 0.0, 1.0, 1.0]).unwrap().name(), "plane");
         assert_eq!(Domain::NAMES, [Domain::Sphere.name(), Domain::Plane { bounds: [0.0, 0.0, 1.0, 1.0] }.name(), Domain::LatLong.name(), Domain::EqualArea.name()]);
+    }
+
+    #[test]
+    fn every_name_has_its_words() {
+        for name in Domain::NAMES.into_iter().chain(["cap"]) {
+            let words = Domain::words_for_name(name).unwrap_or_else(|| panic!("{name}"));
+            assert!(!words.is_empty() && words != "the sphere" || name == "sphere", "{name}: {words}");
+        }
+        assert_eq!(Domain::words_for_name("torus"), None);
     }
 }

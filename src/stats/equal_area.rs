@@ -71,10 +71,7 @@ pub fn sphere_to_square(d: DVec3) -> (f64, f64) {
 /// the sign of the component it came from, not by c's rounding.
 pub fn index(c: f64, n: u32, negative: bool) -> u32 {
     let i = (((c + 1.0) * 0.5 * n as f64).max(0.0) as u32).min(n - 1);
-    if !n.is_multiple_of(2) {
-        return i;
-    }
-    if negative { i.min(n / 2 - 1) } else { i.max(n / 2) }
+    super::histogram::half_by_sign(i, n, negative)
 }
 
 #[cfg(test)]

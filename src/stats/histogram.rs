@@ -8,6 +8,18 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
+/// Index `i` of `n` equal intervals whose middle edge, where `n` is even, lies on an axis (the
+/// equator of a lat-long map, u = ½ or v = ½ of an equal-area one): kept in the first half where
+/// `first`, else in the second, so a sign, not the rounding of the coordinate, places a point on
+/// that edge. The WGSL twin is `lobes_half_by_sign` (`shaders/lib/bins.wgsl`).
+pub fn half_by_sign(i: u32, n: u32, first: bool) -> u32 {
+    match (n.is_multiple_of(2), first) {
+        (false, _) => i,
+        (true, true) => i.min(n / 2 - 1),
+        (true, false) => i.max(n / 2),
+    }
+}
+
 /// A rows × cols grid over the sphere, rows over cos θ from −1 (row 0) to 1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SphereGrid {
