@@ -8,7 +8,7 @@
 
 use lobes::check::{CheckError, Composition, Domain, Source, UserSampler};
 use proptest::prelude::*;
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

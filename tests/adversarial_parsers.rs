@@ -7,7 +7,7 @@
 //! lobes' own scene keys, random text and bytes: tests/bad_input.rs.) No GPU: the command lines
 //! here are refused before any GPU work, and each property runs a modest number of cases.
 
-mod common;
+use crate::common;
 
 use common::text;
 use lobes::check::{CheckError, MAX_PARAMS, Setting, Settings};

@@ -4,7 +4,7 @@
 //! 11's, which end before any GPU work): they need a wgpu adapter (lavapipe in CI); small sample
 //! counts and grids keep each to seconds.
 
-mod common;
+use crate::common;
 
 use common::{finish, text};
 use lobes::check::hard::HardRow;

@@ -3,7 +3,7 @@
 //! GPU adapter, and a case that fails mid-way (no complete-looking `histogram.json` may be left).
 //! The scene parser and the tutorial commands are fuzzed with proptest for panics.
 
-mod common;
+use crate::common;
 use lobes::reference::{effects::Effects, fresnel::Fresnel, masking::Masking};
 use lobes::scene::{Scene, SceneError};
 use proptest::prelude::*;

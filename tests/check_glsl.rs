@@ -8,7 +8,7 @@
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one. glslangValidator
 //! (Debian's `glslang-tools`, installed by .ci/install) is required, not optional.
 
-mod common;
+use crate::common;
 use common::{lobes, root, stderr, verdicts};
 
 use std::path::{Path, PathBuf};

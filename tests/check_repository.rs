@@ -6,7 +6,7 @@
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
 use serde_json::Value;
-mod common;
+use crate::common;
 use common::{lobes, root, stderr};
 
 use std::path::{Path, PathBuf};

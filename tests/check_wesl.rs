@@ -6,7 +6,7 @@
 //! column their span belongs to.
 //! GPU tests: they need a wgpu adapter (lavapipe in CI) and fail without one.
 
-mod common;
+use crate::common;
 use common::{lobes, root, stderr, verdicts};
 
 use serde_json::Value;

@@ -220,10 +220,27 @@ fn bin_dir(tmp: &Path) -> PathBuf {
     bin
 }
 
+/// A `cargo test --test NAME [MODULE::…]` names the one test binary, `integration`, and a module
+/// of it that is a file of tests/ (tests/main.rs).
+fn test_target_exists(cmd: &str) -> Result<(), String> {
+    let Some(rest) = cmd.split("--test ").nth(1) else { return Ok(()) };
+    let mut words = rest.split_whitespace();
+    if words.next() != Some("integration") {
+        return Err("the tests are one binary: `--test integration MODULE::` (tests/main.rs)".into());
+    }
+    match words.next().and_then(|w| w.split_once("::")) {
+        Some((module, _)) if !Path::new(ROOT).join(format!("tests/{module}.rs")).is_file() => Err(format!("tests/{module}.rs does not exist")),
+        _ => Ok(()),
+    }
+}
+
 /// Checks a line of a `sh` block that is not run; Err(why) when it is no listed form.
 fn not_run_form(cmd: &str) -> Option<Result<(), String>> {
     let cmd = command_of(cmd);
-    if ["cargo test", "cargo clippy", "duplicates"].iter().any(|w| starts_with_word(cmd, w)) {
+    if starts_with_word(cmd, "cargo test") {
+        return Some(test_target_exists(cmd));
+    }
+    if ["cargo clippy", "duplicates"].iter().any(|w| starts_with_word(cmd, w)) {
         return Some(Ok(()));
     }
     if let Some(rest) = cmd.strip_prefix("cargo run").filter(|r| r.contains("--example ")) {
@@ -562,4 +579,13 @@ fn the_block_reader_finds_every_shell_line() {
     assert_eq!(errors, ["p.md:15: shell block ```bash: use ```sh (run), ```sh install, ```sh cluster or ```sh dev"]);
     assert_eq!(command_of("CARGO_TARGET_DIR=$PWD/target cargo test --release"), "cargo test --release");
     assert_eq!(normalize(Path::new("docs/../scenes/./a.toml")), "scenes/a.toml");
+}
+
+#[test]
+fn a_documented_test_command_names_a_module_that_exists() {
+    assert!(test_target_exists("cargo test --release --test integration check_sweep:: -- --nocapture").is_ok());
+    assert!(test_target_exists("cargo test --release --test integration tradeoff::f64_pairs").is_ok());
+    assert!(test_target_exists("cargo test --release --lib").is_ok());
+    assert!(test_target_exists("cargo test --release --test check_sweep").is_err());
+    assert!(test_target_exists("cargo test --release --test integration no_such_file::").is_err());
 }

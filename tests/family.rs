@@ -18,7 +18,7 @@
 //!   × three seeds at the default settings (2²² samples, 64 × 128 bins, α = 0.01): the family's
 //!   rejections no more than chance allows (binomial, P(more) < 10⁻³).
 //!
-//! `LOBES_FAMILY_FULL=1 cargo test --release --test family -- --nocapture` runs the searches on
+//! `LOBES_FAMILY_FULL=1 cargo test --release --test integration family:: -- --nocapture` runs the searches on
 //! until the fine grid catches each defect too (up to 2²⁷ samples: minutes), for the table in
 //! docs/statistics.md; by default they stop at 4× the family's count, which is all the
 //! assertion needs.

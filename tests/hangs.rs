@@ -7,7 +7,7 @@
 //! GPU tests (all but the sweep's and the samples' checks): they need a wgpu adapter (lavapipe
 //! in CI) and fail without one. Each runs within seconds: short timeouts, small sample counts.
 
-mod common;
+use crate::common;
 
 use common::{finish, text};
 use lobes::report::output::RunSummary;

@@ -530,3 +530,24 @@ fn the_submodule_parser_resolves_paths_and_skips_strings_and_inline_modules() {
         .collect();
     assert_eq!(circles(&graph), [["a", "b", "c", "a"]]);
 }
+
+/// Every file of tests/ is a module of the one test binary (tests/main.rs, with Cargo.toml's
+/// `autotests = false`): a file it did not name would never be compiled, its tests never run.
+#[test]
+fn every_test_file_is_a_module_of_the_test_binary() {
+    let tests = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let main = std::fs::read_to_string(tests.join("main.rs")).unwrap();
+    let declared: BTreeSet<&str> = main.lines().filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';')).collect();
+    let mut files = BTreeSet::new();
+    for entry in std::fs::read_dir(&tests).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_str().unwrap().to_string();
+        let module = if path.is_dir() { path.join("mod.rs").is_file() } else { path.extension().is_some_and(|e| e == "rs") && name != "main" };
+        if module {
+            files.insert(name);
+        }
+    }
+    let missing: Vec<&String> = files.iter().filter(|f| !declared.contains(f.as_str())).collect();
+    assert!(missing.is_empty(), "tests/main.rs does not name {missing:?}: add `mod NAME;` there, or their tests never run");
+    assert!(declared.len() > 40 && declared.iter().all(|d| files.contains(*d)), "tests/main.rs names {declared:?}; tests/ has {files:?}");
+}

@@ -98,7 +98,7 @@ fn broken<M>(m: M) -> Broken<M> {
 }
 
 /// The f64 limits, for α from 0.001 to 2 and θ to 89.9°. Largest errors measured over the grid
-/// (`cargo test --release --test microfacet_identities -- --nocapture`): normalisation 1.7e-10
+/// (`cargo test --release --test integration microfacet_identities:: -- --nocapture`): normalisation 1.7e-10
 /// (GGX; 2e-11 Beckmann); projected area, symmetry and visible normals 7.2e-7 (Beckmann; 4.4e-7
 /// GGX). Those three integrate max(0, ω·h), whose kink along the great circle ω·h = 0 crosses the
 /// quadrature's parts: Gauss–Legendre converges slowly there, and a kink that clips a part's

@@ -12,7 +12,7 @@
 //! 1/(4|ωr·h|), Ward's pdf missing 1/cos³θh, the VNDF pdf missing G1, GGX's NDF density paired
 //! with Beckmann's sampler) to show that the test can fail.
 
-mod reference_quadrature;
+use crate::reference_quadrature;
 
 use glam::DVec3;
 use lobes::reference::beckmann::Beckmann;

@@ -9,7 +9,7 @@
 //! the reference, not the quadrature. The substitution itself is checked against integrals known in closed form
 //! (solid angle of the hemisphere, projected area, and the reflected-direction Jacobian).
 
-mod reference_quadrature;
+use crate::reference_quadrature;
 
 use glam::DVec3;
 use lobes::reference::beckmann::Beckmann;

@@ -7,7 +7,7 @@
 //! untested ([`Untested`]), never a pass. The same histograms against the density of a lobe 20 %
 //! rougher (a broken sampler) are never passed where the test judges.
 
-mod reference_quadrature;
+use crate::reference_quadrature;
 
 use glam::DVec3;
 use lobes::engine::cpu;

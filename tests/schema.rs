@@ -5,7 +5,7 @@
 //! GPU test: it needs a wgpu adapter (lavapipe in CI) and fails without one.
 //!
 //! After a change to an output struct, regenerate the schemas with
-//! `LOBES_WRITE_SCHEMA=1 cargo test --release --test schema`.
+//! `LOBES_WRITE_SCHEMA=1 cargo test --release --test integration schema::`.
 
 use lobes::report::output::{CaseSummary, HistogramFile, JsonStyle, RunSummary, SUMMARY_VERSION, ShardSummary, TimingFile};
 use lobes::report::schema::{schemas, to_text};
@@ -34,7 +34,7 @@ fn published_schemas_are_up_to_date() {
         assert!(
             stored == text,
             "{} is not the schema generated from the structs; regenerate it with \
-             `LOBES_WRITE_SCHEMA=1 cargo test --release --test schema`",
+             `LOBES_WRITE_SCHEMA=1 cargo test --release --test integration schema::`",
             path.display()
         );
     }
