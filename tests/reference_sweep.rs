@@ -5,7 +5,10 @@
 //! (`reference_quadrature`), and the f64 engine's histogram of the same case never failed by
 //! it. A narrow lobe that fits in a bin or two leaves the χ² no cells to compare: such a case is
 //! untested ([`Untested`]), never a pass. The same histograms against the density of a lobe 20 %
-//! rougher (a broken sampler) are never passed where the test judges.
+//! rougher (a broken sampler) fail wherever the lobe spans more than a few cells of the 32 × 64
+//! grid (α ≥ 0.1, every θi); at α ≤ 0.01 the lobe and its rougher twin fill the same one to four
+//! cells, and the rougher one passed in 32 of the 192 judged cases (measured: every one at α ≤
+//! 0.01): a limit of the grid's resolution, not of the reference.
 
 use crate::reference_quadrature;
 
@@ -65,6 +68,7 @@ fn the_reference_converges_and_judges_over_the_documented_range() {
     let (mut correct, mut broken) = (Tally::default(), Tally::default());
     let mut worst_sigma: f64 = 0.0;
     let mut worst_closure: f64 = 0.0;
+    let mut wide_rougher_passed = Vec::new();
     for (seed, (kind, method)) in SAMPLERS.into_iter().enumerate() {
         for alpha in ALPHAS {
             for theta in THETA_I_DEG {
@@ -94,11 +98,15 @@ fn the_reference_converges_and_judges_over_the_documented_range() {
                 let t = compare::chi2_test(&counts, &wrong, level);
                 eprintln!("{tag}: dof {} correct p {:.3e}; 20 % rougher p {:.3e} {:?}", t.dof, correct_p(&counts, &exp, level), t.p_value, t.untested);
                 broken.add(&t);
+                if t.passed && alpha >= 0.1 {
+                    wide_rougher_passed.push(tag);
+                }
             }
         }
     }
     eprintln!("{cases} cases at level {level:.2e}: correct {correct:?}; 20 % rougher {broken:?}; worst quadrature error {worst_sigma:.3}σ at 10⁶; worst closure {worst_closure:.2e}");
     assert_eq!(correct.failed, 0);
+    assert!(wide_rougher_passed.is_empty(), "a lobe 20 % rougher passed where the lobe spans many cells: {wide_rougher_passed:?}");
 }
 
 fn correct_p(counts: &lobes::engine::job::Counts, exp: &compare::ExpectedCounts, level: f64) -> f64 {

@@ -1,5 +1,5 @@
 //! Helpers of the tests that drive the `lobes` binary as CI does, and copies of fixture trees.
-//! (Each test file that says `mod common;` compiles its own copy, using some of them.)
+//! (A module of the test binary, tests/main.rs; the files that use it say `use crate::common;`.)
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
