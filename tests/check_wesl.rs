@@ -149,7 +149,7 @@ fn a_module_missing_from_its_package_names_the_closest_few() {
     assert!(stderr(&out).contains("--package mathlib=no/such/dir: not a folder"), "{}", stderr(&out));
     let out = lobes(&["check", &file, "--package", "package=x", "--sample", "sample_cosine(rng)", "--pdf", "cosine_pdf(d)"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("--package package=…: a package name is an identifier other than package and super"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--package 'package': a package name is an identifier other than package and super"), "{}", stderr(&out));
 }
 
 /// The scene key `package` is `--package`: a `lobes run` scene whose user case names the

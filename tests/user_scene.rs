@@ -236,7 +236,11 @@ fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
 fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let dir = scratch("bad");
     let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
-    let cases: [(&str, &[&str]); 14] = [
+    let cases: [(&str, &[&str]); 17] = [
+        // a resource's or package's error names its scene key, not lobes check's flag
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", package = { super = \"lib\" } }\n", &["bad.toml:6:", "sampler.package 'super': a package name is an identifier"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", filter = { s = \"bilinear\" } }\n", &["bad.toml:6:", "sampler.filter 's=bilinear': the filter 'bilinear' is unknown"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", texture = { s = \"a.hdr\" }, filter = { s = \"linear\" } }\n", &["bad.toml:6:", "sampler.filter 's=linear': s is bound twice"]),
         ("sampler = \"ggx.wgsl\"\n", &["bad.toml:6:", "expected a sampler table { wgsl = [\"file.wgsl\"]"]),
         ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no pdf function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
@@ -262,6 +266,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
             assert!(stderr.contains(w), "{lines}: want {w:?} in: {stderr}");
         }
         assert!(!out_dir.join("mine").exists(), "{lines}: a case ran");
+        assert!(!["--sampler", "--texture", "--package"].iter().any(|f| stderr.contains(f)), "{lines}: a scene's error names a flag: {stderr}");
     }
     // A user's sampler needs the GPU, and runs whole: --cpu and --shard refuse it.
     let scene = bad_scene(&dir, good);

@@ -5,6 +5,7 @@
 //! `gpu` (the glue) share.
 
 use super::compose::Source;
+use super::resources::{Filter, Resource, ResourceError, ResourceKind};
 use std::path::PathBuf;
 
 /// How lobes finds and calls a sampler beyond the contract's three functions (issue 23 §1–2).
@@ -46,7 +47,7 @@ pub struct Composition {
     pub normal: Option<String>,
     /// The renderer's textures and tables, by the name the sampler's files declare them with
     /// (`--texture NAME=FILE`, `--buffer NAME=FILE`; [`super::resources`]).
-    pub resources: Vec<(String, super::resources::Resource)>,
+    pub resources: Vec<(String, Resource)>,
 }
 
 impl Composition {
@@ -64,29 +65,28 @@ impl Composition {
     }
     /// A `.hdr` image bound as the sampler's `name: texture_2d<f32>` (`--texture NAME=FILE`).
     pub fn texture(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
-        self.resources.push((name.into(), super::resources::Resource::Texture(file.into())));
+        self.resources.push((name.into(), Resource::Texture(file.into())));
         self
     }
     /// A `.npy` table bound as the sampler's `var<storage, read> name: array<…>` (`--buffer
     /// NAME=FILE`).
     pub fn buffer(mut self, name: &str, file: impl Into<PathBuf>) -> Self {
-        self.resources.push((name.into(), super::resources::Resource::Buffer(file.into())));
+        self.resources.push((name.into(), Resource::Buffer(file.into())));
         self
     }
     /// A sampler bound as the sampler's `name: sampler` (`--sampler NAME=linear|nearest`).
-    pub fn sampler(mut self, name: &str, filter: super::resources::Filter) -> Self {
-        self.resources.push((name.into(), super::resources::Resource::Sampler(filter)));
+    pub fn sampler(mut self, name: &str, filter: Filter) -> Self {
+        self.resources.push((name.into(), Resource::Sampler(filter)));
         self
     }
-    /// `--texture` and `--buffer` flags, each NAME=FILE, and `--sampler` flags, each
-    /// NAME=linear|nearest; each NAME named once.
-    pub fn parse_resources(textures: &[String], buffers: &[String], samplers: &[String]) -> Result<Vec<(String, super::resources::Resource)>, String> {
-        let mut out: Vec<(String, super::resources::Resource)> = Vec::new();
-        let flags = textures.iter().map(|t| ("--texture", t)).chain(buffers.iter().map(|b| ("--buffer", b))).chain(samplers.iter().map(|s| ("--sampler", s)));
-        for (flag, item) in flags {
-            let (name, resource) = parse_resource(flag, item)?;
+    /// Resource items, each NAME=FILE (a texture, a buffer) or NAME=linear|nearest (a sampler);
+    /// each NAME bound once.
+    pub fn parse_resources(items: &[(ResourceKind, String)]) -> Result<Vec<(String, Resource)>, ResourceError> {
+        let mut out: Vec<(String, Resource)> = Vec::new();
+        for (kind, item) in items {
+            let (name, resource) = parse_resource(*kind, item).map_err(|message| ResourceError { kind: *kind, message })?;
             if out.iter().any(|(n, _)| n == name) {
-                return Err(format!("{flag} '{item}': {name} is bound twice"));
+                return Err(ResourceError { kind: *kind, message: format!("'{item}': {name} is bound twice") });
             }
             out.push((name.to_string(), resource));
         }
@@ -151,12 +151,13 @@ impl Composition {
         Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), resources: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
     }
 
-    /// `--package NAME=DIR` flags (repeatable): NAME a WESL package name, each at most once.
-    pub fn parse_packages(flags: &[String]) -> Result<Vec<(String, PathBuf)>, String> {
+    /// Package items, each NAME=DIR (`--package`, a scene's `package`): NAME a WESL package name,
+    /// each at most once. The error quotes the item; its caller names the flag or key.
+    pub fn parse_packages(items: &[String]) -> Result<Vec<(String, PathBuf)>, String> {
         let mut out: Vec<(String, PathBuf)> = Vec::new();
-        for f in flags {
+        for f in items {
             let Some((name, dir)) = f.split_once('=').map(|(n, d)| (n.trim(), d.trim())).filter(|(n, d)| !n.is_empty() && !d.is_empty()) else {
-                return Err(format!("--package '{f}': give NAME=DIR, e.g. --package bevy_render=crates/bevy_render/src (then bevy_render::maths is DIR/maths.wesl)"));
+                return Err(format!("'{f}': give NAME=DIR, e.g. bevy_render=crates/bevy_render/src (then bevy_render::maths is DIR/maths.wesl)"));
             };
             check_package(name, &out)?;
             out.push((name.to_string(), PathBuf::from(dir)));
@@ -170,13 +171,14 @@ impl Composition {
     }
 }
 
-/// A `--package` name: an identifier, not `package` (the sampler's own root), given once.
+/// A package's name: an identifier, not `package` (the sampler's own root), given once. The
+/// error quotes the name; its caller names the flag or key.
 pub(super) fn check_package(name: &str, given: &[(String, PathBuf)]) -> Result<(), String> {
     if !is_name(name) || name == "package" || name == "super" {
-        return Err(format!("--package {name}=…: a package name is an identifier other than package and super (WESL's own path starts), as an import names it: bevy_render in `import bevy_render::maths::PI;`"));
+        return Err(format!("'{name}': a package name is an identifier other than package and super (WESL's own path starts), as an import names it: bevy_render in `import bevy_render::maths::PI;`"));
     }
     if given.iter().any(|(n, _)| n == name) {
-        return Err(format!("--package {name}: given twice; one package has one folder"));
+        return Err(format!("'{name}': given twice; one package has one folder"));
     }
     Ok(())
 }
@@ -341,27 +343,22 @@ impl UserCode {
     }
 }
 
-/// One `--texture`/`--buffer` NAME=FILE or `--sampler` NAME=FILTER, as the name and what it binds.
-fn parse_resource<'a>(flag: &str, item: &'a str) -> Result<(&'a str, super::resources::Resource), String> {
-    use super::resources::{Filter, Resource};
-    let example = match flag {
-        "--texture" => "env_map=sky.hdr",
-        "--buffer" => "env_cdf=cdf.npy",
-        _ => "lut_sampler=linear",
-    };
-    let usage = || format!("{flag} '{item}': give NAME={}, NAME the variable the sampler's files declare, e.g. {flag} {example}", if flag == "--sampler" { "linear or nearest" } else { "FILE" });
+/// One resource item, NAME=FILE or (a sampler) NAME=FILTER, as the name and what it binds; the
+/// message quotes the item, its caller names the kind.
+fn parse_resource(kind: ResourceKind, item: &str) -> Result<(&str, Resource), String> {
+    let value_form = if kind == ResourceKind::Sampler { "linear or nearest" } else { "FILE" };
+    let usage = || format!("'{item}': give NAME={value_form}, NAME the variable the sampler's files declare, e.g. {}", kind.example());
     let (name, value) = item.split_once('=').map(|(n, v)| (n.trim(), v.trim())).filter(|(n, v)| is_name(n) && !v.is_empty()).ok_or_else(usage)?;
-    let resource = match flag {
-        "--texture" => Resource::Texture(value.into()),
-        "--buffer" => Resource::Buffer(value.into()),
-        _ => Resource::Sampler(Filter::parse(value).ok_or_else(|| format!("{flag} '{item}': the filter '{value}' is unknown; give linear or nearest (the sampler clamps to the edge)"))?),
+    let resource = match kind {
+        ResourceKind::Texture => Resource::Texture(value.into()),
+        ResourceKind::Buffer => Resource::Buffer(value.into()),
+        ResourceKind::Sampler => Resource::Sampler(Filter::parse(value).ok_or_else(|| format!("'{item}': the filter '{value}' is unknown; give linear or nearest (the sampler clamps to the edge)"))?),
     };
     Ok((name, resource))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::resources::{Filter, Resource};
     use super::*;
 
     #[test]
@@ -376,17 +373,19 @@ mod tests {
 
     #[test]
     fn a_sampler_flag_is_a_name_and_a_filter() {
-        let r = Composition::parse_resources(&["env=sky.hdr".into()], &[], &["lut_sampler=linear".into(), " s = nearest ".into()]).unwrap();
+        let items = [(ResourceKind::Texture, "env=sky.hdr".into()), (ResourceKind::Sampler, "lut_sampler=linear".into()), (ResourceKind::Sampler, " s = nearest ".into())];
+        let r = Composition::parse_resources(&items).unwrap();
         assert_eq!(r, vec![("env".into(), Resource::Texture("sky.hdr".into())), ("lut_sampler".into(), Resource::Sampler(Filter::Linear)), ("s".into(), Resource::Sampler(Filter::Nearest))]);
     }
 
     #[test]
     fn a_bad_sampler_flag_says_what_to_give() {
-        let bad = |s: &str| Composition::parse_resources(&[], &[], &[s.into()]).unwrap_err();
-        assert!(bad("s=bilinear").contains("'bilinear' is unknown; give linear or nearest"), "{}", bad("s=bilinear"));
-        assert!(bad("s").contains("give NAME=linear or nearest"));
-        assert!(bad("1s=linear").contains("e.g. --sampler lut_sampler=linear"));
-        let twice = Composition::parse_resources(&["s=a.hdr".into()], &[], &["s=linear".into()]).unwrap_err();
-        assert!(twice.contains("s is bound twice"), "{twice}");
+        let bad = |s: &str| Composition::parse_resources(&[(ResourceKind::Sampler, s.into())]).unwrap_err();
+        assert_eq!(bad("s=bilinear").kind, ResourceKind::Sampler);
+        assert!(bad("s=bilinear").message.contains("'bilinear' is unknown; give linear or nearest"), "{:?}", bad("s=bilinear"));
+        assert!(bad("s").message.contains("give NAME=linear or nearest"));
+        assert!(bad("1s=linear").message.contains("e.g. lut_sampler=linear"));
+        let twice = Composition::parse_resources(&[(ResourceKind::Texture, "s=a.hdr".into()), (ResourceKind::Sampler, "s=linear".into())]).unwrap_err();
+        assert!(twice.kind == ResourceKind::Sampler && twice.message.contains("s is bound twice"), "{twice:?}");
     }
 }

@@ -13,6 +13,52 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// What a resource item binds: the kind its flag (`--texture`) or a scene's key (`texture`)
+/// names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ResourceKind {
+    Texture,
+    Buffer,
+    Sampler,
+}
+
+impl ResourceKind {
+    /// `lobes check`'s flag: `--texture`, `--buffer`, `--sampler`.
+    pub fn flag(self) -> &'static str {
+        match self {
+            ResourceKind::Texture => "--texture",
+            ResourceKind::Buffer => "--buffer",
+            ResourceKind::Sampler => "--sampler",
+        }
+    }
+
+    /// A scene's `[sampler]` key: `texture`, `buffer`, `filter`.
+    pub fn key(self) -> &'static str {
+        match self {
+            ResourceKind::Texture => "texture",
+            ResourceKind::Buffer => "buffer",
+            ResourceKind::Sampler => "filter",
+        }
+    }
+
+    /// An item of this kind, for messages: `env_map=sky.hdr`.
+    pub(super) fn example(self) -> &'static str {
+        match self {
+            ResourceKind::Texture => "env_map=sky.hdr",
+            ResourceKind::Buffer => "env_cdf=cdf.npy",
+            ResourceKind::Sampler => "lut_sampler=linear",
+        }
+    }
+}
+
+/// A resource item that cannot be bound: its kind, which the caller names by its flag or its
+/// scene key, and why (the item quoted).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResourceError {
+    pub kind: ResourceKind,
+    pub message: String,
+}
+
 /// What a name is bound to.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Resource {

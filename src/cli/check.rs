@@ -5,6 +5,7 @@ use crate::report::check::CHECK_FILES;
 use crate::report::folder::{Access, OutFolder};
 use crate::report::table;
 use crate::check::{self, CheckError, Conventions, Domain, Frame, Incident, Measure, Setting, Settings, UserSampler};
+use crate::check::resources::ResourceKind;
 use crate::engine::gpu::{Gpu, GpuError};
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -250,8 +251,10 @@ impl CheckArgs {
             },
         )
         .map_err(usage)?;
-        let packages = check::Composition::parse_packages(&self.package).map_err(usage)?;
-        let resources = check::Composition::parse_resources(&self.texture, &self.buffer, &self.sampler).map_err(usage)?;
+        let packages = check::Composition::parse_packages(&self.package).map_err(|e| usage(format!("--package {e}")))?;
+        let kinds = [(ResourceKind::Texture, &self.texture), (ResourceKind::Buffer, &self.buffer), (ResourceKind::Sampler, &self.sampler)];
+        let items: Vec<(ResourceKind, String)> = kinds.iter().flat_map(|(k, items)| items.iter().map(|i| (*k, i.clone()))).collect();
+        let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("{} {}", e.kind.flag(), e.message)))?;
         let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
     }

@@ -7,6 +7,7 @@
 use super::sweep::Point;
 use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
 use crate::check::budget::Budget;
+use crate::check::resources::{Resource, ResourceKind};
 use crate::check::{Conventions, DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
 use serde::Deserialize;
 use std::path::Path;
@@ -214,7 +215,7 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
     }
     if let Some(v) = &r.package {
         c.packages = paths(v, "package", "a folder name")?;
-        Composition::parse_packages(&flags(&c.packages)).map_err(|e| ctx.err(v.span(), format!("sampler.package: {e}")))?;
+        Composition::parse_packages(&flags(&c.packages)).map_err(|e| ctx.err(v.span(), format!("sampler.package {e}")))?;
     }
     c.resources = resources(ctx, r, base)?;
     if let Some(v) = &r.sample_returns {
@@ -233,24 +234,25 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
 /// `texture = { NAME = "file.hdr" }`, `buffer = { NAME = "file.npy" }` and `filter = { NAME =
 /// "linear" }`: the renderer's resources (`--texture`, `--buffer`, `--sampler`), the files
 /// relative to `base`.
-fn resources(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<Vec<(String, crate::check::resources::Resource)>, SceneError> {
-    let keyed = [("texture", &r.texture), ("buffer", &r.buffer), ("filter", &r.filter)];
+fn resources(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<Vec<(String, Resource)>, SceneError> {
+    let keyed = [(ResourceKind::Texture, &r.texture), (ResourceKind::Buffer, &r.buffer), (ResourceKind::Sampler, &r.filter)];
     let Some(at) = keyed.iter().find_map(|(_, v)| v.as_ref()).map(|v| v.span()) else { return Ok(Vec::new()) };
-    let mut flags: [Vec<String>; 3] = Default::default();
-    for ((key, v), out) in keyed.iter().zip(&mut flags) {
+    let mut items = Vec::new();
+    for (kind, v) in keyed {
         let Some(v) = v else { continue };
+        let key = kind.key();
         let Value::Table(t) = v.get_ref() else {
             return Err(ctx.err(v.span(), format!("sampler.{key} must be a table, got {}; {SAMPLER_ALLOWED}", kind_of(v.get_ref()))));
         };
-        let what = if *key == "filter" { "\"linear\" or \"nearest\"" } else { "a file name" };
+        let what = if kind == ResourceKind::Sampler { "\"linear\" or \"nearest\"" } else { "a file name" };
         for (name, value) in t {
             let Value::String(s) = value else {
                 return Err(ctx.err(v.span(), format!("sampler.{key}.\"{name}\" must be {what} (a string); {SAMPLER_ALLOWED}")));
             };
-            out.push(if *key == "filter" { format!("{name}={s}") } else { format!("{name}={}", base.join(s).display()) });
+            items.push((kind, if kind == ResourceKind::Sampler { format!("{name}={s}") } else { format!("{name}={}", base.join(s).display()) }));
         }
     }
-    crate::check::Composition::parse_resources(&flags[0], &flags[1], &flags[2]).map_err(|e| ctx.err(at, format!("sampler.texture/buffer/filter: {e}")))
+    crate::check::Composition::parse_resources(&items).map_err(|e| ctx.err(at, format!("sampler.{} {}", e.kind.key(), e.message)))
 }
 
 /// `domain` and `bounds`: the sphere unless `domain = "plane"`, which needs `bounds` and has no

@@ -72,7 +72,7 @@ fn wesl_root(sources: &[Source], c: &Composition) -> Result<(Vec<PathBuf>, wesl:
         }
     }
     for (name, dir) in &c.packages {
-        check_package(name, &[]).map_err(CheckError::Input)?;
+        check_package(name, &[]).map_err(|e| CheckError::Input(format!("package {e}")))?;
         if !dir.is_dir() {
             return Err(CheckError::Input(format!("--package {name}={}: not a folder; give the folder that holds {name}'s modules ({name}::a::b is DIR/a/b.wesl)", dir.display())));
         }
