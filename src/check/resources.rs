@@ -13,8 +13,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// What a resource item binds: the kind its flag (`--texture`) or a scene's key (`texture`)
-/// names.
+/// What a resource item binds: the kind a scene's key (`texture`) or `lobes check`'s flag
+/// (`--texture`, named by the command line) names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ResourceKind {
     Texture,
@@ -23,15 +23,6 @@ pub enum ResourceKind {
 }
 
 impl ResourceKind {
-    /// `lobes check`'s flag: `--texture`, `--buffer`, `--sampler`.
-    pub fn flag(self) -> &'static str {
-        match self {
-            ResourceKind::Texture => "--texture",
-            ResourceKind::Buffer => "--buffer",
-            ResourceKind::Sampler => "--sampler",
-        }
-    }
-
     /// A scene's `[sampler]` key: `texture`, `buffer`, `filter`.
     pub fn key(self) -> &'static str {
         match self {

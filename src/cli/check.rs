@@ -220,6 +220,15 @@ pub(super) fn flag(setting: Setting) -> &'static str {
     }
 }
 
+/// The flag that binds a resource of `kind`.
+fn resource_flag(kind: ResourceKind) -> &'static str {
+    match kind {
+        ResourceKind::Texture => "--texture",
+        ResourceKind::Buffer => "--buffer",
+        ResourceKind::Sampler => "--sampler",
+    }
+}
+
 impl CheckArgs {
     /// What the sampler's flags say beyond its files and functions: its domain, conventions
     /// and composition (each checked here, at once).
@@ -254,7 +263,7 @@ impl CheckArgs {
         let packages = check::Composition::parse_packages(&self.package).map_err(|e| usage(format!("--package {e}")))?;
         let kinds = [(ResourceKind::Texture, &self.texture), (ResourceKind::Buffer, &self.buffer), (ResourceKind::Sampler, &self.sampler)];
         let items: Vec<(ResourceKind, String)> = kinds.iter().flat_map(|(k, items)| items.iter().map(|i| (*k, i.clone()))).collect();
-        let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("{} {}", e.kind.flag(), e.message)))?;
+        let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("{} {}", resource_flag(e.kind), e.message)))?;
         let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
     }
