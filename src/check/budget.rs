@@ -158,6 +158,17 @@ pub fn fit(budget: f64, fixed: f64, per_sample: f64) -> Option<u64> {
     (n >= PILOT_SAMPLES && fixed + n as f64 * per_sample <= budget).then_some(n)
 }
 
+/// A sample's time from the base pilot and the last: the slope of the line through them. Where
+/// the samples' share was not measured (the pilots stopped at an eighth of the budget no slower
+/// than the fixed part's noise: another process on the adapter slowed the base pilot), the slope
+/// is noise, and 0 would pick 2⁴⁰; the last pilot bounds it then: all of its time spent on its
+/// samples is the most a sample can cost, so the count picked does not outrun the budget.
+fn cost_per_sample(base: &Pilot, last: &Pilot) -> f64 {
+    let slope = ((last.seconds - base.seconds) / (last.samples - base.samples) as f64).max(0.0);
+    let measured = last.seconds - base.seconds >= 0.5 * base.seconds || last.samples >= crate::engine::job::MAX_SAMPLES / 4;
+    if measured { slope } else { slope.max(last.seconds / last.samples as f64) }
+}
+
 /// Seconds as a user reads them: as typed for ordinary values, in exponent form for tiny or huge
 /// ones (`1e-300`, not 300 zeros).
 fn seconds(s: f64) -> String {
@@ -170,7 +181,8 @@ fn seconds(s: f64) -> String {
 /// past its timeout is never picked.
 /// The pilots: one at [`PILOT_SAMPLES`] that warms the driver's pipelines (not used), one more
 /// there (the fixed part), then 2²⁰, 2²², … until the samples' share of the time is measurable
-/// (half the fixed part, or an eighth of the budget), and the line through the last two.
+/// (half the fixed part, or an eighth of the budget), and the line through the last two
+/// (`cost_per_sample`, which bounds a slope that was not measured).
 pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, profile: Option<Profile>) -> Result<BudgetPick, CheckError> {
     let (given, budget) = (budget, budget.min(settings.timeout.as_secs_f64() / TIMEOUT_MARGIN));
     let named = if budget < given {
@@ -201,7 +213,7 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
         n *= 4;
     }
     let last = pilots.last().expect("a pilot");
-    let per_sample = ((last.seconds - base.seconds) / (last.samples - base.samples) as f64).max(0.0);
+    let per_sample = cost_per_sample(&base, last);
     let fixed = (base.seconds - per_sample * base.samples as f64).max(0.0);
     let samples = fit(budget, fixed, per_sample).ok_or_else(|| {
         CheckError::Input(format!(
@@ -218,4 +230,26 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
         samples,
         predicted_seconds: fixed + per_sample * samples as f64,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pilot(samples: u64, seconds: f64) -> Pilot {
+        Pilot { samples, seconds, gpu_seconds: None }
+    }
+
+    #[test]
+    fn an_unmeasured_slope_is_bounded_by_the_last_pilot() {
+        // CI's case: the base pilot slowed to 0.66 s by another test, 2²⁰ samples in 0.60 s
+        let (base, last) = (pilot(1 << 16, 0.66), pilot(1 << 20, 0.60));
+        let s = cost_per_sample(&base, &last);
+        assert!((s - 0.60 / (1u64 << 20) as f64).abs() < 1e-15, "{s}");
+        let n = fit(4.0, 0.0, s).unwrap();
+        assert!(n as f64 * s <= 4.0 && n < 1 << 23, "{n}");
+        // a measured share: the line through the two pilots, 0.7 s over 2²⁰ − 2¹⁶ samples
+        let s = cost_per_sample(&pilot(1 << 16, 0.3), &pilot(1 << 20, 1.0));
+        assert!((s - 0.7 / ((1u64 << 20) - (1 << 16)) as f64).abs() < 1e-15, "{s}");
+    }
 }
