@@ -1,5 +1,5 @@
 #define_import_path lobes::domain
-#import lobes::check_params::lobes_check
+#import lobes::params::lobes_params
 #import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
 
 // A spherical cap fitted around a small support as the domain of `lobes check`'s passes
@@ -22,7 +22,7 @@ fn lobes_cap_frame(n: vec3<f32>) -> mat3x3<f32> {
 // cap's frame: the local direction's components across n keep their f32 resolution, so a cap of
 // 10⁻³ rad is resolved to an ulp of its radius, not of 1.
 fn lobes_domain_point(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
-    return lobes_cap_frame(lobes_check.bounds.xyz) * lobes_quadrant_direction(a, b, 1.0, k);
+    return lobes_cap_frame(lobes_params.bounds.xyz) * lobes_quadrant_direction(a, b, 1.0, k);
 }
 
 // A sample's point as the domain reads it: a direction, all three components.
@@ -36,22 +36,22 @@ fn lobes_domain_coordinates(p: vec3<f32>) -> vec3<f32> {
 // the sphere's (shaders/lib/bins.wgsl).
 fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     let l = length(p);
-    let f = lobes_cap_frame(lobes_check.bounds.xyz);
+    let f = lobes_cap_frame(lobes_params.bounds.xyz);
     let z = dot(p, f[2]);
     if (abs(l - 1.0) > 1e-3 || z <= 0.0) {
         return LOBES_DOMAIN_OUTSIDE;
     }
     let c = cross(p, f[2]);
     let a = dot(c, c) / (l * (l + z));
-    let height = lobes_check.bounds.w;
+    let height = lobes_params.bounds.w;
     if (!(a <= height)) {
         return LOBES_DOMAIN_OUTSIDE;
     }
-    let row = min(u32(a / height * f32(lobes_check.rows)), lobes_check.rows - 1u);
+    let row = min(u32(a / height * f32(lobes_params.rows)), lobes_params.rows - 1u);
     let x = dot(p, f[0]);
     let y = dot(p, f[1]);
-    let col = lobes_phi_column(x, y, lobes_check.cols);
-    return row * lobes_check.cols + col;
+    let col = lobes_phi_column(x, y, lobes_params.cols);
+    return row * lobes_params.cols + col;
 }
 
 // What lobes_domain_cell returns for a point outside the domain.

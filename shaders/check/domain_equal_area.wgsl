@@ -1,5 +1,5 @@
 #define_import_path lobes::domain
-#import lobes::check_params::lobes_check
+#import lobes::params::lobes_params
 #import lobes::bins::lobes_half_by_sign
 
 // The texels of an octahedral equal-area map (Clarberg 2008; pbrt-v4's environment maps) as the
@@ -70,9 +70,9 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
         q = r * vec2<f32>(atan2(a.x, a.y), atan2(a.y, a.x)) / LOBES_HALF_PI;
     }
     q = select(q, lobes_equal_area_fold(q), p.z < 0.0);
-    let row = lobes_equal_area_index(select(q.y, -q.y, p.y < 0.0), lobes_check.rows, p.y < 0.0);
-    let col = lobes_equal_area_index(select(q.x, -q.x, p.x < 0.0), lobes_check.cols, p.x < 0.0);
-    return row * lobes_check.cols + col;
+    let row = lobes_equal_area_index(select(q.y, -q.y, p.y < 0.0), lobes_params.rows, p.y < 0.0);
+    let col = lobes_equal_area_index(select(q.x, -q.x, p.x < 0.0), lobes_params.cols, p.x < 0.0);
+    return row * lobes_params.cols + col;
 }
 
 // What lobes_domain_cell returns for a point outside the domain.

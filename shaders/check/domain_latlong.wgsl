@@ -1,5 +1,5 @@
 #define_import_path lobes::domain
-#import lobes::check_params::lobes_check
+#import lobes::params::lobes_params
 #import lobes::bins::{lobes_half_by_sign, lobes_phi_column, lobes_quadrant_direction}
 
 // The texels of a latitude–longitude map as the domain of `lobes check`'s passes
@@ -27,12 +27,12 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     if (abs(length(p) - 1.0) > 1e-3) {
         return LOBES_DOMAIN_OUTSIDE;
     }
-    let rows = lobes_check.rows;
+    let rows = lobes_params.rows;
     let theta = atan2(length(p.xy), p.z);
     let row_t = min(u32(max(theta, 0.0) * (1.0 / 3.14159265358979) * f32(rows)), rows - 1u);
     let row = lobes_half_by_sign(row_t, rows, p.z >= 0.0);
-    let col = lobes_phi_column(p.x, p.y, lobes_check.cols);
-    return row * lobes_check.cols + col;
+    let col = lobes_phi_column(p.x, p.y, lobes_params.cols);
+    return row * lobes_params.cols + col;
 }
 
 // What lobes_domain_cell returns for a point outside the domain.

@@ -1,5 +1,5 @@
 #define_import_path lobes::domain
-#import lobes::check_params::lobes_check
+#import lobes::params::lobes_params
 #import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
 
 // The sphere as the domain of `lobes check`'s passes (src/stats/domain.rs, Domain::Sphere: the
@@ -26,9 +26,9 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
         return LOBES_DOMAIN_OUTSIDE;
     }
     let z = clamp(p.z, -1.0, 1.0);
-    let row = min(u32((z + 1.0) * 0.5 * f32(lobes_check.rows)), lobes_check.rows - 1u);
-    let col = lobes_phi_column(p.x, p.y, lobes_check.cols);
-    return row * lobes_check.cols + col;
+    let row = min(u32((z + 1.0) * 0.5 * f32(lobes_params.rows)), lobes_params.rows - 1u);
+    let col = lobes_phi_column(p.x, p.y, lobes_params.cols);
+    return row * lobes_params.cols + col;
 }
 
 // What lobes_domain_cell returns for a point outside the domain.

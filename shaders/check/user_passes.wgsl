@@ -1,6 +1,6 @@
 #define_import_path lobes::check
 #import lobes::rng::{rng_uniforms, add64}
-#import lobes::check_params::lobes_check
+#import lobes::params::lobes_params
 #import lobes::domain::{LOBES_DOMAIN_OUTSIDE, lobes_domain_point, lobes_domain_coordinates, lobes_domain_cell}
 #import lobes::user::{lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
 #import lobes::invalid::{LOBES_REASON_COUNT, LOBES_REASON_NON_FINITE_POINT, LOBES_REASON_OUTSIDE_DOMAIN, LOBES_REASON_NON_FINITE_PDF, LOBES_REASON_ZERO_PDF}
@@ -19,7 +19,7 @@
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
-// lobes_check.slabs slabs of lobes_cells() cells, one per invocation of lobes_histogram_slabs
+// lobes_params.slabs slabs of lobes_cells() cells, one per invocation of lobes_histogram_slabs
 @group(0) @binding(4) var<storage, read_write> lobes_slabs: array<u32>;
 
 // x > 0 and finite, read from the bits (not relying on NaN comparing false, which fast-math
@@ -76,7 +76,7 @@ struct LobesRect {
 // lobes_in[count + i].xyz.
 fn lobes_rect(i: u32) -> LobesRect {
     let r = lobes_in[i];
-    let more = lobes_in[lobes_check.count + i];
+    let more = lobes_in[lobes_params.count + i];
     return LobesRect(0.5 * vec2<f32>(r.y + r.x, r.w + r.z), 0.5 * vec2<f32>(r.y - r.x, r.w - r.z), more.x, u32(more.y), more.z != 0.0);
 }
 
@@ -86,16 +86,16 @@ fn lobes_rect(i: u32) -> LobesRect {
 @compute @workgroup_size(64)
 fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let q = lobes_rect(i);
-    let wi = lobes_check.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     var seen = vec3<f32>(0.0, 0.0, 3.4e38);
     let r5 = lobes_rule(0u, 5u, q.c, q.hw, q.h, q.quadrant, q.root, wi, &seen);
     let r3 = lobes_rule(5u, 3u, q.c, q.hw, q.h, q.quadrant, q.root, wi, &seen);
     lobes_out[i] = vec4<f32>(r5.x, r3.x, r5.y, r3.y) * (q.hw.x * q.hw.y);
-    lobes_out[lobes_check.count + i] = lobes_support_edge(seen, q.c, q.hw, q.h, q.quadrant, q.root, wi);
+    lobes_out[lobes_params.count + i] = lobes_support_edge(seen, q.c, q.hw, q.h, q.quadrant, q.root, wi);
 }
 
 // Rectangle i of lobes_in (lobes_rect), ∫ pdf by the 5 × 5 rule alone, four rectangles to a
@@ -105,12 +105,12 @@ fn lobes_integrate_rects(@builtin(global_invocation_id) gid: vec3<u32>, @builtin
 @compute @workgroup_size(64)
 fn lobes_integrate_pdf(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let q = lobes_rect(i);
     var seen = vec3<f32>(0.0, 0.0, 3.4e38);
-    let r5 = lobes_rule(0u, 5u, q.c, q.hw, q.h, q.quadrant, q.root, lobes_check.wi.xyz, &seen);
+    let r5 = lobes_rule(0u, 5u, q.c, q.hw, q.h, q.quadrant, q.root, lobes_params.wi.xyz, &seen);
     lobes_out[i / 4u][i % 4u] = r5.x * (q.hw.x * q.hw.y);
 }
 
@@ -311,12 +311,12 @@ struct LobesProbe {
 @compute @workgroup_size(64)
 fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let u = lobes_in[2u * i];
     let wi = lobes_in[2u * i + 1u].xyz;
-    let e = lobes_check.eps;
+    let e = lobes_params.eps;
     let s = lobes_user_sample(wi, u);
     let px = lobes_user_sample(wi, u + vec4<f32>(e, 0.0, 0.0, 0.0));
     let mx = lobes_user_sample(wi, u - vec4<f32>(e, 0.0, 0.0, 0.0));
@@ -334,11 +334,11 @@ fn lobes_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 @compute @workgroup_size(64)
 fn lobes_pdf_at(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let d = lobes_in[i].xyz;
-    let wi = lobes_check.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     lobes_out[i] = vec4<f32>(lobes_user_pdf(wi, d), lobes_user_eval(wi, d), 0.0, 0.0);
 }
 
@@ -349,7 +349,7 @@ fn lobes_pdf_at(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
 @compute @workgroup_size(64)
 fn lobes_draws(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let u = lobes_in[2u * i];
@@ -395,17 +395,17 @@ fn lobes_conditioning_at(wi: vec3<f32>, d: vec3<f32>, pdf: f32) -> f32 {
 @compute @workgroup_size(64)
 fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let t = gid.x + gid.y * nwg.x * 64u;
-    let first = t * lobes_check.samples_per_thread;
-    if (first >= lobes_check.count) {
+    let first = t * lobes_params.samples_per_thread;
+    if (first >= lobes_params.count) {
         return;
     }
-    let wi = lobes_check.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     var acc = vec4<f32>(0.0);
     var err = vec4<f32>(0.0);
-    for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
+    for (var k = 0u; k < lobes_params.samples_per_thread; k++) {
         let local = first + k;
-        if (local < lobes_check.count) {
-            let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+        if (local < lobes_params.count) {
+            let s = lobes_user_sample(wi, rng_uniforms(lobes_params.seed, add64(lobes_params.base, local)));
             let e = lobes_user_eval(wi, s.xyz);
             let pdf = lobes_user_pdf(wi, s.xyz);
             if (e > 0.0 && lobes_positive(s.w) && lobes_positive(pdf)) {
@@ -429,14 +429,14 @@ fn lobes_weights(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
 }
 
 // The sample map at the host's own uniforms (the Jacobian's steps, src/check/jacobian.rs):
-// item i of lobes_in is u, and lobes_out[i] = sample(wi, u) at the incident lobes_check.wi.
+// item i of lobes_in is u, and lobes_out[i] = sample(wi, u) at the incident lobes_params.wi.
 @compute @workgroup_size(64)
 fn lobes_map(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
-    lobes_out[i] = lobes_user_sample(lobes_check.wi.xyz, lobes_in[i]);
+    lobes_out[i] = lobes_user_sample(lobes_params.wi.xyz, lobes_in[i]);
 }
 
 // At a d where the pdf is 0 (outside its support by the pdf function): infinite (1e30) where a
@@ -455,15 +455,15 @@ fn lobes_edge_within_rounding(wi: vec3<f32>, d: vec3<f32>) -> f32 {
 }
 
 // The pdf's f32 conditioning at the host's points: item i of lobes_in is d, and lobes_out[i] =
-// (pdf(d), its conditioning, 0, 0) at the incident lobes_check.wi: lobes_conditioning_at where
+// (pdf(d), its conditioning, 0, 0) at the incident lobes_params.wi: lobes_conditioning_at where
 // pdf(d) > 0, lobes_edge_within_rounding where it is 0, and 0 where it is not finite or < 0.
 @compute @workgroup_size(64)
 fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = gid.x + gid.y * nwg.x * 64u;
-    if (i >= lobes_check.count) {
+    if (i >= lobes_params.count) {
         return;
     }
-    let wi = lobes_check.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     let d = lobes_in[i].xyz;
     let pdf = lobes_user_pdf(wi, d);
     var k = 0.0;
@@ -486,7 +486,7 @@ fn lobes_finite3(d: vec3<f32>) -> bool {
 // pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`); the bin is the domain's
 // (lobes_domain_cell).
 fn lobes_cell(s: vec4<f32>) -> u32 {
-    let bins = lobes_check.rows * lobes_check.cols;
+    let bins = lobes_params.rows * lobes_params.cols;
     if (!lobes_finite3(s.xyz)) {
         return bins + LOBES_REASON_NON_FINITE_POINT - 1u;
     }
@@ -514,7 +514,7 @@ fn lobes_cell(s: vec4<f32>) -> u32 {
 // one sample took (src/check/gpu.rs: Counted). Counted on every sample, not on a probe: a lobe
 // of a mixture that draws a fifth number in 0.2 % of its samples is found at any seed.
 fn lobes_cells() -> u32 {
-    return lobes_check.rows * lobes_check.cols + LOBES_REASON_COUNT + 2u;
+    return lobes_params.rows * lobes_params.cols + LOBES_REASON_COUNT + 2u;
 }
 const LOBES_OVER_DRAWN: u32 = LOBES_REASON_COUNT;
 const LOBES_MOST_DRAWS: u32 = LOBES_REASON_COUNT + 1u;
@@ -526,13 +526,13 @@ const LOBES_MOST_DRAWS: u32 = LOBES_REASON_COUNT + 1u;
 // then an error) adds to the draw counters.
 @compute @workgroup_size(64)
 fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let first = (gid.x + gid.y * nwg.x * 64u) * lobes_check.samples_per_thread;
-    let wi = lobes_check.wi.xyz;
-    let bins = lobes_check.rows * lobes_check.cols;
-    for (var k = 0u; k < lobes_check.samples_per_thread; k++) {
+    let first = (gid.x + gid.y * nwg.x * 64u) * lobes_params.samples_per_thread;
+    let wi = lobes_params.wi.xyz;
+    let bins = lobes_params.rows * lobes_params.cols;
+    for (var k = 0u; k < lobes_params.samples_per_thread; k++) {
         let local = first + k;
-        if (local < lobes_check.count) {
-            let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+        if (local < lobes_params.count) {
+            let s = lobes_user_sample(wi, rng_uniforms(lobes_params.seed, add64(lobes_params.base, local)));
             atomicAdd(&lobes_counts[lobes_cell(s)], 1u);
             let n = lobes_user_draws();
             if (n > 4u) {
@@ -544,7 +544,7 @@ fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
 }
 
 // The histogram in per-invocation slabs (CPU adapters: llvmpipe serialises the lanes' atomics on
-// shared counters; src/engine/gpu/counting.rs): invocation g of lobes_check.slabs counts samples
+// shared counters; src/engine/gpu/counting.rs): invocation g of lobes_params.slabs counts samples
 // base + g, base + g + slabs, ... of the dispatch into its own slab of lobes_cells() cells with
 // plain adds (the most draws with max), which no other invocation touches; lobes_reduce_slabs then
 // adds the slabs into lobes_counts. A slab entry counts some of one dispatch's samples (under
@@ -552,15 +552,15 @@ fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_w
 @compute @workgroup_size(8)
 fn lobes_histogram_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = gid.x + gid.y * nwg.x * 8u;
-    let slabs = lobes_check.slabs;
+    let slabs = lobes_params.slabs;
     if (g >= slabs) {
         return;
     }
     let first = g * lobes_cells();
-    let draws = first + lobes_check.rows * lobes_check.cols;
-    let wi = lobes_check.wi.xyz;
-    for (var local = g; local < lobes_check.count; local += slabs) {
-        let s = lobes_user_sample(wi, rng_uniforms(lobes_check.seed, add64(lobes_check.base, local)));
+    let draws = first + lobes_params.rows * lobes_params.cols;
+    let wi = lobes_params.wi.xyz;
+    for (var local = g; local < lobes_params.count; local += slabs) {
+        let s = lobes_user_sample(wi, rng_uniforms(lobes_params.seed, add64(lobes_params.base, local)));
         let w = first + lobes_cell(s);
         lobes_slabs[w] = lobes_slabs[w] + 1u;
         let n = lobes_user_draws();
@@ -580,9 +580,9 @@ fn lobes_reduce_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
     if (cell >= cells) {
         return;
     }
-    let most = cell == lobes_check.rows * lobes_check.cols + LOBES_MOST_DRAWS;
+    let most = cell == lobes_params.rows * lobes_params.cols + LOBES_MOST_DRAWS;
     var c = 0u;
-    for (var s = 0u; s < lobes_check.slabs; s++) {
+    for (var s = 0u; s < lobes_params.slabs; s++) {
         let v = lobes_slabs[s * cells + cell];
         c = select(c + v, max(c, v), most);
     }

@@ -1,6 +1,7 @@
 #define_import_path lobes::counting
 #import lobes::job::{TILE_BINS, slabs_used}
-#import lobes::bindings::{counts, params}
+#import lobes::params::lobes_params
+#import lobes::bindings::counts
 
 // Bin counting in per-invocation slabs, for CPU adapters (src/engine/gpu/counting.rs chooses; the
 // alternative to shaders/passes/counting_workgroup.wgsl): invocation g of the SLABS counts into
@@ -32,7 +33,7 @@ fn flush_bins(lid: u32) {}
 fn take_count(cell: u32) -> u32 {
     var c = atomicExchange(&counts[cell], 0u);
     if (cell < TILE_BINS) {
-        for (var s = 0u; s < slabs_used(params.count); s++) {
+        for (var s = 0u; s < slabs_used(lobes_params.count); s++) {
             let w = s * TILE_BINS + cell;
             c += slabs[w];
             slabs[w] = 0u;

@@ -1,6 +1,6 @@
 #define_import_path lobes::effect
 #import lobes::job::{effect_anisotropic, sampler_sample, sampler_weight, sampler_eval, sampler_pdf}
-#import lobes::bindings::params
+#import lobes::params::lobes_params
 #import lobes::reflect::LobeSample
 #import lobes::effect_fresnel::effect_fresnel
 #import lobes::effect_masking::effect_masking
@@ -16,17 +16,17 @@
 // case has the effect, else from no_fresnel.wgsl and no_masking.wgsl (1).
 
 fn effect_alpha() -> vec2<f32> {
-    return select(params.alpha.xx, params.alpha, effect_anisotropic());
+    return select(lobes_params.alpha.xx, lobes_params.alpha, effect_anisotropic());
 }
 
 fn effect_sample(u: vec3<f32>) -> LobeSample {
-    return sampler_sample(effect_alpha(), params.wi.xyz, u);
+    return sampler_sample(effect_alpha(), lobes_params.wi.xyz, u);
 }
 
 // w = F(wi.h) G(wi, wr) w_0: the sampler's closed-form weight (src/reference/effects.rs).
 fn effect_weight(s: LobeSample) -> f32 {
     let a = effect_alpha();
-    let wi = params.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     return effect_fresnel(dot(wi, s.h)) * effect_masking(a, wi, s.wr) * sampler_weight(a, wi, s);
 }
 
@@ -34,7 +34,7 @@ fn effect_weight(s: LobeSample) -> f32 {
 // rough dielectric's eval forms its own h, which may lie across the surface).
 fn effect_check(wr: vec3<f32>) -> f32 {
     let a = effect_alpha();
-    let wi = params.wi.xyz;
+    let wi = lobes_params.wi.xyz;
     let h = normalize(wi + wr);
     let f = effect_fresnel(dot(wi, h)) * effect_masking(a, wi, wr) * sampler_eval(a, wi, wr, h);
     return f * abs(wr.z) / sampler_pdf(a, wi, wr);

@@ -1,6 +1,7 @@
 #define_import_path lobes::kernel
 #import lobes::job::{BINS, CELLS, COUNT_WG, SAMPLES_PER_THREAD, SLABS, TILE_BINS, WG_SIZE, slabs_used}
-#import lobes::bindings::{params, counts, totals}
+#import lobes::params::lobes_params
+#import lobes::bindings::{counts, totals}
 #import lobes::rng::add64
 #import lobes::counting::{count_bin, flush_bins, start_counting, take_count}
 #import lobes::draw::draw
@@ -72,8 +73,8 @@ fn sample_histogram(at: Invocation) {
     // fifth (REASON_REFRACTED_NEAR_SIDE) on its own.
     var invalid = vec4<u32>(0u);
     var invalid_5 = 0u;
-    let base = params.base;
-    let span = counted_samples(at, params.count);
+    let base = lobes_params.base;
+    let span = counted_samples(at, lobes_params.count);
     start_counting(invocation_of(at));
     for (var k = 0u; k < span.z; k++) {
         let cell = draw(add64(base, span.x + k * span.y));
@@ -83,7 +84,7 @@ fn sample_histogram(at: Invocation) {
             if (TILE_BINS == BINS) {
                 count_bin(cell);
             } else {
-                let in_tile = cell - params.tile_first;
+                let in_tile = cell - lobes_params.tile_first;
                 if (in_tile < TILE_BINS) {
                     count_bin(in_tile);
                 }

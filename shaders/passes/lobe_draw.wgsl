@@ -1,7 +1,8 @@
 #define_import_path lobes::draw
 #import lobes::math::{Real, f32_pair}
 #import lobes::job::{BINS, WG_SIZE}
-#import lobes::bindings::{params, directions_out}
+#import lobes::params::lobes_params
+#import lobes::bindings::directions_out
 #import lobes::histogram::bin_of
 #import lobes::lobe_kernel::{explicit_u, lobe_classify, lobe_sample_at, lobe_sample_u}
 
@@ -23,7 +24,7 @@ fn draw(index: vec2<u32>) -> u32 {
 @compute @workgroup_size(WG_SIZE)
 fn explicit_samples(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     let s = lobe_sample_u(explicit_u[i].xyz);

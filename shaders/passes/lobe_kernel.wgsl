@@ -1,7 +1,8 @@
 #define_import_path lobes::lobe_kernel
 #import lobes::math::Real
 #import lobes::job::{WG_SIZE, sampler_sample, lobe_alpha, lobe_wi, lobe_eta}
-#import lobes::bindings::{params, directions_out}
+#import lobes::params::lobes_params
+#import lobes::bindings::directions_out
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::reflect::LobeSample
 #import lobes::histogram::{classify, classify_scattered, bin_of}
@@ -33,17 +34,17 @@ fn lobe_classify(s: LobeSample) -> u32 {
 }
 
 fn lobe_sample_at(index: vec2<u32>) -> LobeSample {
-    return lobe_sample_u(rng_uniforms(params.seed, index).xyz);
+    return lobe_sample_u(rng_uniforms(lobes_params.seed, index).xyz);
 }
 
 // Writes (wr, reason code) of samples base .. base + count, for the per-sample check against f64.
 @compute @workgroup_size(WG_SIZE)
 fn directions(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.count) {
+    if (i >= lobes_params.count) {
         return;
     }
-    let s = lobe_sample_at(add64(params.base, i));
+    let s = lobe_sample_at(add64(lobes_params.base, i));
     directions_out[i] = vec4<f32>(vec3<f32>(s.wr), f32(lobe_classify(s)));
 }
 
@@ -63,7 +64,7 @@ struct ExplicitInput {
 @compute @workgroup_size(WG_SIZE)
 fn bin_explicit(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.count) {
+    if (i >= lobes_params.count) {
         return;
     }
     directions_out[i] = vec4<f32>(f32(bin_of(vec3<Real>(explicit_u[i].xyz))), 0.0, 0.0, 0.0);

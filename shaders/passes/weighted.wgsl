@@ -1,6 +1,6 @@
 #define_import_path lobes::weighted
 #import lobes::job::{BINS, CELLS, WG_SIZE, WEIGHT_LIMIT, WEIGHT_SCALE, SQUARE_SCALE}
-#import lobes::bindings::params
+#import lobes::params::lobes_params
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::histogram::bin_of
 #import lobes::lobe_kernel::lobe_classify
@@ -82,9 +82,9 @@ fn weighted_histogram(at: Invocation) {
     var squares_lower = vec2<u32>(0u);
     var overflow = 0u;
     let first = sample_of(at, 0u);
-    let n = samples_of(at, params.count);
+    let n = samples_of(at, lobes_params.count);
     for (var k = 0u; k < n; k++) {
-        let u = rng_uniforms(params.seed, add64(params.base, first + k * WG_SIZE));
+        let u = rng_uniforms(lobes_params.seed, add64(lobes_params.base, first + k * WG_SIZE));
         let s = effect_sample(u.xyz);
         let reason = lobe_classify(s);
         let w = effect_weight(s);

@@ -442,15 +442,11 @@ fn params_of(sampler: &UserSampler, settings: &Settings) -> gpu::Params {
         wi: [wi[0], wi[1], wi[2], 0.0],
         bounds,
         seed: gpu::split(settings.seed),
-        base: [0, 0],
-        count: 0,
         eps: jacobian::EPS,
         samples_per_thread: 1,
         rows,
         cols,
-        slabs: 0,
-        _pad_b: 0,
-        _pad_c: 0,
+        ..bytemuck::Zeroable::zeroed()
     }
 }
 

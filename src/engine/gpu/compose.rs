@@ -230,7 +230,7 @@ pub(crate) fn lobe_kernel(job: &Job, counting: Counting, tile_bins: u32, precisi
         k.job.uses("lobes::dielectric");
     }
     k.job.push(&call_site("sampler_sample", "a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>", "LobeSample", samplers, lobe.is_rotated(), sample));
-    k.job.uses("lobes::bindings");
+    k.job.uses("lobes::params");
     k.job.push(&lobe_parameters(job, precision));
     k
 }
@@ -249,7 +249,7 @@ fn lobe_parameters(job: &Job, precision: Precision) -> String {
             (format!("vec2<f64>({ax}, {ay})"), format!("vec3<f64>({x}, {y}, {z})"), format!("vec2<f64>({c}, {s})"), eta)
         }
         Precision::F32Accurate | Precision::F32Fast => {
-            ("params.alpha".to_string(), "params.wi.xyz".to_string(), "params.frame".to_string(), "params.wi.w".to_string())
+            ("lobes_params.alpha".to_string(), "lobes_params.wi.xyz".to_string(), "lobes_params.frame".to_string(), "lobes_params.wi.w".to_string())
         }
     };
     format!(
@@ -405,7 +405,7 @@ mod tests {
                     assert!(src.contains(&call), "{} {}", spec.name(), precision.name());
                     assert_eq!(src.contains("let wi = frame_to_local(lobe_frame(), wi_world);"), lobe.is_rotated());
                     assert!(!src.contains("u_world"), "the uniforms are no direction");
-                    let eta = if precision == Precision::F64 { format!("return {};", precision::lit(1.5)) } else { "return params.wi.w;".into() };
+                    let eta = if precision == Precision::F64 { format!("return {};", precision::lit(1.5)) } else { "return lobes_params.wi.w;".into() };
                     assert!(src.contains(&eta), "{} {}", spec.name(), precision.name());
                 }
             }

@@ -328,7 +328,8 @@ impl<'g> SamplingPasses<'g> {
         let dim = gpu.limits.max_compute_workgroups_per_dimension as u64;
         let chunk = chunking.chunk_samples.clamp(1, (1 << 31).min(dim * dim * per_group));
         let per_submit = chunking.chunks_per_submit.max(1) as u64;
-        let stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Params>() as u64);
+        // a dynamic offset is a multiple of the adapter's alignment
+        let stride = (std::mem::size_of::<Params>() as u64).next_multiple_of(gpu.limits.min_uniform_buffer_offset_alignment as u64);
         let params = gpu.buffer("params", stride * per_submit, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         Self { gpu, params, stride, chunk, per_submit }
     }

@@ -102,6 +102,7 @@ static FILES: [File; 39] = [
     shader!("lib/histogram.wgsl"),
     shader!("math/f32.wgsl"),
     shader!("math/erf_f32.wgsl"),
+    shader!("passes/params.wgsl"),
     shader!("passes/bindings.wgsl"),
     shader!("passes/kernel.wgsl"),
     shader!("passes/counting_workgroup.wgsl"),
@@ -113,7 +114,6 @@ static FILES: [File; 39] = [
     shader!("passes/effect_masking.wgsl"),
     shader!("passes/weighted.wgsl"),
     shader!("passes/quadrature.wgsl"),
-    shader!("check/check_params.wgsl"),
     shader!("check/domain_sphere.wgsl"),
     shader!("check/user_passes.wgsl"),
 ];

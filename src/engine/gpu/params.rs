@@ -1,26 +1,45 @@
-//! The uniform block every sampling pass reads (`Params` in `shaders/passes/kernel.wgsl`, bound at
-//! binding 0 of the counting and the weighted layouts) and the layout entries those share.
+//! The uniform block every pass reads (`LobesParams` in `shaders/passes/params.wgsl`, bound at
+//! binding 0): `lobes run`'s sampling kernels (the counting and the weighted layouts) and `lobes
+//! check`'s passes, and the layout entries those share.
 
 use crate::engine::job::{Job, SampleRange};
 use bytemuck::{Pod, Zeroable};
 
-/// The kernel's uniform block (`Params` in `shaders/passes/kernel.wgsl`; `tests::params_layout`
-/// checks the two layouts agree).
+/// The passes' uniform block (`LobesParams` in `shaders/passes/params.wgsl`; `tests::params_layout`
+/// checks the two layouts agree). A pass reads the fields of its job; the others stay 0.
 #[repr(C, align(16))]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct Params {
-    seed: [u32; 2],
-    base: [u32; 2],
-    count: u32,
-    n_items: u32,
-    last_positive: u32,
+    pub seed: [u32; 2],
+    /// The index of the dispatch's first sample, (lo, hi).
+    pub base: [u32; 2],
+    pub count: u32,
+    /// A discrete job's items and the last of them with a positive weight.
+    pub n_items: u32,
+    pub last_positive: u32,
     /// First bin of the tile being counted (see [`super::GpuEngine::tiling`]; 0 when untiled).
-    tile_first: u32,
-    alpha: [f32; 2],
+    pub tile_first: u32,
+    /// A built-in lobe's α.
+    pub alpha: [f32; 2],
     /// (cos, sin) of the lobe's frame angle (rotated anisotropy, `lobe_frame()` of the kernels).
-    frame: [f32; 2],
+    pub frame: [f32; 2],
     /// ωi in xyz, a dielectric's η in w (0 for a reflection).
-    wi: [f32; 4],
+    pub wi: [f32; 4],
+    /// A user's sampler's 16 numbers (`lobes check --params`), zero-padded.
+    pub user: [[f32; 4]; 4],
+    /// A plane domain's box (x0, y0, x1, y1); unused on the sphere.
+    pub bounds: [f32; 4],
+    /// The finite-difference step of `lobes check`'s probe pass.
+    pub eps: f32,
+    /// The samples each invocation of `lobes check`'s histogram and weights passes draws.
+    pub samples_per_thread: u32,
+    /// `lobes check`'s histogram grid.
+    pub rows: u32,
+    pub cols: u32,
+    /// `lobes check`'s per-invocation slabs of the histogram (0: global atomics).
+    pub slabs: u32,
+    /// To the struct's size in WGSL, a multiple of its 16-byte alignment.
+    pub(crate) _pad: [u32; 3],
 }
 
 impl Params {
@@ -31,12 +50,8 @@ impl Params {
             seed: [range.seed as u32, (range.seed >> 32) as u32],
             base: [range.first as u32, (range.first >> 32) as u32],
             count,
-            n_items: 0,
-            last_positive: 0,
-            tile_first: 0,
-            alpha: [0.0; 2],
             frame: [1.0, 0.0],
-            wi: [0.0; 4],
+            ..Zeroable::zeroed()
         };
         match job {
             Job::Lobe { lobe, incident, scatter, .. } => {
@@ -134,10 +149,17 @@ mod tests {
             ("alpha", offset_of!(Params, alpha)),
             ("frame", offset_of!(Params, frame)),
             ("wi", offset_of!(Params, wi)),
+            ("user", offset_of!(Params, user)),
+            ("bounds", offset_of!(Params, bounds)),
+            ("eps", offset_of!(Params, eps)),
+            ("samples_per_thread", offset_of!(Params, samples_per_thread)),
+            ("rows", offset_of!(Params, rows)),
+            ("cols", offset_of!(Params, cols)),
+            ("slabs", offset_of!(Params, slabs)),
         ];
         let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();
         let source = super::super::compose::compose(&Job::Discrete { dist, method: DiscreteMethod::Alias }, 4096);
-        super::super::layout::check_struct(&source, "Params", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
+        super::super::layout::check_struct(&source, "LobesParams", size_of::<Params>(), align_of::<Params>(), &members).unwrap();
     }
 
     #[test]
