@@ -6,7 +6,7 @@
 //! Most cases are refused before any GPU work; the ones that pass run a small check (a wgpu
 //! adapter: lavapipe in CI).
 
-use lobes::check::{CheckError, Composition, Domain, Source, UserSampler};
+use lobes::check::{CheckError, Composition, Domain, Draw, Setting, Source, UserSampler};
 use proptest::prelude::*;
 use crate::common;
 
@@ -273,6 +273,24 @@ fn define_values_out_of_range_are_named() {
     assert!(docs.contains("`--define X=false`") && docs.contains("`#ifdef X`"), "the docs say what X=false does to #ifdef X");
 }
 
+/// A composition's setting the front ends cannot use is refused before any reads a file, named
+/// by its flag: a shader root that is not a folder, a define that is not a name, an order of
+/// draws with no random function named (the library keys them by setting, Composition::validate).
+#[test]
+fn composition_settings_are_refused_naming_their_flag() {
+    let dir = scratch("composition-settings");
+    let file = plain(&dir);
+    let check = |extra: &[&str]| {
+        let mut args = vec!["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "p(d)"];
+        args.extend_from_slice(extra);
+        lobes(&args)
+    };
+    let missing = dir.join("no_such_dir");
+    bad_input(&check(&["--shader-root", missing.to_str().unwrap()]), &[&format!("--shader-root: {} is not a folder", missing.display())]);
+    bad_input(&check(&["--define", "TWO WORDS"]), &["--define: 'TWO WORDS' is no shader def"]);
+    bad_input(&check(&["--rand-order", "x,y"]), &["--rand-order: an order for the draws of the named random functions"]);
+}
+
 /// Item 16: `--budget 1e-300` is refused with a short message (no 300 zeros).
 #[test]
 fn a_tiny_budget_gets_a_short_message() {
@@ -292,7 +310,7 @@ fn unused_or_repeated_stubs_are_refused_naming_them() {
     let other = format!("common::lights={}", dir.join("stubs/view.wgsl").display());
     bad_input(&oil_check(&dir, &["--stub", &other]), &["--stub common::lights", "no import"]);
     let again = format!("common::view={}", dir.join("stubs/view.wgsl").display());
-    bad_input(&oil_check(&dir, &["--stub", &again]), &["--stub common::view", "twice"]);
+    bad_input(&oil_check(&dir, &["--stub", &again]), &["--stub: common::view is given twice"]);
     // WESL: a stub of a module nothing imports
     let wesl = scratch("stubs-wesl");
     common::copy_dir(&root().join(WESL), &wesl);
@@ -348,14 +366,16 @@ proptest! {
         }
     }
 
-    /// `--define`, `--stub`, `--rand` and `--rand-order` as typed: no panic; a rejection names
-    /// the flag.
+    /// A define, a stub, a random function and an order of draws as typed: no panic; a rejection
+    /// is keyed by a setting of the composition, which the command line names by its flag.
     #[test]
-    fn flags_never_panic(define in "[ -~é]{0,12}", stub in "[ -~é]{0,12}", rand in "[ -~é]{0,8}", order in "[ -~]{0,12}") {
-        let flags = Composition::from_flags(&[], std::slice::from_ref(&define), std::slice::from_ref(&stub), std::slice::from_ref(&rand), Some(&order), Default::default());
-        if let Err(e) = flags {
-            prop_assert!(["--define", "--stub", "--rand"].iter().any(|f| e.contains(f)), "{e}");
-        }
+    fn composition_settings_never_panic(define in "[ -~é]{0,12}", stub in "[ -~é]{0,12}", rand in "[ -~é]{0,8}", order in "[ -~]{0,12}") {
+        let mut c = Composition::default().define(&define, None).stub(&stub, "stub.wgsl").stub(&stub, "again.wgsl").rand(&rand);
+        c.rand_order = Draw::parse_list(&order).ok();
+        let e = c.validate().unwrap_err();
+        prop_assert!(matches!(e, CheckError::Setting { setting: Setting::Define | Setting::Stub, .. }), "{e:?}");
+        let ordered_alone = Composition { rand_order: Some(vec![Draw::X]), ..Composition::default() }.validate().unwrap_err();
+        prop_assert!(matches!(ordered_alone, CheckError::Setting { setting: Setting::RandOrder, .. }), "{ordered_alone:?}");
     }
 
     /// Module paths and `--rand` names through composition: no panic, bad input naming them.

@@ -146,7 +146,7 @@ fn a_module_missing_from_its_package_names_the_closest_few() {
     // a folder that is not there, and a name that is not a package's
     let out = lobes(&["check", &file, "--package", "mathlib=no/such/dir", "--sample", "sample_cosine(rng)", "--pdf", "cosine_pdf(d)"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("--package mathlib=no/such/dir: not a folder"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--package: mathlib=no/such/dir: not a folder"), "{}", stderr(&out));
     let out = lobes(&["check", &file, "--package", "package=x", "--sample", "sample_cosine(rng)", "--pdf", "cosine_pdf(d)"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--package 'package': a package name is an identifier other than package and super"), "{}", stderr(&out));

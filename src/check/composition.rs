@@ -5,6 +5,7 @@
 //! `gpu` (the glue) share.
 
 use super::compose::Source;
+use super::{CheckError, Setting};
 use super::resources::{Filter, Resource, ResourceError, ResourceKind};
 use std::path::PathBuf;
 
@@ -114,41 +115,38 @@ impl Composition {
         self.normal = Some(expr.into());
         self
     }
-    /// The command line's flags: `--define NAME[=VALUE]`, `--stub MODULE=FILE`, `--rand-order
-    /// event,x,y`; a bad one is an error naming the flag.
-    pub fn from_flags(
-        shader_roots: &[PathBuf],
-        defines: &[String],
-        stubs: &[String],
-        rand: &[String],
-        rand_order: Option<&str>,
-        sample_returns: SampleReturns,
-    ) -> Result<Self, String> {
-        let defines = defines
-            .iter()
-            .map(|d| match d.split_once('=') {
-                Some((n, v)) => Ok((n.trim().to_string(), Some(v.trim().to_string()))),
-                None => Ok((d.trim().to_string(), None)),
-            })
-            .collect::<Result<Vec<_>, String>>()?;
-        if let Some((n, _)) = defines.iter().find(|(n, _)| !is_name(n)) {
-            return Err(format!("--define '{n}': a shader def is a name (letters, digits, _), as in --define UNIFORM_HEMISPHERE or --define SAMPLES=4"));
+    /// What the front ends assume of the settings, checked once before any of them reads a
+    /// file: shader defs are names, a module has one stand-in, an order of the draws orders
+    /// named random functions, the shader roots and the packages' folders are folders, a package
+    /// is named once. The error is keyed by the [`Setting`]: the command line names its flag, a
+    /// scene its key.
+    ///
+    /// ```
+    /// use lobes::check::{CheckError, Composition, Setting};
+    /// let e = Composition::default().define("TWO WORDS", None).validate().unwrap_err();
+    /// assert!(matches!(e, CheckError::Setting { setting: Setting::Define, .. }));
+    /// ```
+    pub fn validate(&self) -> Result<(), CheckError> {
+        let bad = |setting, message: String| Err(CheckError::Setting { setting, message });
+        if let Some((n, _)) = self.defines.iter().find(|(n, _)| !is_name(n)) {
+            return bad(Setting::Define, format!("'{n}' is no shader def: a def is a name (letters, digits, _) with a value or none, as UNIFORM_HEMISPHERE or SAMPLES=4"));
         }
-        let stubs = stubs
-            .iter()
-            .map(|s| match s.split_once('=') {
-                Some((m, f)) if !m.trim().is_empty() && !f.trim().is_empty() => Ok((m.trim().to_string(), PathBuf::from(f.trim()))),
-                _ => Err(format!("--stub '{s}': give MODULE=FILE, e.g. --stub package::bindings=tests/no_bindings.wesl")),
-            })
-            .collect::<Result<Vec<_>, String>>()?;
-        if let Some((m, _)) = stubs.iter().enumerate().find(|(i, (m, _))| stubs[..*i].iter().any(|(n, _)| n == m)).map(|(_, s)| s) {
-            return Err(format!("--stub {m}: given twice; one module has one stand-in"));
+        if let Some((m, _)) = self.stubs.iter().enumerate().find(|(i, (m, _))| self.stubs[..*i].iter().any(|(n, _)| n == m)).map(|(_, s)| s) {
+            return bad(Setting::Stub, format!("{m} is given twice; one module has one stand-in"));
         }
-        let rand_order = rand_order.map(|o| Draw::parse_list(o).map_err(|e| format!("--rand-order: {e}"))).transpose()?;
-        if rand_order.is_some() && rand.is_empty() {
-            return Err("--rand-order: only with --rand (the order of the draws of the functions --rand names)".into());
+        if self.rand_order.is_some() && self.rand.is_empty() {
+            return bad(Setting::RandOrder, "an order for the draws of the named random functions, and no random function is named".into());
         }
-        Ok(Self { shader_roots: shader_roots.to_vec(), defines, stubs, packages: Vec::new(), resources: Vec::new(), rand: rand.to_vec(), rand_order, sample_returns, normal: None })
+        if let Some(r) = self.shader_roots.iter().find(|r| !r.is_dir()) {
+            return bad(Setting::ShaderRoot, format!("{} is not a folder", r.display()));
+        }
+        for (i, (name, dir)) in self.packages.iter().enumerate() {
+            check_package(name, &self.packages[..i]).map_err(|message| CheckError::Setting { setting: Setting::Package, message })?;
+            if !dir.is_dir() {
+                return bad(Setting::Package, format!("{name}={}: not a folder; give the folder that holds {name}'s modules ({name}::a::b is DIR/a/b.wesl)", dir.display()));
+            }
+        }
+        Ok(())
     }
 
     /// Package items, each NAME=DIR (`--package`, a scene's `package`): NAME a WESL package name,

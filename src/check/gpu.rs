@@ -667,7 +667,7 @@ fn move_resources(c: &mut Composed) -> Result<Vec<(String, naga::ResourceBinding
         c.text = super::resources::rebind(&c.text, range, k as u32)
             .ok_or_else(|| CheckError::Internal(format!("no @group/@binding before `{}` in the composed text", g.name.as_deref().unwrap_or("?"))))?;
     }
-    Ok(users.iter().map(|(_, g)| (g.name.clone().unwrap_or_default(), g.binding.clone().expect("a binding"))).collect())
+    Ok(users.iter().map(|(_, g)| (g.name.clone().unwrap_or_default(), g.binding.expect("a binding"))).collect())
 }
 
 /// The renderer's resources that lobes' passes reach through the sampler, bound from the files
@@ -691,7 +691,7 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
         let span = module.global_variables.get_span(h);
         let global = g.name.as_deref().unwrap_or("?");
         let Some((name, resource)) = given.iter().find(|(n, _)| resources::names(global, n)) else {
-            let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| b.clone()).or_else(|| g.binding.clone()).expect("a binding");
+            let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or_else(|| g.binding).expect("a binding");
             return Err(CheckError::Input(c.diagnostic_at(span, &unbound(g, &as_declared, module))));
         };
         let data = resources::load(name, resource).map_err(CheckError::Input)?;

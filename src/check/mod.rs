@@ -101,7 +101,7 @@ impl CheckError {
     }
 }
 
-/// A field of [`Settings`], as errors name it.
+/// A field of [`Settings`] or of a sampler's [`Composition`], as errors name it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Setting {
     Params,
@@ -111,6 +111,11 @@ pub enum Setting {
     Timeout,
     Bins,
     Significance,
+    ShaderRoot,
+    Define,
+    Stub,
+    Package,
+    RandOrder,
 }
 
 impl Setting {
@@ -124,6 +129,11 @@ impl Setting {
             Setting::Timeout => "timeout",
             Setting::Bins => "bins",
             Setting::Significance => "significance",
+            Setting::ShaderRoot => "shader_root",
+            Setting::Define => "define",
+            Setting::Stub => "stub",
+            Setting::Package => "package",
+            Setting::RandOrder => "rand_order",
         }
     }
 }

@@ -90,5 +90,6 @@ fn compose_anew(sources: &[Source], c: &Composition) -> Result<UserCode, CheckEr
     if sources.is_empty() {
         return Err(CheckError::Input("no WGSL file given: name at least one file that defines the sampler".into()));
     }
+    c.validate()?;
     sniff(sources).front_end().compose(sources, c)
 }

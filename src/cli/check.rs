@@ -217,6 +217,11 @@ pub(super) fn flag(setting: Setting) -> &'static str {
         Setting::Timeout => "timeout",
         Setting::Bins => "bins",
         Setting::Significance => "significance",
+        Setting::ShaderRoot => "shader-root",
+        Setting::Define => "define",
+        Setting::Stub => "stub",
+        Setting::Package => "package",
+        Setting::RandOrder => "rand-order",
     }
 }
 
@@ -248,24 +253,41 @@ impl CheckArgs {
             return Err(usage(format!("--fit always: only with --domain sphere (a cap is fitted on the sphere; --domain {} keeps its own grid)", domain.name())));
         }
         let conventions = Conventions { incident: self.incident, reflection_only: self.reflection_only, u_open: self.u_open, measure: self.measure, frame: self.frame };
-        let composition = check::Composition::from_flags(
-            &self.shader_root,
-            &self.define,
-            &self.stub,
-            &self.rand,
-            self.rand_order.as_deref(),
-            match self.sample_returns {
-                ReturnsChoice::Direction => check::SampleReturns::Direction,
-                ReturnsChoice::HalfVector => check::SampleReturns::HalfVector,
-            },
-        )
-        .map_err(usage)?;
+        let returns = match self.sample_returns {
+            ReturnsChoice::Direction => check::SampleReturns::Direction,
+            ReturnsChoice::HalfVector => check::SampleReturns::HalfVector,
+        };
+        let composition = self.composition(returns)?;
         let packages = check::Composition::parse_packages(&self.package).map_err(|e| usage(format!("--package {e}")))?;
         let kinds = [(ResourceKind::Texture, &self.texture), (ResourceKind::Buffer, &self.buffer), (ResourceKind::Sampler, &self.sampler)];
         let items: Vec<(ResourceKind, String)> = kinds.iter().flat_map(|(k, items)| items.iter().map(|i| (*k, i.clone()))).collect();
         let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("{} {}", resource_flag(e.kind), e.message)))?;
         let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
+    }
+
+    /// The composition the flags give: `--define NAME[=VALUE]`, `--stub MODULE=FILE`,
+    /// `--rand-order event,x,y`, read here; what they say is the library's to check
+    /// ([`check::Composition::validate`]).
+    fn composition(&self, sample_returns: check::SampleReturns) -> anyhow::Result<check::Composition> {
+        let defines = self.define.iter().map(|d| match d.split_once('=') {
+            Some((n, v)) => (n.trim().to_string(), Some(v.trim().to_string())),
+            None => (d.trim().to_string(), None),
+        });
+        let stubs = self.stub.iter().map(|s| match s.split_once('=') {
+            Some((m, f)) if !m.trim().is_empty() && !f.trim().is_empty() => Ok((m.trim().to_string(), PathBuf::from(f.trim()))),
+            _ => Err(usage(format!("--stub '{s}': give MODULE=FILE, e.g. --stub package::bindings=tests/no_bindings.wesl"))),
+        });
+        let rand_order = self.rand_order.as_deref().map(|o| check::Draw::parse_list(o).map_err(|e| usage(format!("--rand-order: {e}")))).transpose()?;
+        Ok(check::Composition {
+            shader_roots: self.shader_root.clone(),
+            defines: defines.collect(),
+            stubs: stubs.collect::<anyhow::Result<_>>()?,
+            rand: self.rand.clone(),
+            rand_order,
+            sample_returns,
+            ..Default::default()
+        })
     }
 
     /// The sampler, read and composed on a thread of its own while this one waits for it

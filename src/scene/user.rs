@@ -101,7 +101,10 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
     let composition = composition(ctx, r, base)?;
     UserSampler::from_repository(&paths, &sample, &pdf, eval.as_deref(), domain, composition)
         .and_then(|s| s.with_conventions(conventions))
-        .map_err(|e| ctx.err(raw.span(), format!("sampler: {e}")))
+        .map_err(|e| match e {
+            crate::check::CheckError::Setting { setting, message } => ctx.err(raw.span(), format!("sampler.{}: {message}", setting.key())),
+            e => ctx.err(raw.span(), format!("sampler: {e}")),
+        })
         .map(Arc::new)
 }
 
@@ -175,9 +178,6 @@ fn composition(ctx: &Ctx, r: &RawSampler, base: &Path) -> Result<crate::check::C
     if let Some(v) = &r.rand_order {
         let o = string(ctx, v, "sampler.rand_order", "write rand_order = \"event,x,y\"")?;
         c.rand_order = Some(Draw::parse_list(o).map_err(|e| ctx.err(v.span(), format!("sampler.rand_order: {e}")))?);
-        if c.rand.is_empty() {
-            return Err(ctx.err(v.span(), "sampler.rand_order: only with rand = [...] (the order of the draws of the functions rand names)"));
-        }
     }
     if let Some(v) = &r.shader_root {
         c.shader_roots = strings(ctx, v, "shader_root")?.into_iter().map(|d| base.join(d)).collect();

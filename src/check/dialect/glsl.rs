@@ -100,11 +100,6 @@ impl Expanded {
 /// The user's GLSL files, their includes expanded and `--define`s given, translated to WGSL.
 pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translation, CheckError> {
     let roots = c.shader_roots.clone();
-    for r in &roots {
-        if !r.is_dir() {
-            return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
-        }
-    }
     let mut x = Expanded::default();
     for (i, s) in sources.iter().enumerate() {
         expand(&mut x, s, &roots, &mut Vec::new(), i == 0)?;

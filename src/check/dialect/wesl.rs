@@ -10,7 +10,6 @@ use super::super::composition::{Composition, Dialect, Origin, UserCode};
 use super::front_end::FrontEnd;
 use super::naga_oil::foreign_directives;
 #[cfg(feature = "wesl")]
-use super::super::composition::check_package;
 #[cfg(feature = "wesl")]
 use super::{
     roots::{roots, show_roots, stubs},
@@ -65,18 +64,8 @@ fn wesl_root(sources: &[Source], c: &Composition) -> Result<(Vec<PathBuf>, wesl:
             s.name
         )));
     }
+    // each a folder, each package named once (Composition::validate)
     let roots = roots(sources, c);
-    for r in &roots {
-        if !r.is_dir() {
-            return Err(CheckError::Input(format!("--shader-root {}: not a folder", r.display())));
-        }
-    }
-    for (name, dir) in &c.packages {
-        check_package(name, &[]).map_err(|e| CheckError::Input(format!("package {e}")))?;
-        if !dir.is_dir() {
-            return Err(CheckError::Input(format!("--package {name}={}: not a folder; give the folder that holds {name}'s modules ({name}::a::b is DIR/a/b.wesl)", dir.display())));
-        }
-    }
     let file = std::fs::canonicalize(&sources[0].name).map_err(|e| CheckError::Input(format!("{}: {e}", sources[0].name)))?;
     let rel = roots
         .iter()
