@@ -5,7 +5,7 @@ use super::compose::{Composed, Source};
 use super::composition::{Draw, UserCode, is_name};
 use super::modules::compose_user;
 use super::probe::Probe;
-use super::{CheckError, Domain, UserSampler};
+use super::{CheckError, UserSampler, shaders};
 use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::counting::SLAB_WORKGROUP;
@@ -632,7 +632,7 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
     let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
     let module = format!("#define_import_path lobes::user\n#import lobes::params::lobes_params\n{user}{glue}");
     let reasons = format!("#define_import_path lobes::invalid\n{}", Invalid::wgsl_consts("LOBES_REASON"));
-    let chosen = [File::generated(USER_MODULE, module), domain_file(sampler.domain), File::generated("lobes::invalid", reasons)];
+    let chosen = [shaders::PASSES, File::generated(USER_MODULE, module), shaders::domain_file(sampler.domain), File::generated("lobes::invalid", reasons)];
     match library::validate_files(&["lobes::check"], &chosen) {
         Err(GpuError::Shader { what, .. }) if what == USER_MODULE => {}
         other => other?,
@@ -730,11 +730,6 @@ fn resource_kind(g: &naga::GlobalVariable, inner: &naga::TypeInner) -> &'static 
         (_, naga::TypeInner::AccelerationStructure { .. }) => "an acceleration structure",
         _ => "a resource",
     }
-}
-
-/// `lobes::domain` of the sampler's domain: where its points lie and which bin each falls in.
-fn domain_file(domain: Domain) -> File {
-    library::DOMAINS.into_iter().find(|f| f.path == domain.binning_wgsl()).expect("library::DOMAINS holds every domain's binning_wgsl")
 }
 
 /// Whether the user's files may not use `name` at module scope: the `lobes_`/`LOBES_`/`Lobes`
@@ -1040,7 +1035,7 @@ mod tests {
 
     fn sampler(text: &str) -> UserSampler {
         let sources = vec![super::super::Source { name: "t.wgsl".into(), text: text.into() }];
-        UserSampler { sources, sample: "s".into(), pdf: "p".into(), eval: None, domain: Domain::Sphere, conventions: Default::default(), composition: Default::default() }
+        UserSampler { sources, sample: "s".into(), pdf: "p".into(), eval: None, domain: super::super::Domain::Sphere, conventions: Default::default(), composition: Default::default() }
     }
 
     /// The user's lines keep their file's numbers in the composition, and valid WGSL that

@@ -53,6 +53,7 @@ pub mod probe;
 pub mod quadrature;
 pub mod report;
 pub mod resources;
+mod shaders;
 pub mod support;
 
 pub use compose::Source;

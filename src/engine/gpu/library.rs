@@ -53,7 +53,8 @@ pub struct File {
 }
 
 impl File {
-    const fn builtin(path: &'static str, source: &'static str) -> Self {
+    /// A file of `shaders/` compiled in (the [`shader!`] macro makes them).
+    pub(crate) const fn builtin(path: &'static str, source: &'static str) -> Self {
         Self { path: Cow::Borrowed(path), source: Cow::Borrowed(source) }
     }
 
@@ -68,15 +69,19 @@ impl File {
     }
 }
 
+/// The built-in [`File`] at `$path` under `shaders/`, its text compiled in.
 macro_rules! shader {
     ($path:literal) => {
-        File::builtin(concat!("shaders/", $path), include_str!(concat!("../../../shaders/", $path)))
+        $crate::engine::gpu::library::File::builtin(concat!("shaders/", $path), include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/", $path)))
     };
 }
+pub(crate) use shader;
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
-/// passes (`shaders/passes`, and `shaders/check` of `lobes check`). Where a module has alternatives (below), this is its default.
-static FILES: [File; 39] = [
+/// passes of `lobes run` (`shaders/passes`). Where a module has alternatives (below), this is its
+/// default. `lobes check` hands its own passes and domains (`shaders/check`) to each composition
+/// (`check::shaders`).
+static FILES: [File; 37] = [
     shader!("lib/rng.wgsl"),
     shader!("lib/reflect.wgsl"),
     shader!("lib/microfacet.wgsl"),
@@ -114,18 +119,6 @@ static FILES: [File; 39] = [
     shader!("passes/effect_masking.wgsl"),
     shader!("passes/weighted.wgsl"),
     shader!("passes/quadrature.wgsl"),
-    shader!("check/domain_sphere.wgsl"),
-    shader!("check/user_passes.wgsl"),
-];
-
-/// `lobes::domain` of each domain `lobes check` bins on, by the path its
-/// [`crate::stats::domain::Domain::binning_wgsl`] names (the sphere's is also the built-in one).
-pub const DOMAINS: [File; 5] = [
-    shader!("check/domain_sphere.wgsl"),
-    shader!("check/domain_plane.wgsl"),
-    shader!("check/domain_cap.wgsl"),
-    shader!("check/domain_latlong.wgsl"),
-    shader!("check/domain_equal_area.wgsl"),
 ];
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
@@ -387,7 +380,7 @@ mod tests {
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING].into_iter().chain(DOMAINS) {
+        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }
