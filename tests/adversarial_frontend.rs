@@ -250,14 +250,14 @@ fn density_expressions_of_the_wrong_type_or_empty_are_named_in_the_flags_terms()
         }
         lobes(&a)
     };
-    for out in [bad_input(&check("v(d)", None), &["--pdf 'v(d)' returns vec3<f32>; expected f32"]), bad_input(&check("p(d)", Some("v(d)")), &["--eval 'v(d)' returns vec3<f32>; expected f32"])] {
+    for out in [bad_input(&check("v(d)", None), &["--pdf: 'v(d)' returns vec3<f32>; expected f32"]), bad_input(&check("p(d)", Some("v(d)")), &["--eval: 'v(d)' returns vec3<f32>; expected f32"])] {
         assert!(!out.contains("Handle") && !out.contains("Some(["), "{out}");
     }
-    bad_input(&check("", None), &["--pdf is empty"]);
-    bad_input(&check("  ", None), &["--pdf is empty"]);
-    let e = bad_input(&check("p(d, d)", None), &["--pdf 'p(d, d)'"]);
+    bad_input(&check("", None), &["--pdf: the expression is empty"]);
+    bad_input(&check("  ", None), &["--pdf: the expression is empty"]);
+    let e = bad_input(&check("p(d, d)", None), &["--pdf: 'p(d, d)'"]);
     assert!(!e.contains("Some(["), "{e}");
-    bad_input(&lobes(&["check", file.to_str().unwrap(), "--sample", "", "--pdf", "p(d)"]), &["--sample is empty"]);
+    bad_input(&lobes(&["check", file.to_str().unwrap(), "--sample", "", "--pdf", "p(d)"]), &["--sample: the expression is empty"]);
 }
 
 /// Item 16: `--define N=99999999999` is out of i32's range (said so); `X=false` vs `#ifdef X`
@@ -325,10 +325,11 @@ fn unused_or_repeated_stubs_are_refused_naming_them() {
     bad_input(&out, &["--stub package::lights", "no import"]);
 }
 
-/// Whether `e` is bad input naming `what` (or a WGSL error at a file:line:column).
+/// Whether `e` is bad input naming `what` (or a WGSL error at a file:line:column), a setting's
+/// (a call expression's) included.
 fn names_input(e: &CheckError, what: &str) -> bool {
     match e {
-        CheckError::Input(m) => m.contains(what) || what.trim().is_empty(),
+        CheckError::Input(m) | CheckError::Setting { message: m, .. } => m.contains(what) || what.trim().is_empty(),
         CheckError::Wgsl(m) => m.contains(':'),
         _ => false,
     }

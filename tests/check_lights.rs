@@ -75,7 +75,7 @@ fn the_flags_of_an_area_light_come_together() {
     let cases: [(&[&str], &str); 4] = [
         (&["--measure", "area"], "--measure area needs --normal"),
         (&["--normal", DOWN], "--normal: only with --measure area"),
-        (&["--measure", "area", "--normal", "p0"], "--normal 'p0' returns f32; expected vec3<f32>"),
+        (&["--measure", "area", "--normal", "p0"], "--normal: 'p0' returns f32; expected vec3<f32>"),
         (&["--measure", "area", "--normal", DOWN, "--domain", "plane", "--bounds", "0,0,1,1"], "--measure area: only with --domain sphere"),
     ];
     for (extra, message) in cases {

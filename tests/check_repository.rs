@@ -167,7 +167,7 @@ fn qualified_names_in_call_expressions_resolve_or_are_refused() {
     let unknown = run(&with_pdf("d.z / maths::PIE"));
     assert_eq!(unknown.status.code(), Some(2));
     let e = stderr(&unknown);
-    assert!(e.contains("--pdf 'd.z / maths::PIE': no item `PIE` of a module `maths`") && e.contains("common::maths::PI"), "{e}");
+    assert!(e.contains("--pdf: 'd.z / maths::PIE': no item `PIE` of a module `maths`") && e.contains("common::maths::PI"), "{e}");
     let f = plain("qualified.wgsl", "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> { return vec4<f32>(0.0, 0.0, 1.0, 1.0); }\n");
     let out = lobes(&["check", f.to_str().unwrap(), "--sample", "s", "--pdf", "d.z / maths::PI"]);
     assert_eq!(out.status.code(), Some(2));
@@ -343,7 +343,7 @@ fn a_sample_expression_of_the_wrong_type_is_refused_at_the_glue() {
     let f = plain("wrong_type.wgsl", "fn s(wi: vec3<f32>) -> f32 { return 1.0; }\nfn p(d: vec3<f32>) -> f32 { return 1.0; }\n");
     let out = lobes(&["check", f.to_str().unwrap(), "--sample", "s(wi)", "--pdf", "p(d)"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("--sample 's(wi)' returns f32"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--sample: 's(wi)' returns f32"), "{}", stderr(&out));
 }
 
 /// The same keys in a scene: the WESL package and the naga_oil tree as cases of `lobes run`,

@@ -236,7 +236,7 @@ fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
 fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let dir = scratch("bad");
     let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
-    let cases: [(&str, &[&str]); 20] = [
+    let cases: [(&str, &[&str]); 21] = [
         // a resource's or package's error names its scene key, not lobes check's flag
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", package = { super = \"lib\" } }\n", &["bad.toml:6:", "sampler.package 'super': a package name is an identifier"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", filter = { s = \"bilinear\" } }\n", &["bad.toml:6:", "sampler.filter 's=bilinear': the filter 'bilinear' is unknown"]),
@@ -245,6 +245,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", shader_root = [\"no_such_dir\"] }\n", &["bad.toml:6:", "sampler.shader_root: ", "no_such_dir is not a folder"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", define = { \"TWO WORDS\" = true } }\n", &["bad.toml:6:", "sampler.define: 'TWO WORDS' is no shader def"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", rand_order = \"x,y\" }\n", &["bad.toml:6:", "sampler.rand_order: an order for the draws of the named random functions"]),
+        ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"vec3<f32>(ggx_pdf(wi, d, params))\" }\n", &["bad.toml:6:", "sampler.pdf: 'vec3<f32>(ggx_pdf(wi, d, params))' returns vec3<f32>; expected f32"]),
         ("sampler = \"ggx.wgsl\"\n", &["bad.toml:6:", "expected a sampler table { wgsl = [\"file.wgsl\"]"]),
         ("sampler = { wgsl = [\"missing.wgsl\"], sample = \"s\", pdf = \"p\" }\n", &["bad.toml:6:", "missing.wgsl", "cannot read"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"nope\" }\n", &["bad.toml:6:", "no pdf function `nope`", "expected `fn nope(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"]),
@@ -270,7 +271,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
             assert!(stderr.contains(w), "{lines}: want {w:?} in: {stderr}");
         }
         assert!(!out_dir.join("mine").exists(), "{lines}: a case ran");
-        assert!(!["--sampler", "--texture", "--package", "--shader-root", "--define", "--rand"].iter().any(|f| stderr.contains(f)), "{lines}: a scene's error names a flag: {stderr}");
+        assert!(!["--sampler", "--texture", "--package", "--shader-root", "--define", "--rand", "--sample", "--pdf", "--eval"].iter().any(|f| stderr.contains(f)), "{lines}: a scene's error names a flag: {stderr}");
     }
     // A user's sampler needs the GPU, and runs whole: --cpu and --shard refuse it.
     let scene = bad_scene(&dir, good);

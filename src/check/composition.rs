@@ -181,6 +181,39 @@ pub(super) fn check_package(name: &str, given: &[(String, PathBuf)]) -> Result<(
     Ok(())
 }
 
+/// A call expression of a sampler: which of its functions it stands for, and so the names it
+/// is written over (`wi` and `u` for the sample, `d` for the densities, `p` for a light's normal).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Call {
+    Sample,
+    Pdf,
+    Eval,
+    Normal,
+}
+
+impl Call {
+    /// The setting that gives it (the command line names its flag, a scene its key).
+    pub fn setting(self) -> Setting {
+        match self {
+            Call::Sample => Setting::Sample,
+            Call::Pdf => Setting::Pdf,
+            Call::Eval => Setting::Eval,
+            Call::Normal => Setting::Normal,
+        }
+    }
+
+    /// The error `why` of its expression `expr`, keyed by its setting.
+    pub fn error(self, expr: &str, why: impl std::fmt::Display) -> CheckError {
+        CheckError::Setting { setting: self.setting(), message: format!("'{expr}': {why}") }
+    }
+
+    /// The error of its expression `expr` whose value has the wrong type: `'{expr}' returns
+    /// {what}`, keyed by its setting.
+    pub fn returns(self, expr: &str, what: impl std::fmt::Display) -> CheckError {
+        CheckError::Setting { setting: self.setting(), message: format!("'{expr}' returns {what}") }
+    }
+}
+
 /// What a sample expression's result means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum SampleReturns {

@@ -117,6 +117,10 @@ pub enum Setting {
     Stub,
     Package,
     RandOrder,
+    Sample,
+    Pdf,
+    Eval,
+    Normal,
 }
 
 impl Setting {
@@ -135,6 +139,10 @@ impl Setting {
             Setting::Stub => "stub",
             Setting::Package => "package",
             Setting::RandOrder => "rand_order",
+            Setting::Sample => "sample",
+            Setting::Pdf => "pdf",
+            Setting::Eval => "eval",
+            Setting::Normal => "normal",
         }
     }
 }

@@ -10,7 +10,7 @@
 
 use super::CheckError;
 use super::compose::Source;
-use super::composition::{Composition, Dialect, UserCode};
+use super::composition::{Call, Composition, Dialect, UserCode};
 use super::dialect::roots::{roots, scan, show_roots};
 use super::dialect::sniff;
 use super::dialect::stage::Stage;
@@ -19,13 +19,13 @@ use std::path::PathBuf;
 pub use super::dialect::stage::composing;
 
 impl UserCode {
-    /// `expr` (a call expression of --sample, --pdf or --eval) with each name as the user's
+    /// `expr` (the sample's, pdf's or eval's call expression, `call`) with each name as the user's
     /// files name it (WESL's `ggx::pdf` or `package::sampling::ggx::pdf`, naga_oil's `ggx::pdf`
     /// or an `#import … as` alias's `alias::pdf`, a GLSL function WGSL cannot spell) replaced by
     /// that item's name in the composed text, as the dialect's front end reads it. A name no
     /// imported module holds is an error naming the imported items.
-    pub fn resolve_qualified(&self, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
-        self.dialect.front_end().call(self, flag, expr, root_text)
+    pub fn resolve_qualified(&self, call: Call, expr: &str, root_text: &str) -> Result<String, CheckError> {
+        self.dialect.front_end().call(self, call, expr, root_text)
     }
 }
 

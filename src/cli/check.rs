@@ -222,6 +222,10 @@ pub(super) fn flag(setting: Setting) -> &'static str {
         Setting::Stub => "stub",
         Setting::Package => "package",
         Setting::RandOrder => "rand-order",
+        Setting::Sample => "sample",
+        Setting::Pdf => "pdf",
+        Setting::Eval => "eval",
+        Setting::Normal => "normal",
     }
 }
 

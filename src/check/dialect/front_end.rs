@@ -3,7 +3,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::{Composition, UserCode};
+use super::super::composition::{Call, Composition, UserCode};
 
 /// One dialect's front end: how its files are told apart, composed into the WGSL that lobes'
 /// glue calls, and how a call expression (`--sample`, `--pdf`, `--eval`) names their functions.
@@ -19,5 +19,5 @@ pub(in crate::check) trait FrontEnd: Sync {
     /// `expr` with each name as the user's files name it (`ggx::pdf`, an import's alias, a GLSL
     /// function WGSL cannot spell) replaced by its name in `code`'s composed text; `root_text` is
     /// the sampler's file.
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError>;
+    fn call(&self, code: &UserCode, call: Call, expr: &str, root_text: &str) -> Result<String, CheckError>;
 }

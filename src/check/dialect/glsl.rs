@@ -17,7 +17,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::{Composition, Dialect, UserCode};
+use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
 use super::gl_uniforms;
 use super::translate::{Translation, fall_through, to_wgsl, translated};
@@ -33,8 +33,8 @@ impl FrontEnd for Glsl {
     fn compose(&self, sources: &[Source], c: &Composition) -> Result<UserCode, CheckError> {
         translated(Dialect::Glsl, sources, c, || translate(sources, c))
     }
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, _root_text: &str) -> Result<String, CheckError> {
-        super::translate::call(code, flag, expr)
+    fn call(&self, code: &UserCode, call: Call, expr: &str, _root_text: &str) -> Result<String, CheckError> {
+        super::translate::call(code, call, expr)
     }
 }
 
@@ -304,9 +304,9 @@ mod name_tests {
         let text = "#version 450\nfloat saturate(float x) { return clamp(x, 0.0, 1.0); }\nfloat sqr(float x) { return x * x; }\nvec3 sqr(vec3 x) { return x * x; }\n";
         let t = translate(&[Source { name: "n.glsl".into(), text: text.into() }], &Composition::default()).unwrap();
         naga::front::wgsl::parse_str(&t.text).unwrap();
-        let call = super::super::translate::call_names("--pdf", "saturate(p0) * d.z", &t.origins).unwrap();
+        let call = super::super::translate::call_names(Call::Pdf, "saturate(p0) * d.z", &t.origins).unwrap();
         assert!(call.starts_with("saturate_(") && t.text.contains("fn saturate_("), "{call}\n{}", t.text);
-        let e = super::super::translate::call_names("--pdf", "sqr(p0)", &t.origins).unwrap_err().to_string();
+        let e = super::super::translate::call_names(Call::Pdf, "sqr(p0)", &t.origins).unwrap_err().to_string();
         assert!(e.contains("`sqr` is overloaded"), "{e}");
     }
 }

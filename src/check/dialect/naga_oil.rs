@@ -5,7 +5,7 @@
 
 use super::super::CheckError;
 use super::super::compose::{Source, global_names, write_wgsl};
-use super::super::composition::{Composition, Dialect, Origin, Renamed, UserCode};
+use super::super::composition::{Call, Composition, Dialect, Origin, Renamed, UserCode};
 use super::front_end::FrontEnd;
 use super::roots::{roots, scan, show_roots, stubs};
 use super::stage::Stage;
@@ -32,13 +32,13 @@ impl FrontEnd for NagaOil {
     }
 
     /// Qualified names ([`super::qualified`]), an `#import a::b as x`'s `x` standing for `a::b`.
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
+    fn call(&self, code: &UserCode, call: Call, expr: &str, root_text: &str) -> Result<String, CheckError> {
         let aliases: Vec<(String, String)> = root_text
             .lines()
             .filter_map(|l| l.trim().strip_prefix("#import "))
             .filter_map(|l| l.split_once(" as ").map(|(m, a)| (a.trim().to_string(), m.trim().to_string())))
             .collect();
-        super::qualified::resolve(code, flag, expr, root_text, &aliases)
+        super::qualified::resolve(code, call, expr, root_text, &aliases)
     }
 }
 

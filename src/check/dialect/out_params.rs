@@ -14,6 +14,7 @@
 //! parameter calls `NAME_pointers`, the module's own, instead.
 
 use super::super::CheckError;
+use super::super::composition::Call;
 
 /// A function of the translation with pointer parameters: the name a call expression uses, the
 /// function called, and per parameter the pointee's type where it is a pointer.
@@ -93,8 +94,8 @@ fn split_top(s: &str, sep: char) -> Vec<&str> {
 }
 
 /// The rewriting of one call expression: the variables declared so far and the module's names.
-struct Rewrite<'a> {
-    flag: &'a str,
+struct Rewrite {
+    call: Call,
     signatures: Vec<Signature>,
     module: Vec<String>,
     /// `var …;` lines, in order, and the variables' (name, type).
@@ -103,7 +104,7 @@ struct Rewrite<'a> {
     copies: usize,
 }
 
-impl Rewrite<'_> {
+impl Rewrite {
     /// `expr` with each call of a function taking pointers passing them.
     fn expression(&mut self, expr: &str) -> Result<String, CheckError> {
         let mut out = String::new();
@@ -111,7 +112,7 @@ impl Rewrite<'_> {
         while let Some((at, name)) = next_call(rest, &self.signatures) {
             out.push_str(&rest[..at]);
             let open = at + name.len() + rest[at + name.len()..].find('(').unwrap_or(0);
-            let close = closing(rest, open).ok_or_else(|| CheckError::Input(format!("{} '{expr}': `{name}(` is not closed", self.flag)))?;
+            let close = closing(rest, open).ok_or_else(|| self.call.error(expr, format!("`{name}(` is not closed")))?;
             out.push_str(&self.call(&name, &rest[open + 1..close])?);
             rest = &rest[close + 1..];
         }
@@ -161,10 +162,10 @@ impl Rewrite<'_> {
     fn variable(&mut self, name: &str, ty: &str) -> Result<(), CheckError> {
         match self.variables.iter().find(|(n, _)| n == name) {
             Some((_, t)) if t == ty => Ok(()),
-            Some((_, t)) => Err(CheckError::Input(format!(
-                "{}: the variable `{name}` is passed to an out/inout parameter of type {t} and to one of type {ty}; give each its own name",
-                self.flag
-            ))),
+            Some((_, t)) => Err(CheckError::Setting {
+                setting: self.call.setting(),
+                message: format!("the variable `{name}` is passed to an out/inout parameter of type {t} and to one of type {ty}; give each its own name"),
+            }),
             None => {
                 self.variables.push((name.to_string(), ty.to_string()));
                 self.declared.push(format!("var {name}: {ty};"));
@@ -212,15 +213,15 @@ pub(crate) fn closing(s: &str, open: usize) -> Option<usize> {
     None
 }
 
-/// The call expression `expr` of `flag` over the translation `text`, with its out and inout
+/// The `call` expression `expr` over the translation `text`, with its out and inout
 /// arguments passed by pointer and the variables they name declared first: `var …; … ; EXPR`.
 /// An expression that calls no function taking pointers is returned as it is.
-pub(crate) fn rewrite(flag: &str, expr: &str, text: &str) -> Result<String, CheckError> {
+pub(crate) fn rewrite(call: Call, expr: &str, text: &str) -> Result<String, CheckError> {
     let signatures = signatures(text);
     if signatures.is_empty() || split_top(expr, ';').iter().all(|s| next_call(s, &signatures).is_none()) {
         return Ok(expr.to_string());
     }
-    let mut r = Rewrite { flag, signatures, module: module_names(text), declared: Vec::new(), variables: Vec::new(), copies: 0 };
+    let mut r = Rewrite { call, signatures, module: module_names(text), declared: Vec::new(), variables: Vec::new(), copies: 0 };
     let statements: Vec<String> = split_top(expr, ';').into_iter().map(|s| r.expression(s.trim())).collect::<Result<_, _>>()?;
     let statements: Vec<String> = statements.into_iter().filter(|s| !s.is_empty()).collect();
     Ok(r.declared.into_iter().chain(statements.iter().map(|s| format!("{s};"))).collect::<Vec<_>>().join(" ").trim_end_matches(';').to_string())
@@ -236,33 +237,33 @@ mod tests {
 
     #[test]
     fn a_named_out_argument_is_a_variable_declared_first() {
-        let e = rewrite("--sample", "vec4(sample_(wi, u.xy, pdf), pdf)", GLSL).unwrap();
+        let e = rewrite(Call::Sample, "vec4(sample_(wi, u.xy, pdf), pdf)", GLSL).unwrap();
         assert_eq!(e, "var pdf: f32; vec4(sample_(wi, u.xy, &pdf), pdf)");
         // an expression without such calls is left alone
-        assert_eq!(rewrite("--pdf", "pdf_(wi) * 2.0", GLSL).unwrap(), "pdf_(wi) * 2.0");
+        assert_eq!(rewrite(Call::Pdf, "pdf_(wi) * 2.0", GLSL).unwrap(), "pdf_(wi) * 2.0");
     }
 
     #[test]
     fn statements_and_inout_structs_and_copies() {
-        let e = rewrite("--sample", "s.a = p0; step_(s, wi); vec4(s.a)", GLSL).unwrap();
+        let e = rewrite(Call::Sample, "s.a = p0; step_(s, wi); vec4(s.a)", GLSL).unwrap();
         assert_eq!(e, "var s: State; s.a = p0; step_(&s, wi); vec4(s.a)");
         // a value at a pointer parameter goes through a copy
-        let e = rewrite("--sample", "sample_(wi, u.xy, p0 * 2.0)", GLSL).unwrap();
+        let e = rewrite(Call::Sample, "sample_(wi, u.xy, p0 * 2.0)", GLSL).unwrap();
         assert_eq!(e, "var lobes_arg0: f32 = p0 * 2.0; sample_(wi, u.xy, &lobes_arg0)");
     }
 
     #[test]
     fn spirv_wrappers_are_bypassed_only_for_variables() {
         let text = "fn f_pointers(V: ptr<function, vec3<f32>>, pdf: ptr<function, f32>) -> vec3<f32> {\n}\nfn f(V: vec3<f32>, pdf: f32) -> vec3<f32> {\n}\n";
-        assert_eq!(rewrite("--sample", "f(wi, 1.0)", text).unwrap(), "f(wi, 1.0)");
-        let e = rewrite("--sample", "vec4(f(wi, q), q)", text).unwrap();
+        assert_eq!(rewrite(Call::Sample, "f(wi, 1.0)", text).unwrap(), "f(wi, 1.0)");
+        let e = rewrite(Call::Sample, "vec4(f(wi, q), q)", text).unwrap();
         assert_eq!(e, "var lobes_arg0: vec3<f32> = wi; var q: f32; vec4(f_pointers(&lobes_arg0, &q), q)");
     }
 
     #[test]
     fn one_variable_of_two_types_is_refused() {
         let text = "fn f(a: ptr<function, f32>, b: ptr<function, vec3<f32>>) -> f32 {\n}\n";
-        let e = rewrite("--pdf", "f(x, x)", text).unwrap_err().to_string();
+        let e = rewrite(Call::Pdf, "f(x, x)", text).unwrap_err().to_string();
         assert!(e.contains("`x` is passed to an out/inout parameter of type f32 and to one of type vec3<f32>"), "{e}");
     }
 

@@ -4,7 +4,7 @@
 //! as name` alias of an item), replaced by the name the composition gave it.
 
 use super::super::CheckError;
-use super::super::composition::UserCode;
+use super::super::composition::{Call, UserCode};
 use crate::wgsl_tokens::{Kind, Token, paths, tokens, try_replace};
 
 /// `expr` (a call expression of --sample, --pdf or --eval) with each qualified name
@@ -12,21 +12,21 @@ use crate::wgsl_tokens::{Kind, Token, paths, tokens, try_replace};
 /// each name the file imports by that name ([`imported`]) likewise. A module path matches an
 /// import's full path or its last segments; `aliases` are (alias, module path). A name no
 /// imported module holds is an error naming the imported items.
-pub(super) fn resolve(code: &UserCode, flag: &str, expr: &str, root_text: &str, aliases: &[(String, String)]) -> Result<String, CheckError> {
+pub(super) fn resolve(code: &UserCode, call: Call, expr: &str, root_text: &str, aliases: &[(String, String)]) -> Result<String, CheckError> {
     let mut previous: Option<Token> = None;
     try_replace(expr, paths(expr), |t| {
         let member = previous.is_some_and(|p| p.is("."));
         previous = Some(*t);
         match t.kind {
             Kind::Ident if !member => Ok(imported(code, t.text, root_text).or_else(|| item_alias(code, t.text, aliases)).map(str::to_string)),
-            Kind::Path => qualified(code, flag, expr, &t.segments(), aliases).map(Some),
+            Kind::Path => qualified(code, call, expr, &t.segments(), aliases).map(Some),
             _ => Ok(None),
         }
     })
 }
 
 /// The composed name of the item `segments` names (`[module…, item]`).
-fn qualified(code: &UserCode, flag: &str, expr: &str, segments: &[&str], aliases: &[(String, String)]) -> Result<String, CheckError> {
+fn qualified(code: &UserCode, call: Call, expr: &str, segments: &[&str], aliases: &[(String, String)]) -> Result<String, CheckError> {
     let (item, module) = segments.split_last().expect("a path has two segments or more");
     let (path, module) = (segments.join("::"), module.join("::"));
     let module = aliases.iter().find(|(a, _)| *a == module).map_or(module.as_str(), |(_, m)| m.as_str());
@@ -35,11 +35,14 @@ fn qualified(code: &UserCode, flag: &str, expr: &str, segments: &[&str], aliases
         return Ok(name.clone());
     }
     let known: Vec<String> = code.origins.iter().map(|(_, p, it)| format!("{p}::{it}")).collect();
-    Err(CheckError::Input(format!(
-        "{flag} '{expr}': no item `{item}` of a module `{module}` among what the sampler's file imports{} (imported: {}); name an item of a module the file imports, as its import names it",
-        crate::suggest::did_you_mean(&path, known.iter().map(String::as_str)),
-        if known.is_empty() { "nothing".to_string() } else { known.join(", ") }
-    )))
+    Err(call.error(
+        expr,
+        format!(
+            "no item `{item}` of a module `{module}` among what the sampler's file imports{} (imported: {}); name an item of a module the file imports, as its import names it",
+            crate::suggest::did_you_mean(&path, known.iter().map(String::as_str)),
+            if known.is_empty() { "nothing".to_string() } else { known.join(", ") }
+        ),
+    ))
 }
 
 /// The composed name of the item an `#import a::b::item as name` names (Bevy's
@@ -76,7 +79,7 @@ mod tests {
         let code = UserCode::tree(Dialect::NagaOil, &sources, "naga_oil", String::new(), origins);
         let aliases = [("luminance".to_string(), "bevy_core_pipeline::tonemapping::tonemapping_luminance".to_string())];
         let root = "#import bevy_core_pipeline::tonemapping::tonemapping_luminance as luminance\n";
-        let out = resolve(&code, "--pdf", "1.0 - luminance(c) + s.luminance", root, &aliases).unwrap();
+        let out = resolve(&code, Call::Pdf, "1.0 - luminance(c) + s.luminance", root, &aliases).unwrap();
         assert_eq!(out, "1.0 - tonemapping_luminanceX_mod_X(c) + s.luminance");
     }
 }

@@ -6,7 +6,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::{Composition, Dialect, UserCode};
+use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
 use super::translate::{Translation, fall_through, to_wgsl, translated};
 use std::path::Path;
@@ -30,8 +30,8 @@ impl FrontEnd for Spirv {
             Ok(Translation { text: sources[0].text.clone(), origins: Vec::new(), uniforms: Vec::new() })
         })
     }
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, _root_text: &str) -> Result<String, CheckError> {
-        super::translate::call(code, flag, expr)
+    fn call(&self, code: &UserCode, call: Call, expr: &str, _root_text: &str) -> Result<String, CheckError> {
+        super::translate::call(code, call, expr)
     }
 }
 

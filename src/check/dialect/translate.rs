@@ -6,7 +6,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::{Composition, Dialect, Origin, UserCode};
+use super::super::composition::{Call, Composition, Dialect, Origin, UserCode};
 use crate::wgsl_tokens::{Kind, tokens, try_replace};
 
 /// The user's files (GLSL, or a SPIR-V module) as the one WGSL part `text` they translate to,
@@ -110,26 +110,29 @@ fn ends_in_jump(block: &naga::Block) -> bool {
 /// A call expression over a translation's functions as the user's files name them
 /// ([`call_names`]), with its out and inout arguments passed as WGSL passes them
 /// ([`super::out_params`]).
-pub(super) fn call(code: &UserCode, flag: &str, expr: &str) -> Result<String, CheckError> {
-    let named = call_names(flag, expr, &code.origins)?;
-    super::out_params::rewrite(flag, &named, &code.parts[0].text)
+pub(super) fn call(code: &UserCode, call: Call, expr: &str) -> Result<String, CheckError> {
+    let named = call_names(call, expr, &code.origins)?;
+    super::out_params::rewrite(call, &named, &code.parts[0].text)
 }
 
 /// A call expression (`--sample`, `--pdf`, `--eval`) over the functions as the user's file names
 /// them, with each name that the translation wrote differently replaced by the name written. An
 /// overloaded name is an error naming the translation's names of its overloads.
-pub(super) fn call_names(flag: &str, expr: &str, origins: &[Origin]) -> Result<String, CheckError> {
+pub(super) fn call_names(call: Call, expr: &str, origins: &[Origin]) -> Result<String, CheckError> {
     try_replace(expr, tokens(expr).filter(|t| t.kind == Kind::Ident), |t| {
         let word = t.text;
         let written: Vec<&str> = origins.iter().filter(|o| o.2 == word).map(|o| o.0.as_str()).collect();
         match written[..] {
             [] => Ok(None),
             [w] => Ok(Some(w.to_string())),
-            _ => Err(CheckError::Input(format!(
-                "{flag} '{expr}': `{word}` is overloaded in {}; in the translation its overloads are {} (in the order declared): call the one you mean by that name",
-                origins.iter().find(|o| o.2 == word).map_or("", |o| o.1.as_str()),
-                written.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ")
-            ))),
+            _ => Err(call.error(
+                expr,
+                format!(
+                    "`{word}` is overloaded in {}; in the translation its overloads are {} (in the order declared): call the one you mean by that name",
+                    origins.iter().find(|o| o.2 == word).map_or("", |o| o.1.as_str()),
+                    written.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ")
+                ),
+            )),
         }
     })
 }
@@ -153,8 +156,8 @@ mod tests {
             ("rnd".to_string(), "a.glsl".to_string(), "rnd".to_string()),
             ("rnd_1".to_string(), "a.glsl".to_string(), "rnd".to_string()),
         ];
-        assert_eq!(call_names("--pdf", "saturate(d.z) * p0 + saturated", &origins).unwrap(), "saturate_(d.z) * p0 + saturated");
-        let e = call_names("--sample", "f(wi, rnd(u.x))", &origins).unwrap_err().to_string();
+        assert_eq!(call_names(Call::Pdf, "saturate(d.z) * p0 + saturated", &origins).unwrap(), "saturate_(d.z) * p0 + saturated");
+        let e = call_names(Call::Sample, "f(wi, rnd(u.x))", &origins).unwrap_err().to_string();
         assert!(e.contains("`rnd` is overloaded in a.glsl") && e.contains("`rnd`, `rnd_1`"), "{e}");
     }
 

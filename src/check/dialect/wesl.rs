@@ -6,7 +6,7 @@
 
 use super::super::CheckError;
 use super::super::compose::{DeclOrigin, Source};
-use super::super::composition::{Composition, Dialect, Origin, UserCode};
+use super::super::composition::{Call, Composition, Dialect, Origin, UserCode};
 use super::front_end::FrontEnd;
 use super::naga_oil::foreign_directives;
 #[cfg(feature = "wesl")]
@@ -41,8 +41,8 @@ impl FrontEnd for Wesl {
     }
 
     /// Qualified names ([`super::qualified`]): WESL has no import aliases lobes reads.
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, root_text: &str) -> Result<String, CheckError> {
-        super::qualified::resolve(code, flag, expr, root_text, &[])
+    fn call(&self, code: &UserCode, call: Call, expr: &str, root_text: &str) -> Result<String, CheckError> {
+        super::qualified::resolve(code, call, expr, root_text, &[])
     }
 }
 

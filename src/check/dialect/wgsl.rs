@@ -3,7 +3,7 @@
 
 use super::super::CheckError;
 use super::super::compose::Source;
-use super::super::composition::{Composition, Dialect, UserCode};
+use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
 use super::naga_oil::{NagaOil, foreign_directives};
 
@@ -29,13 +29,10 @@ impl FrontEnd for Wgsl {
     }
 
     /// The expression as it is: plain files import nothing, so a qualified name is an error.
-    fn call(&self, code: &UserCode, flag: &str, expr: &str, _root_text: &str) -> Result<String, CheckError> {
+    fn call(&self, code: &UserCode, call: Call, expr: &str, _root_text: &str) -> Result<String, CheckError> {
         if !expr.contains("::") {
             return Ok(expr.to_string());
         }
-        Err(CheckError::Input(format!(
-            "{flag} '{expr}': a qualified name (module::function) needs imports, and {} import nothing; name the function as it is declared",
-            code.files.join(", ")
-        )))
+        Err(call.error(expr, format!("a qualified name (module::function) needs imports, and {} import nothing; name the function as it is declared", code.files.join(", "))))
     }
 }
