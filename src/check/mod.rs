@@ -102,7 +102,9 @@ impl CheckError {
     }
 }
 
-/// A field of [`Settings`] or of a sampler's [`Composition`], as errors name it.
+/// A field of [`Settings`], of a sampler's [`Composition`] or one of its call expressions
+/// ([`composition::Call`]), as errors name it: the command line by its flag, a scene by its key
+/// ([`Setting::key`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Setting {
     Params,
