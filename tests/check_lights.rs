@@ -73,8 +73,8 @@ fn an_area_density_reported_as_solid_angle_fails() {
 #[test]
 fn the_flags_of_an_area_light_come_together() {
     let cases: [(&[&str], &str); 4] = [
-        (&["--measure", "area"], "--measure area needs --normal"),
-        (&["--normal", DOWN], "--normal: only with --measure area"),
+        (&["--measure", "area"], "--normal: needed with the area measure"),
+        (&["--normal", DOWN], "--normal: only with the area measure"),
         (&["--measure", "area", "--normal", "p0"], "--normal: 'p0' returns f32; expected vec3<f32>"),
         (&["--measure", "area", "--normal", DOWN, "--domain", "plane", "--bounds", "0,0,1,1"], "--measure area: only with --domain sphere"),
     ];

@@ -246,8 +246,14 @@ impl UserSampler {
     fn light_measure(&self) -> Result<(), CheckError> {
         let area = self.conventions.measure == conventions::Measure::Area;
         match (area, &self.composition.normal) {
-            (true, None) => Err(CheckError::Input("--measure area needs --normal EXPR: the light's unit normal at the sampled point p (WGSL over p and params), for the area-to-solid-angle factor |p|²/|n·d|".into())),
-            (false, Some(_)) => Err(CheckError::Input("--normal: only with --measure area (a sample that is a point of a light, with its area density); remove it".into())),
+            (true, None) => Err(CheckError::Setting {
+                setting: Setting::Normal,
+                message: "needed with the area measure (a sample that is a point of a light): the light's unit normal at the sampled point p, WGSL over p and params, for the area-to-solid-angle factor |p|²/|n·d|".into(),
+            }),
+            (false, Some(_)) => Err(CheckError::Setting {
+                setting: Setting::Normal,
+                message: "only with the area measure (a sample that is a point of a light, with its area density); remove it".into(),
+            }),
             (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => {
                 Err(CheckError::Input("--measure area with --sample-returns half-vector: a light's point is not a half vector; keep one".into()))
             }
