@@ -296,8 +296,12 @@ fn two_runs_into_one_folder() {
 fn a_second_signal_writes_the_summary() {
     let dir = scratch("second-signal");
     let names: Vec<String> = (0..6).map(|i| format!("c{i}")).collect();
-    scene(&dir, "s.toml", &names.iter().map(String::as_str).collect::<Vec<_>>(), 3_000_000);
+    // cases of about 3 s on CPU (30·10⁶ samples; 0.3 s for 3·10⁶ at CI), both signals half a
+    // second into the second: a first signal that landed between two cases (writing the first
+    // case's outputs) would stop the run there, leaving nothing in flight for the second to stop
+    scene(&dir, "s.toml", &names.iter().map(String::as_str).collect::<Vec<_>>(), 30_000_000);
     let child = started(&dir, &["run", "--cpu", "s.toml", "--out", "out"]);
+    std::thread::sleep(std::time::Duration::from_millis(500));
     signal(&child, "INT");
     std::thread::sleep(std::time::Duration::from_millis(100));
     signal(&child, "INT");
