@@ -216,12 +216,14 @@ fn broken_input_is_reported_at_the_users_file() {
     assert!(e.to_string().starts_with(&format!("{}:4:1: the pdf function `p` has the wrong signature", wrong.display())), "{e}");
     assert!(e.to_string().contains("expected `fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`"), "{e}");
 
-    // a `lobes_` name is lobes' own; the RNG's `pcg4d` is the user's to use (lobes' is
-    // `lobes_pcg4d` in a check's composition)
+    // a `lobes_` name is lobes' own; the names lobes' files declare (the RNG's `pcg4d`, the
+    // binning's `Real`, `PI` and `math_atan2`) are the user's to use (lobes' are `lobes_pcg4d`, …
+    // in a check's composition)
     let clash = temp_wgsl("clash.wgsl", &format!("{GOOD_SAMPLE}fn lobes_pcg4d(x: f32) -> f32 {{ return x; }}\nfn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{ return 1.0; }}\n"));
     let e = UserSampler::from_files(&[clash], "s", "p", None, Domain::Sphere).unwrap_err();
     assert!(e.to_string().contains("`lobes_pcg4d` is lobes' own"), "{e}");
-    let own = temp_wgsl("own-pcg4d.wgsl", &format!("{GOOD_SAMPLE}fn pcg4d(x: f32) -> f32 {{ return x; }}\nfn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{ return pcg4d(0.25) / 3.14159265; }}\n"));
+    let names = "fn pcg4d(x: f32) -> f32 { return x; }\nalias Real = i32;\nconst PI: Real = 3;\nfn math_atan2(x: Real) -> Real { return x; }\n";
+    let own = temp_wgsl("own-pcg4d.wgsl", &format!("{GOOD_SAMPLE}{names}fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{ return pcg4d(0.25) * f32(math_atan2(PI)) / 9.424778; }}\n"));
     UserSampler::from_files(&[own], "s", "p", None, Domain::Sphere).unwrap();
 }
 

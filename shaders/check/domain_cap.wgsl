@@ -1,6 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::params::lobes_params
-#import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
+#import lobes::bins::{lobes_sphere_column, lobes_quadrant_direction}
 
 // A spherical cap fitted around a small support as the domain of `lobes check`'s passes
 // (src/stats/domain.rs, Domain::Cap: the CPU twin of each function here; domain_sphere.wgsl says
@@ -50,7 +50,7 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     let row = min(u32(a / height * f32(lobes_params.rows)), lobes_params.rows - 1u);
     let x = dot(p, f[0]);
     let y = dot(p, f[1]);
-    let col = lobes_phi_column(x, y, lobes_params.cols);
+    let col = lobes_sphere_column(x, y, lobes_params.cols);
     return row * lobes_params.cols + col;
 }
 

@@ -1,6 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::params::lobes_params
-#import lobes::bins::{lobes_half_by_sign, lobes_phi_column, lobes_quadrant_direction}
+#import lobes::bins::{lobes_half_by_sign, lobes_sphere_column, lobes_quadrant_direction}
 
 // The texels of a latitude–longitude map as the domain of `lobes check`'s passes
 // (src/stats/domain.rs, Domain::LatLong: the CPU twin of each function here;
@@ -31,7 +31,7 @@ fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     let theta = atan2(length(p.xy), p.z);
     let row_t = min(u32(max(theta, 0.0) * (1.0 / 3.14159265358979) * f32(rows)), rows - 1u);
     let row = lobes_half_by_sign(row_t, rows, p.z >= 0.0);
-    let col = lobes_phi_column(p.x, p.y, lobes_params.cols);
+    let col = lobes_sphere_column(p.x, p.y, lobes_params.cols);
     return row * lobes_params.cols + col;
 }
 

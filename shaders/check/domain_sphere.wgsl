@@ -1,6 +1,6 @@
 #define_import_path lobes::domain
 #import lobes::params::lobes_params
-#import lobes::bins::{lobes_phi_column, lobes_quadrant_direction}
+#import lobes::bins::{lobes_sphere_cell, lobes_quadrant_direction}
 
 // The sphere as the domain of `lobes check`'s passes (src/stats/domain.rs, Domain::Sphere: the
 // CPU twin of each function here). The plane's twin is domain_plane.wgsl; the host composes the
@@ -18,17 +18,12 @@ fn lobes_domain_coordinates(p: vec3<f32>) -> vec3<f32> {
 }
 
 // The bin of a finite sample point, or LOBES_DOMAIN_OUTSIDE where it is not a unit direction
-// (within 10⁻³): rows uniform in cos θ over [−1, 1], columns in φ over [−π, π), φ = π wrapping
-// to column 0, the column exact on the axes' edges (shaders/lib/bins.wgsl), as lobes bins its
-// own lobes (shaders/lib/histogram.wgsl's bin_of, src/stats/histogram.rs).
+// (within 10⁻³): the sphere's grid (shaders/lib/bins.wgsl), as lobes bins its own lobes.
 fn lobes_domain_cell(p: vec3<f32>) -> u32 {
     if (abs(length(p) - 1.0) > 1e-3) {
         return LOBES_DOMAIN_OUTSIDE;
     }
-    let z = clamp(p.z, -1.0, 1.0);
-    let row = min(u32((z + 1.0) * 0.5 * f32(lobes_params.rows)), lobes_params.rows - 1u);
-    let col = lobes_phi_column(p.x, p.y, lobes_params.cols);
-    return row * lobes_params.cols + col;
+    return lobes_sphere_cell(p, lobes_params.rows, lobes_params.cols);
 }
 
 // What lobes_domain_cell returns for a point outside the domain.

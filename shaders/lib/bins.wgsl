@@ -1,10 +1,29 @@
 #define_import_path lobes::bins
+#import lobes::math::{Real, math_atan2}
+#import lobes::reflect::PI
 
-// The column of a direction on a sphere grid, where the column ⌊t · cols⌋ with t = (φ + π)/2π
-// rounds: shared by the engine's binning (shaders/lib/histogram.wgsl, over Real) and by
-// `lobes check`'s (shaders/check/user_passes.wgsl, f32). CPU twin: SphereGrid::bin_of
-// (src/stats/histogram.rs). Its names start with `lobes_`, which `lobes check` keeps from users'
-// files (src/check/gpu.rs: reserved), since it composes this module with them.
+// The cells of the sphere's grids, one binning for the engine's kernels (shaders/lib/histogram.wgsl,
+// over Real, so that the f64 kernels bin in f64) and for `lobes check`'s domains
+// (shaders/check/domain_*.wgsl, Real = f32). CPU twin: SphereGrid (src/stats/histogram.rs).
+
+// Equal-solid-angle bins: rows uniform in cos θ over [−1, 1] (cos θ = 1 in the top row),
+// columns uniform in φ over [−π, π) (lobes_sphere_column). CPU twin: SphereGrid::bin_of.
+fn lobes_sphere_cell(w: vec3<Real>, rows: u32, cols: u32) -> u32 {
+    let z = clamp(w.z, -1.0, 1.0);
+    let row = min(u32((z + 1.0) * 0.5 * Real(rows)), rows - 1u);
+    return row * cols + lobes_sphere_column(w.x, w.y, cols);
+}
+
+// The column of a direction whose components across the grid's axis are (x, y): ⌊t · cols⌋ with
+// t = (φ + π)/2π, φ = atan2(y, x), made exact on the axes' edges (lobes_axis_column). At a pole
+// (x = y = 0) φ is undefined (atan2 of two zeros differs between implementations): 0 there.
+// CPU twin: SphereGrid::column_of.
+fn lobes_sphere_column(x: Real, y: Real, cols: u32) -> u32 {
+    let pole = x == 0.0 && y == 0.0;
+    let t = select((math_atan2(y, x) + PI) * (1.0 / (2.0 * PI)), 0.5, pole);
+    // the signs, not f32(x) and f32(y), which an f64 kernel's tiny values would round to 0
+    return lobes_axis_column(u32(max(t, 0.0) * Real(cols)), cols, f32(sign(x)), f32(sign(y)));
+}
 
 // The column t gives is within one of the exact one, but not exact: t rounds, and a value within
 // half an ulp of t below a column's edge rounds onto it (at φ = π − 10⁻⁷ in f32, t = 1: column
@@ -14,8 +33,7 @@
 // lobe narrower than an ulp of t on an axis edge (φi = 0 at grazing incidence: 2 α cos θi wide)
 // is split as the directions are, not by the rounding (docs/statistics.md, "Binning at the
 // axes"). `col_t` is ⌊t · cols⌋ before any wrap (cols itself at t = 1 wraps to 0); only the signs
-// of x and y are read (a caller in f64 passes f32(sign(x)), f32(sign(y))); x = y = 0 is a pole,
-// whose φ the callers take as 0 (t = 1/2).
+// of x and y are read; x = y = 0 is a pole, whose φ lobes_sphere_column takes as 0 (t = 1/2).
 fn lobes_axis_column(col_t: u32, cols: u32, x: f32, y: f32) -> u32 {
     let wrapped = select(col_t, 0u, col_t >= cols);
     if ((x == 0.0 && y == 0.0) || cols < 2u) {
@@ -71,15 +89,4 @@ fn lobes_quadrant_direction(a: f32, b: f32, h: f32, k: u32) -> vec3<f32> {
     t = select(t, -e, k == 2u);
     t = select(t, vec2<f32>(e.y, -e.x), k == 3u);
     return vec3<f32>(s * t.x, s * t.y, h * (1.0 - a));
-}
-
-// The column of a direction whose components across the grid's axis are (x, y): ⌊(φ + π)/2π ·
-// cols⌋ with φ = atan2(y, x), φ = 0 at x = y = 0 (a pole), made exact on the axes' edges.
-// CPU twin: SphereGrid::column_of (src/stats/histogram.rs).
-fn lobes_phi_column(x: f32, y: f32, cols: u32) -> u32 {
-    var t = 0.5;
-    if (x != 0.0 || y != 0.0) {
-        t = (atan2(y, x) + 3.14159265358979) * (0.5 / 3.14159265358979);
-    }
-    return lobes_axis_column(u32(max(t, 0.0) * f32(cols)), cols, x, y);
 }

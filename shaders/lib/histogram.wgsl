@@ -1,8 +1,7 @@
 #define_import_path lobes::histogram
 #import lobes::job::{ROWS, COLS, REASON_NON_FINITE_POINT, REASON_OUTSIDE_DOMAIN, REASON_NON_FINITE_PDF, REASON_ZERO_PDF, REASON_REFRACTED_NEAR_SIDE}
-#import lobes::math::{Real, math_atan2, math_is_finite}
-#import lobes::reflect::PI
-#import lobes::bins::lobes_axis_column
+#import lobes::math::{Real, math_is_finite}
+#import lobes::bins::lobes_sphere_cell
 
 // Binning and exact counting; CPU twin: src/stats/histogram.rs. ROWS and COLS are the job's
 // grid and REASON_* the codes of src/reference/invalid.rs, from the generated `lobes::job`.
@@ -34,16 +33,8 @@ fn classify_scattered(wi: vec3<Real>, wo: vec3<Real>, pdf: Real, reflected: bool
     return select(reason, REASON_NON_FINITE_POINT, !finite);
 }
 
-// Equal-solid-angle bins: rows uniform in cos th over [-1, 1], columns uniform in phi over
-// [-pi, pi); phi = pi wraps to column 0, cos th = 1 falls in the top row. The column t gives is
-// made exact on the axes' edges by lobes_axis_column (shaders/lib/bins.wgsl), which `lobes
-// check` bins with too. CPU twin: SphereGrid::bin_of.
+// The bin of direction w on the job's sphere grid (shaders/lib/bins.wgsl, which `lobes check`
+// bins with too). CPU twin: SphereGrid::bin_of.
 fn bin_of(w: vec3<Real>) -> u32 {
-    let z = clamp(w.z, -1.0, 1.0);
-    let row = min(u32((z + 1.0) * 0.5 * Real(ROWS)), ROWS - 1u);
-    // At the poles phi is undefined (atan2 of two zeros differs between implementations): use 0.
-    let pole = w.x == 0.0 && w.y == 0.0;
-    let t = select((math_atan2(w.y, w.x) + PI) * (1.0 / (2.0 * PI)), 0.5, pole);
-    // the signs, not f32(w.x) and f32(w.y), which an f64 kernel's tiny values would round to 0
-    return row * COLS + lobes_axis_column(u32(max(t, 0.0) * Real(COLS)), COLS, f32(sign(w.x)), f32(sign(w.y)));
+    return lobes_sphere_cell(w, ROWS, COLS);
 }

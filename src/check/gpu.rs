@@ -640,15 +640,17 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
         Err(GpuError::Shader { what, .. }) if what == USER_MODULE => {}
         other => other?,
     }
+    let pieces = library::pieces(&["lobes::check"], &chosen)?;
+    let own = lobes_own_names(&pieces);
     let mut c = Composed::default();
-    for (path, text) in library::pieces(&["lobes::check"], &chosen)? {
+    for (path, text) in &pieces {
         if path == USER_MODULE {
             for s in &parts {
                 c.push(&s.name, &s.text);
             }
             c.push(USER_MODULE, &glue);
         } else {
-            c.push(&path, &lobes_own_names(&text));
+            c.push(path, &crate::embed::rename(text, |t| own.contains(&t).then(|| format!("lobes_{t}"))));
         }
     }
     let declared = move_resources(&mut c)?;
@@ -736,17 +738,19 @@ fn resource_kind(g: &naga::GlobalVariable, inner: &naga::TypeInner) -> &'static 
 }
 
 /// Whether the user's files may not use `name` at module scope: the `lobes_`/`LOBES_`/`Lobes`
-/// prefix of the passes (and of lobes' RNG in them, [`lobes_own_names`]).
+/// prefix of the passes and of every name of lobes' own files in a composition
+/// ([`lobes_own_names`]).
 pub(super) fn reserved(name: &str) -> bool {
     name.starts_with("lobes_") || name.starts_with("LOBES_") || name.starts_with("Lobes")
 }
 
-/// A file of lobes' own (the RNG, the passes) with the RNG's functions named `lobes_…`: the
-/// library exports them as `pcg4d`, `rng_uniforms`, … (`lobes wgsl`), names a renderer's own
-/// files hold too (GLSL-PathTracer's RNG is a `pcg4d`), and a composed check holds both.
-fn lobes_own_names(text: &str) -> String {
-    const RNG_NAMES: [&str; 4] = ["pcg4d", "rng_to_unit", "rng_uniforms", "add64"];
-    RNG_NAMES.iter().fold(text.to_string(), |t, name| super::compose::replace_word(&t, name, &format!("lobes_{name}")))
+/// The names lobes' own files (the passes, the RNG, the binning and what it imports) declare at
+/// module scope without a reserved prefix, which the composition renames to `lobes_…` (an
+/// α-renaming): a renderer's files hold `PI`, `Real` or `pcg4d` too (GLSL-PathTracer's RNG is a
+/// `pcg4d`), and a composed check holds both.
+fn lobes_own_names(pieces: &[(String, String)]) -> Vec<&str> {
+    let own = pieces.iter().filter(|(path, _)| path != USER_MODULE);
+    own.flat_map(|(_, text)| crate::embed::declared(text)).filter(|n| !reserved(n)).collect()
 }
 
 impl Drop for Passes<'_> {

@@ -75,6 +75,8 @@ mod text;
 pub use discrete::DiscreteBuffers;
 pub use discrete::{BLOCK, DISCRETE_INFO_WGSL, DiscreteBindings, DiscreteInfo, DiscreteTable};
 pub use namespace::prefixed;
+pub(crate) use namespace::rename;
+pub(crate) use text::declared;
 
 /// The texts, names and dependencies `build.rs` generates from `shaders/`, indexed by
 /// `Module as usize`.
