@@ -291,6 +291,31 @@ fn composition_settings_are_refused_naming_their_flag() {
     bad_input(&check(&["--rand-order", "x,y"]), &["--rand-order: an order for the draws of the named random functions"]);
 }
 
+/// Conventions that do not fit the domain or the incidence are refused naming their flag, where
+/// the library keys them by setting (Conventions::validate, check_incident): a plane's points have
+/// no normal, a sampler declared for light from above gets no θ past 90°, a half vector is
+/// neither a plane's point nor a light's.
+#[test]
+fn conventions_that_do_not_fit_are_refused_naming_their_flag() {
+    let dir = scratch("conventions-settings");
+    let file = plain(&dir);
+    let check = |extra: &str| {
+        let mut args = vec!["check", file.to_str().unwrap(), "--sample", "s(wi, u)", "--pdf", "p(d)"];
+        args.extend(extra.split(' '));
+        lobes(&args)
+    };
+    let plane = "--domain plane --bounds 0,0,1,1";
+    let directions = "only for directions (a point of the plane has no normal)";
+    bad_input(&check(&format!("{plane} --reflection-only")), &[&format!("--reflection-only: {directions}")]);
+    bad_input(&check(&format!("{plane} --incident upper")), &[&format!("--incident: {directions}")]);
+    bad_input(&check(&format!("{plane} --measure projected")), &[&format!("--measure: {directions}")]);
+    bad_input(&check(&format!("{plane} --frame y-up")), &[&format!("--frame: {directions}")]);
+    bad_input(&check(&format!("{plane} --sample-returns half-vector")), &["--sample-returns: a half vector reflects wi into a direction"]);
+    bad_input(&check("--measure area --normal vec3(0.0,0.0,1.0) --sample-returns half-vector"), &["--sample-returns: a half vector is not a light's point"]);
+    bad_input(&check("--incident upper --incident-theta 95"), &["--incident-theta: 95° is not above the surface, and the sampler is declared for upper incidence"]);
+    bad_input(&check("--reflection-only --incident-theta 90"), &["--incident-theta: 90° is not above the surface, and the sampler is declared reflection-only"]);
+}
+
 /// Item 16: `--budget 1e-300` is refused with a short message (no 300 zeros).
 #[test]
 fn a_tiny_budget_gets_a_short_message() {

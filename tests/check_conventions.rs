@@ -5,7 +5,7 @@
 
 use lobes::check::hard::HardRow;
 use lobes::check::report::{Chi2Figures, PdfValuesFigures};
-use lobes::check::{Conventions, Domain, Frame, Incident, Measure, Report, Settings, Source, UserSampler, check};
+use lobes::check::{CheckError, Conventions, Domain, Frame, Incident, Measure, Report, Setting, Settings, Source, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 use std::path::PathBuf;
 
@@ -79,9 +79,10 @@ fn incident_upper() {
     let r = run(&sampler("upper.wgsl", text, "upper_broken_sample", "upper_broken_pdf", None, UPPER), &settings);
     assert!(!r.get("jacobian").unwrap().passed && !r.get("chi2").unwrap().passed);
 
-    // an incident direction from below is refused, before any GPU work, naming the flag
+    // an incident direction from below is refused, before any GPU work, keyed by its setting
     let e = check(&gpu(), &sampler("upper.wgsl", text, "upper_sample", "upper_pdf", None, UPPER), &Settings { incident_theta: 120.0, ..settings }).unwrap_err();
-    assert!(e.is_input() && e.to_string().starts_with("--incident-theta: 120°") && e.to_string().contains("--incident upper"), "{e}");
+    assert!(matches!(e, CheckError::Setting { setting: Setting::IncidentTheta, .. }), "{e}");
+    assert!(e.is_input() && e.to_string().starts_with("incident_theta: 120°") && e.to_string().contains("declared for upper incidence"), "{e}");
 }
 
 /// A sampler of the whole sphere whose pdf formula holds only above the horizon (NaN below, as
@@ -233,8 +234,8 @@ fn convention_flags() {
         (vec!["--measure", "volume"], "projected"),
         (vec!["--frame", "x-up"], "y-up"),
         (vec!["--incident", "upper", "--incident-theta", "135"], "--incident-theta"),
-        (vec!["--reflection-only", "--incident-theta", "90"], "--reflection-only"),
-        (vec!["--domain", "plane", "--bounds", "0,0,1,1", "--frame", "y-up"], "--frame y-up"),
+        (vec!["--reflection-only", "--incident-theta", "90"], "declared reflection-only"),
+        (vec!["--domain", "plane", "--bounds", "0,0,1,1", "--frame", "y-up"], "--frame: only for directions"),
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_lobes"))
             .arg("check")

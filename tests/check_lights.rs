@@ -76,7 +76,7 @@ fn the_flags_of_an_area_light_come_together() {
         (&["--measure", "area"], "--normal: needed with the area measure"),
         (&["--normal", DOWN], "--normal: only with the area measure"),
         (&["--measure", "area", "--normal", "p0"], "--normal: 'p0' returns f32; expected vec3<f32>"),
-        (&["--measure", "area", "--normal", DOWN, "--domain", "plane", "--bounds", "0,0,1,1"], "--measure area: only with --domain sphere"),
+        (&["--measure", "area", "--normal", DOWN, "--domain", "plane", "--bounds", "0,0,1,1"], "--measure: only for directions"),
     ];
     for (extra, message) in cases {
         let out = check("rect_sample", "rect_pdf", extra);

@@ -236,7 +236,14 @@ fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
 fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     let dir = scratch("bad");
     let good = "sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\n";
-    let cases: [(&str, &[&str]); 21] = [
+    let conventions = |c: &str| format!("sampler = {{ wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", {c} }}\n");
+    let plane = "domain = \"plane\"\nbounds = [0, 0, 1, 1]\n";
+    let cases: [(&str, &[&str]); 25] = [
+        // so do the conventions, keyed in the sampler table, and the incidence they allow
+        (&format!("{}{plane}", conventions("measure = \"projected\"")), &["bad.toml:6:", "sampler.measure: only for directions (a point of the plane has no normal)"]),
+        (&format!("{}{plane}", conventions("frame = \"y-up\"")), &["bad.toml:6:", "sampler.frame: only for directions"]),
+        (&format!("{}{plane}", conventions("sample_returns = \"half-vector\"")), &["bad.toml:6:", "sampler.sample_returns: a half vector reflects wi into a direction"]),
+        (&format!("{}incident_theta = [30, 95]\n", conventions("reflection_only = true")), &["bad.toml:7:", "incident_theta: 95° is not above the surface, and the sampler is declared reflection-only"]),
         // a resource's or package's error names its scene key, not lobes check's flag
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", package = { super = \"lib\" } }\n", &["bad.toml:6:", "sampler.package 'super': a package name is an identifier"]),
         ("sampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\", filter = { s = \"bilinear\" } }\n", &["bad.toml:6:", "sampler.filter 's=bilinear': the filter 'bilinear' is unknown"]),
@@ -271,7 +278,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
             assert!(stderr.contains(w), "{lines}: want {w:?} in: {stderr}");
         }
         assert!(!out_dir.join("mine").exists(), "{lines}: a case ran");
-        assert!(!["--sampler", "--texture", "--package", "--shader-root", "--define", "--rand", "--sample", "--pdf", "--eval"].iter().any(|f| stderr.contains(f)), "{lines}: a scene's error names a flag: {stderr}");
+        assert!(!["--sampler", "--texture", "--package", "--shader-root", "--define", "--rand", "--sample", "--pdf", "--eval", "--measure", "--frame", "--incident", "--reflection-only", "--domain", "--bounds"].iter().any(|f| stderr.contains(f)), "{lines}: a scene's error names a flag: {stderr}");
     }
     // A user's sampler needs the GPU, and runs whole: --cpu and --shard refuse it.
     let scene = bad_scene(&dir, good);

@@ -11,7 +11,7 @@
 //! rejections. The host half here keeps the hard cases, the incident directions and the grid of
 //! u values within what the sampler is declared for.
 
-use super::CheckError;
+use super::{CheckError, Setting};
 use serde::{Deserialize, Serialize};
 
 /// Where the incident light of the sampler may come from.
@@ -118,29 +118,28 @@ impl Conventions {
         *self == Self::default()
     }
 
-    /// Conventions that mean nothing for 2-D points: all but `--u-open` apply to directions.
+    /// Conventions that mean nothing for the plane's points, which have no normal: all but
+    /// `u_open` apply to directions.
     pub fn validate(&self, domain: super::Domain) -> Result<(), CheckError> {
         let directional = [
-            ("--incident upper", self.incident == Incident::Upper),
-            ("--reflection-only", self.reflection_only),
-            ("--measure projected", self.measure == Measure::Projected),
-            ("--measure area", self.measure == Measure::Area),
-            ("--frame y-up", self.frame == Frame::YUp),
+            (Setting::Incident, self.incident == Incident::Upper),
+            (Setting::ReflectionOnly, self.reflection_only),
+            (Setting::Measure, self.measure != Measure::SolidAngle),
+            (Setting::Frame, self.frame == Frame::YUp),
         ];
         match directional.iter().find(|(_, set)| !domain.directions() && *set) {
-            Some((flag, _)) => Err(CheckError::Input(format!("{flag}: only with --domain sphere (a point of the plane has no normal); remove it"))),
+            Some(&(setting, _)) => Err(CheckError::Setting { setting, message: "only for directions (a point of the plane has no normal); remove it".into() }),
             None => Ok(()),
         }
     }
 
     /// An incident θ in degrees (from the normal of the user's frame) that the sampler is declared
-    /// for: below 90° with `--incident upper`.
+    /// for: below 90° when it takes light from above only.
     pub fn check_incident(&self, theta: f64) -> Result<(), CheckError> {
         if self.incident() == Incident::Upper && theta >= 90.0 {
-            let why = if self.reflection_only { "--reflection-only" } else { "--incident upper" };
-            return Err(CheckError::Input(format!(
-                "--incident-theta: {theta}° is not above the surface, and the sampler is declared {why} (θ below 90°); give θ < 90 or drop {why}"
-            )));
+            let why = if self.reflection_only { "reflection-only" } else { "for upper incidence" };
+            let message = format!("{theta}° is not above the surface, and the sampler is declared {why} (θ below 90°); give θ < 90 or drop that declaration");
+            return Err(CheckError::Setting { setting: Setting::IncidentTheta, message });
         }
         Ok(())
     }
@@ -179,24 +178,17 @@ impl Conventions {
         )
     }
 
-    /// The flags that declare these conventions, as on the command line ("" for the default).
-    pub fn flags(&self) -> String {
-        let mut f = Vec::new();
-        if self.reflection_only {
-            f.push("--reflection-only");
-        } else if self.incident == Incident::Upper {
-            f.push("--incident upper");
-        }
-        if self.u_open {
-            f.push("--u-open");
-        }
-        if self.measure != Measure::SolidAngle {
-            f.push(if self.measure == Measure::Projected { "--measure projected" } else { "--measure area" });
-        }
-        if self.frame == Frame::YUp {
-            f.push("--frame y-up");
-        }
-        f.join(" ")
+    /// The conventions declared, each by its setting and value as a report names them
+    /// ("reflection-only, measure projected"; "" for the default).
+    pub fn declared(&self) -> String {
+        let set = [
+            (self.incident == Incident::Upper && !self.reflection_only).then(|| format!("incident {}", self.incident.name())),
+            self.reflection_only.then(|| "reflection-only".to_string()),
+            self.u_open.then(|| "u-open".to_string()),
+            (self.measure != Measure::SolidAngle).then(|| format!("measure {}", self.measure.name())),
+            (self.frame == Frame::YUp).then(|| format!("frame {}", self.frame.name())),
+        ];
+        set.into_iter().flatten().collect::<Vec<_>>().join(", ")
     }
 }
 
@@ -241,7 +233,9 @@ mod tests {
         let c = Conventions { measure: Measure::Projected, ..Conventions::default() };
         let plane = crate::stats::domain::Domain::UNIT_SQUARE;
         assert!(c.validate(crate::stats::domain::Domain::Sphere).is_ok());
-        assert!(c.validate(plane).unwrap_err().to_string().starts_with("--measure projected"));
+        assert!(matches!(c.validate(plane), Err(CheckError::Setting { setting: Setting::Measure, .. })));
+        let y_up = Conventions { frame: Frame::YUp, ..Conventions::default() };
+        assert!(matches!(y_up.validate(plane), Err(CheckError::Setting { setting: Setting::Frame, .. })));
         assert!(Conventions { u_open: true, ..Conventions::default() }.validate(plane).is_ok());
     }
 }

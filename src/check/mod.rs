@@ -123,6 +123,12 @@ pub enum Setting {
     Pdf,
     Eval,
     Normal,
+    Incident,
+    ReflectionOnly,
+    Measure,
+    Frame,
+    Bounds,
+    SampleReturns,
 }
 
 impl Setting {
@@ -145,6 +151,12 @@ impl Setting {
             Setting::Pdf => "pdf",
             Setting::Eval => "eval",
             Setting::Normal => "normal",
+            Setting::Incident => "incident",
+            Setting::ReflectionOnly => "reflection_only",
+            Setting::Measure => "measure",
+            Setting::Frame => "frame",
+            Setting::Bounds => "bounds",
+            Setting::SampleReturns => "sample_returns",
         }
     }
 }
@@ -254,9 +266,10 @@ impl UserSampler {
                 setting: Setting::Normal,
                 message: "only with the area measure (a sample that is a point of a light, with its area density); remove it".into(),
             }),
-            (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => {
-                Err(CheckError::Input("--measure area with --sample-returns half-vector: a light's point is not a half vector; keep one".into()))
-            }
+            (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => Err(CheckError::Setting {
+                setting: Setting::SampleReturns,
+                message: "a half vector is not a light's point (the area measure); keep one".into(),
+            }),
             _ => Ok(()),
         }
     }
@@ -271,9 +284,10 @@ impl UserSampler {
     /// The files alone must validate, define the named functions with the contract's
     /// signatures, and leave lobes' own names free.
     fn validate_code(&self) -> Result<(), CheckError> {
-        self.domain.validate().map_err(|e| CheckError::Input(format!("--bounds: {e}")))?;
+        self.domain.validate().map_err(|e| CheckError::Setting { setting: Setting::Bounds, message: e.to_string() })?;
         if self.composition.sample_returns == SampleReturns::HalfVector && !self.domain.directions() {
-            return Err(CheckError::Input("--sample-returns half-vector: a half vector reflects wi into a direction; it does not apply to --domain plane".into()));
+            let message = "a half vector reflects wi into a direction; a point of the plane is none".into();
+            return Err(CheckError::Setting { setting: Setting::SampleReturns, message });
         }
         let code = modules::compose_user(&self.sources, &self.composition)?;
         // a name is a function of the contract's signature; an expression is judged in the glue
@@ -620,10 +634,10 @@ pub fn invalid_expectation(samples: u64, invalid: u64, pdf_total: f64, resolutio
     n * (invalid as f64 / n).clamp((missing - band).max(0.0), (missing + band).max(band))
 }
 
-/// "my_sample/my_pdf in file.wgsl", and the conventions declared: "… (--reflection-only)".
+/// "my_sample/my_pdf in file.wgsl", and the conventions declared: "… (reflection-only)".
 fn describe(s: &UserSampler) -> String {
     let files: Vec<&str> = s.sources.iter().map(|f| f.name.as_str()).collect();
-    let conventions = if s.conventions.is_default() { String::new() } else { format!(" ({})", s.conventions.flags()) };
+    let conventions = if s.conventions.is_default() { String::new() } else { format!(" ({})", s.conventions.declared()) };
     format!("{}/{} in {}{conventions}", s.sample, s.pdf, files.join(", "))
 }
 

@@ -226,6 +226,12 @@ pub(super) fn flag(setting: Setting) -> &'static str {
         Setting::Pdf => "pdf",
         Setting::Eval => "eval",
         Setting::Normal => "normal",
+        Setting::Incident => "incident",
+        Setting::ReflectionOnly => "reflection-only",
+        Setting::Measure => "measure",
+        Setting::Frame => "frame",
+        Setting::Bounds => "bounds",
+        Setting::SampleReturns => "sample-returns",
     }
 }
 

@@ -102,10 +102,20 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
     UserSampler::from_repository(&paths, &sample, &pdf, eval.as_deref(), domain, composition)
         .and_then(|s| s.with_conventions(conventions))
         .map_err(|e| match e {
-            crate::check::CheckError::Setting { setting, message } => ctx.err(raw.span(), format!("sampler.{}: {message}", setting.key())),
+            crate::check::CheckError::Setting { setting, message } => ctx.err(raw.span(), format!("{}: {message}", scene_key(setting))),
             e => ctx.err(raw.span(), format!("sampler: {e}")),
         })
         .map(Arc::new)
+}
+
+/// A setting as a scene names it: a key of the case (`incident_theta`, `bounds`) or of its
+/// `sampler` table (`sampler.measure`).
+fn scene_key(setting: crate::check::Setting) -> String {
+    use crate::check::Setting::*;
+    match setting {
+        Params | IncidentTheta | IncidentPhi | Samples | Timeout | Bins | Significance | Bounds => setting.key().to_string(),
+        _ => format!("sampler.{}", setting.key()),
+    }
 }
 
 /// `sampler = { light = "NAME" }`: lobes' built-in light of that name (the case's `params` its
@@ -315,7 +325,7 @@ pub(super) fn case(ctx: &Ctx, d: &Defaults, point: &Point, common: Common, sampl
             let theta = number(ctx, t, "incident_theta", |x| (0.0..=180.0).contains(&x), "incident_theta is in degrees from the normal, 0 ≤ θ ≤ 180 (above 90 the light comes from below)")?;
             // a sweep stays where the sampler is declared for (incident = "upper": below 90°)
             if sampler.domain.directions() {
-                sampler.conventions.check_incident(theta).map_err(|e| ctx.err(t.span(), format!("incident_theta: {e}")))?;
+                sampler.conventions.check_incident(theta).map_err(|e| ctx.err(t.span(), e.to_string()))?;
             }
             theta
         }
