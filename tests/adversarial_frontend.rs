@@ -267,8 +267,8 @@ fn density_expressions_of_the_wrong_type_or_empty_are_named_in_the_flags_terms()
 fn define_values_out_of_range_are_named() {
     let dir = scratch("define-range");
     common::copy_dir(&root().join(OIL), &dir);
-    bad_input(&oil_check(&dir, &["--define", "N=99999999999"]), &["--define N=99999999999", "out of the range of i32"]);
-    bad_input(&oil_check(&dir, &["--define", "N=99999999999u"]), &["--define N=99999999999u", "out of the range of u32"]);
+    bad_input(&oil_check(&dir, &["--define", "N=99999999999"]), &["--define: N=99999999999: 99999999999 is out of the range of i32"]);
+    bad_input(&oil_check(&dir, &["--define", "N=99999999999u"]), &["--define: N=99999999999u: 99999999999u is out of the range of u32"]);
     let docs = std::fs::read_to_string(root().join("docs/samplers-in-repositories.md")).unwrap();
     assert!(docs.contains("`--define X=false`") && docs.contains("`#ifdef X`"), "the docs say what X=false does to #ifdef X");
 }
@@ -333,7 +333,7 @@ fn unused_or_repeated_stubs_are_refused_naming_them() {
     let dir = scratch("stubs");
     common::copy_dir(&root().join(OIL), &dir);
     let other = format!("common::lights={}", dir.join("stubs/view.wgsl").display());
-    bad_input(&oil_check(&dir, &["--stub", &other]), &["--stub common::lights", "no import"]);
+    bad_input(&oil_check(&dir, &["--stub", &other]), &["--stub: common::lights: no import"]);
     let again = format!("common::view={}", dir.join("stubs/view.wgsl").display());
     bad_input(&oil_check(&dir, &["--stub", &again]), &["--stub: common::view is given twice"]);
     // WESL: a stub of a module nothing imports
@@ -347,7 +347,7 @@ fn unused_or_repeated_stubs_are_refused_naming_them() {
         "check", file.to_str().unwrap(), "--shader-root", roots.to_str().unwrap(), "--stub", &stub, "--stub", &unused,
         "--sample", "sample_ggx_vndf(wi, p0, rng)", "--sample-returns", "half-vector", "--pdf", "ggx_vndf_pdf(wi, d, p0)", "--params", "0.5",
     ]);
-    bad_input(&out, &["--stub package::lights", "no import"]);
+    bad_input(&out, &["--stub: package::lights: no import"]);
 }
 
 /// Whether `e` is bad input naming `what` (or a WGSL error at a file:line:column), a setting's

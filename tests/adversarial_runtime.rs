@@ -8,7 +8,7 @@ use crate::common;
 
 use common::{finish, text};
 use lobes::check::hard::HardRow;
-use lobes::check::{CheckError, Composition, Conventions, Domain, SampleReturns, Settings, UserSampler, check};
+use lobes::check::{CheckError, Composition, Conventions, Domain, SampleReturns, Setting, Settings, UserSampler, check};
 use lobes::engine::gpu::Gpu;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -166,8 +166,8 @@ fn a_fifth_draw_in_a_few_samples_is_bad_input_at_every_seed() {
     let n: u64 = 1 << 18;
     for seed in 1..=4 {
         let e = check(&gpu, &s, &Settings { seed, samples: n, ..small(vec![], 30.0) }).expect_err("five draws");
-        let CheckError::Input(m) = &e else { panic!("seed {seed}: {e}") };
-        assert!(m.contains("--rand rnd") && m.contains("drew 5 random numbers"), "seed {seed}: {m}");
+        let CheckError::Setting { setting: Setting::Rand, message: m } = &e else { panic!("seed {seed}: {e}") };
+        assert!(m.starts_with("rnd: one sample") && m.contains("drew 5 random numbers"), "seed {seed}: {m}");
         let (mean, sd) = (0.002 * n as f64, (0.002 * 0.998 * n as f64).sqrt());
         let over: f64 = m.split(" of ").next().and_then(|h| h.rsplit(' ').next()).and_then(|c| c.parse().ok()).unwrap_or_else(|| panic!("a count: {m}"));
         assert!(m.contains(&format!(" of {n} samples drew more than four")) && (over - mean).abs() <= 5.0 * sd, "seed {seed}: {over} of {n}: {m}");

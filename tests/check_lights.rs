@@ -426,9 +426,9 @@ fn bindings_without_the_right_file_are_exit_2() {
     std::fs::write(&npy_of_u32, bytes).unwrap();
     let cases: [(&str, String, &str); 4] = [
         ("env_marginal", String::new(), "`env_marginal` (@group(0) @binding(1), a storage buffer) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture env_marginal=FILE.hdr"),
-        ("env_marginal", npy_of_u32.display().to_string(), "--buffer env_marginal: the file holds u32 and `env_marginal` is an array<f32>"),
+        ("env_marginal", npy_of_u32.display().to_string(), "the buffer file of `env_marginal` holds u32 and `env_marginal` is an array<f32>"),
         ("env_conditional", format!("{ENVMAP}/sky.hdr"), "a table is a NumPy .npy array or raw little-endian 32-bit words (.bin, .raw), by its extension"),
-        ("env_radiance", format!("{ENVMAP}/missing.hdr"), "--texture env_radiance=examples/envmap/missing.hdr: cannot read the file"),
+        ("env_radiance", format!("{ENVMAP}/missing.hdr"), "--texture: env_radiance=examples/envmap/missing.hdr: cannot read the file"),
     ];
     for (name, file, message) in cases {
         let out = check_env("env_sample", "1", &[(name, file.clone())]);
@@ -441,7 +441,7 @@ fn bindings_without_the_right_file_are_exit_2() {
     let file = format!("{ENVMAP}/envmap.wgsl");
     let out = lobes(&["check", &file, "--sample", "env_sample", "--pdf", "env_pdf", "--params", INTEGRAL, "--texture", "env_marginal=examples/envmap/sky.hdr", "--texture", "env_radiance=examples/envmap/sky.hdr", "--buffer", "env_conditional=examples/envmap/conditional.npy"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--texture env_marginal: `env_marginal` is not declared as a texture_2d<f32>"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`env_marginal` is not declared as a texture_2d<f32>"));
     // one name twice
     let out = lobes(&["check", &file, "--sample", "env_sample", "--pdf", "env_pdf", "--buffer", "env_marginal=a.npy", "--buffer", "env_marginal=b.npy"]);
     assert_eq!(out.status.code(), Some(2));
@@ -521,5 +521,5 @@ fn a_renderers_sampler_is_bound_by_its_filter() {
     assert!(stderr.contains("`lut_sampler` of module renderer::lut (@group(0) @binding(1), a sampler) is a resource of the renderer that the sampler reads, and nothing is bound to it") && stderr.contains("--sampler lut_sampler=linear or nearest"), "{stderr}");
     let swapped = check(&["--sampler", "lut=nearest", "--texture", &format!("lut_sampler={}", dir.join("one.hdr").display())]);
     assert_eq!(swapped.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&swapped.stderr).contains("--sampler lut=nearest: `lut` is not declared as a `sampler`"));
+    assert!(String::from_utf8_lossy(&swapped.stderr).contains("`lut` is not declared as a `sampler`, which its filter (nearest) makes"));
 }

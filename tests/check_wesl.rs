@@ -53,7 +53,7 @@ fn if_blocks_compose_the_path_the_features_choose() {
     // an @if feature is true or false
     let out = cosine_if(&dir, &["--define", "FAST_Z=2"]);
     assert_eq!(out.status.code(), Some(2));
-    assert!(stderr(&out).contains("--define FAST_Z=2: WESL's @if features are true or false"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--define: FAST_Z=2: WESL's @if features are true or false"), "{}", stderr(&out));
 }
 
 /// A malformed condition in an imported module: exit 2 at its file, line and column, saying

@@ -137,8 +137,8 @@ fn unfilterable(gpu: &Gpu, bound: &[super::resources::Bound]) -> Result<(), Chec
     let reads = |b: &super::resources::Bound, other: &super::resources::Bound| b.entries.iter().any(|e| other.entries.contains(e));
     for s in bound.iter().filter(|b| matches!(*b.data, Data::Sampler(_))) {
         if let Some(t) = bound.iter().find(|t| matches!(*t.data, Data::Texture { .. }) && reads(t, s)) {
-            return Err(CheckError::Input(format!(
-                "--sampler {}: the sampler reads the texture `{}` (--texture, rgba32float) through it, and this adapter, {}, lacks wgpu's FLOAT32_FILTERABLE, without which wgpu binds no float32 texture to a pass that samples it (nearest or linear); lobes does not lower the image's precision: run the check on an adapter that has it (lavapipe and desktop Vulkan do), or give a stand-in that reads the texture with textureLoad (--stub MODULE=FILE)",
+            return Err(CheckError::setting(Setting::Filter, format!(
+                "{}: the sampler reads the texture `{}` (rgba32float) through it, and this adapter, {}, lacks wgpu's FLOAT32_FILTERABLE, without which wgpu binds no float32 texture to a pass that samples it (nearest or linear); lobes does not lower the image's precision: run the check on an adapter that has it (lavapipe and desktop Vulkan do), or give a stand-in module that reads the texture with textureLoad",
                 s.name,
                 t.name,
                 gpu.adapter_name()
@@ -211,10 +211,11 @@ pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler,
 /// The error of a sampler of which `over` of `of` samples drew more than the queue's four
 /// uniforms, one of them `most`.
 pub(super) fn too_many_draws(sampler: &UserSampler, most: u32, over: u64, of: u64) -> CheckError {
-    CheckError::Input(format!(
-        "--rand {}: one sample drew {most} random numbers, and {over} of {of} samples drew more than four; lobes hands out four (u.x, u.y, u.z, u.w). A sampler checked with --rand draws at most four per sample",
+    let message = format!(
+        "{}: one sample drew {most} random numbers, and {over} of {of} samples drew more than four; lobes hands out four (u.x, u.y, u.z, u.w), so a sampler whose random functions are named draws at most four per sample",
         sampler.composition.rand.join(", ")
-    ))
+    );
+    CheckError::setting(Setting::Rand, message)
 }
 
 /// The path of the generated glue in messages: errors in a call expression point here.
@@ -497,10 +498,8 @@ fn rand_body(name: &str, module: &naga::Module, f: &naga::Function) -> Result<St
         Some(naga::TypeInner::Scalar(s)) if *s == naga::Scalar::F32 => 1,
         Some(naga::TypeInner::Vector { size, scalar }) if *scalar == naga::Scalar::F32 => *size as u32,
         other => {
-            return Err(CheckError::Input(format!(
-                "--rand {name}: returns {}; lobes hands out uniforms in [0, 1] as f32, vec2<f32>, vec3<f32> or vec4<f32>",
-                other.map_or("nothing".to_string(), super::compose::describe_inner)
-            )));
+            let returns = other.map_or("nothing".to_string(), super::compose::describe_inner);
+            return Err(CheckError::setting(Setting::Rand, format!("{name} returns {returns}; lobes hands out uniforms in [0, 1] as f32, vec2<f32>, vec3<f32> or vec4<f32>")));
         }
     };
     let swizzle = ["", ".x", ".xy", ".xyz", ""][n as usize];
@@ -529,8 +528,8 @@ fn replace_rand(parts: &[Source], code: &UserCode, rand: &[String]) -> Result<Ve
                 .filter(|n| !n.starts_with("lobes_"))
                 .map(|n| code.origins.iter().find(|o| o.0 == n).map_or(n.to_string(), |o| format!("{}::{}", o.1, o.2)))
                 .collect();
-            return Err(CheckError::Input(format!(
-                "--rand {name}: no function `{name}` in {}{} (functions there: {})",
+            return Err(CheckError::setting(Setting::Rand, format!(
+                "{name}: no function `{name}` in {}{} (functions there: {})",
                 code.files.join(", "),
                 crate::suggest::did_you_mean(name, known.iter().map(String::as_str)),
                 known.join(", ")
@@ -699,7 +698,7 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
             let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or_else(|| g.binding).expect("a binding");
             return Err(CheckError::Input(c.diagnostic_at(span, &unbound(g, &as_declared, module))));
         };
-        let data = resources::load(name, resource).map_err(CheckError::Input)?;
+        let data = resources::load(name, resource).map_err(|e| CheckError::setting(e.kind.into(), e.message))?;
         resources::fits(name, &data, g, module).map_err(|e| CheckError::Input(c.diagnostic_at(span, &e)))?;
         let binding = g.binding.as_ref().expect("a binding").binding;
         bound.push(resources::Bound { name: name.clone(), binding, data: std::sync::Arc::new(data), entries });
@@ -987,14 +986,14 @@ pub(super) fn rand_order(passes: &Passes, params: &Params, sampler: &UserSampler
     let most = out.iter().map(|o| o[0][0] as u32).max().unwrap_or(0).min(4);
     let names = sampler.composition.rand.join(", ");
     if most == 0 {
-        return Err(CheckError::Input(format!(
-            "--rand {names}: no sample called {} (256 probed); name the functions the sampler draws its random numbers from",
+        return Err(CheckError::setting(Setting::Rand, format!(
+            "{names}: no sample called {} (256 probed); name the functions the sampler draws its random numbers from",
             if sampler.composition.rand.len() == 1 { "it" } else { "them" }
         )));
     }
     if let Some(order) = &sampler.composition.rand_order {
         let c = Draw::components(order);
-        return Ok((c, format!("; random draws {} (--rand-order)", Draw::list(&c, most as usize))));
+        return Ok((c, format!("; random draws {} (in the order given)", Draw::list(&c, most as usize))));
     }
     let mut kinds = Vec::new();
     for k in 0..most as usize {

@@ -96,6 +96,11 @@ pub enum CheckError {
 }
 
 impl CheckError {
+    /// A setting's error: `message` says what is wrong with its value.
+    pub fn setting(setting: Setting, message: impl Into<String>) -> Self {
+        CheckError::Setting { setting, message: message.into() }
+    }
+
     /// Whether the error is the user's input (exit code 2) rather than a failure to run (1).
     pub fn is_input(&self) -> bool {
         matches!(self, CheckError::Input(_) | CheckError::Wgsl(_) | CheckError::Setting { .. })
@@ -129,6 +134,10 @@ pub enum Setting {
     Frame,
     Bounds,
     SampleReturns,
+    Rand,
+    Texture,
+    Buffer,
+    Filter,
 }
 
 impl Setting {
@@ -157,6 +166,20 @@ impl Setting {
             Setting::Frame => "frame",
             Setting::Bounds => "bounds",
             Setting::SampleReturns => "sample_returns",
+            Setting::Rand => "rand",
+            Setting::Texture => "texture",
+            Setting::Buffer => "buffer",
+            Setting::Filter => "filter",
+        }
+    }
+}
+
+impl From<resources::ResourceKind> for Setting {
+    fn from(kind: resources::ResourceKind) -> Self {
+        match kind {
+            resources::ResourceKind::Texture => Setting::Texture,
+            resources::ResourceKind::Buffer => Setting::Buffer,
+            resources::ResourceKind::Sampler => Setting::Filter,
         }
     }
 }

@@ -70,11 +70,12 @@ impl Resource {
             Resource::Sampler(_) => None,
         }
     }
-    fn flag(&self) -> &'static str {
+    /// What it binds.
+    pub fn kind(&self) -> ResourceKind {
         match self {
-            Resource::Texture(_) => "--texture",
-            Resource::Buffer(_) => "--buffer",
-            Resource::Sampler(_) => "--sampler",
+            Resource::Texture(_) => ResourceKind::Texture,
+            Resource::Buffer(_) => ResourceKind::Buffer,
+            Resource::Sampler(_) => ResourceKind::Sampler,
         }
     }
 }
@@ -143,19 +144,19 @@ pub struct Bound {
     pub entries: Vec<String>,
 }
 
-/// Reads `r`; the message says what is wrong with the file, after `{flag} NAME=FILE: `.
-pub fn load(name: &str, r: &Resource) -> Result<Data, String> {
+/// Reads `r`; the error's message says what is wrong with the file, after `NAME=FILE: `.
+pub fn load(name: &str, r: &Resource) -> Result<Data, ResourceError> {
     let Some(path) = r.path() else {
         return Ok(match r {
             Resource::Sampler(f) => Data::Sampler(*f),
             _ => unreachable!("only a sampler has no file"),
         });
     };
-    let at = format!("{} {name}={}", r.flag(), path.display());
-    let bytes = std::fs::read(path).map_err(|e| format!("{at}: cannot read the file: {e}"))?;
+    let error = |e: String| ResourceError { kind: r.kind(), message: format!("{name}={}: {e}", path.display()) };
+    let bytes = std::fs::read(path).map_err(|e| error(format!("cannot read the file: {e}")))?;
     match r {
-        Resource::Texture(_) => read_image(path, &bytes).map_err(|e| format!("{at}: {e}")),
-        Resource::Buffer(_) => read_table(path, &bytes).map_err(|e| format!("{at}: {e}")),
+        Resource::Texture(_) => read_image(path, &bytes).map_err(error),
+        Resource::Buffer(_) => read_table(path, &bytes).map_err(error),
         Resource::Sampler(_) => unreachable!("a sampler has no file"),
     }
 }
@@ -248,7 +249,7 @@ pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Mo
     let inner = &module.types[g.ty].inner;
     match (data, inner) {
         (Data::Texture { .. }, TypeInner::Image { dim: ImageDimension::D2, arrayed: false, class: ImageClass::Sampled { kind: ScalarKind::Float, multi: false } }) => Ok(()),
-        (Data::Texture { .. }, _) => Err(format!("--texture {name}: `{name}` is not declared as a texture_2d<f32>; --texture binds an image as one")),
+        (Data::Texture { .. }, _) => Err(format!("`{name}` is not declared as a texture_2d<f32>, and its texture is an image, bound as one")),
         (Data::Buffer { scalar, .. }, TypeInner::Array { base, .. }) if matches!(g.space, naga::AddressSpace::Storage { .. }) => {
             let want = match module.types[*base].inner {
                 TypeInner::Scalar(s) if s.width == 4 => match s.kind {
@@ -261,14 +262,14 @@ pub fn fits(name: &str, data: &Data, g: &naga::GlobalVariable, module: &naga::Mo
             };
             match want {
                 Some(w) if scalar.is_none_or(|s| s == w) => Ok(()),
-                Some(w) => Err(format!("--buffer {name}: the file holds {} and `{name}` is an array<{}>", scalar.map_or("raw words", Scalar::wgsl), w.wgsl())),
-                None => Err(format!("--buffer {name}: `{name}` is not an array of f32, u32 or i32; --buffer binds a flat table")),
+                Some(w) => Err(format!("the buffer file of `{name}` holds {} and `{name}` is an array<{}>", scalar.map_or("raw words", Scalar::wgsl), w.wgsl())),
+                None => Err(format!("`{name}` is not an array of f32, u32 or i32, and its buffer file is a flat table")),
             }
         }
-        (Data::Buffer { .. }, _) => Err(format!("--buffer {name}: `{name}` is not declared as var<storage, read> {name}: array<f32> (or u32, i32)")),
+        (Data::Buffer { .. }, _) => Err(format!("`{name}` is not declared as var<storage, read> {name}: array<f32> (or u32, i32), which its buffer file is bound as")),
         (Data::Sampler(_), TypeInner::Sampler { comparison: false }) => Ok(()),
-        (Data::Sampler(f), TypeInner::Sampler { comparison: true }) => Err(format!("--sampler {name}={}: `{name}` is a sampler_comparison (a depth comparison), which lobes does not bind: --sampler binds a filtering `sampler`; give the test a stand-in without it (--stub MODULE=FILE)", f.name())),
-        (Data::Sampler(f), _) => Err(format!("--sampler {name}={}: `{name}` is not declared as a `sampler`; --sampler binds one (var {name}: sampler;)", f.name())),
+        (Data::Sampler(f), TypeInner::Sampler { comparison: true }) => Err(format!("`{name}` is a sampler_comparison (a depth comparison), which lobes does not bind: its filter ({}) makes a filtering `sampler`; give the test a stand-in module without it", f.name())),
+        (Data::Sampler(f), _) => Err(format!("`{name}` is not declared as a `sampler`, which its filter ({}) makes (var {name}: sampler;)", f.name())),
     }
 }
 
@@ -423,7 +424,7 @@ mod tests {
         };
         assert_eq!(fit("s"), Ok(()));
         assert!(fit("c").unwrap_err().contains("`c` is a sampler_comparison (a depth comparison), which lobes does not bind"));
-        assert!(fit("t").unwrap_err().contains("--sampler t=linear: `t` is not declared as a `sampler`"));
+        assert!(fit("t").unwrap_err().contains("`t` is not declared as a `sampler`, which its filter (linear) makes"));
     }
 
     #[test]

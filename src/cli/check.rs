@@ -232,15 +232,10 @@ pub(super) fn flag(setting: Setting) -> &'static str {
         Setting::Frame => "frame",
         Setting::Bounds => "bounds",
         Setting::SampleReturns => "sample-returns",
-    }
-}
-
-/// The flag that binds a resource of `kind`.
-fn resource_flag(kind: ResourceKind) -> &'static str {
-    match kind {
-        ResourceKind::Texture => "--texture",
-        ResourceKind::Buffer => "--buffer",
-        ResourceKind::Sampler => "--sampler",
+        Setting::Rand => "rand",
+        Setting::Texture => "texture",
+        Setting::Buffer => "buffer",
+        Setting::Filter => "sampler",
     }
 }
 
@@ -271,7 +266,7 @@ impl CheckArgs {
         let packages = check::Composition::parse_packages(&self.package).map_err(|e| usage(format!("--package {e}")))?;
         let kinds = [(ResourceKind::Texture, &self.texture), (ResourceKind::Buffer, &self.buffer), (ResourceKind::Sampler, &self.sampler)];
         let items: Vec<(ResourceKind, String)> = kinds.iter().flat_map(|(k, items)| items.iter().map(|i| (*k, i.clone()))).collect();
-        let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("{} {}", resource_flag(e.kind), e.message)))?;
+        let resources = check::Composition::parse_resources(&items).map_err(|e| usage(format!("--{} {}", flag(e.kind.into()), e.message)))?;
         let composition = check::Composition { normal: self.normal.clone(), packages, resources, ..composition };
         Ok((domain, conventions, composition))
     }

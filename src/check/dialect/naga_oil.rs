@@ -3,7 +3,7 @@
 //! roots ([`oil_modules`]) and orders them ([`oil_order`]); naga_oil's `Composer` composes the
 //! tree, and naga's WGSL writer writes it back as one text.
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::{Source, global_names, write_wgsl};
 use super::super::composition::{Call, Composition, Dialect, Origin, Renamed, UserCode};
 use super::front_end::FrontEnd;
@@ -83,12 +83,12 @@ fn shader_defs(c: &Composition) -> Result<std::collections::HashMap<String, naga
                     (_, Ok(i)) => V::Int(i),
                     // an integer, but not one naga_oil's i32 or u32 holds
                     (Some(Err(_)), _) if s.strip_suffix('u').is_some_and(digits) => {
-                        return Err(CheckError::Input(format!("--define {n}={s}: {s} is out of the range of u32 (0 to {}u)", u32::MAX)));
+                        return Err(CheckError::setting(Setting::Define, format!("{n}={s}: {s} is out of the range of u32 (0 to {}u)", u32::MAX)));
                     }
                     (None, Err(_)) if digits(s.strip_prefix('-').unwrap_or(s)) => {
-                        return Err(CheckError::Input(format!("--define {n}={s}: {s} is out of the range of i32 ({} to {})", i32::MIN, i32::MAX)));
+                        return Err(CheckError::setting(Setting::Define, format!("{n}={s}: {s} is out of the range of i32 ({} to {})", i32::MIN, i32::MAX)));
                     }
-                    _ => return Err(CheckError::Input(format!("--define {n}={s}: the value must be true, false or an integer (7, -1, 7u)"))),
+                    _ => return Err(CheckError::setting(Setting::Define, format!("{n}={s}: the value must be true, false or an integer (7, -1, 7u)"))),
                 },
             };
             Ok((n.clone(), value))
@@ -255,10 +255,8 @@ fn naga_oil_tree(sources: &[Source], c: &Composition) -> Result<(String, Vec<Ori
     let root_path = naga_oil::compose::get_preprocessor_data(&sources[0].text).0;
     let order = oil_order(&root, root_path.as_deref(), &modules, &roots)?;
     if let Some(m) = modules.iter().enumerate().find(|(i, m)| m.stub && !order.contains(i)).map(|(_, m)| m) {
-        return Err(CheckError::Input(format!(
-            "--stub {}: no import of {} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the #import names it)",
-            m.path, sources[0].name
-        )));
+        let message = format!("{}: no import of {} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the #import names it)", m.path, sources[0].name);
+        return Err(CheckError::setting(Setting::Stub, message));
     }
     let _stage = Stage::enter(format!(
         "composing {} and the {} naga_oil modules it imports (under {}) with naga_oil's Composer",

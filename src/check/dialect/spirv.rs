@@ -4,7 +4,7 @@
 //! signature (`sample_ggx(vf3;f1;`) dropped. A module without debug names (compiled with `-g0`
 //! or stripped) has no names to call.
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::Source;
 use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
@@ -25,7 +25,7 @@ impl FrontEnd for Spirv {
                 return Err(CheckError::Input(format!("{}: give one SPIR-V module alone (it is a whole program; link several with spirv-link first)", files.join(", "))));
             }
             if !c.defines.is_empty() {
-                return Err(CheckError::Input("--define: a SPIR-V module is already compiled; give the defines to the compiler that made it".into()));
+                return Err(CheckError::setting(Setting::Define, "a SPIR-V module is already compiled; give the defines to the compiler that made it"));
             }
             Ok(Translation { text: sources[0].text.clone(), origins: Vec::new(), uniforms: Vec::new() })
         })

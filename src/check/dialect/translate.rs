@@ -4,7 +4,7 @@
 //! and how a call expression reaches them ([`call_names`]). The GLSL and SPIR-V front ends
 //! ([`super::glsl`], [`super::spirv`]) share it.
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::Source;
 use super::super::composition::{Call, Composition, Dialect, Origin, UserCode};
 use crate::wgsl_tokens::{Kind, tokens, try_replace};
@@ -14,7 +14,7 @@ use crate::wgsl_tokens::{Kind, tokens, try_replace};
 pub(super) fn translated(dialect: Dialect, sources: &[Source], c: &Composition, make: impl FnOnce() -> Result<Translation, CheckError>) -> Result<UserCode, CheckError> {
     let files: Vec<String> = sources.iter().map(|s| s.name.clone()).collect();
     if let Some((m, _)) = c.stubs.first() {
-        return Err(CheckError::Input(format!("--stub {m}: {} has no modules to stand in for ({} reads the files as they are)", files.join(", "), dialect.name())));
+        return Err(CheckError::setting(Setting::Stub, format!("{m}: {} has no modules to stand in for ({} reads the files as they are)", files.join(", "), dialect.name())));
     }
     let Translation { text, origins, uniforms } = make()?;
     let name = format!("<{} translated to WGSL by naga's {} front end>", files.join(", "), dialect.name());

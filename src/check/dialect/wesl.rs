@@ -4,7 +4,7 @@
 //! The crate writes the tree anew from its syntax, so each declaration's origin is kept
 //! (`compose::DeclOrigin`) for messages at the user's file and line.
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::{DeclOrigin, Source};
 use super::super::composition::{Call, Composition, Dialect, Origin, UserCode};
 use super::front_end::FrontEnd;
@@ -211,7 +211,7 @@ fn feature_flags(c: &Composition) -> Result<std::collections::HashMap<String, bo
         let on = match v.as_deref() {
             None | Some("true") => true,
             Some("false") => false,
-            Some(other) => return Err(CheckError::Input(format!("--define {n}={other}: WESL's @if features are true or false"))),
+            Some(other) => return Err(CheckError::setting(Setting::Define, format!("{n}={other}: WESL's @if features are true or false"))),
         };
         flags.insert(n.clone(), on);
     }

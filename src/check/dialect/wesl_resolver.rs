@@ -3,7 +3,7 @@
 //! stub where one is given; what it refuses (a module reachable two ways, one that imports
 //! itself) and why an import is not found (the closest modules under the roots).
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::Source;
 use super::super::composition::Composition;
 use super::roots::{scan, show_roots};
@@ -42,9 +42,10 @@ impl Resolved {
             return Err(CheckError::Input(why.clone()));
         }
         match c.stubs.iter().find(|(m, _)| !self.stubs_used.contains(m)) {
-            Some((m, _)) => Err(CheckError::Input(format!(
-                "--stub {m}: no import of {root} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the import names it: package::a::b)"
-            ))),
+            Some((m, _)) => Err(CheckError::setting(
+                Setting::Stub,
+                format!("{m}: no import of {root} or of the modules it imports names that module, so the stub stands in for nothing; check the module path (as the import names it: package::a::b)"),
+            )),
             None => Ok(()),
         }
     }

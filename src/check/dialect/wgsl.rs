@@ -1,7 +1,7 @@
 //! Plain WGSL: the files, in order, as they are (their lines keep their numbers in the
 //! composition, `compose::Composed`). With `--define` they are naga_oil's (`#ifdef` shader defs).
 
-use super::super::CheckError;
+use super::super::{CheckError, Setting};
 use super::super::compose::Source;
 use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
@@ -22,7 +22,7 @@ impl FrontEnd for Wgsl {
             return NagaOil.compose(sources, c);
         }
         if let Some((m, _)) = c.stubs.first() {
-            return Err(CheckError::Input(format!("--stub {m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
+            return Err(CheckError::setting(Setting::Stub, format!("{m}: the files import nothing (no #import or import statement), so there is no module to stand in for")));
         }
         let files = sources.iter().map(|s| s.name.clone()).collect();
         Ok(UserCode { dialect: Dialect::Wgsl, parts: sources.to_vec(), origins: Vec::new(), files, decls: Vec::new(), renamed: Vec::new(), uniforms: Vec::new() })
