@@ -133,7 +133,7 @@ fn budget_and_profile_bad_input_exits_2() {
     }
     let (code, _, stderr) = turned(&["--budget", "0.001"]);
     assert_eq!(code, Some(2), "{stderr}");
-    assert!(stderr.contains("lobes: error: --budget 0.001 s is too small: a check of 65536 samples of this sampler took "), "{stderr}");
+    assert!(stderr.contains("lobes: error: --budget: 0.001 s is too small: a check of 65536 samples of this sampler took "), "{stderr}");
 }
 
 /// The detection table at small scale: turns of 3 % and 6 % (3 seeds, 2¹⁶ … 2²¹). A bigger

@@ -5,7 +5,7 @@
 //! both on the adapter at hand, and the count is the largest whose predicted time
 //! t₀ + N · s is within the budget (docs/check-reference.md, `--budget`).
 
-use super::{CheckError, Settings, UserSampler, check};
+use super::{CheckError, Setting, Settings, UserSampler, check};
 use crate::engine::gpu::Gpu;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -127,7 +127,7 @@ pub struct BudgetPick {
 impl BudgetPick {
     /// One line saying what was picked and why.
     pub fn explain(&self) -> String {
-        let named = self.profile.as_ref().map_or(String::new(), |p| format!(" (--profile {p})"));
+        let named = self.profile.as_ref().map_or(String::new(), |p| format!(" (profile {p})"));
         let rate = if self.seconds_per_sample > 0.0 { format!("{:.3e} samples/s", 1.0 / self.seconds_per_sample) } else { "no measurable time per sample".into() };
         let capped = if self.samples == crate::engine::job::MAX_SAMPLES { ", capped at 2^40" } else { "" };
         format!(
@@ -186,9 +186,9 @@ fn seconds(s: f64) -> String {
 pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, profile: Option<Profile>) -> Result<BudgetPick, CheckError> {
     let (given, budget) = (budget, budget.min(settings.timeout.as_secs_f64() / TIMEOUT_MARGIN));
     let named = if budget < given {
-        format!("--budget {} s, capped at 1/{TIMEOUT_MARGIN} of the timeout ({} s),", seconds(given), seconds(budget))
+        format!("{} s, capped at 1/{TIMEOUT_MARGIN} of the timeout ({} s),", seconds(given), seconds(budget))
     } else {
-        format!("--budget {} s", seconds(budget))
+        format!("{} s", seconds(budget))
     };
     let run = |samples: u64| -> Result<Pilot, CheckError> {
         let r = check(gpu, sampler, &Settings { samples, ..settings.clone() })?;
@@ -197,7 +197,7 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let mut pilots = vec![run(PILOT_SAMPLES)?, run(PILOT_SAMPLES)?];
     let base = pilots[1].clone();
     if base.seconds >= budget {
-        return Err(CheckError::Input(format!(
+        return Err(CheckError::setting(Setting::Budget, format!(
             "{named} is too small: a check of {PILOT_SAMPLES} samples of this sampler took {:.2} s on this adapter (the fixed part: composing, compiling, the quadrature of the pdf); give a budget above {:.1} s",
             base.seconds,
             2.0 * base.seconds
@@ -216,7 +216,7 @@ pub fn pick(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, budget: f64, 
     let per_sample = cost_per_sample(&base, last);
     let fixed = (base.seconds - per_sample * base.samples as f64).max(0.0);
     let samples = fit(budget, fixed, per_sample).ok_or_else(|| {
-        CheckError::Input(format!(
+        CheckError::setting(Setting::Budget, format!(
             "{named} is too small: the check's fixed part on this adapter is {fixed:.2} s and {PILOT_SAMPLES} samples do not fit after it; give a budget above {:.1} s",
             fixed + 2.0 * per_sample * PILOT_SAMPLES as f64 + 0.5
         ))

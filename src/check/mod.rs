@@ -138,6 +138,7 @@ pub enum Setting {
     Texture,
     Buffer,
     Filter,
+    Budget,
 }
 
 impl Setting {
@@ -170,6 +171,7 @@ impl Setting {
             Setting::Texture => "texture",
             Setting::Buffer => "buffer",
             Setting::Filter => "filter",
+            Setting::Budget => "budget",
         }
     }
 }

@@ -236,6 +236,7 @@ pub(super) fn flag(setting: Setting) -> &'static str {
         Setting::Texture => "texture",
         Setting::Buffer => "buffer",
         Setting::Filter => "sampler",
+        Setting::Budget => "budget",
     }
 }
 

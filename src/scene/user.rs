@@ -113,7 +113,7 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
 fn scene_key(setting: crate::check::Setting) -> String {
     use crate::check::Setting::*;
     match setting {
-        Params | IncidentTheta | IncidentPhi | Samples | Timeout | Bins | Significance | Bounds => setting.key().to_string(),
+        Params | IncidentTheta | IncidentPhi | Samples | Timeout | Bins | Significance | Bounds | Budget => setting.key().to_string(),
         _ => format!("sampler.{}", setting.key()),
     }
 }
