@@ -127,7 +127,7 @@ impl Composition {
     /// assert!(matches!(e, CheckError::Setting { setting: Setting::Define, .. }));
     /// ```
     pub fn validate(&self) -> Result<(), CheckError> {
-        let bad = |setting, message: String| Err(CheckError::Setting { setting, message });
+        let bad = |setting, message: String| Err(CheckError::setting(setting, message));
         if let Some((n, _)) = self.defines.iter().find(|(n, _)| !is_name(n)) {
             return bad(Setting::Define, format!("'{n}' is no shader def: a def is a name (letters, digits, _) with a value or none, as UNIFORM_HEMISPHERE or SAMPLES=4"));
         }
@@ -141,7 +141,7 @@ impl Composition {
             return bad(Setting::ShaderRoot, format!("{} is not a folder", r.display()));
         }
         for (i, (name, dir)) in self.packages.iter().enumerate() {
-            check_package(name, &self.packages[..i]).map_err(|message| CheckError::Setting { setting: Setting::Package, message })?;
+            check_package(name, &self.packages[..i]).map_err(|message| CheckError::setting(Setting::Package, message))?;
             if !dir.is_dir() {
                 return bad(Setting::Package, format!("{name}={}: not a folder; give the folder that holds {name}'s modules ({name}::a::b is DIR/a/b.wesl)", dir.display()));
             }
@@ -204,13 +204,13 @@ impl Call {
 
     /// The error `why` of its expression `expr`, keyed by its setting.
     pub fn error(self, expr: &str, why: impl std::fmt::Display) -> CheckError {
-        CheckError::Setting { setting: self.setting(), message: format!("'{expr}': {why}") }
+        CheckError::setting(self.setting(), format!("'{expr}': {why}"))
     }
 
     /// The error of its expression `expr` whose value has the wrong type: `'{expr}' returns
     /// {what}`, keyed by its setting.
     pub fn returns(self, expr: &str, what: impl std::fmt::Display) -> CheckError {
-        CheckError::Setting { setting: self.setting(), message: format!("'{expr}' returns {what}") }
+        CheckError::setting(self.setting(), format!("'{expr}' returns {what}"))
     }
 }
 

@@ -128,7 +128,7 @@ impl Conventions {
             (Setting::Frame, self.frame == Frame::YUp),
         ];
         match directional.iter().find(|(_, set)| !domain.directions() && *set) {
-            Some(&(setting, _)) => Err(CheckError::Setting { setting, message: "only for directions (a point of the plane has no normal); remove it".into() }),
+            Some(&(setting, _)) => Err(CheckError::setting(setting, "only for directions (a point of the plane has no normal); remove it")),
             None => Ok(()),
         }
     }
@@ -139,7 +139,7 @@ impl Conventions {
         if self.incident() == Incident::Upper && theta >= 90.0 {
             let why = if self.reflection_only { "reflection-only" } else { "for upper incidence" };
             let message = format!("{theta}° is not above the surface, and the sampler is declared {why} (θ below 90°); give θ < 90 or drop that declaration");
-            return Err(CheckError::Setting { setting: Setting::IncidentTheta, message });
+            return Err(CheckError::setting(Setting::IncidentTheta, message));
         }
         Ok(())
     }

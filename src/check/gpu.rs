@@ -431,10 +431,10 @@ fn expression_type(code: &UserCode, call: Call, expr: &str) -> Result<naga::Type
 /// The light's normal expression (`--normal`): a vec3<f32> over p.
 fn check_normal(code: &UserCode, normal: &str) -> Result<(), CheckError> {
     if normal.trim().is_empty() {
-        return Err(CheckError::Setting {
-            setting: Setting::Normal,
-            message: "the expression is empty; give the light's unit normal at the sampled point p as WGSL, e.g. 'vec3<f32>(0.0, 0.0, -1.0)' or 'normalize(p - p.xyz)'".into(),
-        });
+        return Err(CheckError::setting(
+            Setting::Normal,
+            "the expression is empty; give the light's unit normal at the sampled point p as WGSL, e.g. 'vec3<f32>(0.0, 0.0, -1.0)' or 'normalize(p - p.xyz)'",
+        ));
     }
     match expression_type(code, Call::Normal, normal)? {
         naga::TypeInner::Vector { size: naga::VectorSize::Tri, scalar } if scalar == naga::Scalar::F32 => Ok(()),
@@ -452,13 +452,9 @@ pub(super) fn check_expressions(code: &UserCode, sampler: &UserSampler) -> Resul
     for (call, expr) in calls {
         let Some(expr) = expr else { continue };
         if expr.trim().is_empty() {
-            return Err(CheckError::Setting {
-                setting: call.setting(),
-                message: format!(
-                    "the expression is empty; give a function name of the contract or a call expression over lobes' names, e.g. {}",
-                    if call == Call::Sample { "'sample_ggx(wi, u.xy, p0)'" } else { "'ggx_pdf(wi, d, p0)'" }
-                ),
-            });
+            let example = if call == Call::Sample { "'sample_ggx(wi, u.xy, p0)'" } else { "'ggx_pdf(wi, d, p0)'" };
+            let message = format!("the expression is empty; give a function name of the contract or a call expression over lobes' names, e.g. {example}");
+            return Err(CheckError::setting(call.setting(), message));
         }
         if call == Call::Sample || is_name(expr) {
             continue;

@@ -283,18 +283,14 @@ impl UserSampler {
     fn light_measure(&self) -> Result<(), CheckError> {
         let area = self.conventions.measure == conventions::Measure::Area;
         match (area, &self.composition.normal) {
-            (true, None) => Err(CheckError::Setting {
-                setting: Setting::Normal,
-                message: "needed with the area measure (a sample that is a point of a light): the light's unit normal at the sampled point p, WGSL over p and params, for the area-to-solid-angle factor |p|²/|n·d|".into(),
-            }),
-            (false, Some(_)) => Err(CheckError::Setting {
-                setting: Setting::Normal,
-                message: "only with the area measure (a sample that is a point of a light, with its area density); remove it".into(),
-            }),
-            (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => Err(CheckError::Setting {
-                setting: Setting::SampleReturns,
-                message: "a half vector is not a light's point (the area measure); keep one".into(),
-            }),
+            (true, None) => Err(CheckError::setting(
+                Setting::Normal,
+                "needed with the area measure (a sample that is a point of a light): the light's unit normal at the sampled point p, WGSL over p and params, for the area-to-solid-angle factor |p|²/|n·d|",
+            )),
+            (false, Some(_)) => Err(CheckError::setting(Setting::Normal, "only with the area measure (a sample that is a point of a light, with its area density); remove it")),
+            (true, Some(_)) if self.composition.sample_returns == SampleReturns::HalfVector => {
+                Err(CheckError::setting(Setting::SampleReturns, "a half vector is not a light's point (the area measure); keep one"))
+            }
             _ => Ok(()),
         }
     }
@@ -309,10 +305,9 @@ impl UserSampler {
     /// The files alone must validate, define the named functions with the contract's
     /// signatures, and leave lobes' own names free.
     fn validate_code(&self) -> Result<(), CheckError> {
-        self.domain.validate().map_err(|e| CheckError::Setting { setting: Setting::Bounds, message: e.to_string() })?;
+        self.domain.validate().map_err(|e| CheckError::setting(Setting::Bounds, e.to_string()))?;
         if self.composition.sample_returns == SampleReturns::HalfVector && !self.domain.directions() {
-            let message = "a half vector reflects wi into a direction; a point of the plane is none".into();
-            return Err(CheckError::Setting { setting: Setting::SampleReturns, message });
+            return Err(CheckError::setting(Setting::SampleReturns, "a half vector reflects wi into a direction; a point of the plane is none"));
         }
         let code = modules::compose_user(&self.sources, &self.composition)?;
         // a name is a function of the contract's signature; an expression is judged in the glue
@@ -437,7 +432,7 @@ impl Settings {
     /// assert_eq!(e.to_string(), "incident_theta: 200 is outside [0, 180] degrees");
     /// ```
     pub fn validate(&self) -> Result<(), CheckError> {
-        let bad = |setting, message: String| Err(CheckError::Setting { setting, message });
+        let bad = |setting, message: String| Err(CheckError::setting(setting, message));
         if self.params.len() > MAX_PARAMS {
             return bad(Setting::Params, format!("{} numbers given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", self.params.len()));
         }

@@ -67,7 +67,8 @@ mod glsl;
 #[cfg(feature = "glsl")]
 pub use glsl::glsl;
 mod namespace;
-// the text rules; besides `with_bindings` they are build.rs's (and the unit tests')
+// the text rules; besides `with_bindings` and `declared` (a check's renaming of lobes' own names)
+// they are build.rs's (and the unit tests')
 #[allow(dead_code)]
 mod text;
 
