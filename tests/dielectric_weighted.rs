@@ -8,7 +8,7 @@
 //! WGSL against the f64 reference over Λ from 0 to 10³ (grazing), and through the weighted pass.
 //! GPU test: it needs a wgpu adapter (lavapipe in CI).
 
-use lobes::engine::gpu::effects::{Composed, Specialisation};
+use lobes::engine::gpu::effects::{PipelineSource, Specialisation};
 use lobes::engine::gpu::params::storage_entry;
 use lobes::engine::gpu::precision::Precision;
 use lobes::engine::gpu::{Gpu, GpuEngine, library};
@@ -40,7 +40,7 @@ fn masked(masking: Masking) -> Effects {
     Effects { fresnel: Fresnel::None, masking }
 }
 
-fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&Composed>, level: f64) -> AlbedoCheck {
+fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&PipelineSource>, level: f64) -> AlbedoCheck {
     let composed = module.cloned().unwrap_or_else(|| e.weighted_module(job, effects, Specialisation::Specialised));
     let run = e.weighted_with(job, effects, &composed, SampleRange::whole(11, N)).expect("weighted run");
     albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
@@ -107,9 +107,9 @@ fn gpu_and_cpu_weighted_sums_agree() {
 }
 
 /// `good` with its first `from` replaced by `to` (which must be there): a module broken on purpose.
-fn replaced(good: &Composed, from: &str, to: &str) -> Composed {
+fn replaced(good: &PipelineSource, from: &str, to: &str) -> PipelineSource {
     assert!(good.source.contains(from), "{from:?} is not in the module");
-    Composed { source: good.source.replacen(from, to, 1), constants: good.constants.clone() }
+    PipelineSource { source: good.source.replacen(from, to, 1), constants: good.constants.clone() }
 }
 
 /// A BTDF broken in the GPU module, each as a renderer might break it, is rejected by the same

@@ -3,7 +3,7 @@
 //! per-bin weight check. Each check is shown to reject a deliberately broken weight.
 
 use lobes::engine::gpu::{Counting, GpuEngine};
-use lobes::engine::gpu::effects::{self, Composed, Specialisation};
+use lobes::engine::gpu::effects::{self, PipelineSource, Specialisation};
 use lobes::engine::job::{Job, SampleRange, Scatter};
 use lobes::reference::effects::Effects;
 use lobes::reference::fresnel::Fresnel;
@@ -34,7 +34,7 @@ fn functions(source: &str) -> Vec<String> {
     module.functions.iter().filter_map(|(_, f)| f.name.clone()).collect()
 }
 
-fn scene_modules(toml: &str) -> Vec<Composed> {
+fn scene_modules(toml: &str) -> Vec<PipelineSource> {
     let scene = Scene::parse("test.toml", toml).unwrap();
     scene.cases.iter().map(|c| effects::case_module(&c.job, c.effects.as_ref(), Counting::Workgroup, c.job.bins() as u32)).collect()
 }
@@ -86,7 +86,7 @@ fn pipelines_are_made_once_per_effect_set() {
     assert_eq!(e.weighted_pipelines_built(), 2, "101 cases of two effect sets");
 }
 
-fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&Composed>, level: f64) -> AlbedoCheck {
+fn check(e: &mut GpuEngine, job: &Job, effects: &Effects, module: Option<&PipelineSource>, level: f64) -> AlbedoCheck {
     let composed = module.cloned().unwrap_or_else(|| e.weighted_module(job, effects, Specialisation::Specialised));
     let run = e.weighted_with(job, effects, &composed, SampleRange::whole(7, N)).expect("weighted run");
     albedo_check(job, effects, &run.sums, N, level, &Quadrature::default())
@@ -148,7 +148,7 @@ fn broken_weights_are_rejected() {
     let good = e.weighted_module(&j, &schlick, Specialisation::Specialised);
     let broken = |from: &str, to: &str| {
         assert!(good.source.contains(from), "{from:?} is not in the module");
-        Composed { source: good.source.replacen(from, to, 1), constants: good.constants.clone() }
+        PipelineSource { source: good.source.replacen(from, to, 1), constants: good.constants.clone() }
     };
     // 1. the weight forgets Fresnel: the weight check and the albedo both catch it
     let no_fresnel = broken("return effect_fresnel(dot(wi, s.h)) * effect_masking", "return effect_masking");

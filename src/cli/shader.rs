@@ -3,7 +3,7 @@
 
 use super::{OutputArgs, emit, emit_json, usage};
 use crate::engine::gpu::{Counting, GpuEngine};
-use crate::engine::gpu::effects::{self, Composed};
+use crate::engine::gpu::effects::{self, PipelineSource};
 use crate::scene::Entry;
 use clap::Args;
 use std::path::PathBuf;
@@ -30,7 +30,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     // storage, the storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
     let engine = GpuEngine::open().map_err(|e| crate::console::say(format_args!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits"))).ok();
-    let mut modules: Vec<(Composed, Vec<&str>)> = Vec::new();
+    let mut modules: Vec<(PipelineSource, Vec<&str>)> = Vec::new();
     for entry in entries {
         let m = match entry {
             Entry::Lobe(case) => {
@@ -48,7 +48,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
             }
             // a user's sampler: its files, the glue and `lobes check`'s passes (one module for
             // every incident angle and params, which are uniforms)
-            Entry::User(case) => Composed { source: case.sampler.composed()?, constants: Vec::new() },
+            Entry::User(case) => PipelineSource { source: case.sampler.composed()?, constants: Vec::new() },
         };
         match modules.iter_mut().find(|(k, _)| *k == m) {
             Some((_, names)) => names.push(entry.name()),

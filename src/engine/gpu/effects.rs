@@ -39,12 +39,12 @@ pub enum Specialisation {
 
 /// A composed module and the override constants its pipelines are made with.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Composed {
+pub struct PipelineSource {
     pub source: String,
     pub constants: Vec<(&'static str, f64)>,
 }
 
-impl Composed {
+impl PipelineSource {
     /// A key naming the pipeline: the source with its constants.
     pub fn key(&self) -> String {
         format!("{}\n// pipeline constants: {:?}", self.source, self.constants)
@@ -128,7 +128,7 @@ fn weighted(mut kernel: Kernel, samplers: &[&SamplerSpec], sel: &Selectors, rota
 /// The weighted module of a lobe `job` with `effects`: the counting module of the job (so
 /// that one module serves both passes of the case) and `shaders/passes/weighted.wgsl` with the
 /// effect files it needs.
-pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Specialisation) -> Composed {
+pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Specialisation) -> PipelineSource {
     let Job::Lobe { lobe, scatter, .. } = job else { panic!("effects apply to lobe jobs only") };
     let dielectric = matches!(scatter, Scatter::Dielectric { .. });
     match how {
@@ -147,11 +147,11 @@ pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Sp
                 kernel.job.push("override MASKING: u32 = 1u;\n");
                 constants.push(("MASKING", effects.masking.mode() as f64));
             }
-            Composed { source: weighted(kernel, &[spec], &OVERRIDES, lobe.is_rotated(), fresnel, masking, dielectric), constants }
+            PipelineSource { source: weighted(kernel, &[spec], &OVERRIDES, lobe.is_rotated(), fresnel, masking, dielectric), constants }
         }
         Specialisation::Uber => {
             assert!(!dielectric, "the uber-kernel draws reflections only (Ward and bounded VNDF have no dielectric)");
-            Composed { source: compose_uber(job, counting), constants: Vec::new() }
+            PipelineSource { source: compose_uber(job, counting), constants: Vec::new() }
         }
     }
 }
@@ -159,10 +159,10 @@ pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Sp
 /// The module a case runs: its weighted module (which holds its counting kernels too) with
 /// effects, else its counting module (`tile_bins` bins per pass where the histogram is tiled),
 /// counting as `counting` says.
-pub fn case_module(job: &Job, effects: Option<&Effects>, counting: Counting, tile_bins: u32) -> Composed {
+pub fn case_module(job: &Job, effects: Option<&Effects>, counting: Counting, tile_bins: u32) -> PipelineSource {
     match (effects, job) {
         (Some(e), Job::Lobe { .. }) => compose_effects(job, e, counting, Specialisation::Specialised),
-        _ => Composed { source: compose::compose_counting(job, counting, tile_bins, Precision::F32Accurate), constants: Vec::new() },
+        _ => PipelineSource { source: compose::compose_counting(job, counting, tile_bins, Precision::F32Accurate), constants: Vec::new() },
     }
 }
 

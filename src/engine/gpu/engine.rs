@@ -7,7 +7,7 @@ use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::counting::{Counting, Strategy};
 use super::dispatch::{Chunking, Pass, SamplingPasses, Step};
-use super::effects::{self, Composed, Specialisation};
+use super::effects::{self, PipelineSource, Specialisation};
 use super::library::File;
 use super::params::{ExplicitInput, Params, storage_entry};
 use super::weighted::{WeightedPipelines, WeightedRun};
@@ -24,7 +24,7 @@ use wgpu::util::DeviceExt;
 const SLAB_BINDING: u32 = 9;
 
 /// The pipelines of one composed module.
-struct Kernel {
+struct KernelPipelines {
     sample: wgpu::ComputePipeline,
     fold: wgpu::ComputePipeline,
     directions: Option<wgpu::ComputePipeline>,
@@ -64,7 +64,7 @@ pub struct GpuEngine {
     pub gpu: Gpu,
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    cache: HashMap<String, Arc<Kernel>>,
+    cache: HashMap<String, Arc<KernelPipelines>>,
     pub chunking: Chunking,
     /// Number of modules compiled so far (for tests of the cache).
     pub compiled: usize,
@@ -155,13 +155,13 @@ impl GpuEngine {
         Ok(Tiling { tile_bins, tiles: bins.div_ceil(tile_bins) })
     }
 
-    fn kernel(&mut self, job: &Job) -> Result<Arc<Kernel>, GpuError> {
+    fn kernel(&mut self, job: &Job) -> Result<Arc<KernelPipelines>, GpuError> {
         self.kernel_tiled(job, None)
     }
 
     /// The kernel of `job`, counting all bins (`tile` None) or the `tile` bins from
     /// `params.tile_first` on.
-    fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<Kernel>, GpuError> {
+    fn kernel_tiled(&mut self, job: &Job, tile: Option<u32>) -> Result<Arc<KernelPipelines>, GpuError> {
         let source = self.source(job, tile);
         let counting = self.counting(tile.unwrap_or(job.bins() as u32));
         if let Some(k) = self.cache.get(&source) {
@@ -170,7 +170,7 @@ impl GpuEngine {
         let module = self.gpu.module(&compose::describe(job), &source)?;
         let pipeline = |entry: &str| self.gpu.pipeline(&module, Some(&self.pipeline_layout), entry, &[]);
         let lobe = matches!(job, Job::Lobe { .. });
-        let kernel = Arc::new(Kernel {
+        let kernel = Arc::new(KernelPipelines {
             sample: pipeline("sample_histogram")?,
             fold: pipeline("fold")?,
             directions: lobe.then(|| pipeline("directions")).transpose()?,
@@ -377,7 +377,7 @@ impl GpuEngine {
     }
 
     /// The weighted module of `job` with `effects`, as [`GpuEngine::weighted`] compiles it.
-    pub fn weighted_module(&self, job: &Job, effects: &Effects, how: Specialisation) -> Composed {
+    pub fn weighted_module(&self, job: &Job, effects: &Effects, how: Specialisation) -> PipelineSource {
         effects::compose_effects(job, effects, self.counting(job.bins() as u32), how)
     }
 
@@ -396,7 +396,7 @@ impl GpuEngine {
     /// As [`GpuEngine::weighted`] with a module of the caller's (from
     /// [`GpuEngine::weighted_module`], possibly altered: the tests break a weight on purpose
     /// and check that the verdict catches it).
-    pub fn weighted_with(&mut self, job: &Job, effects: &Effects, composed: &Composed, range: SampleRange) -> Result<WeightedRun, GpuError> {
+    pub fn weighted_with(&mut self, job: &Job, effects: &Effects, composed: &PipelineSource, range: SampleRange) -> Result<WeightedRun, GpuError> {
         self.weighted.run(&self.gpu, self.chunking, job, effects, composed, range)
     }
 }

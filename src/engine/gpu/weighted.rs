@@ -3,7 +3,7 @@
 
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, SamplingPasses, Step};
-use super::effects::{self, Composed};
+use super::effects::{self, PipelineSource};
 use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS, sampling_groups};
 use super::params::{Params, storage_entry};
 use crate::engine::job::{Job, SampleRange};
@@ -45,7 +45,7 @@ impl WeightedPipelines {
         Self { layout, pipeline_layout, cache: HashMap::new(), compiled: 0 }
     }
 
-    fn pipeline(&mut self, gpu: &Gpu, job: &Job, composed: &Composed) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+    fn pipeline(&mut self, gpu: &Gpu, job: &Job, composed: &PipelineSource) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
         let key = composed.key();
         if let Some(p) = self.cache.get(&key) {
             return Ok(p.clone());
@@ -67,7 +67,7 @@ impl WeightedPipelines {
         chunking: Chunking,
         job: &Job,
         effects: &Effects,
-        composed: &Composed,
+        composed: &PipelineSource,
         range: SampleRange,
     ) -> Result<WeightedRun, GpuError> {
         let Job::Lobe { lobe, .. } = job else { panic!("weighted histograms are for lobe jobs") };
