@@ -292,18 +292,21 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     }
 }
 
-/// `lobes shader` shows the modules of users' cases too (nothing in a scene is left out): one
-/// module per sampler, shared by the cases of its sweep, holding the user's own functions, valid
-/// WGSL.
+/// `lobes shader` shows the modules of users' cases too (nothing in a scene is left out): two
+/// modules per sampler (lobes check's passes, and the histogram's counting kernel drawing it),
+/// shared by the cases of its sweep, each holding the user's own functions, valid WGSL.
 #[test]
 fn lobes_shader_shows_users_samplers() {
     let out = lobes(&["shader", "scenes/user-samplers.toml", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let modules = v["modules"].as_array().unwrap();
-    assert_eq!(modules.len(), 3, "ggx (3 angles), Henyey–Greenstein (2 params), piecewise 2-D");
+    assert_eq!(modules.len(), 6, "ggx (3 angles), Henyey–Greenstein (2 params), piecewise 2-D: passes and histogram each");
     assert_eq!(modules[0]["cases"].as_array().unwrap().len(), 3);
-    for (m, function) in modules.iter().zip(["fn ggx_sample(", "fn hg_sample(", "fn env_sample("]) {
+    let functions = ["fn ggx_sample(", "fn ggx_sample(", "fn hg_sample(", "fn hg_sample(", "fn env_sample(", "fn env_sample("];
+    for (k, (m, function)) in modules.iter().zip(functions).enumerate() {
+        let entry = if k % 2 == 0 { "fn lobes_probe(" } else { "fn lobes_sample_histogram(" };
+        assert!(m["source"].as_str().unwrap().contains(entry), "module {k}: {entry}");
         let source = m["source"].as_str().unwrap();
         assert!(source.contains(function), "{function}");
         let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));

@@ -1,9 +1,8 @@
 #define_import_path lobes::check
 #import lobes::rng::{rng_uniforms, add64}
 #import lobes::params::lobes_params
-#import lobes::domain::{LOBES_DOMAIN_OUTSIDE, lobes_domain_point, lobes_domain_coordinates, lobes_domain_cell}
+#import lobes::domain::{lobes_domain_point, lobes_domain_coordinates}
 #import lobes::user::{lobes_user_sample, lobes_user_pdf, lobes_user_eval, lobes_user_draws}
-#import lobes::invalid::{LOBES_REASON_COUNT, LOBES_REASON_NON_FINITE_POINT, LOBES_REASON_OUTSIDE_DOMAIN, LOBES_REASON_NON_FINITE_PDF, LOBES_REASON_ZERO_PDF}
 
 // The passes that judge a user's WGSL sampler (CPU side: src/check/). They call the user's
 // functions through three wrappers of `lobes::user`, the module that the composing host
@@ -13,14 +12,13 @@
 //   fn lobes_user_eval(wi: vec3<f32>, d: vec3<f32>) -> f32           // 0 when the user gave none
 // and fn lobes_user_draws() -> u32, the draws the last sample took from the queue of the user's
 // --rand functions. `lobes::domain` (domain_sphere.wgsl or domain_plane.wgsl, as the sampler's
-// domain says) maps quadrature coordinates to points and points to bins. Every name here starts with `lobes_` so that it cannot
-// collide with the user's own.
+// domain says) maps quadrature coordinates to points. The histogram is not here: `lobes run`'s
+// counting kernel (shaders/passes/kernel.wgsl) counts it, drawing the user's sampler through
+// shaders/check/user_draw.wgsl. Every name here starts with `lobes_` so that it cannot collide
+// with the user's own.
 
 @group(0) @binding(1) var<storage, read> lobes_in: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> lobes_out: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> lobes_counts: array<atomic<u32>>;
-// lobes_params.slabs slabs of lobes_cells() cells, one per invocation of lobes_histogram_slabs
-@group(0) @binding(4) var<storage, read_write> lobes_slabs: array<u32>;
 
 // x > 0 and finite, read from the bits (not relying on NaN comparing false, which fast-math
 // lowerings may not keep).
@@ -473,118 +471,4 @@ fn lobes_conditioning(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
         k = lobes_edge_within_rounding(wi, d);
     }
     lobes_out[i] = vec4<f32>(pdf, k, 0.0, 0.0);
-}
-
-fn lobes_finite3(d: vec3<f32>) -> bool {
-    let b = bitcast<vec3<u32>>(d) & vec3<u32>(0x7f800000u);
-    return all(b != vec3<u32>(0x7f800000u));
-}
-
-// The cell of a sample (d, reported pdf): its bin, or rows · cols + reason − 1, the reasons' codes
-// those of `lobes::invalid` (src/reference/invalid.rs, generated; a user's sampler has no
-// refracted_near_side, whose cell stays 0) (a rejection,
-// pdf exactly 0 at any finite d, (0, 0, 0) among them, is `zero_pdf`); the bin is the domain's
-// (lobes_domain_cell).
-fn lobes_cell(s: vec4<f32>) -> u32 {
-    let bins = lobes_params.rows * lobes_params.cols;
-    if (!lobes_finite3(s.xyz)) {
-        return bins + LOBES_REASON_NON_FINITE_POINT - 1u;
-    }
-    // pdf exactly 0 at a finite point, (0, 0, 0) or any other: the rejection the contract allows,
-    // whatever the point (as the hard cases read it), not a point outside the domain
-    if (s.w == 0.0) {
-        return bins + LOBES_REASON_ZERO_PDF - 1u;
-    }
-    let cell = lobes_domain_cell(s.xyz);
-    if (cell == LOBES_DOMAIN_OUTSIDE) {
-        return bins + LOBES_REASON_OUTSIDE_DOMAIN - 1u;
-    }
-    let bits = bitcast<u32>(s.w);
-    if ((bits & 0x7f800000u) == 0x7f800000u) {
-        return bins + LOBES_REASON_NON_FINITE_PDF - 1u;
-    }
-    if (!(s.w > 0.0)) {
-        return bins + LOBES_REASON_ZERO_PDF - 1u;
-    }
-    return cell;
-}
-
-// The cells of the histogram: the bins, the reasons, then the two draw counters of the
-// --rand queue: the samples that drew more than the four uniforms it holds, and the most draws
-// one sample took (src/check/gpu.rs: Counted). Counted on every sample, not on a probe: a lobe
-// of a mixture that draws a fifth number in 0.2 % of its samples is found at any seed.
-fn lobes_cells() -> u32 {
-    return lobes_params.rows * lobes_params.cols + LOBES_REASON_COUNT + 2u;
-}
-const LOBES_OVER_DRAWN: u32 = LOBES_REASON_COUNT;
-const LOBES_MOST_DRAWS: u32 = LOBES_REASON_COUNT + 1u;
-
-// Counts samples base + (gid · samples_per_thread + k) into lobes_counts (u32 per cell; the host
-// keeps each dispatch under 2^32 samples and adds into 64-bit totals), one storage atomic per
-// sample: on GPUs. On CPU adapters lobes_histogram_slabs and lobes_reduce_slabs instead
-// (src/engine/gpu/counting.rs chooses). A sample that drew more than four numbers (rare, and
-// then an error) adds to the draw counters.
-@compute @workgroup_size(64)
-fn lobes_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let first = (gid.x + gid.y * nwg.x * 64u) * lobes_params.samples_per_thread;
-    let wi = lobes_params.wi.xyz;
-    let bins = lobes_params.rows * lobes_params.cols;
-    for (var k = 0u; k < lobes_params.samples_per_thread; k++) {
-        let local = first + k;
-        if (local < lobes_params.count) {
-            let s = lobes_user_sample(wi, rng_uniforms(lobes_params.seed, add64(lobes_params.base, local)));
-            atomicAdd(&lobes_counts[lobes_cell(s)], 1u);
-            let n = lobes_user_draws();
-            if (n > 4u) {
-                atomicAdd(&lobes_counts[bins + LOBES_OVER_DRAWN], 1u);
-                atomicMax(&lobes_counts[bins + LOBES_MOST_DRAWS], n);
-            }
-        }
-    }
-}
-
-// The histogram in per-invocation slabs (CPU adapters: llvmpipe serialises the lanes' atomics on
-// shared counters; src/engine/gpu/counting.rs): invocation g of lobes_params.slabs counts samples
-// base + g, base + g + slabs, ... of the dispatch into its own slab of lobes_cells() cells with
-// plain adds (the most draws with max), which no other invocation touches; lobes_reduce_slabs then
-// adds the slabs into lobes_counts. A slab entry counts some of one dispatch's samples (under
-// 2^32), so none wraps.
-@compute @workgroup_size(8)
-fn lobes_histogram_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let g = gid.x + gid.y * nwg.x * 8u;
-    let slabs = lobes_params.slabs;
-    if (g >= slabs) {
-        return;
-    }
-    let first = g * lobes_cells();
-    let draws = first + lobes_params.rows * lobes_params.cols;
-    let wi = lobes_params.wi.xyz;
-    for (var local = g; local < lobes_params.count; local += slabs) {
-        let s = lobes_user_sample(wi, rng_uniforms(lobes_params.seed, add64(lobes_params.base, local)));
-        let w = first + lobes_cell(s);
-        lobes_slabs[w] = lobes_slabs[w] + 1u;
-        let n = lobes_user_draws();
-        if (n > 4u) {
-            lobes_slabs[draws + LOBES_OVER_DRAWN] += 1u;
-            lobes_slabs[draws + LOBES_MOST_DRAWS] = max(lobes_slabs[draws + LOBES_MOST_DRAWS], n);
-        }
-    }
-}
-
-// lobes_counts[cell] = the sum of the slabs' counts of `cell` (the most draws: their largest),
-// one invocation per cell.
-@compute @workgroup_size(64)
-fn lobes_reduce_slabs(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let cell = gid.x + gid.y * nwg.x * 64u;
-    let cells = lobes_cells();
-    if (cell >= cells) {
-        return;
-    }
-    let most = cell == lobes_params.rows * lobes_params.cols + LOBES_MOST_DRAWS;
-    var c = 0u;
-    for (var s = 0u; s < lobes_params.slabs; s++) {
-        let v = lobes_slabs[s * cells + cell];
-        c = select(c + v, max(c, v), most);
-    }
-    atomicStore(&lobes_counts[cell], c);
 }

@@ -25,13 +25,11 @@ struct LobesParams {
     bounds: vec4<f32>,
     // the finite-difference step of `lobes check`'s probe pass
     eps: f32,
-    // the samples each invocation of `lobes check`'s histogram and weights passes draws
+    // the samples each invocation of `lobes check`'s weights pass draws
     samples_per_thread: u32,
-    // `lobes check`'s histogram grid
+    // `lobes check`'s histogram grid (its binning reads it; the counting kernel's are constants)
     rows: u32,
     cols: u32,
-    // `lobes check`'s per-invocation slabs of the histogram (0: global atomics)
-    slabs: u32,
 }
 
 @group(0) @binding(0) var<uniform> lobes_params: LobesParams;

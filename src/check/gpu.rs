@@ -1,5 +1,6 @@
-//! The GPU passes over a user's sampler (`shaders/check/user_passes.wgsl`): histogram, weights,
-//! quadrature of rectangles and the probe of the sample map.
+//! The GPU passes over a user's sampler (`shaders/check/user_passes.wgsl`): weights, quadrature
+//! of rectangles and the probe of the sample map; and its histogram, counted by `lobes run`'s
+//! counting kernel drawing the user's sampler (`shaders/check/user_draw.wgsl`).
 
 use super::compose::{Composed, Source};
 use super::composition::{Call, Draw, UserCode, is_name};
@@ -8,8 +9,12 @@ use super::probe::Probe;
 use super::{CheckError, Setting, UserSampler, shaders};
 use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
-use crate::engine::gpu::counting::SLAB_WORKGROUP;
-use crate::engine::gpu::{Counting, Gpu, GpuError, Strategy};
+use crate::engine::gpu::compose::grid_counting_kernel;
+use crate::engine::gpu::layout::{N_REASONS, WG_SIZE};
+use crate::engine::gpu::precision::Precision;
+use crate::engine::gpu::engine::Tiling;
+use crate::engine::gpu::{Counting, Gpu, Strategy};
+use crate::engine::job::SampleRange;
 use crate::engine::gpu::dispatch::{Pass, Step};
 use wgpu::util::DeviceExt;
 
@@ -26,8 +31,6 @@ enum Output {
     Values,
     /// `lobes_probes`, one [`Probe`] per item (binding 5).
     Probes,
-    /// `lobes_counts`, the histogram's u32 cells (binding 3); the pass reads no input.
-    Counts,
 }
 
 impl Output {
@@ -35,7 +38,6 @@ impl Output {
         match self {
             Output::Values => 2,
             Output::Probes => 5,
-            Output::Counts => 3,
         }
     }
 }
@@ -60,6 +62,63 @@ pub(super) struct Passes<'g> {
     resources: Vec<(u32, Vec<String>, GpuResource)>,
     /// Each entry point's group 1 (its layout is the pipeline's own), where it reads any.
     group1: std::cell::RefCell<std::collections::HashMap<String, Option<wgpu::BindGroup>>>,
+    /// The sampler and the order of its --rand draws, from which the histogram's modules are
+    /// composed.
+    sampler: UserSampler,
+    order: [u32; 4],
+    /// The histogram's kernel of each grid (rows, cols, bins a tile) and counting, made at its
+    /// first use.
+    histograms: std::cell::RefCell<std::collections::HashMap<HistogramKey, std::rc::Rc<HistogramKernel>>>,
+}
+
+/// A histogram kernel's grid: rows, columns, bins a tile, and its counting.
+type HistogramKey = (u32, u32, u32, Counting);
+
+/// `lobes run`'s counting kernel drawing the user's sampler ([`compose_histogram`]), compiled:
+/// its sampling and fold pipelines, each with the bindings of group 0 it reads, and the
+/// sampling's group 1 (the user's resources it reads).
+struct HistogramKernel {
+    /// Kept with its pipelines (and leaked with them on an abandoned device, as [`Passes`] is).
+    _module: wgpu::ShaderModule,
+    sample: (wgpu::ComputePipeline, Vec<u32>),
+    fold: (wgpu::ComputePipeline, Vec<u32>),
+    group1: Option<wgpu::BindGroup>,
+}
+
+/// The histogram kernel's storage buffers: a chunk's u32 counters per cell, the 64-bit totals
+/// they are folded into, the slabs (CPU adapters) and the --rand draw counters.
+struct HistogramBuffers {
+    counts: wgpu::Buffer,
+    totals: wgpu::Buffer,
+    slabs: wgpu::Buffer,
+    draws: wgpu::Buffer,
+}
+
+impl HistogramBuffers {
+    /// Zeroed (as wgpu makes a buffer; the fold leaves the counters and slabs 0) for `cells`
+    /// cells of `bins` bins counted as `counting` says.
+    fn new(gpu: &Gpu, cells: u64, bins: u32, counting: Counting) -> Self {
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        Self {
+            counts: gpu.buffer("check chunk counts", cells * 4, storage),
+            totals: gpu.buffer("check totals", cells * 8, storage),
+            slabs: gpu.buffer("check slabs", counting.slab_bytes(bins).max(4), wgpu::BufferUsages::STORAGE),
+            draws: gpu.buffer("check draws", 8, storage),
+        }
+    }
+
+    /// The buffer at `binding` of group 0 (`shaders/passes/params.wgsl` and `bindings.wgsl`,
+    /// `counting_slabs.wgsl`, `shaders/check/user_draw.wgsl`), the uniform block `uniform`.
+    fn at<'a>(&'a self, binding: u32, uniform: &'a wgpu::Buffer) -> Result<&'a wgpu::Buffer, CheckError> {
+        match binding {
+            0 => Ok(uniform),
+            1 => Ok(&self.counts),
+            2 => Ok(&self.totals),
+            9 => Ok(&self.slabs),
+            10 => Ok(&self.draws),
+            b => Err(CheckError::Internal(format!("the histogram's kernel reads binding {b} of group 0, which lobes check does not bind"))),
+        }
+    }
 }
 
 /// A user's resource uploaded.
@@ -158,54 +217,33 @@ pub(super) enum Returned {
     Vec4,
 }
 
-/// The cells after the bins and reasons: the --rand draw counters (user_passes.wgsl,
-/// `lobes_cells`).
-const DRAW_CELLS: usize = 2;
-
-/// What the histogram pass counted in one dispatch.
+/// What the histogram pass counted.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(super) struct Counted {
     /// Per cell: the bins, then the reasons of [`Invalid::ALL`].
-    pub counts: Vec<u32>,
+    pub counts: Vec<u64>,
     /// Samples that drew more than the four numbers of the --rand queue, and the most draws one
     /// of them took (0 where none did).
-    pub over_drawn: u32,
+    pub over_drawn: u64,
     pub most_draws: u32,
-}
-
-impl Counted {
-    fn new(words: &[u32], cells: usize) -> Self {
-        Self { counts: words[..cells].to_vec(), over_drawn: words[cells], most_draws: words[cells + 1] }
-    }
 }
 
 /// The most samples of one dispatch of the histogram and weights passes.
 pub(super) const CHUNK: u64 = 1 << 26;
 
-/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason, in
-/// dispatches of at most [`CHUNK`] samples. Samples that drew more than the --rand queue's four
-/// numbers, counted on every sample, are bad input ([`too_many_draws`]).
-pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64, bins: usize) -> Result<Vec<u64>, CheckError> {
-    let mut totals = vec![0u64; bins + Invalid::COUNT];
-    let (mut over, mut most) = (0u64, 0u32);
-    let mut first = 0;
-    while first < samples {
-        let n = CHUNK.min(samples - first) as u32;
-        let counted = passes.histogram(params, first, n, bins + Invalid::COUNT, None)?;
-        for (t, c) in totals.iter_mut().zip(counted.counts) {
-            *t += c as u64;
-        }
-        (over, most) = (over + counted.over_drawn as u64, most.max(counted.most_draws));
-        first += n as u64;
+/// The histogram of `samples` samples of `sampler`: counts per bin, then per invalid reason.
+/// Samples that drew more than the --rand queue's four numbers, counted on every sample, are bad
+/// input ([`too_many_draws`]).
+pub(super) fn histogram(passes: &Passes, params: &Params, sampler: &UserSampler, samples: u64) -> Result<Vec<u64>, CheckError> {
+    let counted = passes.histogram(params, 0, samples, None)?;
+    if counted.over_drawn > 0 {
+        return Err(too_many_draws(sampler, counted.most_draws, counted.over_drawn, samples));
     }
-    if over > 0 {
-        return Err(too_many_draws(sampler, most, over, samples));
+    let total: u64 = counted.counts.iter().sum();
+    if total != samples {
+        return Err(CheckError::Internal(format!("{total} samples counted for {samples} drawn")));
     }
-    let counted: u64 = totals.iter().sum();
-    if counted != samples {
-        return Err(CheckError::Internal(format!("{counted} samples counted for {samples} drawn")));
-    }
-    Ok(totals)
+    Ok(counted.counts)
 }
 
 /// The error of a sampler of which `over` of `of` samples drew more than the queue's four
@@ -614,28 +652,58 @@ fn unset_uniform(module: &naga::Module, uniforms: &[(String, String)], expressio
 ///
 /// lobes' passes (`shaders/check/user_passes.wgsl`, `lobes::check`) are a naga_oil module like
 /// the engine's: it imports the RNG, the uniform block and `lobes::user`, the user's files with
-/// the glue, generated here. naga_oil validates lobes' files, each as its own root; the user's
-/// files are naga's to judge (alone in `check_user`, then in the whole composition), since
-/// naga_oil refuses some valid WGSL (a struct member whose name ends in a digit), so an error
-/// naga_oil finds in `lobes::user` itself is left to naga.
+/// the glue, generated here. naga validates the whole composition; in the unit tests naga_oil
+/// also builds each of lobes' files as its own root. The user's files are naga's to judge (alone
+/// in `check_user`, then in the whole composition), since naga_oil refuses some valid WGSL (a
+/// struct member whose name ends in a digit), so an error naga_oil finds in `lobes::user` itself
+/// is left to naga.
 pub fn compose(sampler: &UserSampler) -> Result<Composed, CheckError> {
-    let order = Draw::components(sampler.composition.rand_order.as_deref().unwrap_or(&[]));
-    compose_ordered(sampler, order)
+    compose_ordered(sampler, default_order(sampler))
+}
+
+/// The order of the --rand draws that `sampler` declares (`--rand-order`), else u's own.
+pub(super) fn default_order(sampler: &UserSampler) -> [u32; 4] {
+    Draw::components(sampler.composition.rand_order.as_deref().unwrap_or(&[]))
 }
 
 /// [`compose`] with the --rand queue in the order `order` of u's components.
 pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<Composed, CheckError> {
+    Ok(compose_roots(sampler, order, &["lobes::check"], vec![shaders::PASSES])?.0)
+}
+
+/// The histogram's module: `lobes run`'s counting kernel over a `rows` × `cols` grid, tiles of
+/// `tile_bins` of its bins a pass, counted as `counting` says, drawing the user's sampler
+/// (`shaders/check/user_draw.wgsl`) where it draws a lobe, so that a user's samples are counted
+/// as lobes' are.
+pub(super) fn compose_histogram(sampler: &UserSampler, order: [u32; 4], (rows, cols, tile_bins): (u32, u32, u32), counting: Counting) -> Result<Validated, CheckError> {
+    let kernel = grid_counting_kernel("lobes check's histogram", rows, cols, counting, tile_bins, Precision::F32Accurate);
+    let mut files = kernel.files()?;
+    files.push(shaders::DRAW);
+    compose_roots(sampler, order, &kernel.roots, files)
+}
+
+/// A composition with naga's module and its validation.
+pub(super) type Validated = (Composed, naga::Module, naga::valid::ModuleInfo);
+
+/// The module of lobes' `roots` (from `chosen` and the built-in files) with the user's files and
+/// glue as `lobes::user`, the domain's binning and the invalid reasons.
+fn compose_roots(sampler: &UserSampler, order: [u32; 4], roots: &[&str], mut chosen: Vec<File>) -> Result<Validated, CheckError> {
     let parts = prepare(sampler, order)?;
     let glue = contract_glue(sampler);
     let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
     let module = format!("#define_import_path lobes::user\n#import lobes::params::lobes_params\n{user}{glue}");
     let reasons = format!("#define_import_path lobes::invalid\n{}", Invalid::wgsl_consts("LOBES_REASON"));
-    let chosen = [shaders::PASSES, File::generated(USER_MODULE, module), shaders::domain_file(sampler.domain), File::generated("lobes::invalid", reasons)];
-    match library::validate_files(&["lobes::check"], &chosen) {
-        Err(GpuError::Shader { what, .. }) if what == USER_MODULE => {}
+    chosen.extend([File::generated(USER_MODULE, module), shaders::domain_file(sampler.domain), File::generated("lobes::invalid", reasons)]);
+    // lobes' files each a naga_oil root of its own (which refuses a name used without its
+    // #import), as the engine's compositions are checked: in the unit tests, which compose the
+    // passes and the histogram; a run validates the joined module (below, its errors at each
+    // file's line) and saves the 40 ms this takes per composition
+    #[cfg(test)]
+    match library::validate_files(roots, &chosen) {
+        Err(crate::engine::gpu::GpuError::Shader { what, .. }) if what == USER_MODULE => {}
         other => other?,
     }
-    let pieces = library::pieces(&["lobes::check"], &chosen)?;
+    let pieces = library::pieces(roots, &chosen)?;
     let own = lobes_own_names(&pieces);
     let mut c = Composed::default();
     for (path, text) in &pieces {
@@ -651,7 +719,28 @@ pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<
     let declared = move_resources(&mut c)?;
     let (module, info) = c.validate_with(naga::valid::Capabilities::default())?;
     bind_resources(&mut c, &module, &info, &sampler.composition.resources, &declared)?;
-    Ok(c)
+    Ok((c, module, info))
+}
+
+/// How a histogram of `bins` bins is counted on an adapter of `device` type with `limits`: in
+/// tiles as [`Tiling::fit`] splits it, each counted as [`Counting::choose`] picks (`force`: a
+/// strategy asked for), as `lobes run` counts its jobs.
+pub(super) fn histogram_counting(device: wgpu::DeviceType, limits: &wgpu::Limits, bins: u32, force: Option<Strategy>) -> Result<(Tiling, Counting), CheckError> {
+    let tiling = Tiling::fit(bins as u64, limits).ok_or_else(|| CheckError::setting(Setting::Bins, "this adapter's storage limits hold no histogram"))?;
+    Ok((tiling, Counting::choose(device, limits, tiling.tile_bins as u32, force)))
+}
+
+/// The entry point that draws and counts in the histogram's module (`lobes::kernel`'s
+/// `sample_histogram`, renamed as lobes' own names are, [`lobes_own_names`]).
+const SAMPLE_ENTRY: &str = "lobes_sample_histogram";
+
+/// The bindings of group 0 that `entry` of `module` reads or writes: those its pipeline's
+/// derived layout holds, and so those its bind group must have.
+fn group0_bindings(module: &naga::Module, info: &naga::valid::ModuleInfo, entry: &str) -> Vec<u32> {
+    let Some(i) = module.entry_points.iter().position(|e| e.name == entry) else { return Vec::new() };
+    let uses = info.get_entry_point(i);
+    let bound = module.global_variables.iter().filter(|(h, _)| !uses[*h].is_empty());
+    bound.filter_map(|(_, g)| g.binding.as_ref().filter(|b| b.group == 0).map(|b| b.binding)).collect()
 }
 
 /// Moves every resource the user's files declare to `@group(1)`, binding 0, 1, … in declaration
@@ -757,20 +846,29 @@ impl Drop for Passes<'_> {
     fn drop(&mut self) {
         if self.gpu.abandoned().is_some() {
             std::mem::forget(std::mem::take(self.pipelines.get_mut()));
+            std::mem::forget(std::mem::take(self.histograms.get_mut()));
             std::mem::forget(self.module.clone());
         }
     }
 }
 
 impl<'g> Passes<'g> {
-    pub fn new(gpu: &'g Gpu, composed: &Composed) -> Result<Self, CheckError> {
+    /// The passes of `sampler`, its --rand draws in the order it declares ([`compose`]).
+    pub fn new(gpu: &'g Gpu, sampler: &UserSampler) -> Result<Self, CheckError> {
+        Self::ordered(gpu, sampler, default_order(sampler))
+    }
+
+    /// The passes of `sampler` with its --rand draws in the order `order` ([`compose_ordered`]).
+    pub fn ordered(gpu: &'g Gpu, sampler: &UserSampler, order: [u32; 4]) -> Result<Self, CheckError> {
+        let composed = compose_ordered(sampler, order)?;
         // `composed` is already validated with its errors mapped to the user's files
         let module = gpu.module_unvalidated("lobes check", &composed.text)?;
         gpu.check_errors()?;
         unfilterable(gpu, &composed.bound)?;
         let resources = composed.bound.iter().map(|b| (b.binding, b.entries.clone(), GpuResource::upload(gpu, b))).collect();
         gpu.check_errors()?;
-        Ok(Self { gpu, module, gpu_seconds: std::cell::Cell::new(gpu.has_timestamps().then_some(0.0)), pipelines: Default::default(), resources, group1: Default::default() })
+        let timed = std::cell::Cell::new(gpu.has_timestamps().then_some(0.0));
+        Ok(Self { gpu, module, gpu_seconds: timed, pipelines: Default::default(), resources, group1: Default::default(), sampler: sampler.clone(), order, histograms: Default::default() })
     }
 
     /// Group 1 of `entry`'s pipeline: the user's resources it reads; `None` where it reads none.
@@ -808,7 +906,7 @@ impl<'g> Passes<'g> {
             usage: wgpu::BufferUsages::STORAGE,
         });
         let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
-        if output != Output::Counts && !input.is_empty() {
+        if !input.is_empty() {
             entries.push(wgpu::BindGroupEntry { binding: 1, resource: input_buf.as_entire_binding() });
         }
         entries.push(wgpu::BindGroupEntry { binding: output.binding(), resource: out.as_entire_binding() });
@@ -876,46 +974,88 @@ impl<'g> Passes<'g> {
         Ok(flat.chunks(2).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// Counts of samples `first .. first + count` (< 2^32) per cell: bins, then the reasons
-    /// (`cells` in all), and the --rand draws past the queue's four; in per-invocation slabs on a
-    /// CPU adapter, else in storage atomics ([`Counting::choose`]; `force` asks for one, as
-    /// tests do).
-    pub fn histogram(&self, params: &Params, first: u64, count: u32, cells: usize, force: Option<Strategy>) -> Result<Counted, CheckError> {
+    /// Counts of samples `first .. first + count` per cell (the bins of the grid of `params`,
+    /// then the reasons), and the --rand draws past the queue's four: by `lobes run`'s counting
+    /// kernel ([`compose_histogram`]) in the counting [`Counting::choose`] picks for the adapter
+    /// (`force` asks for a strategy, as tests do), in dispatches of at most [`CHUNK`] samples
+    /// folded into 64-bit totals, and as `lobes run` does in tiles of bins where the totals of
+    /// all of them do not fit one storage binding ([`Tiling::fit`]), each a pass over the samples.
+    pub fn histogram(&self, params: &Params, first: u64, count: u64, force: Option<Strategy>) -> Result<Counted, CheckError> {
         let gpu = self.gpu;
-        let p = Params { base: split(first), count, ..*params };
-        let all = cells + DRAW_CELLS;
-        let slabs = match Counting::choose(gpu.info.device_type, &gpu.limits, all as u32, force) {
-            Counting::Slabs { slabs } => slabs,
-            _ => {
-                let spt = 64u32;
-                let p = Params { samples_per_thread: spt, slabs: 0, ..p };
-                let bytes = self.run("lobes_histogram", &p, &[], count.div_ceil(spt), all as u64 * 4, Output::Counts)?;
-                return Ok(Counted::new(bytemuck::cast_slice(&bytes), cells));
+        let bins = params.rows * params.cols;
+        let (tiling, counting) = histogram_counting(gpu.info.device_type, &gpu.limits, bins, force)?;
+        let tile_bins = tiling.tile_bins as u32;
+        let kernel = self.histogram_kernel(params.rows, params.cols, tile_bins, counting)?;
+        let cells = tile_bins as u64 + N_REASONS as u64;
+        let mut counted = Counted { counts: vec![0; bins as usize + N_REASONS as usize], over_drawn: 0, most_draws: 0 };
+        for tile in 0..tiling.tiles as u32 {
+            let buffers = HistogramBuffers::new(gpu, cells, tile_bins, counting);
+            let tile_first = tile * tile_bins;
+            for chunk in (SampleRange { seed: 0, first, count }).chunks(CHUNK) {
+                let p = Params { base: split(chunk.first), count: chunk.count as u32, tile_first, ..*params };
+                let draws = self.count_chunk(&kernel, &buffers, &p, counting.groups(chunk.count), cells)?;
+                // every tile draws every sample: the draws are the first tile's
+                if tile == 0 {
+                    (counted.over_drawn, counted.most_draws) = (counted.over_drawn + draws[0] as u64, counted.most_draws.max(draws[1]));
+                }
             }
+            let totals = gpu.read_u64(&buffers.totals, cells)?;
+            let in_tile = (tile_bins as usize).min(bins as usize - tile_first as usize);
+            counted.counts[tile_first as usize..][..in_tile].copy_from_slice(&totals[..in_tile]);
+            // every tile counts the reasons alike
+            counted.counts[bins as usize..].copy_from_slice(&totals[tile_bins as usize..]);
+        }
+        Ok(counted)
+    }
+
+    /// Counts one chunk of samples (`p`'s range, `groups` workgroups of the sampling) into
+    /// `buffers`' totals; the --rand draw counters of the chunk, left 0.
+    fn count_chunk(&self, kernel: &HistogramKernel, buffers: &HistogramBuffers, p: &Params, groups: u64, cells: u64) -> Result<[u32; 2], CheckError> {
+        let gpu = self.gpu;
+        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("check params"), contents: bytemuck::bytes_of(p), usage: wgpu::BufferUsages::UNIFORM });
+        let bind = |(pipeline, used): &(wgpu::ComputePipeline, Vec<u32>)| -> Result<wgpu::BindGroup, CheckError> {
+            let entries = used.iter().map(|&b| Ok(wgpu::BindGroupEntry { binding: b, resource: buffers.at(b, &uniform)?.as_entire_binding() }));
+            let entries: Vec<wgpu::BindGroupEntry> = entries.collect::<Result<_, CheckError>>()?;
+            Ok(gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check histogram"), layout: &pipeline.get_bind_group_layout(0), entries: &entries }))
         };
-        let p = Params { slabs, ..p };
-        let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("check params"),
-            contents: bytemuck::bytes_of(&p),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let bytes = all as u64 * 4;
-        let counts = gpu.buffer("check counts", bytes, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let slab_buffer = gpu.buffer("check slabs", slabs as u64 * bytes, wgpu::BufferUsages::STORAGE);
-        let (sample, reduce) = (self.pipeline("lobes_histogram_slabs")?, self.pipeline("lobes_reduce_slabs")?);
-        let bind = |pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]| {
-            let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check slabs"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
-        };
-        let (sample_bind, reduce_bind) = (bind(&sample, &[(0, &uniform), (4, &slab_buffer)]), bind(&reduce, &[(0, &uniform), (3, &counts), (4, &slab_buffer)]));
-        let sample_group1 = self.group1("lobes_histogram_slabs", &sample);
+        let (sample_bind, fold_bind) = (bind(&kernel.sample)?, bind(&kernel.fold)?);
         let passes = [
-            Pass { label: "lobes_histogram_slabs", bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &sample, groups: (slabs / SLAB_WORKGROUP) as u64 }], group1: sample_group1.as_ref() },
-            Pass { label: "lobes_reduce_slabs", bind: &reduce_bind, offset: None, steps: vec![Step { pipeline: &reduce, groups: (all as u32).div_ceil(WG) as u64 }], group1: None },
+            Pass { label: SAMPLE_ENTRY, bind: &sample_bind, offset: None, steps: vec![Step { pipeline: &kernel.sample.0, groups }], group1: kernel.group1.as_ref() },
+            Pass { label: "lobes_fold", bind: &fold_bind, offset: None, steps: vec![Step { pipeline: &kernel.fold.0, groups: cells.div_ceil(WG_SIZE as u64) }], group1: None },
         ];
         let seconds = gpu.dispatch(&passes)?;
         self.gpu_seconds.set(self.gpu_seconds.get().zip(seconds).map(|(a, b)| a + b));
-        Ok(Counted::new(bytemuck::cast_slice(&gpu.read(&counts, bytes)?), cells))
+        let draws: [u32; 2] = bytemuck::pod_read_unaligned(&gpu.read(&buffers.draws, 8)?);
+        gpu.clear(&buffers.draws);
+        Ok(draws)
+    }
+
+    /// The histogram's kernel of a `rows` × `cols` grid counting tiles of `tile_bins` bins as
+    /// `counting` says, composed and compiled at its first use.
+    fn histogram_kernel(&self, rows: u32, cols: u32, tile_bins: u32, counting: Counting) -> Result<std::rc::Rc<HistogramKernel>, CheckError> {
+        let key = (rows, cols, tile_bins, counting);
+        if let Some(k) = self.histograms.borrow().get(&key) {
+            return Ok(k.clone());
+        }
+        let (composed, naga_module, info) = compose_histogram(&self.sampler, self.order, (rows, cols, tile_bins), counting)?;
+        let module = self.gpu.module_unvalidated("lobes check's histogram", &composed.text)?;
+        self.gpu.check_errors()?;
+        let pipeline = |entry: &str| -> Result<(wgpu::ComputePipeline, Vec<u32>), CheckError> {
+            Ok((self.gpu.pipeline(&module, None, entry, &[])?, group0_bindings(&naga_module, &info, entry)))
+        };
+        let (sample, fold) = (pipeline(SAMPLE_ENTRY)?, pipeline("lobes_fold")?);
+        let read: Option<Vec<wgpu::BindGroupEntry>> = composed
+            .bound
+            .iter()
+            .filter(|b| b.entries.iter().any(|e| e == SAMPLE_ENTRY))
+            .map(|b| self.resources.iter().find(|(k, ..)| *k == b.binding).map(|(k, _, r)| r.entry(*k)))
+            .collect();
+        let read = read.ok_or_else(|| CheckError::Internal("the histogram reads a resource that no other pass reads".into()))?;
+        let layout = sample.0.get_bind_group_layout(1);
+        let group1 = (!read.is_empty()).then(|| self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("check histogram group 1"), layout: &layout, entries: &read }));
+        let k = std::rc::Rc::new(HistogramKernel { _module: module, sample, fold, group1 });
+        self.histograms.borrow_mut().insert(key, k.clone());
+        Ok(k)
     }
 
     /// The pipeline of `entry`, made at its first use.
@@ -1050,7 +1190,7 @@ mod tests {
         let c = compose(&sampler(text)).unwrap();
         let line = c.text.lines().position(|l| l.starts_with("fn s(")).unwrap() as u32 + 1;
         assert_eq!(c.locate(line, 1), "t.wgsl:2:1");
-        for entry in ["fn lobes_histogram(", "fn lobes_probe(", "fn lobes_rng_uniforms(", "fn lobes_user_sample("] {
+        for entry in ["fn lobes_weights(", "fn lobes_probe(", "fn lobes_rng_uniforms(", "fn lobes_user_sample("] {
             assert!(c.text.contains(entry), "{entry}");
         }
     }
@@ -1068,7 +1208,7 @@ mod tests {
         let mut s = sampler(text);
         s.eval = Some("e".into());
         let gpu = Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
-        let passes = Passes::new(&gpu, &compose(&s).unwrap()).unwrap();
+        let passes = Passes::new(&gpu, &s).unwrap();
         let wi = crate::check::incident(40.0, 20.0);
         let params = Params { user: [[0.05, 0.0, 0.0, 0.0], [0.0; 4], [0.0; 4], [0.0; 4]], wi: [wi[0], wi[1], wi[2], 0.0], ..bytemuck::Zeroable::zeroed() };
         let mut rects = Vec::new();
@@ -1084,33 +1224,58 @@ mod tests {
         assert_eq!(differ, 0, "{differ} of {} rectangles' ∫pdf differ", rects.len());
     }
 
-    /// The histogram pass counts alike in per-invocation slabs (CPU adapters) and in storage
-    /// atomics (GPUs), bit for bit, on whatever adapter wgpu finds (lavapipe in CI): a sampler
-    /// that spreads over the sphere's bins and sends known shares of u to each invalid reason.
+    /// The histogram counts alike in per-invocation slabs (CPU adapters) and in workgroup
+    /// atomics (GPUs), bit for bit, on whatever adapter wgpu finds (lavapipe in CI), and over
+    /// several dispatches as over their ranges apart: a sampler that spreads over the sphere's
+    /// bins and sends known shares of u to each invalid reason.
+    /// Uniform over the sphere, with 1 % of its samples outside the domain (|d| = 2) and 1 %
+    /// rejected (pdf 0).
+    const SPREAD: &str = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
+                              let z = 2.0 * u.x - 1.0; let r = sqrt(max(1.0 - z * z, 0.0)); let phi = 6.2831853 * u.y;\n\
+                              let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
+                              if (u.z < 0.01) { return vec4<f32>(2.0 * d, 1.0); }\n\
+                              if (u.z < 0.02) { return vec4<f32>(d, 0.0); }\n\
+                              return vec4<f32>(d, 0.25 / 3.14159265); }\n\
+                          fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 0.25 / 3.14159265; }\n";
+
     #[test]
     fn histogram_slabs_count_as_atomics() {
-        let text = "fn s(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {\n\
-                        let z = 2.0 * u.x - 1.0; let r = sqrt(max(1.0 - z * z, 0.0)); let phi = 6.2831853 * u.y;\n\
-                        let d = vec3<f32>(r * cos(phi), r * sin(phi), z);\n\
-                        if (u.z < 0.01) { return vec4<f32>(2.0 * d, 1.0); }\n\
-                        if (u.z < 0.02) { return vec4<f32>(d, 0.0); }\n\
-                        return vec4<f32>(d, 0.25 / 3.14159265); }\n\
-                    fn p(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 { return 0.25 / 3.14159265; }\n";
         let gpu = Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
-        let passes = Passes::new(&gpu, &compose(&sampler(text)).unwrap()).unwrap();
+        let passes = Passes::new(&gpu, &sampler(SPREAD)).unwrap();
         let (rows, cols) = (32, 64);
         let params = Params { wi: [0.0, 0.0, 1.0, 0.0], seed: [7, 0], rows, cols, ..bytemuck::Zeroable::zeroed() };
-        let cells = (rows * cols) as usize + Invalid::COUNT;
-        for (first, count) in [(0u64, 1_000_003u32), (5_000_000_000, 77)] {
-            let atomics = passes.histogram(&params, first, count, cells, Some(Strategy::Atomics)).unwrap().counts;
-            let slabs = passes.histogram(&params, first, count, cells, Some(Strategy::Slabs)).unwrap().counts;
-            assert_eq!(atomics.iter().map(|&c| c as u64).sum::<u64>(), count as u64);
+        for (first, count) in [(0u64, 1_000_003u64), (5_000_000_000, 77)] {
+            let atomics = passes.histogram(&params, first, count, Some(Strategy::Atomics)).unwrap().counts;
+            let slabs = passes.histogram(&params, first, count, Some(Strategy::Slabs)).unwrap().counts;
+            assert_eq!(atomics.len(), (rows * cols) as usize + Invalid::COUNT);
+            assert_eq!(atomics.iter().sum::<u64>(), count);
             assert!(atomics == slabs, "slabs and atomics counted samples {first}.. differently");
         }
+        // over more than one dispatch, the counts of its two ranges summed
+        let whole = passes.histogram(&params, 3, CHUNK + 77, None).unwrap().counts;
+        let (a, b) = (passes.histogram(&params, 3, CHUNK, None).unwrap().counts, passes.histogram(&params, CHUNK + 3, 77, None).unwrap().counts);
+        assert!(whole.iter().zip(a.iter().zip(&b)).all(|(w, (a, b))| *w == a + b), "the chunks of one histogram count as their ranges apart");
         // about 1 % each outside the domain and with pdf 0 (10 000 ± 100)
-        let counts = passes.histogram(&params, 0, 1_000_003, cells, Some(Strategy::Slabs)).unwrap().counts;
+        let counts = passes.histogram(&params, 0, 1_000_003, Some(Strategy::Slabs)).unwrap().counts;
         let bins = (rows * cols) as usize;
         let (outside, zero) = (counts[bins + Invalid::OutsideDomain.index()], counts[bins + Invalid::ZeroPdf.index()]);
         assert!((9_500..10_500).contains(&outside) && (9_500..10_500).contains(&zero), "{outside} {zero}");
+    }
+
+    /// A grid whose 64-bit totals do not fit one storage binding is counted in tiles, each a
+    /// pass over the samples, as `lobes run` counts its jobs: on an adapter that binds 8 KiB,
+    /// 32 × 64 bins in three tiles, counted bit for bit as in one pass, the reasons and the
+    /// --rand draws once.
+    #[test]
+    fn a_grid_too_large_for_one_binding_is_counted_in_tiles() {
+        let whole = Gpu::new().unwrap_or_else(|e| panic!("GPU tests need a wgpu adapter: {e}"));
+        let small = Gpu::with_limits(|l| wgpu::Limits { max_storage_buffer_binding_size: 8192, ..l }).unwrap();
+        let (rows, cols) = (32, 64);
+        assert_eq!(histogram_counting(small.info.device_type, &small.limits, rows * cols, None).unwrap().0.tiles, 3);
+        let params = Params { wi: [0.0, 0.0, 1.0, 0.0], seed: [3, 0], rows, cols, ..bytemuck::Zeroable::zeroed() };
+        let one = Passes::new(&whole, &sampler(SPREAD)).unwrap().histogram(&params, 11, 300_001, None).unwrap();
+        let tiled = Passes::new(&small, &sampler(SPREAD)).unwrap().histogram(&params, 11, 300_001, None).unwrap();
+        assert_eq!(tiled.counts.iter().sum::<u64>(), 300_001);
+        assert!(one == tiled, "the tiles count as one pass does");
     }
 }

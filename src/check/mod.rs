@@ -325,13 +325,22 @@ impl UserSampler {
             )));
         }
         // the glue's own errors (a call expression's, a --rand function's) now, not at the GPU
-        gpu::prepare(self, Draw::components(self.composition.rand_order.as_deref().unwrap_or(&[])))?;
+        gpu::prepare(self, gpu::default_order(self))?;
         Ok(())
     }
 
-    /// The composed WGSL that `check` runs (the user's files, the glue, lobes' passes).
+    /// The composed WGSL of lobes' passes with the user's files and glue (the probes, the
+    /// quadrature, the weights), one module that `check` runs.
     pub fn composed(&self) -> Result<String, CheckError> {
         Ok(gpu::compose(self)?.text)
+    }
+
+    /// The composed WGSL of the histogram on a `rows` × `cols` grid as `check` counts it on an
+    /// adapter of `device` type with `limits`: `lobes run`'s counting kernel drawing the
+    /// sampler, the other module that `check` runs.
+    pub fn composed_histogram(&self, device: wgpu::DeviceType, limits: &wgpu::Limits, rows: u32, cols: u32) -> Result<String, CheckError> {
+        let (tiling, counting) = gpu::histogram_counting(device, limits, rows * cols, None)?;
+        Ok(gpu::compose_histogram(self, gpu::default_order(self), (rows, cols, tiling.tile_bins as u32), counting)?.0.text)
     }
 }
 
@@ -514,12 +523,12 @@ fn params_of(sampler: &UserSampler, settings: &Settings) -> gpu::Params {
 /// The sampler's passes, with the user's --rand draws (at most four) in the order lobes' probe
 /// finds them unless --rand-order gave it, and the note on that order for the report.
 fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, params: &gpu::Params) -> Result<(gpu::Passes<'g>, String), CheckError> {
-    let mut passes = gpu::Passes::new(gpu, &gpu::compose(sampler)?)?;
+    let mut passes = gpu::Passes::new(gpu, sampler)?;
     let mut draws = String::new();
     if !sampler.composition.rand.is_empty() {
         let (order, note) = gpu::rand_order(&passes, params, sampler, settings.seed)?;
         if sampler.composition.rand_order.is_none() && order != Draw::components(&[]) {
-            passes = gpu::Passes::new(gpu, &gpu::compose_ordered(sampler, order)?)?;
+            passes = gpu::Passes::ordered(gpu, sampler, order)?;
         }
         draws = note;
     }
@@ -536,13 +545,12 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
     settings.validate()?;
     let _deadline = gpu.deadline(settings.timeout);
     sampler.validate()?;
-    let (rows, cols) = settings.grid(&sampler.domain);
     let (passes, _) = compose_passes(gpu, sampler, settings, &params_of(sampler, settings))?;
     runs.iter()
         .map(|&(samples, seed)| {
             let params = params_of(sampler, &Settings { seed, ..settings.clone() });
             let started = std::time::Instant::now();
-            let counts = gpu::histogram(&passes, &params, sampler, samples, (rows * cols) as usize)?;
+            let counts = gpu::histogram(&passes, &params, sampler, samples)?;
             Ok((counts, started.elapsed().as_secs_f64()))
         })
         .collect()

@@ -27,7 +27,7 @@
 //! [`sphere_integral_f64`] on the CPU), from parts graded toward the poles rather than a
 //! histogram's bins: what the microfacet identities of `tests/microfacet_identities.rs` need.
 
-use super::gpu::{self, Params, Passes};
+use super::gpu::{Params, Passes};
 
 use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
 use crate::engine::gpu::Gpu;
@@ -633,7 +633,7 @@ impl<'g> WgslIntegrand<'g> {
         });
         let sampler = UserSampler { sources, sample: UNSAMPLED.into(), pdf: function.into(), eval: None, domain: Domain::Sphere, conventions: Default::default(), composition: Default::default() };
         sampler.validate()?;
-        Ok(Self { passes: Passes::new(gpu, &gpu::compose(&sampler)?)? })
+        Ok(Self { passes: Passes::new(gpu, &sampler)? })
     }
 
     /// ∫ function(wi, d, params) dω(d) over the unit sphere; `params` are at most 16 numbers,

@@ -1,13 +1,17 @@
 //! `lobes check`'s own WGSL (`shaders/check`), handed to each composition of a user's sampler
-//! beside the files made for it: the passes (`lobes::check`) and the binning of each domain
+//! beside the files made for it: the passes (`lobes::check`), the histogram's draw (`lobes::draw`) and the binning of each domain
 //! (`lobes::domain`, the file [`Domain::binning_wgsl`] names). The engine's library holds
 //! `lobes run`'s files only.
 
 use super::Domain;
 use crate::engine::gpu::library::{File, shader};
 
-/// The passes: histogram, probes, quadrature, weights (`shaders/check/user_passes.wgsl`).
+/// The passes: probes, quadrature, weights (`shaders/check/user_passes.wgsl`).
 pub(super) const PASSES: File = shader!("check/user_passes.wgsl");
+
+/// The histogram's draw of a user's sampler (`lobes::draw`, `shaders/check/user_draw.wgsl`), in
+/// the place of a lobe's in `lobes run`'s counting kernel.
+pub(super) const DRAW: File = shader!("check/user_draw.wgsl");
 
 /// `lobes::domain` of every domain.
 const DOMAINS: [File; 5] = [

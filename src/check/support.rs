@@ -110,7 +110,7 @@ pub(super) fn fit<'g>(gpu: &'g crate::engine::gpu::Gpu, sampler: &UserSampler, s
     for height in tries {
         let bounds = [axis[0] as f32, axis[1] as f32, axis[2] as f32, height as f32];
         let params = super::gpu::Params { bounds, ..params };
-        let counts = super::gpu::histogram(&passes, &params, &trial, settings.samples, FIT_ROWS as usize)?;
+        let counts = super::gpu::histogram(&passes, &params, &trial, settings.samples)?;
         if let Some(cap) = fitted(axis, height, &counts) {
             return Ok(Some((cap, passes, draws)));
         }

@@ -489,7 +489,11 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         Err(e) => return Err(input(e)),
     };
     if let Some(dir) = &args.out {
-        crate::report::check::write(dir, &report, &sampler.composed().map_err(input)?)?;
+        // the module that ran: on the report's domain (a cap fitted to the samples, where one was)
+        let ran = UserSampler { domain: report.domain, ..sampler.clone() };
+        let histogram = ran.composed_histogram(gpu.info.device_type, &gpu.limits, report.rows, report.cols).map_err(input)?;
+        let modules = [ran.composed().map_err(input)?, histogram];
+        crate::report::check::write(dir, &report, &modules)?;
     }
     if args.output.json {
         emit_json(&report)?;

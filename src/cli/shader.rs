@@ -32,27 +32,34 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     let engine = GpuEngine::open().map_err(|e| crate::console::say(format_args!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits"))).ok();
     let mut modules: Vec<(PipelineSource, Vec<&str>)> = Vec::new();
     for entry in entries {
-        let m = match entry {
+        let ms = match entry {
             Entry::Lobe(case) => {
                 let (counting, tile) = match &engine {
                     Some(e) => {
                         let tile = e.tiling(&case.job).map_or(case.job.bins() as u64, |t| t.tile_bins) as u32;
                         (e.counting(tile), tile)
                     }
-                    None => {
-                        let tile = case.job.bins() as u32;
-                        (Counting::atomics(wgpu::Limits::default().max_compute_workgroup_storage_size / 4, tile), tile)
-                    }
+                    None => default_counting(case.job.bins() as u32),
                 };
-                effects::case_module(&case.job, case.effects.as_ref(), counting, tile)
+                vec![effects::case_module(&case.job, case.effects.as_ref(), counting, tile)]
             }
-            // a user's sampler: its files, the glue and `lobes check`'s passes (one module for
-            // every incident angle and params, which are uniforms)
-            Entry::User(case) => PipelineSource { source: case.sampler.composed()?, constants: Vec::new() },
+            // a user's sampler: its files, the glue and `lobes check`'s passes, and the
+            // histogram's module (each one for every incident angle and params, which are
+            // uniforms)
+            Entry::User(case) => {
+                let (rows, cols) = case.settings.grid(&case.sampler.domain);
+                let histogram = match &engine {
+                    Some(e) => case.sampler.composed_histogram(e.gpu.info.device_type, &e.gpu.limits, rows, cols)?,
+                    None => case.sampler.composed_histogram(wgpu::DeviceType::Other, &wgpu::Limits::default(), rows, cols)?,
+                };
+                [case.sampler.composed()?, histogram].map(|source| PipelineSource { source, constants: Vec::new() }).into()
+            }
         };
-        match modules.iter_mut().find(|(k, _)| *k == m) {
-            Some((_, names)) => names.push(entry.name()),
-            None => modules.push((m, vec![entry.name()])),
+        for m in ms {
+            match modules.iter_mut().find(|(k, _)| *k == m) {
+                Some((_, names)) => names.push(entry.name()),
+                None => modules.push((m, vec![entry.name()])),
+            }
         }
     }
     if args.output.json {
@@ -77,4 +84,10 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
         text += "\n";
     }
     emit(&text)
+}
+
+/// The counting of `tile` bins on an adapter with wgpu's default limits (none found), and the
+/// tile.
+fn default_counting(tile: u32) -> (Counting, u32) {
+    (Counting::atomics(wgpu::Limits::default().max_compute_workgroup_storage_size / 4, tile), tile)
 }

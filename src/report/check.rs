@@ -15,17 +15,21 @@ use std::path::Path;
 /// The file names in the output folder (and the pictures', [`super::compare`]).
 pub use super::compare::{EXPECTED_PNG, MARGINALS_PNG, MEASURED_PNG, RESIDUAL_PNG};
 pub const COMPOSED_WGSL: &str = "composed.wgsl";
+pub const HISTOGRAM_WGSL: &str = "composed_histogram.wgsl";
 pub const REPORT_JSON: &str = "report.json";
 pub const POWER_JSON: &str = "power.json";
 
 /// Every file a check writes into its folder: an owner removes them all before it runs
 /// ([`super::folder::OutFolder::clean_files`]), so that none is left looking like this check's.
-pub const CHECK_FILES: [&str; 9] = [REPORT_JSON, POWER_JSON, COMPOSED_WGSL, MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, super::compare::RESIDUAL_COARSE_PNG, MARGINALS_PNG, super::compare::BARS_PNG];
+pub const CHECK_FILES: [&str; 10] = [REPORT_JSON, POWER_JSON, COMPOSED_WGSL, HISTOGRAM_WGSL, MEASURED_PNG, EXPECTED_PNG, RESIDUAL_PNG, super::compare::RESIDUAL_COARSE_PNG, MARGINALS_PNG, super::compare::BARS_PNG];
 
-/// Writes the heat maps, `composed.wgsl` (the module that ran) and then `report.json` into `dir`.
-pub fn write(dir: &Path, report: &Report, composed: &str) -> anyhow::Result<()> {
+/// Writes the heat maps, the two modules that ran (`composed.wgsl`, lobes' passes with the
+/// user's files, and `composed_histogram.wgsl`, the histogram's) and then `report.json` into
+/// `dir`.
+pub fn write(dir: &Path, report: &Report, [passes, histogram]: &[String; 2]) -> anyhow::Result<()> {
     write_maps(dir, report)?;
-    write_atomic(&dir.join(COMPOSED_WGSL), composed.as_bytes())?;
+    write_atomic(&dir.join(COMPOSED_WGSL), passes.as_bytes())?;
+    write_atomic(&dir.join(HISTOGRAM_WGSL), histogram.as_bytes())?;
     write_atomic(&dir.join(REPORT_JSON), serde_json::to_string_pretty(report)?.as_bytes())?;
     Ok(())
 }

@@ -126,7 +126,7 @@ impl Measured {
 
 /// Measures `run`: the histogram, the probes, and the quadrature of the pdf.
 pub(crate) fn measure(run: &Run) -> Result<Measured, CheckError> {
-    let totals = histogram(&run.passes, &run.params, &run.sampler, run.settings.samples, run.bins())?;
+    let totals = histogram(&run.passes, &run.params, &run.sampler, run.settings.samples)?;
     let probe_u = probe_uniforms(run.settings);
     let probes = run.passes.probe(&run.params, &probe_items(run))?;
     let points: Vec<[f32; 3]> = probes.iter().map(Probe::d).map(|d| if d.iter().all(|x| x.is_finite()) { d } else { [0.0; 3] }).collect();

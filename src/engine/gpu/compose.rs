@@ -102,10 +102,16 @@ impl Kernel {
         self.compose().unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// The composed WGSL, or the first file that does not compose (at its line).
-    fn compose(&self) -> Result<String, GpuError> {
+    /// The files chosen in place of built-in ones, its generated `lobes::job` among them.
+    pub fn files(&self) -> Result<Vec<File>, GpuError> {
         let mut chosen = self.chosen.clone();
         chosen.push(self.job.file(&self.chosen)?);
+        Ok(chosen)
+    }
+
+    /// The composed WGSL, or the first file that does not compose (at its line).
+    fn compose(&self) -> Result<String, GpuError> {
+        let chosen = self.files()?;
         let composed = library::compose(&self.roots, &chosen)?;
         // the per-file build that `compose` skips when the joined module validates: in the unit
         // tests, which compose every kind of kernel, a file that uses a name it does not import
@@ -268,15 +274,23 @@ pub(crate) fn quadrature_kernel(spec: &SamplerSpec, rows: u32, cols: u32, n_node
     Kernel { roots: vec!["lobes::quadrature"], chosen: Vec::new(), job }
 }
 
-/// `lobes::kernel` with the job's constants, the math of `precision` and `counting`'s module
-/// (`shaders/passes/counting_workgroup.wgsl`, `counting_global.wgsl`, `counting_slabs.wgsl`);
+/// `lobes::kernel` with the job's constants, the math of `precision` and `counting`'s module;
 /// the draw is the caller's.
 fn counting_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Precision) -> Kernel {
-    let bins = job.bins() as u32;
     let (rows, cols) = match job {
         Job::Lobe { grid, .. } => (grid.rows, grid.cols),
-        Job::Discrete { .. } => (1, bins),
+        Job::Discrete { .. } => (1, job.bins() as u32),
     };
+    grid_counting_kernel(&describe(job), rows, cols, counting, tile_bins, precision)
+}
+
+/// `lobes::kernel` counting a `rows` × `cols` grid (`tile_bins` of its bins a pass) as
+/// `counting` says (`shaders/passes/counting_workgroup.wgsl`, `counting_global.wgsl`,
+/// `counting_slabs.wgsl`), in the math of `precision`, for `what`: the one counting kernel of
+/// `lobes run`'s jobs and of `lobes check`'s histogram (whose `lobes::draw` draws a user's
+/// sampler). The draw is the caller's.
+pub(crate) fn grid_counting_kernel(what: &str, rows: u32, cols: u32, counting: Counting, tile_bins: u32, precision: Precision) -> Kernel {
+    let bins = rows * cols;
     let bins_per_word = if counting == Counting::WorkgroupPacked { 2 } else { 1 };
     // the workgroup array of counting_workgroup.wgsl, which only that module declares
     let wg_words = tile_bins.div_ceil(bins_per_word);
@@ -301,7 +315,7 @@ fn counting_kernel(job: &Job, counting: Counting, tile_bins: u32, precision: Pre
         }
         _ => "fn slabs_used(count: u32) -> u32 {\n    return 0u;\n}\n".to_string(),
     };
-    let mut job_module = JobModule::new(describe(job));
+    let mut job_module = JobModule::new(what);
     job_module.push(&format!(
         "const ROWS: u32 = {rows}u;\nconst COLS: u32 = {cols}u;\nconst BINS: u32 = {bins}u;\n\
          const TILE_BINS: u32 = {tile_bins}u;\nconst CELLS: u32 = TILE_BINS + REASON_COUNT;\nconst WG_WORDS: u32 = {wg_words}u;\n\

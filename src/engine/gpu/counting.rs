@@ -1,5 +1,7 @@
 //! How the counting kernel counts a tile's bins: the one choice, a function of the adapter's
-//! device type and limits ([`Counting::choose`]), and what each choice needs of the host.
+//! device type and limits ([`Counting::choose`]), and what each choice needs of the host. The
+//! kernel counts `lobes run`'s jobs and `lobes check`'s histogram alike (`src/check/gpu.rs`
+//! composes it with a user's sampler as its draw).
 //!
 //! - On a GPU, workgroup atomics (`shaders/passes/counting_workgroup.wgsl`): a u32 counter per
 //!   bin in workgroup memory, or two 16-bit counters a word where only half fits, flushed to the
@@ -42,7 +44,7 @@ pub enum Strategy {
 }
 
 /// How a kernel counts its tile's bins.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Counting {
     /// A u32 workgroup atomic per bin.
     Workgroup,

@@ -58,6 +58,20 @@ pub struct Tiling {
     pub tiles: u64,
 }
 
+impl Tiling {
+    /// How a histogram of `bins` bins is split to fit `limits`: a tile's cells (its bins and
+    /// the invalid reasons) must fit one storage binding as 64-bit totals, and the fold
+    /// kernel's grid (one invocation per cell) the per-dimension dispatch limit. `None` where
+    /// the limits hold no histogram at all.
+    pub fn fit(bins: u64, limits: &wgpu::Limits) -> Option<Tiling> {
+        let bytes = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let dim = limits.max_compute_workgroups_per_dimension as u64;
+        let max_cells = (bytes / 8).min(dim * dim * WG_SIZE as u64).min(u32::MAX as u64);
+        let tile_bins = bins.max(1).min(max_cells.checked_sub(N_REASONS as u64).filter(|&c| c > 0)?);
+        Some(Tiling { tile_bins, tiles: bins.max(1).div_ceil(tile_bins) })
+    }
+}
+
 /// Histograms jobs on a GPU; pipelines are cached by composed source, so cases of one shape
 /// compile once.
 pub struct GpuEngine {
@@ -122,15 +136,12 @@ impl GpuEngine {
         self.gpu.limits.max_storage_buffer_binding_size.min(self.gpu.limits.max_buffer_size)
     }
 
-    /// How `job`'s histogram is split to fit this adapter's limits: a tile's cells (its bins and
-    /// the invalid reasons) must fit one storage binding as 64-bit totals, and the fold
-    /// kernel's grid (one invocation per cell) the per-dimension dispatch limit. An error if
-    /// the job cannot run here at all (a discrete table larger than a storage binding).
+    /// How `job`'s histogram is split to fit this adapter's limits ([`Tiling::fit`]). An error
+    /// if the job cannot run here at all (a discrete table larger than a storage binding).
     pub fn tiling(&self, job: &Job) -> Result<Tiling, GpuError> {
         let limits = &self.gpu.limits;
         let bytes = self.max_storage_bytes();
         let dim = limits.max_compute_workgroups_per_dimension as u64;
-        let max_cells = (bytes / 8).min(dim * dim * WG_SIZE as u64).min(u32::MAX as u64);
         let what = compose::describe(job);
         let limit_names = format!(
             "max_storage_buffer_binding_size {}, max_buffer_size {}",
@@ -145,14 +156,9 @@ impl GpuEngine {
                 )));
             }
         }
-        if max_cells <= N_REASONS as u64 {
-            return Err(GpuError::TooLarge(format!(
-                "{what}: this adapter's limits hold no histogram ({limit_names}, max_compute_workgroups_per_dimension {dim})"
-            )));
-        }
-        let bins = (job.bins() as u64).max(1);
-        let tile_bins = bins.min(max_cells - N_REASONS as u64);
-        Ok(Tiling { tile_bins, tiles: bins.div_ceil(tile_bins) })
+        Tiling::fit(job.bins() as u64, limits).ok_or_else(|| {
+            GpuError::TooLarge(format!("{what}: this adapter's limits hold no histogram ({limit_names}, max_compute_workgroups_per_dimension {dim})"))
+        })
     }
 
     fn kernel(&mut self, job: &Job) -> Result<Arc<KernelPipelines>, GpuError> {

@@ -31,15 +31,12 @@ pub struct Params {
     pub bounds: [f32; 4],
     /// The finite-difference step of `lobes check`'s probe pass.
     pub eps: f32,
-    /// The samples each invocation of `lobes check`'s histogram and weights passes draws.
+    /// The samples each invocation of `lobes check`'s weights pass draws.
     pub samples_per_thread: u32,
-    /// `lobes check`'s histogram grid.
+    /// `lobes check`'s histogram grid (its binning reads it; the counting kernel's are
+    /// constants).
     pub rows: u32,
     pub cols: u32,
-    /// `lobes check`'s per-invocation slabs of the histogram (0: global atomics).
-    pub slabs: u32,
-    /// To the struct's size in WGSL, a multiple of its 16-byte alignment.
-    pub(crate) _pad: [u32; 3],
 }
 
 impl Params {
@@ -155,7 +152,6 @@ mod tests {
             ("samples_per_thread", offset_of!(Params, samples_per_thread)),
             ("rows", offset_of!(Params, rows)),
             ("cols", offset_of!(Params, cols)),
-            ("slabs", offset_of!(Params, slabs)),
         ];
         let dist = crate::reference::discrete::Distribution::new(&[1.0, 2.0]).unwrap();
         let source = super::super::compose::compose(&Job::Discrete { dist, method: DiscreteMethod::Alias }, 4096);
