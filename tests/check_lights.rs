@@ -424,8 +424,9 @@ fn bindings_without_the_right_file_are_exit_2() {
     bytes.extend(header.bytes());
     bytes.extend([0u8; 8]);
     std::fs::write(&npy_of_u32, bytes).unwrap();
-    let cases: [(&str, String, &str); 4] = [
-        ("env_marginal", String::new(), "`env_marginal` (@group(0) @binding(1), a storage buffer) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture env_marginal=FILE.hdr"),
+    let cases: [(&str, String, &str); 5] = [
+        ("env_marginal", String::new(), "`env_marginal` (@group(0) @binding(1), a storage buffer) is a resource of the renderer that the sampler reads, and nothing is bound to it"),
+        ("env_marginal", String::new(), "help: bind its contents (--texture env_marginal=FILE.hdr"),
         ("env_marginal", npy_of_u32.display().to_string(), "the buffer file of `env_marginal` holds u32 and `env_marginal` is an array<f32>"),
         ("env_conditional", format!("{ENVMAP}/sky.hdr"), "a table is a NumPy .npy array or raw little-endian 32-bit words (.bin, .raw), by its extension"),
         ("env_radiance", format!("{ENVMAP}/missing.hdr"), "--texture: env_radiance=examples/envmap/missing.hdr: cannot read the file"),

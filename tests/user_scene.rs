@@ -292,6 +292,24 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
     }
 }
 
+/// The advice in a check's error names settings as the scene writes them: a case whose sampler
+/// reads a texture that nothing binds says `sampler.texture NAME=FILE.hdr` (and `sampler.stub`),
+/// where `lobes check` says `--texture NAME=FILE.hdr`.
+#[test]
+fn advice_names_the_scene_keys() {
+    let dir = scratch("advice");
+    std::fs::copy(root().join("examples/envmap/envmap.wgsl"), dir.join("envmap.wgsl")).unwrap();
+    let scene = dir.join("s.toml");
+    std::fs::write(&scene, "[defaults]\nsamples = 65536\n\n[[case]]\nname = \"env\"\nsampler = { wgsl = [\"envmap.wgsl\"], sample = \"env_sample\", pdf = \"env_pdf\" }\nparams = [1]\n").unwrap();
+    let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("nothing is bound to it") && stderr.contains("(sampler.texture env_radiance=FILE.hdr for a texture_2d<f32>") && stderr.contains("(sampler.stub MODULE=FILE"), "{stderr}");
+    assert!(!stderr.contains("--texture") && !stderr.contains("--stub"), "{stderr}");
+    let check = lobes(&["check", "examples/envmap/envmap.wgsl", "--sample", "env_sample", "--pdf", "env_pdf", "--params", "1"]);
+    assert_eq!(check.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&check.stderr).contains("help: bind its contents (--texture env_radiance=FILE.hdr"));
+}
+
 /// `lobes shader` shows the modules of users' cases too (nothing in a scene is left out): two
 /// modules per sampler (lobes check's passes, and the histogram's counting kernel drawing it),
 /// shared by the cases of its sweep, each holding the user's own functions, valid WGSL.

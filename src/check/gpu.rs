@@ -6,7 +6,7 @@ use super::compose::{Composed, Source};
 use super::composition::{Call, Draw, UserCode, is_name};
 use super::modules::compose_user;
 use super::probe::Probe;
-use super::{CheckError, Setting, UserSampler, shaders};
+use super::{CheckError, Message, Setting, UserSampler, shaders};
 use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::compose::grid_counting_kernel;
@@ -356,7 +356,7 @@ fn area_to_solid_angle(returned: Returned) -> String {
 fn light_cos(sampler: &UserSampler) -> String {
     match sampler.composition.normal.as_deref().filter(|_| sampler.conventions.measure == super::conventions::Measure::Area) {
         Some(normal) => format!(
-            "fn lobes_light_cos(p: vec3<f32>, lobes_d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{}    // --normal\n    return abs(dot({normal}, lobes_d));\n}}\n",
+            "fn lobes_light_cos(p: vec3<f32>, lobes_d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32 {{\n{}    // the light's normal at p (the composition's normal expression)\n    return abs(dot({normal}, lobes_d));\n}}\n",
             names("0u")
         ),
         None => String::new(),
@@ -640,9 +640,13 @@ fn unset_uniform(module: &naga::Module, uniforms: &[(String, String)], expressio
     let reached = |name: &str| module.global_variables.iter().any(|(_, g)| g.name.as_deref() == Some(name));
     let set = |name: &str| expressions.iter().any(|e| e.split(|c: char| !(c.is_alphanumeric() || c == '_')).any(|w| w == name));
     match uniforms.iter().find(|(name, _)| reached(name) && !set(name)) {
-        Some((name, at)) => Err(CheckError::Input(format!(
-            "{at}: the sampler reads the OpenGL uniform `{name}`, which the renderer sets with glUniform and lobes cannot (it is 0 here); set it where the call expression starts, e.g. --sample '{name} = 1; …' (or --params and p0)"
-        ))),
+        Some((name, at)) => Err(CheckError::Advised(
+            Message::text(format!("{at}: the sampler reads the OpenGL uniform `{name}`, which the renderer sets with glUniform and lobes cannot (it is 0 here); set it where the call expression starts, e.g. "))
+                .setting(Setting::Sample)
+                .then(format!(" '{name} = 1; …' (or "))
+                .setting(Setting::Params)
+                .then(" and p0)"),
+        )),
         None => Ok(()),
     }
 }
@@ -781,7 +785,7 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
         let global = g.name.as_deref().unwrap_or("?");
         let Some((name, resource)) = given.iter().find(|(n, _)| resources::names(global, n)) else {
             let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or_else(|| g.binding).expect("a binding");
-            return Err(CheckError::Input(c.diagnostic_at(span, &unbound(g, &as_declared, module))));
+            return Err(CheckError::Advised(unbound(c.diagnostic_at(span, &unbound_message(g, &as_declared, module)), g)));
         };
         let data = resources::load(name, resource).map_err(|e| CheckError::setting(e.kind.into(), e.message))?;
         resources::fits(name, &data, g, module).map_err(|e| CheckError::Input(c.diagnostic_at(span, &e)))?;
@@ -792,20 +796,36 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
     Ok(())
 }
 
-/// Why a reached resource of the user's has nothing bound, and what to give; a naga_oil name
-/// (`nameX_naga_oil_mod_X…X`) as the user's plain name and its module.
-fn unbound(g: &naga::GlobalVariable, b: &naga::ResourceBinding, module: &naga::Module) -> String {
+/// Why a reached resource of the user's has nothing bound (what to give: [`unbound`]); a
+/// naga_oil name (`nameX_naga_oil_mod_X…X`) as the user's plain name and its module.
+fn unbound_message(g: &naga::GlobalVariable, b: &naga::ResourceBinding, module: &naga::Module) -> String {
     let global = g.name.as_deref().unwrap_or("?");
     let (name, from) = match super::resources::undecorated(global) {
         Some((name, module)) => (name, format!(" of module {module}")),
         None => (global, String::new()),
     };
     format!(
-        "`{name}`{from} (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads, and nothing is bound to it: bind its contents (--texture {name}=FILE.hdr for a texture_2d<f32>, --buffer {name}=FILE.npy for a storage array, --sampler {name}=linear or nearest for a sampler), or give the test a stand-in without it (--stub MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)",
+        "`{name}`{from} (@group({}) @binding({}), {}) is a resource of the renderer that the sampler reads, and nothing is bound to it",
         b.group,
         b.binding,
         resource_kind(g, &module.types[g.ty].inner)
     )
+}
+
+/// `diagnostic` (of an unbound resource `g`) with how to mend it: bind its contents, or stand in
+/// for its module.
+fn unbound(diagnostic: String, g: &naga::GlobalVariable) -> Message {
+    let global = g.name.as_deref().unwrap_or("?");
+    let name = super::resources::undecorated(global).map_or(global, |(name, _)| name);
+    Message::text(format!("{diagnostic}\n    help: bind its contents ("))
+        .setting(Setting::Texture)
+        .then(format!(" {name}=FILE.hdr for a texture_2d<f32>, "))
+        .setting(Setting::Buffer)
+        .then(format!(" {name}=FILE.npy for a storage array, "))
+        .setting(Setting::Filter)
+        .then(format!(" {name}=linear or nearest for a sampler), or give the test a stand-in without it ("))
+        .setting(Setting::Stub)
+        .then(" MODULE=FILE with a constant or a function in its place, e.g. a lookup table as a const array)")
 }
 
 /// What kind of resource a bound global is, for messages: "a storage buffer", "a texture", ….

@@ -48,6 +48,7 @@ pub mod modules;
 pub mod jacobian;
 mod judge;
 pub mod light;
+mod message;
 pub mod power;
 pub mod probe;
 pub mod quadrature;
@@ -57,6 +58,7 @@ mod shaders;
 pub mod support;
 
 pub use compose::Source;
+pub use message::Message;
 pub use conventions::{Conventions, Frame, Incident, Measure};
 /// glam, whose `DVec3` [`Reference`] takes: a renderer's tests need no glam of their own.
 pub use glam;
@@ -73,6 +75,10 @@ pub enum CheckError {
     /// Bad input: a flag, a file, a function name.
     #[error("{0}")]
     Input(String),
+    /// Bad input whose message names the settings that would mend it (the command line shows
+    /// each by its flag, a scene by its key).
+    #[error("{0}")]
+    Advised(Message),
     /// The user's WGSL does not parse or validate; the message points at file:line:column.
     #[error("{0}")]
     Wgsl(String),
@@ -103,7 +109,7 @@ impl CheckError {
 
     /// Whether the error is the user's input (exit code 2) rather than a failure to run (1).
     pub fn is_input(&self) -> bool {
-        matches!(self, CheckError::Input(_) | CheckError::Wgsl(_) | CheckError::Setting { .. })
+        matches!(self, CheckError::Input(_) | CheckError::Advised(_) | CheckError::Wgsl(_) | CheckError::Setting { .. })
     }
 }
 

@@ -52,10 +52,14 @@ impl Albedo {
 }
 
 /// A check's error as a run's: a GPU error keeps its type, so that a lost device stops the run's
-/// remaining cases ([`super::device_lost`]).
+/// remaining cases ([`super::device_lost`]); settings are named by their scene keys.
 fn run_error(e: CheckError) -> anyhow::Error {
+    use crate::scene::user::scene_key;
     match e {
         CheckError::Gpu(g) => anyhow::Error::new(g),
+        // a setting, and the settings a message names, as the scene names them
+        CheckError::Setting { setting, message } => anyhow::anyhow!("{}: {message}", scene_key(setting)),
+        CheckError::Advised(m) => anyhow::anyhow!("{}", m.render(&scene_key)),
         other => other.into(),
     }
 }

@@ -44,7 +44,7 @@ mod select;
 pub use crate::suggest;
 mod sweep;
 pub mod template;
-mod user;
+pub(crate) mod user;
 
 pub use sweep::MAX_CASES;
 pub use user::UserCase;

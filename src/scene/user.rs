@@ -103,6 +103,7 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
         .and_then(|s| s.with_conventions(conventions))
         .map_err(|e| match e {
             crate::check::CheckError::Setting { setting, message } => ctx.err(raw.span(), format!("{}: {message}", scene_key(setting))),
+            crate::check::CheckError::Advised(m) => ctx.err(raw.span(), format!("sampler: {}", m.render(&scene_key))),
             e => ctx.err(raw.span(), format!("sampler: {e}")),
         })
         .map(Arc::new)
@@ -110,7 +111,7 @@ pub(super) fn sampler(ctx: &Ctx, c: &RawCase, p: &Point, raw: &Spanned<RawSample
 
 /// A setting as a scene names it: a key of the case (`incident_theta`, `bounds`) or of its
 /// `sampler` table (`sampler.measure`).
-fn scene_key(setting: crate::check::Setting) -> String {
+pub(crate) fn scene_key(setting: crate::check::Setting) -> String {
     use crate::check::Setting::*;
     match setting {
         Params | IncidentTheta | IncidentPhi | Samples | Timeout | Bins | Significance | Bounds | Budget => setting.key().to_string(),

@@ -3,7 +3,7 @@
 //! roots ([`oil_modules`]) and orders them ([`oil_order`]); naga_oil's `Composer` composes the
 //! tree, and naga's WGSL writer writes it back as one text.
 
-use super::super::{CheckError, Setting};
+use super::super::{CheckError, Message, Setting};
 use super::super::compose::{Source, global_names, write_wgsl};
 use super::super::composition::{Call, Composition, Dialect, Origin, Renamed, UserCode};
 use super::front_end::FrontEnd;
@@ -56,12 +56,13 @@ pub(super) fn foreign_directives(sources: &[Source]) -> Result<(), CheckError> {
             if word.is_empty() || DIRECTIVES.iter().any(|d| d[1..] == *word) {
                 continue;
             }
-            return Err(CheckError::Input(format!(
-                "{}:{}: `{}` is a preprocessor line of the renderer's own (not WGSL, nor naga_oil's #import/#ifdef family), which lobes cannot expand; give lobes the file as the renderer's preprocessor writes it (a pre-expanded file), or, where the line pulls in a module, write it as a naga_oil `#import` and stand in for that module with --stub MODULE=FILE; a switch the line tests is a --define",
+            let m = Message::text(format!(
+                "{}:{}: `{}` is a preprocessor line of the renderer's own (not WGSL, nor naga_oil's #import/#ifdef family), which lobes cannot expand; give lobes the file as the renderer's preprocessor writes it (a pre-expanded file), or, where the line pulls in a module, write it as a naga_oil `#import` and stand in for that module with ",
                 s.name,
                 n + 1,
                 l.trim_end()
-            )));
+            ));
+            return Err(CheckError::Advised(m.setting(Setting::Stub).then(" MODULE=FILE; a switch the line tests is a ").setting(Setting::Define)));
         }
     }
     Ok(())
@@ -126,10 +127,8 @@ fn oil_modules(sources: &[Source], c: &Composition, roots: &[PathBuf]) -> Result
         match oil_module(s.clone(), None) {
             Some(m) => modules.push(m),
             None => {
-                return Err(CheckError::Input(format!(
-                    "{}: no #define_import_path: with naga_oil imports, give the sampler's file first and its modules by --shader-root (or as files with their #define_import_path)",
-                    s.name
-                )));
+                let m = Message::text(format!("{}: no #define_import_path: with naga_oil imports, give the sampler's file first and its modules by ", s.name));
+                return Err(CheckError::Advised(m.setting(Setting::ShaderRoot).then(" (or as files with their #define_import_path)")));
             }
         }
     }
@@ -199,15 +198,15 @@ fn oil_order(root: &OilModule, root_path: Option<&str>, modules: &[OilModule], r
             return Err(CheckError::Input(format!("{}: imports form a cycle: {} -> {}", modules[i].source.name, stack.join(" -> "), modules[i].path)));
         }
         if !modules[i].also.is_empty() {
-            return Err(CheckError::Input(format!(
-                "{}: `{}` is declared (#define_import_path {}) by more than one file under the shader roots: {} and {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with --stub {}=FILE",
+            let m = Message::text(format!(
+                "{}: `{}` is declared (#define_import_path {}) by more than one file under the shader roots: {} and {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with ",
                 from.source.name,
                 modules[i].path,
                 modules[i].path,
                 modules[i].source.name,
                 modules[i].also.join(" and "),
-                modules[i].path
-            )));
+            ));
+            return Err(CheckError::Advised(m.setting(Setting::Stub).then(format!(" {}=FILE", modules[i].path))));
         }
         stack.push(modules[i].path.clone());
         todo.push((Some(i), 0));
@@ -222,12 +221,13 @@ fn unresolved(from: &OilModule, import: &str, parent: Option<&str>, modules: &[O
     let at = at.map_or(from.source.name.clone(), |(l, c)| format!("{}:{l}:{c}", from.source.name));
     let names: Vec<&str> = modules.iter().map(|m| m.path.as_str()).collect();
     let close = crate::suggest::closest(import, names.iter().copied()).or_else(|| parent.and_then(|p| crate::suggest::closest(p, names.iter().copied())));
-    CheckError::Input(format!(
-        "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; {}. Add its folder with --shader-root, or stand in for it with --stub {import}=FILE",
+    let m = Message::text(format!(
+        "{at}: error: unresolved import `{import}`: no file under the shader roots ({}) has `#define_import_path {import}`{}; {}. Add its folder with ",
         show_roots(roots),
         close.map_or(String::new(), |c| format!(" (closest: `{c}`)")),
         some_names("modules found", &names, import),
-    ))
+    ));
+    CheckError::Advised(m.setting(Setting::ShaderRoot).then(", or stand in for it with ").setting(Setting::Stub).then(format!(" {import}=FILE")))
 }
 
 /// "modules found: a, b, c" for a few names; past 12 the 8 closest to `near` and how many more.

@@ -4,7 +4,7 @@
 //! The crate writes the tree anew from its syntax, so each declaration's origin is kept
 //! (`compose::DeclOrigin`) for messages at the user's file and line.
 
-use super::super::{CheckError, Setting};
+use super::super::{CheckError, Message, Setting};
 use super::super::compose::{DeclOrigin, Source};
 use super::super::composition::{Call, Composition, Dialect, Origin, UserCode};
 use super::front_end::FrontEnd;
@@ -59,10 +59,8 @@ fn wesl_tree(sources: &[Source], _c: &Composition) -> Result<WeslTree, CheckErro
 #[cfg(feature = "wesl")]
 fn wesl_root(sources: &[Source], c: &Composition) -> Result<(Vec<PathBuf>, wesl::ModulePath), CheckError> {
     if let Some(s) = sources.get(1) {
-        return Err(CheckError::Input(format!(
-            "{}: with WESL imports give only the sampler's file; the modules it imports are found under --shader-root",
-            s.name
-        )));
+        let m = Message::text(format!("{}: with WESL imports give only the sampler's file; the modules it imports are found under ", s.name));
+        return Err(CheckError::Advised(m.setting(Setting::ShaderRoot)));
     }
     // each a folder, each package named once (Composition::validate)
     let roots = roots(sources, c);

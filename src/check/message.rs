@@ -1,0 +1,59 @@
+//! Messages that name settings of a check, as the advice in an error does ("add its folder with
+//! --shader-root"): the command line names a setting by its flag, a scene by its key, so the
+//! message holds the [`Setting`] and whoever shows it names it.
+
+use super::Setting;
+
+/// Text and settings in turn.
+///
+/// ```
+/// use lobes::check::{Message, Setting};
+/// let m = Message::text("add its folder with ").setting(Setting::ShaderRoot);
+/// assert_eq!(m.render(&|s| format!("--{}", s.key().replace('_', "-"))), "add its folder with --shader-root");
+/// assert_eq!(m.to_string(), "add its folder with shader_root");
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Message(Vec<Piece>);
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Piece {
+    Text(String),
+    Setting(Setting),
+}
+
+impl Message {
+    /// `text` alone.
+    pub fn text(text: impl Into<String>) -> Self {
+        Message(vec![Piece::Text(text.into())])
+    }
+
+    /// The message, then `setting`'s name.
+    pub fn setting(mut self, setting: Setting) -> Self {
+        self.0.push(Piece::Setting(setting));
+        self
+    }
+
+    /// The message, then `text`.
+    pub fn then(mut self, text: impl Into<String>) -> Self {
+        self.0.push(Piece::Text(text.into()));
+        self
+    }
+
+    /// The text with each setting named by `name`.
+    pub fn render(&self, name: &dyn Fn(Setting) -> String) -> String {
+        self.0
+            .iter()
+            .map(|p| match p {
+                Piece::Text(t) => t.clone(),
+                Piece::Setting(s) => name(*s),
+            })
+            .collect()
+    }
+}
+
+impl std::fmt::Display for Message {
+    /// Each setting by its key ([`Setting::key`]).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.render(&|s| s.key().to_string()))
+    }
+}
