@@ -351,10 +351,11 @@ fn unused_or_repeated_stubs_are_refused_naming_them() {
 }
 
 /// Whether `e` is bad input naming `what` (or a WGSL error at a file:line:column), a setting's
-/// (a call expression's) included.
+/// (a call expression's) and one with advice included.
 fn names_input(e: &CheckError, what: &str) -> bool {
     match e {
         CheckError::Input(m) | CheckError::Setting { message: m, .. } => m.contains(what) || what.trim().is_empty(),
+        CheckError::Advised(m) => m.to_string().contains(what) || what.trim().is_empty(),
         CheckError::Wgsl(m) => m.contains(':'),
         _ => false,
     }
