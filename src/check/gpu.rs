@@ -66,6 +66,8 @@ pub(super) struct Passes<'g> {
     /// composed.
     sampler: UserSampler,
     order: [u32; 4],
+    /// The user's resources as the passes' composition read them, which the histogram's reuse.
+    loaded: Vec<super::resources::Bound>,
     /// The histogram's kernel of each grid (rows, cols, bins a tile) and counting, made at its
     /// first use.
     histograms: std::cell::RefCell<std::collections::HashMap<HistogramKey, std::rc::Rc<HistogramKernel>>>,
@@ -672,26 +674,27 @@ pub(super) fn default_order(sampler: &UserSampler) -> [u32; 4] {
 
 /// [`compose`] with the --rand queue in the order `order` of u's components.
 pub(super) fn compose_ordered(sampler: &UserSampler, order: [u32; 4]) -> Result<Composed, CheckError> {
-    Ok(compose_roots(sampler, order, &["lobes::check"], vec![shaders::PASSES])?.0)
+    Ok(compose_roots(sampler, order, &["lobes::check"], vec![shaders::PASSES], &[])?.0)
 }
 
 /// The histogram's module: `lobes run`'s counting kernel over a `rows` × `cols` grid, tiles of
 /// `tile_bins` of its bins a pass, counted as `counting` says, drawing the user's sampler
 /// (`shaders/check/user_draw.wgsl`) where it draws a lobe, so that a user's samples are counted
 /// as lobes' are.
-pub(super) fn compose_histogram(sampler: &UserSampler, order: [u32; 4], (rows, cols, tile_bins): (u32, u32, u32), counting: Counting) -> Result<Validated, CheckError> {
+pub(super) fn compose_histogram(sampler: &UserSampler, order: [u32; 4], (rows, cols, tile_bins): (u32, u32, u32), counting: Counting, loaded: &[super::resources::Bound]) -> Result<Validated, CheckError> {
     let kernel = grid_counting_kernel("lobes check's histogram", rows, cols, counting, tile_bins, Precision::F32Accurate);
     let mut files = kernel.files()?;
     files.push(shaders::DRAW);
-    compose_roots(sampler, order, &kernel.roots, files)
+    compose_roots(sampler, order, &kernel.roots, files, loaded)
 }
 
 /// A composition with naga's module and its validation.
 pub(super) type Validated = (Composed, naga::Module, naga::valid::ModuleInfo);
 
 /// The module of lobes' `roots` (from `chosen` and the built-in files) with the user's files and
-/// glue as `lobes::user`, the domain's binning and the invalid reasons.
-fn compose_roots(sampler: &UserSampler, order: [u32; 4], roots: &[&str], mut chosen: Vec<File>) -> Result<Validated, CheckError> {
+/// glue as `lobes::user`, the domain's binning and the invalid reasons; the user's resources
+/// read anew, but for those in `loaded` (another composition's of the same files).
+fn compose_roots(sampler: &UserSampler, order: [u32; 4], roots: &[&str], mut chosen: Vec<File>, loaded: &[super::resources::Bound]) -> Result<Validated, CheckError> {
     let parts = prepare(sampler, order)?;
     let glue = contract_glue(sampler);
     let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
@@ -722,7 +725,7 @@ fn compose_roots(sampler: &UserSampler, order: [u32; 4], roots: &[&str], mut cho
     }
     let declared = move_resources(&mut c)?;
     let (module, info) = c.validate_with(naga::valid::Capabilities::default())?;
-    bind_resources(&mut c, &module, &info, &sampler.composition.resources, &declared)?;
+    bind_resources(&mut c, &module, &info, &sampler.composition.resources, &declared, loaded)?;
     Ok((c, module, info))
 }
 
@@ -770,7 +773,7 @@ fn move_resources(c: &mut Composed) -> Result<Vec<(String, naga::ResourceBinding
 /// nothing bound at dispatch (wgpu: "expects a BindGroup to be set"): bad input, named at its
 /// declaration (with the group and binding it was `declared` with), before any GPU work.
 /// Declared and never reached is fine.
-fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::ModuleInfo, given: &[(String, super::resources::Resource)], declared: &[(String, naga::ResourceBinding)]) -> Result<(), CheckError> {
+fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::ModuleInfo, given: &[(String, super::resources::Resource)], declared: &[(String, naga::ResourceBinding)], loaded: &[super::resources::Bound]) -> Result<(), CheckError> {
     use super::resources;
     // by lobes' passes (a renderer's own entry points, where a file keeps them, bind their own)
     let passes: Vec<usize> = module.entry_points.iter().enumerate().filter(|(_, e)| e.name.starts_with("lobes_")).map(|(i, _)| i).collect();
@@ -787,10 +790,17 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
             let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or_else(|| g.binding).expect("a binding");
             return Err(CheckError::Advised(unbound(c.diagnostic_at(span, &unbound_message(g, &as_declared, module)), g)));
         };
-        let data = resources::load(name, resource).map_err(|e| CheckError::setting(e.kind.into(), e.message))?;
-        resources::fits(name, &data, g, module).map_err(|e| CheckError::Input(c.diagnostic_at(span, &e)))?;
+        // a file another composition of the same files read and held to this declaration is not read again
+        let data = match loaded.iter().find(|b| &b.name == name) {
+            Some(b) => b.data.clone(),
+            None => {
+                let data = resources::load(name, resource).map_err(|e| CheckError::setting(e.kind.into(), e.message))?;
+                resources::fits(name, &data, g, module).map_err(|e| CheckError::Input(c.diagnostic_at(span, &e)))?;
+                std::sync::Arc::new(data)
+            }
+        };
         let binding = g.binding.as_ref().expect("a binding").binding;
-        bound.push(resources::Bound { name: name.clone(), binding, data: std::sync::Arc::new(data), entries });
+        bound.push(resources::Bound { name: name.clone(), binding, data, entries });
     }
     c.bound = bound;
     Ok(())
@@ -888,7 +898,7 @@ impl<'g> Passes<'g> {
         let resources = composed.bound.iter().map(|b| (b.binding, b.entries.clone(), GpuResource::upload(gpu, b))).collect();
         gpu.check_errors()?;
         let timed = std::cell::Cell::new(gpu.has_timestamps().then_some(0.0));
-        Ok(Self { gpu, module, gpu_seconds: timed, pipelines: Default::default(), resources, group1: Default::default(), sampler: sampler.clone(), order, histograms: Default::default() })
+        Ok(Self { gpu, module, gpu_seconds: timed, pipelines: Default::default(), resources, group1: Default::default(), sampler: sampler.clone(), order, loaded: composed.bound.clone(), histograms: Default::default() })
     }
 
     /// Group 1 of `entry`'s pipeline: the user's resources it reads; `None` where it reads none.
@@ -1057,7 +1067,7 @@ impl<'g> Passes<'g> {
         if let Some(k) = self.histograms.borrow().get(&key) {
             return Ok(k.clone());
         }
-        let (composed, naga_module, info) = compose_histogram(&self.sampler, self.order, (rows, cols, tile_bins), counting)?;
+        let (composed, naga_module, info) = compose_histogram(&self.sampler, self.order, (rows, cols, tile_bins), counting, &self.loaded)?;
         let module = self.gpu.module_unvalidated("lobes check's histogram", &composed.text)?;
         self.gpu.check_errors()?;
         let pipeline = |entry: &str| -> Result<(wgpu::ComputePipeline, Vec<u32>), CheckError> {

@@ -346,7 +346,7 @@ impl UserSampler {
     /// sampler, the other module that `check` runs.
     pub fn composed_histogram(&self, device: wgpu::DeviceType, limits: &wgpu::Limits, rows: u32, cols: u32) -> Result<String, CheckError> {
         let (tiling, counting) = gpu::histogram_counting(device, limits, rows * cols, None)?;
-        Ok(gpu::compose_histogram(self, gpu::default_order(self), (rows, cols, tiling.tile_bins as u32), counting)?.0.text)
+        Ok(gpu::compose_histogram(self, gpu::default_order(self), (rows, cols, tiling.tile_bins as u32), counting, &[])?.0.text)
     }
 }
 
