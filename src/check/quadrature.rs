@@ -203,12 +203,11 @@ pub const CAP_PARTS_PER_ROW: f64 = 4.0;
 /// [`CAP_PARTS_PER_ROW`]th of a row's mean extent in θ.
 pub(super) fn initial_width(p_max: f64, domain: Domain, rows: u32) -> f64 {
     let width = if p_max > 0.0 { (0.5 / p_max.sqrt()).clamp(1e-4, 1.0) } else { 0.1 };
-    match domain {
-        // θmax of a cap of height 1 − cos θmax, as 2 asin √(height/2) (no cancellation)
-        Domain::Cap { height, .. } => width.min(MAX_SPHERE_WIDTH).min(2.0 * (0.5 * height).sqrt().asin() / (CAP_PARTS_PER_ROW * rows as f64)),
-        Domain::Sphere | Domain::LatLong | Domain::EqualArea => width.min(MAX_SPHERE_WIDTH),
-        Domain::Plane { .. } => width,
+    if !domain.directions() {
+        return width;
     }
+    let row = domain.cap_radius().map_or(f64::INFINITY, |radius| radius / (CAP_PARTS_PER_ROW * rows as f64));
+    width.min(MAX_SPHERE_WIDTH).min(row)
 }
 
 /// The parts a bin starts as: on the sphere its (a, φ) rectangle per hemisphere it touches,

@@ -78,7 +78,7 @@ pub fn probed_cap(probes: &[Probe], limit: f64) -> Option<([f64; 3], f64)> {
     if mean.length() < 0.5 {
         return None;
     }
-    let Domain::Cap { axis, .. } = Domain::cap(mean.into(), 1.0)? else { unreachable!("Domain::cap gives a cap") };
+    let (axis, _) = Domain::cap(mean.into(), 1.0)?.as_cap()?;
     let frame = crate::stats::domain::Frame::of(axis);
     let farthest = d.iter().map(|&v| frame.local(v).0).fold(0.0, f64::max);
     (farthest > 0.0 && farthest <= limit).then_some((axis, (4.0 * farthest).min(limit)))
@@ -98,7 +98,7 @@ pub fn fitted(axis: [f64; 3], height: f64, counts: &[u64]) -> Option<Domain> {
 /// the run's probed samples (drawn by any domain's passes: probes do not bin).
 pub(super) fn fit<'g>(gpu: &'g crate::engine::gpu::Gpu, sampler: &UserSampler, settings: &Settings, probes: &[Probe]) -> Result<Option<(Domain, Passes<'g>, String)>, CheckError> {
     let Some(limit) = settings.fit.limit() else { return Ok(None) };
-    if sampler.domain != Domain::Sphere {
+    if !sampler.domain.is_sphere() {
         return Ok(None);
     }
     let Some((axis, first)) = probed_cap(probes, limit) else { return Ok(None) };

@@ -133,7 +133,7 @@ impl<'a> Outcome<'a> {
                 Job::Lobe { grid, .. } => Some(*grid),
                 Job::Discrete { .. } => None,
             },
-            Outcome::User(r) => (r.report.domain == Domain::Sphere).then_some(SphereGrid { rows: r.report.rows, cols: r.report.cols }),
+            Outcome::User(r) => r.report.domain.is_sphere().then_some(SphereGrid { rows: r.report.rows, cols: r.report.cols }),
         }
     }
 

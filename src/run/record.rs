@@ -121,10 +121,7 @@ impl Params {
     fn user(case: &UserCase, domain: &Domain) -> Self {
         let (s, set) = (&case.sampler, &case.settings);
         let sphere = domain.directions();
-        let (cap_axis, cap_height) = match *domain {
-            Domain::Cap { axis, height } => (Some(axis), Some(height)),
-            _ => (None, None),
-        };
+        let (cap_axis, cap_height) = domain.as_cap().unzip();
         Params::User {
             wgsl: s.sources.iter().map(|f| f.name.clone()).collect(),
             sample: s.sample.clone(),

@@ -274,11 +274,11 @@ fn domain(ctx: &Ctx, c: &RawCase) -> Result<Domain, SceneError> {
     let directions = match &c.domain {
         None => Some(Domain::Sphere),
         Some(v) => match string(ctx, v, "domain", allowed)? {
-            "sphere" => Some(Domain::Sphere),
-            "latlong" => Some(Domain::LatLong),
-            "equal-area" => Some(Domain::EqualArea),
             "plane" => None,
-            other => return Err(ctx.err(v.span(), format!("domain '{other}' is unknown; {allowed}{}", super::suggest::did_you_mean(other, Domain::NAMES)))),
+            name => match Domain::of_directions(name) {
+                Some(directions) => Some(directions),
+                None => return Err(ctx.err(v.span(), format!("domain '{name}' is unknown; {allowed}{}", super::suggest::did_you_mean(name, Domain::NAMES)))),
+            },
         },
     };
     if let Some(directions) = directions {

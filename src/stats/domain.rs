@@ -138,10 +138,27 @@ impl Domain {
 
     /// A cap's frame.
     pub fn frame(&self) -> Option<Frame> {
+        self.as_cap().map(|(axis, _)| Frame::of(axis))
+    }
+
+    /// A cap's axis and height.
+    pub fn as_cap(&self) -> Option<([f64; 3], f64)> {
         match *self {
-            Domain::Cap { axis, .. } => Some(Frame::of(axis)),
+            Domain::Cap { axis, height } => Some((axis, height)),
             _ => None,
         }
+    }
+
+    /// A cap's angular radius ρ = 2 asin √(h/2), from h = 1 − cos ρ without its cancellation;
+    /// `None` for the domains that are not fitted to a support.
+    pub fn cap_radius(&self) -> Option<f64> {
+        self.as_cap().map(|(_, height)| 2.0 * (0.5 * height).sqrt().asin())
+    }
+
+    /// Whether it is the (cos θ, φ) grid of the whole sphere: the grid `lobes run`'s lobes are
+    /// binned on, and the only one a cap is fitted within ([`crate::check::support`]).
+    pub fn is_sphere(&self) -> bool {
+        matches!(self, Domain::Sphere)
     }
 
     /// The solid angle it spans (sr): 4π, a cap's 2π h; `None` on the plane.
@@ -223,6 +240,19 @@ impl Domain {
         }
     }
 
+    /// The domain of unit directions named `name` ([`Self::name`]: `sphere`, `latlong` or
+    /// `equal-area`); `None` for `plane`, which needs its box ([`Self::plane`]), and for other
+    /// names.
+    ///
+    /// ```
+    /// use lobes::stats::domain::Domain;
+    /// assert_eq!(Domain::of_directions("latlong"), Some(Domain::LatLong));
+    /// assert_eq!(Domain::of_directions("plane"), None);
+    /// ```
+    pub fn of_directions(name: &str) -> Option<Domain> {
+        [Domain::Sphere, Domain::LatLong, Domain::EqualArea].into_iter().find(|d| d.name() == name)
+    }
+
     /// The names [`Domain::name`] gives, for messages that list them.
     pub const NAMES: [&'static str; 4] = ["sphere", "plane", "latlong", "equal-area"];
 
@@ -238,7 +268,7 @@ impl Domain {
     /// a cap, φ′ comes from the direction's components across the axis, whose rounding is the
     /// sample's own.
     pub fn rounds_phi_edges(&self) -> bool {
-        matches!(self, Domain::Sphere)
+        self.is_sphere()
     }
 
     /// A point as the domain reads it: a direction as it is, a point of the plane as (x, y, 0)
@@ -263,6 +293,18 @@ impl Domain {
             Domain::Cap { axis, .. } => Frame::of(*axis).direction(a, b).into(),
             Domain::Plane { .. } => [a, b, 0.0],
             Domain::EqualArea => equal_area::square_to_sphere(a / SQRT_PI, b / SQRT_PI).into(),
+        }
+    }
+
+    /// [`Domain::part_point`] with b given as (b, cos b, sin b) and a cap's `frame` given, so
+    /// that a quadrature computes them once per node of its rule rather than per point.
+    pub fn part_point_at(&self, frame: Option<&Frame>, a: f64, (b, cos, sin): (f64, f64, f64), h: f32) -> DVec3 {
+        let s = || (a * (2.0 - a)).max(0.0).sqrt();
+        match (self, frame) {
+            (Domain::Plane { .. }, _) => DVec3::new(a, b, 0.0),
+            (Domain::EqualArea, _) => DVec3::from(self.part_point(a, b, 0.0)),
+            (Domain::Cap { .. }, Some(frame)) => s() * cos * frame.t + s() * sin * frame.b + (1.0 - a) * frame.axis,
+            _ => DVec3::new(s() * cos, s() * sin, h as f64 * (1.0 - a)),
         }
     }
 

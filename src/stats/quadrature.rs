@@ -428,22 +428,9 @@ impl<'a> CpuPdf<'a> {
         CpuPdf { pdf, domain, jumps, frame: domain.frame() }
     }
 
-    /// The point at (a, b) of a part in hemisphere h, given (cos b, sin b): [`Domain::part_point`]
-    /// with the trigonometry of b computed once per node of the rule rather than per point.
+    /// The point at (a, b) of a part in hemisphere h, given (b, cos b, sin b).
     fn point(&self, a: f64, b: (f64, f64, f64), h: f32) -> DVec3 {
-        let (b, cos, sin) = b;
-        match (self.domain, &self.frame) {
-            (Domain::Plane { .. }, _) => DVec3::new(a, b, 0.0),
-            (Domain::EqualArea, _) => DVec3::from(self.domain.part_point(a, b, 0.0)),
-            (_, Some(frame)) => {
-                let s = (a * (2.0 - a)).max(0.0).sqrt();
-                s * cos * frame.t + s * sin * frame.b + (1.0 - a) * frame.axis
-            }
-            _ => {
-                let s = (a * (2.0 - a)).max(0.0).sqrt();
-                DVec3::new(s * cos, s * sin, h as f64 * (1.0 - a))
-            }
-        }
+        self.domain.part_point_at(self.frame.as_ref(), a, b, h)
     }
 
     /// ∫∫ pdf over `rect` by `rule`'s tensor product, in s = √a (dω = 2s ds db) for

@@ -17,7 +17,7 @@ pub mod weights;
 use super::gpu::{CHUNK, Params, Passes, histogram};
 use super::probe::Probe;
 use super::quadrature::{self, Integrals, Integrand};
-use super::{CheckError, Domain, Settings, UserSampler, jacobian as map};
+use super::{CheckError, Settings, UserSampler, jacobian as map};
 use crate::stats::domain::Grid;
 use crate::engine::gpu::Gpu;
 use crate::reference::rng;
@@ -44,7 +44,7 @@ impl<'a, 'g> Run<'a, 'g> {
         let params = super::params_of(sampler, settings);
         let (passes, draws) = super::compose_passes(gpu, sampler, settings, &params)?;
         let run = Self::on(std::borrow::Cow::Borrowed(sampler), settings, passes, draws);
-        if settings.fit.limit().is_none() || sampler.domain != super::Domain::Sphere {
+        if settings.fit.limit().is_none() || !sampler.domain.is_sphere() {
             return Ok(run);
         }
         let probes = run.passes.probe(&run.params, &probe_items(&run))?;
@@ -216,7 +216,7 @@ fn integrate(run: &Run, evidence: &quadrature::Evidence, width: f64) -> Result<(
         return Ok((integrals, 0.0));
     }
     let inputs = quadrature::f32_sensitivity(&run.passes, &run.params, &leaves)?;
-    let direction = if matches!(domain, Domain::Cap { .. }) { quadrature::direction_sensitivity(&(&run.passes, &run.params), &leaves)? } else { 0.0 };
+    let direction = if domain.as_cap().is_some() { quadrature::direction_sensitivity(&(&run.passes, &run.params), &leaves)? } else { 0.0 };
     Ok((integrals, inputs + direction))
 }
 
