@@ -10,7 +10,7 @@ use super::{CheckError, Message, Setting, UserSampler, shaders};
 use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::compose::grid_counting_kernel;
-use crate::engine::gpu::layout::{N_REASONS, WG_SIZE};
+use crate::engine::gpu::layout::{N_REASONS, WG_SIZE, binding};
 use crate::engine::gpu::precision::Precision;
 use crate::engine::gpu::engine::Tiling;
 use crate::engine::gpu::{Counting, Gpu, Strategy};
@@ -27,17 +27,17 @@ pub(super) use crate::engine::gpu::params::Params;
 /// What a pass writes, and where it is bound (`shaders/check/user_passes.wgsl`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Output {
-    /// `lobes_out`, vec4s (binding 2).
+    /// `lobes_out`, vec4s.
     Values,
-    /// `lobes_probes`, one [`Probe`] per item (binding 5).
+    /// `lobes_probes`, one [`Probe`] per item.
     Probes,
 }
 
 impl Output {
     fn binding(self) -> u32 {
         match self {
-            Output::Values => 2,
-            Output::Probes => 5,
+            Output::Values => binding::CHECK_OUT,
+            Output::Probes => binding::CHECK_PROBES,
         }
     }
 }
@@ -109,15 +109,14 @@ impl HistogramBuffers {
         }
     }
 
-    /// The buffer at `binding` of group 0 (`shaders/passes/params.wgsl` and `bindings.wgsl`,
-    /// `counting_slabs.wgsl`, `shaders/check/user_draw.wgsl`), the uniform block `uniform`.
-    fn at<'a>(&'a self, binding: u32, uniform: &'a wgpu::Buffer) -> Result<&'a wgpu::Buffer, CheckError> {
-        match binding {
-            0 => Ok(uniform),
-            1 => Ok(&self.counts),
-            2 => Ok(&self.totals),
-            9 => Ok(&self.slabs),
-            10 => Ok(&self.draws),
+    /// The buffer at `b` of group 0, the uniform block `uniform`.
+    fn at<'a>(&'a self, b: u32, uniform: &'a wgpu::Buffer) -> Result<&'a wgpu::Buffer, CheckError> {
+        match b {
+            binding::PARAMS => Ok(uniform),
+            binding::COUNTS => Ok(&self.counts),
+            binding::TOTALS => Ok(&self.totals),
+            binding::SLABS => Ok(&self.slabs),
+            binding::DRAWS => Ok(&self.draws),
             b => Err(CheckError::Internal(format!("the histogram's kernel reads binding {b} of group 0, which lobes check does not bind"))),
         }
     }
@@ -935,9 +934,9 @@ impl<'g> Passes<'g> {
             contents: &padded,
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
+        let mut entries = vec![wgpu::BindGroupEntry { binding: binding::PARAMS, resource: uniform.as_entire_binding() }];
         if !input.is_empty() {
-            entries.push(wgpu::BindGroupEntry { binding: 1, resource: input_buf.as_entire_binding() });
+            entries.push(wgpu::BindGroupEntry { binding: binding::CHECK_IN, resource: input_buf.as_entire_binding() });
         }
         entries.push(wgpu::BindGroupEntry { binding: output.binding(), resource: out.as_entire_binding() });
         let bind = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(entry), layout: &pipeline.get_bind_group_layout(0), entries: &entries });

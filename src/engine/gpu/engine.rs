@@ -2,7 +2,7 @@
 //! the per-sample passes; and the weighted passes of [`super::weighted`].
 
 use super::compose;
-use super::layout::{N_REASONS, WG_SIZE};
+use super::layout::{N_REASONS, WG_SIZE, binding};
 use super::precision::Precision;
 use super::context::{Gpu, GpuError};
 use super::counting::{Counting, Strategy};
@@ -19,9 +19,6 @@ use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
-
-/// The binding of the slabs (`shaders/passes/counting_slabs.wgsl`; 6 to 8 are the weighted pass's).
-const SLAB_BINDING: u32 = 9;
 
 /// The pipelines of one composed module.
 struct KernelPipelines {
@@ -101,12 +98,12 @@ impl GpuEngine {
     pub fn new(gpu: Gpu) -> Self {
         let entries = [
             Params::layout_entry(),
-            storage_entry(1, false),
-            storage_entry(2, false),
-            storage_entry(3, true),
-            storage_entry(4, true),
-            storage_entry(5, false),
-            storage_entry(SLAB_BINDING, false),
+            storage_entry(binding::COUNTS, false),
+            storage_entry(binding::TOTALS, false),
+            storage_entry(binding::INPUT, true),
+            storage_entry(binding::ALIASES, true),
+            storage_entry(binding::DIRECTIONS, false),
+            storage_entry(binding::SLABS, false),
         ];
         let (layout, pipeline_layout) = gpu.layout("lobes kernel", &entries);
         let weighted = WeightedPipelines::new(&gpu);
@@ -372,12 +369,12 @@ impl GpuEngine {
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
 
-    /// The kernel's bind group: `buffers[i]` at binding `i` (binding 0 the parameters), the
-    /// last at [`SLAB_BINDING`].
+    /// The kernel's bind group: the parameters, counts, totals, input, aliases, directions and
+    /// slabs, each at its [`binding`].
     fn bind_group(&self, buffers: [&wgpu::Buffer; 7]) -> wgpu::BindGroup {
         let [params, rest @ ..] = buffers;
         let mut entries = vec![Params::bind_entry(params)];
-        let bindings = [1, 2, 3, 4, 5, SLAB_BINDING];
+        let bindings = [binding::COUNTS, binding::TOTALS, binding::INPUT, binding::ALIASES, binding::DIRECTIONS, binding::SLABS];
         entries.extend(rest.iter().zip(bindings).map(|(b, binding)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }));
         self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("lobes kernel"), layout: &self.layout, entries: &entries })
     }

@@ -28,6 +28,58 @@ pub const N_REASONS: u32 = Invalid::ALL.len() as u32;
 /// horizon.
 pub const WEIGHT_EXTRA_CELLS: u32 = 4;
 
+/// Group 0 of `lobes run`'s kernels and of `lobes check`'s passes: the binding of each storage
+/// and uniform variable `shaders/` declares there, so that the host binds by name (the test
+/// `tests::group_0_is_the_wgsls` holds the WGSL to it).
+pub mod binding {
+    /// `lobes_params`, the uniform block of every kernel and pass (`passes/params.wgsl`).
+    pub const PARAMS: u32 = 0;
+    /// `counts`: a chunk's u32 counter per cell (`passes/bindings.wgsl`).
+    pub const COUNTS: u32 = 1;
+    /// `totals`: the 64-bit totals the chunks fold into.
+    pub const TOTALS: u32 = 2;
+    /// `explicit_u` (`passes/lobe_kernel.wgsl`) or `discrete_f` (`lib/discrete.wgsl`): the
+    /// host's uniforms, or a discrete table's CDF or thresholds.
+    pub const INPUT: u32 = 3;
+    /// `discrete_u`: an alias table's indices.
+    pub const ALIASES: u32 = 4;
+    /// `directions_out`: the directions pass's samples.
+    pub const DIRECTIONS: u32 = 5;
+    /// `effect`, the weighted pass's uniform (`passes/effect_uniform.wgsl`).
+    pub const EFFECT: u32 = 6;
+    /// `weight_sums` and `weight_error`, the weighted pass's fixed-point sums (`passes/weighted.wgsl`).
+    pub const WEIGHT_SUMS: u32 = 7;
+    pub const WEIGHT_ERROR: u32 = 8;
+    /// `slabs`: the per-slab counters of CPU adapters (`passes/counting_slabs.wgsl`).
+    pub const SLABS: u32 = 9;
+    /// `lobes_draw_counts`: a user sampler's --rand draws past four (`check/user_draw.wgsl`).
+    pub const DRAWS: u32 = 10;
+    /// `lobes_in`, `lobes_out` and `lobes_probes`: a check pass's items, values and probes
+    /// (`check/user_passes.wgsl`).
+    pub const CHECK_IN: u32 = 1;
+    pub const CHECK_OUT: u32 = 2;
+    pub const CHECK_PROBES: u32 = 5;
+
+    /// Each variable with its binding, as the WGSL names it.
+    pub const DECLARED: [(&str, u32); 15] = [
+        ("lobes_params", PARAMS),
+        ("counts", COUNTS),
+        ("totals", TOTALS),
+        ("explicit_u", INPUT),
+        ("discrete_f", INPUT),
+        ("discrete_u", ALIASES),
+        ("directions_out", DIRECTIONS),
+        ("effect", EFFECT),
+        ("weight_sums", WEIGHT_SUMS),
+        ("weight_error", WEIGHT_ERROR),
+        ("slabs", SLABS),
+        ("lobes_draw_counts", DRAWS),
+        ("lobes_in", CHECK_IN),
+        ("lobes_out", CHECK_OUT),
+        ("lobes_probes", CHECK_PROBES),
+    ];
+}
+
 /// `SCREAMING_CASE` of a kebab or snake name.
 fn constant_name(prefix: &str, name: &str) -> String {
     format!("{prefix}_{}", name.replace('-', "_").to_uppercase())
@@ -109,6 +161,37 @@ mod tests {
     fn embedded_constants_match_the_host() {
         let discrete = super::super::library::plain(include_str!("../../../shaders/lib/discrete.wgsl"));
         assert_eq!(u32_const(&discrete, "DISCRETE_BLOCK") as usize, crate::reference::discrete::BLOCK);
+    }
+
+    /// Every `@group(0) @binding(N) var… name` of `shaders/passes`, `shaders/check` and
+    /// `shaders/lib` is at the binding [`binding::DECLARED`] gives its name, and each name there
+    /// is declared.
+    #[test]
+    fn group_0_is_the_wgsls() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+        let mut seen = std::collections::BTreeSet::new();
+        for dir in ["passes", "check", "lib"] {
+            for entry in std::fs::read_dir(root.join(dir)).unwrap() {
+                let path = entry.unwrap().path();
+                if path.ends_with("passes/quadrature.wgsl") {
+                    continue; // `lobes tradeoff`'s quadrature kernel, a layout of its own
+                }
+                let text = std::fs::read_to_string(&path).unwrap();
+                for line in text.lines().filter_map(|l| l.trim_start().strip_prefix("@group(0) @binding(")) {
+                    let (number, rest) = line.split_once(')').unwrap();
+                    let decl = rest.split_once("var").unwrap().1;
+                    let decl = if decl.starts_with('<') { decl.split_once('>').unwrap().1 } else { decl };
+                    let name = decl.split(':').next().unwrap().trim();
+                    let Some(&(_, host)) = binding::DECLARED.iter().find(|(n, _)| *n == name) else {
+                        panic!("{}: `{name}` at binding {number} is not in binding::DECLARED", path.display());
+                    };
+                    assert_eq!(number.parse::<u32>().unwrap(), host, "{}: `{name}`", path.display());
+                    seen.insert(name.to_owned());
+                }
+            }
+        }
+        let missing: Vec<_> = binding::DECLARED.iter().filter(|(n, _)| !seen.contains(*n)).collect();
+        assert!(missing.is_empty(), "declared nowhere: {missing:?}");
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! binding 0): `lobes run`'s sampling kernels (the counting and the weighted layouts) and `lobes
 //! check`'s passes, and the layout entries those share.
 
+use super::layout::binding;
 use crate::engine::job::{Job, SampleRange};
 use bytemuck::{Pod, Zeroable};
 
@@ -70,10 +71,10 @@ impl Params {
         Self { tile_first: first, ..self }
     }
 
-    /// Binding 0: the parameters, at a dynamic offset per dispatch.
+    /// [`binding::PARAMS`]: the parameters, at a dynamic offset per dispatch.
     pub fn layout_entry() -> wgpu::BindGroupLayoutEntry {
         wgpu::BindGroupLayoutEntry {
-            binding: 0,
+            binding: binding::PARAMS,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer {
                 ty: wgpu::BufferBindingType::Uniform,
@@ -84,10 +85,11 @@ impl Params {
         }
     }
 
-    /// Binding 0 bound to one `Params` of `buffer` (the dispatch picks which by its offset).
+    /// [`binding::PARAMS`] bound to one `Params` of `buffer` (the dispatch picks which by its
+    /// offset).
     pub fn bind_entry(buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
         wgpu::BindGroupEntry {
-            binding: 0,
+            binding: binding::PARAMS,
             resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
                 buffer,
                 offset: 0,

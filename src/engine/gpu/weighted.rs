@@ -4,7 +4,7 @@
 use super::context::{Gpu, GpuError};
 use super::dispatch::{Chunking, SamplingPasses, Step};
 use super::effects::{self, PipelineSource};
-use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS, sampling_groups};
+use super::layout::{N_REASONS, WEIGHT_EXTRA_CELLS, binding, sampling_groups};
 use super::params::{Params, storage_entry};
 use crate::engine::job::{Job, SampleRange};
 use crate::reference::effects::Effects;
@@ -36,12 +36,12 @@ pub struct WeightedPipelines {
 impl WeightedPipelines {
     pub fn new(gpu: &Gpu) -> Self {
         let effect = wgpu::BindGroupLayoutEntry {
-            binding: 6,
+            binding: binding::EFFECT,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
             count: None,
         };
-        let (layout, pipeline_layout) = gpu.layout("lobes weighted", &[Params::layout_entry(), effect, storage_entry(7, false), storage_entry(8, false)]);
+        let (layout, pipeline_layout) = gpu.layout("lobes weighted", &[Params::layout_entry(), effect, storage_entry(binding::WEIGHT_SUMS, false), storage_entry(binding::WEIGHT_ERROR, false)]);
         Self { layout, pipeline_layout, cache: HashMap::new(), compiled: 0 }
     }
 
@@ -97,9 +97,9 @@ impl WeightedPipelines {
             layout: &self.layout,
             entries: &[
                 Params::bind_entry(passes.params()),
-                wgpu::BindGroupEntry { binding: 6, resource: effect.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: sums.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 8, resource: errors.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: binding::EFFECT, resource: effect.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: binding::WEIGHT_SUMS, resource: sums.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: binding::WEIGHT_ERROR, resource: errors.as_entire_binding() },
             ],
         });
         let start = Instant::now();
