@@ -547,7 +547,7 @@ fn a_check_owns_its_out_folder() {
     drop(lock);
     let waited = waiting.wait_with_output().unwrap();
     assert_eq!(waited.status.code(), Some(0), "{}", String::from_utf8_lossy(&waited.stderr));
-    assert!(String::from_utf8_lossy(&waited.stderr).contains("lobes: waiting for --out out, in use by another lobes"));
+    assert!(String::from_utf8_lossy(&waited.stderr).contains("lobes: waiting for the output folder out, in use by another lobes"));
     assert!(temporary(&out).is_empty(), "the killed check's temporary file is removed: {:?}", files(&out));
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["passed"], true);

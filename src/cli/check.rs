@@ -245,18 +245,17 @@ impl CheckArgs {
     /// What the sampler's flags say beyond its files and functions: its domain, conventions
     /// and composition (each checked here, at once).
     fn sampler_parts(&self) -> anyhow::Result<(Domain, Conventions, check::Composition)> {
-        let domain = match (self.domain, &self.bounds) {
-            (DomainChoice::Sphere, None) => Domain::Sphere,
-            (DomainChoice::Latlong, None) => Domain::LatLong,
-            (DomainChoice::EqualArea, None) => Domain::EqualArea,
-            (DomainChoice::Sphere | DomainChoice::Latlong | DomainChoice::EqualArea, Some(_)) => return Err(usage("--bounds: only with --domain plane")),
-            (DomainChoice::Plane, None) => return Err(usage("--domain plane needs --bounds X0,Y0,X1,Y1")),
-            (DomainChoice::Plane, Some(b)) => match b.0[..] {
+        let name = self.domain.to_possible_value().expect("every domain is a value");
+        let domain = match (Domain::of_directions(name.get_name()), &self.bounds) {
+            (Some(directions), None) => directions,
+            (Some(_), Some(_)) => return Err(usage("--bounds: only with --domain plane")),
+            (None, None) => return Err(usage("--domain plane needs --bounds X0,Y0,X1,Y1")),
+            (None, Some(b)) => match b.0[..] {
                 [x0, y0, x1, y1] => Domain::Plane { bounds: [x0, y0, x1, y1] },
                 _ => return Err(usage(format!("--bounds: expected 4 numbers X0,Y0,X1,Y1, got {}", b.0.len()))),
             },
         };
-        if self.fit == check::support::Fit::Always && domain != Domain::Sphere {
+        if self.fit == check::support::Fit::Always && !domain.is_sphere() {
             return Err(usage(format!("--fit always: only with --domain sphere (a cap is fitted on the sphere; --domain {} keeps its own grid)", domain.name())));
         }
         let conventions = Conventions { incident: self.incident, reflection_only: self.reflection_only, u_open: self.u_open, measure: self.measure, frame: self.frame };
@@ -422,7 +421,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     // An --out that exists is locked first (as `lobes run` does): where another lobes holds
     // it, nothing is touched; bad input then removes the earlier check's outputs, so that no
     // report.json is left that reads as this check's
-    let existing = args.out.as_deref().map(|dir| OutFolder::claim_existing(dir, Access::Owner, args.wait)).transpose()?.flatten();
+    let existing = args.out.as_deref().map(|dir| OutFolder::claim_existing(dir, Access::Owner, args.wait)).transpose().map_err(super::folder_error)?.flatten();
     // before the sampler is composed, which a long chain of imports makes slow: a signal while
     // it is (also where a script's `&` left SIGINT ignored) ends the check at once (exit 130);
     // on the GPU the stop is seen within 50 ms of a wait, and 1.5 s after it a process still
@@ -452,7 +451,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     // held until the process ends: a second check or run into the folder waits or exits 2
     let out_folder = match (existing, &args.out) {
         (Some(folder), _) => Some(folder),
-        (None, Some(dir)) => Some(OutFolder::claim(dir, Access::Owner, args.wait)?),
+        (None, Some(dir)) => Some(OutFolder::claim(dir, Access::Owner, args.wait).map_err(super::folder_error)?),
         (None, None) => None,
     };
     if let Some(folder) = &out_folder {

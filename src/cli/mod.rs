@@ -147,6 +147,11 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
 }
 
+/// An output folder lobes cannot use, named by its flags: bad input.
+pub fn folder_error(e: FolderError) -> anyhow::Error {
+    usage(e.render("--out", "--wait"))
+}
+
 /// Cases or checks that ran and failed their tests (the outputs are complete).
 /// [`exit_code`] maps it to [`EXIT_CHECKS_FAILED`].
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -215,13 +220,13 @@ pub struct FileArgs {
 
 impl FileArgs {
     /// Creates and locks the output folder `out` ([`OutFolder::claim`]).
-    pub fn claim(&self, out: &Path, access: Access) -> Result<OutFolder, FolderError> {
-        OutFolder::claim(out, access, self.wait)
+    pub fn claim(&self, out: &Path, access: Access) -> anyhow::Result<OutFolder> {
+        OutFolder::claim(out, access, self.wait).map_err(folder_error)
     }
 
     /// Locks `out` if it is already a folder ([`OutFolder::claim_existing`]).
-    pub fn claim_existing(&self, out: &Path) -> Result<Option<OutFolder>, FolderError> {
-        OutFolder::claim_existing(out, Access::Owner, self.wait)
+    pub fn claim_existing(&self, out: &Path) -> anyhow::Result<Option<OutFolder>> {
+        OutFolder::claim_existing(out, Access::Owner, self.wait).map_err(folder_error)
     }
 
     pub fn style(&self) -> crate::report::output::JsonStyle {
@@ -481,5 +486,14 @@ mod tests {
         for code in [EXIT_CHECKS_FAILED, EXIT_USAGE, EXIT_TOOL_FAILURE, EXIT_INTERRUPTED] {
             assert!(EXIT_CODES.contains(&format!("\n  {code} ")), "--help documents {code}");
         }
+    }
+
+    #[test]
+    fn every_domain_flag_value_is_a_domains_name() {
+        use clap::ValueEnum;
+        let flags: Vec<String> = check::DomainChoice::value_variants().iter().map(|d| d.to_possible_value().unwrap().get_name().to_owned()).collect();
+        assert_eq!(flags, crate::stats::domain::Domain::NAMES);
+        let directions = flags.iter().filter(|f| crate::stats::domain::Domain::of_directions(f).is_some()).count();
+        assert_eq!(directions, 3, "every name but plane is a domain of directions");
     }
 }

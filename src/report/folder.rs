@@ -42,8 +42,46 @@ pub const CASE_FILES: [&str; 11] = [
 /// A folder lobes cannot use: not a folder, cannot be created, or in use by another lobes.
 /// Bad input: the CLI exits with its usage code, and writes nothing into the folder.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct FolderError(pub String);
+#[error("{}", self.render("output folder", "`wait = true`"))]
+pub struct FolderError {
+    pub path: PathBuf,
+    pub problem: FolderProblem,
+}
+
+/// What is wrong with an output folder (each with the system's words where it gave some).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum FolderProblem {
+    NotAFolder,
+    CannotCreate(String),
+    /// Its lock file cannot be opened or locked.
+    CannotLock { lock: PathBuf, error: String },
+    /// Another lobes holds it (the holder as its lock file names it).
+    InUse { holder: String },
+    /// A shard run could not remove the temporary files a killed run left.
+    Temporary(String),
+}
+
+impl FolderError {
+    fn new(path: &Path, problem: FolderProblem) -> Self {
+        Self { path: path.to_path_buf(), problem }
+    }
+
+    /// Its message, naming the folder's setting `folder` and the setting that waits for a
+    /// holder `wait` as the reader knows them (the CLI's `--out` and `--wait`).
+    pub fn render(&self, folder: &str, wait: &str) -> String {
+        let path = self.path.display();
+        match &self.problem {
+            FolderProblem::NotAFolder => format!("{folder} {path}: exists and is not a folder; give a folder (created if missing)"),
+            FolderProblem::CannotCreate(e) => format!("{folder} {path}: cannot create the output folder: {e}"),
+            FolderProblem::CannotLock { lock, error } => format!("{folder} {path}: cannot lock the output folder ({}): {error}", lock.display()),
+            FolderProblem::InUse { holder } => format!(
+                "{folder} {path} is in use by another lobes ({holder}); two runs into one folder would mix their results. \
+                 Wait for it to finish, give another {folder}, or pass {wait} to wait for it"
+            ),
+            FolderProblem::Temporary(e) => format!("{folder} {path}: {e}"),
+        }
+    }
+}
 
 /// How a run uses the folder.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -68,7 +106,7 @@ impl OutFolder {
         if path.exists() && !path.is_dir() {
             return Err(not_a_folder(path));
         }
-        std::fs::create_dir_all(path).map_err(|e| FolderError(format!("--out {}: cannot create the output folder: {e}", path.display())))?;
+        std::fs::create_dir_all(path).map_err(|e| FolderError::new(path, FolderProblem::CannotCreate(e.to_string())))?;
         Self::lock(path, access, wait)
     }
 
@@ -88,7 +126,7 @@ impl OutFolder {
     /// free removes the temporary files a killed run left before sharing it.
     fn lock(path: &Path, access: Access, wait: bool) -> Result<OutFolder, FolderError> {
         let file_path = path.join(LOCK_FILE);
-        let cannot = |e: std::io::Error| FolderError(format!("--out {}: cannot lock the output folder ({}): {e}", path.display(), file_path.display()));
+        let cannot = |e: std::io::Error| FolderError::new(path, FolderProblem::CannotLock { lock: file_path.clone(), error: e.to_string() });
         let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&file_path).map_err(cannot)?;
         let exclusive = match file.try_lock() {
             Ok(()) => true,
@@ -97,13 +135,9 @@ impl OutFolder {
             Err(std::fs::TryLockError::WouldBlock) => {
                 let holder = holder(&mut file);
                 if !wait {
-                    return Err(FolderError(format!(
-                        "--out {} is in use by another lobes ({holder}); two runs into one folder would mix their results. \
-                         Wait for it to finish, give another --out, or pass --wait to wait for it",
-                        path.display()
-                    )));
+                    return Err(FolderError::new(path, FolderProblem::InUse { holder }));
                 }
-                crate::console::say(format_args!("lobes: waiting for --out {}, in use by another lobes ({holder})", path.display()));
+                crate::console::say(format_args!("lobes: waiting for the output folder {}, in use by another lobes ({holder})", path.display()));
                 match access {
                     Access::Owner => file.lock().map_err(cannot)?,
                     Access::Shard => file.lock_shared().map_err(cannot)?,
@@ -116,7 +150,7 @@ impl OutFolder {
         if exclusive {
             folder.write_holder();
             if access == Access::Shard {
-                folder.remove_temporary().map_err(|e| FolderError(format!("--out {}: {e}", path.display())))?;
+                folder.remove_temporary().map_err(|e| FolderError::new(path, FolderProblem::Temporary(e.to_string())))?;
                 folder._lock.lock_shared().map_err(cannot)?;
             }
         }
@@ -206,7 +240,7 @@ impl OutFolder {
 }
 
 fn not_a_folder(path: &Path) -> FolderError {
-    FolderError(format!("--out {}: exists and is not a folder; give a folder (created if missing)", path.display()))
+    FolderError::new(path, FolderProblem::NotAFolder)
 }
 
 /// The holder named in the lock file, or a note that it names none.
@@ -239,8 +273,11 @@ mod tests {
     fn a_second_owner_is_refused_and_names_the_first() {
         let dir = tempfile::tempdir().unwrap();
         let first = OutFolder::claim(dir.path(), Access::Owner, false).unwrap();
-        let err = OutFolder::claim(dir.path(), Access::Owner, false).unwrap_err().to_string();
-        assert!(err.contains("is in use by another lobes") && err.contains(&format!("pid {}", std::process::id())), "{err}");
+        let err = OutFolder::claim(dir.path(), Access::Owner, false).unwrap_err();
+        let FolderProblem::InUse { holder } = &err.problem else { panic!("{err}") };
+        assert!(holder.contains(&format!("pid {}", std::process::id())), "{err}");
+        let shown = err.render("--out", "--wait");
+        assert!(shown.starts_with(&format!("--out {} is in use by another lobes", dir.path().display())) && shown.ends_with("pass --wait to wait for it"), "{shown}");
         assert!(OutFolder::claim(dir.path(), Access::Shard, false).is_err(), "a shard run waits for an owner too");
         drop(first);
         let shard = OutFolder::claim(dir.path(), Access::Shard, false).unwrap();
