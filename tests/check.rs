@@ -507,7 +507,10 @@ fn an_unconverged_quadrature_gives_no_verdict() {
     let settings = Settings { samples: 1 << 18, bins: Some((4, 8)), ..Settings::default() };
     let noisy = UserSampler::from_files(std::slice::from_ref(&path), "noisy_sample", "noisy_pdf", None, Domain::Sphere).unwrap();
     match check(&gpu, &noisy, &settings) {
-        Err(lobes::check::CheckError::NoVerdict(m)) => assert!(m.contains("did not converge") && m.contains("no verdict"), "{m}"),
+        Err(lobes::check::CheckError::NoVerdict(m)) => {
+            let shown = m.render(&|s| format!("<{}>", s.key()));
+            assert!(shown.contains("did not converge") && shown.contains("no verdict") && shown.ends_with("fewer <samples> or more <bins>"), "{shown}")
+        }
         Err(e) => panic!("another error: {e}"),
         Ok(r) => panic!("a verdict ({}) from an unconverged quadrature", if r.passed { "pass" } else { "fail" }),
     }

@@ -314,4 +314,5 @@ fn opengl_uniforms_are_named_where_the_sampler_reads_them() {
     let e = stderr(&out);
     let line = std::fs::read_to_string(&file).unwrap().lines().position(|l| l.starts_with("vec3 Sky")).unwrap() + 1;
     assert!(e.contains(&format!("sampling.glsl:{line}:")) && e.contains("`envMapTex` is an OpenGL uniform sampler or image (") && e.contains("include/uniforms.glsl:8)"), "{e}");
+    assert!(e.contains("behind an #ifdef that --define leaves off)"), "the advice names the flag: {e}");
 }

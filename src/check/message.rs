@@ -39,6 +39,17 @@ impl Message {
         self
     }
 
+    /// The message, then `other`.
+    pub fn append(mut self, other: Message) -> Self {
+        self.0.extend(other.0);
+        self
+    }
+
+    /// Whether it names a setting.
+    pub fn names_settings(&self) -> bool {
+        self.0.iter().any(|p| matches!(p, Piece::Setting(_)))
+    }
+
     /// The text with each setting named by `name`.
     pub fn render(&self, name: &dyn Fn(Setting) -> String) -> String {
         self.0

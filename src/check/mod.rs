@@ -96,9 +96,9 @@ pub enum CheckError {
     Internal(String),
     /// The expected histogram is not accurate enough to judge by (the quadrature of the pdf did
     /// not converge, [`quadrature::Integrals::converged`]): no verdict, neither pass nor fail
-    /// (exit 3, as `lobes run`'s unconverged reference).
+    /// (exit 3, as `lobes run`'s unconverged reference); the message may name settings.
     #[error("{0}")]
-    NoVerdict(String),
+    NoVerdict(Message),
 }
 
 impl CheckError {
@@ -627,7 +627,7 @@ fn report(run: &judge::Run, m: &judge::Measured, checks: Vec<Check>, adapter: St
 /// θi > 0); no f32 quadrature resolves it, and the f32 pdf may be ∞ or NaN beside it. `bad_at`:
 /// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
 /// points), which must lie within 1° of −wi; None for an unconverged quadrature.
-fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<String> {
+fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<Message> {
     if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || !sampler.domain.directions() {
         return None;
     }
@@ -638,9 +638,13 @@ fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<O
         return None;
     }
     let (t, p) = (pole.z.clamp(-1.0, 1.0).acos().to_degrees(), pole.y.atan2(pole.x).to_degrees());
-    Some(format!(
-        "; with --sample-returns half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with --reflection-only (they are then rejections, and d = −wi is one of them)"
-    ))
+    Some(
+        Message::text("; with ")
+            .setting(Setting::SampleReturns)
+            .then(format!(" half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with "))
+            .setting(Setting::ReflectionOnly)
+            .then(" (they are then rejections, and d = −wi is one of them)"),
+    )
 }
 
 /// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf

@@ -29,7 +29,7 @@
 
 use super::gpu::{Params, Passes};
 
-use super::{CheckError, Domain, MAX_PARAMS, Source, UserSampler};
+use super::{CheckError, Domain, MAX_PARAMS, Message, Setting, Source, UserSampler};
 use crate::engine::gpu::Gpu;
 pub use crate::stats::expected::MAX_QUADRATURE_SIGMA;
 use crate::stats::domain::{Cell, SQRT_PI};
@@ -113,16 +113,17 @@ impl Integrals {
     ///     unconverged_parts: 0, bad_parts: 0, dropped: vec![], parts: 2, rounds: 1, hidden_support_bins: 0 };
     /// assert!(i.converged(1_000_000).is_ok());
     /// i.max_error_sigma = 2.0;
-    /// assert!(i.converged(1_000_000).unwrap_err().contains("no verdict"));
+    /// assert!(i.converged(1_000_000).unwrap_err().to_string().contains("no verdict"));
     /// ```
-    pub fn converged(&self, samples: u64) -> Result<(), String> {
+    pub fn converged(&self, samples: u64) -> Result<(), Message> {
         if self.max_error_sigma <= MAX_QUADRATURE_SIGMA {
             return Ok(());
         }
-        Err(format!(
-            "the quadrature of the pdf did not converge: a bin's error estimate is {:.3}σ of its count at {samples} samples (at most {MAX_QUADRATURE_SIGMA}σ gives a verdict; {} parts accepted at the depth limit or the parts' budget after {RETRIES} finer retries), so no verdict is drawn; a pdf with an edge or a peak narrower than the quadrature resolves (a small cone, a near-delta lobe) needs fewer --samples or more --bins",
+        let what = format!(
+            "the quadrature of the pdf did not converge: a bin's error estimate is {:.3}σ of its count at {samples} samples (at most {MAX_QUADRATURE_SIGMA}σ gives a verdict; {} parts accepted at the depth limit or the parts' budget after {RETRIES} finer retries), so no verdict is drawn; a pdf with an edge or a peak narrower than the quadrature resolves (a small cone, a near-delta lobe) needs fewer ",
             self.max_error_sigma, self.unconverged_parts
-        ))
+        );
+        Err(Message::text(what).setting(Setting::Samples).then(" or more ").setting(Setting::Bins))
     }
 
     /// `Err` with what is wrong where [`Integrals::hidden_support_bins`] holds a bin: its
@@ -134,17 +135,18 @@ impl Integrals {
     ///     unconverged_parts: 0, bad_parts: 0, dropped: vec![], parts: 1, rounds: 1, hidden_support_bins: 0 };
     /// assert!(i.support_seen().is_ok());
     /// i.hidden_support_bins = 2;
-    /// assert!(i.support_seen().unwrap_err().contains("no verdict"));
+    /// assert!(i.support_seen().unwrap_err().to_string().contains("no verdict"));
     /// ```
-    pub fn support_seen(&self) -> Result<(), String> {
+    pub fn support_seen(&self) -> Result<(), Message> {
         if self.hidden_support_bins == 0 {
             return Ok(());
         }
-        Err(format!(
-            "the quadrature cannot see all of the pdf's support: in {} bin{} it is narrower than the quadrature's nodes (found only about the samples, as a sliver of a light and its tapering tips are) and there the samples exceed the integral by over {HIDDEN_SIGMA}σ, mass the nodes may have missed; the checks that read no integral pass, so no verdict is drawn; fewer --bins or fewer --samples",
+        let what = format!(
+            "the quadrature cannot see all of the pdf's support: in {} bin{} it is narrower than the quadrature's nodes (found only about the samples, as a sliver of a light and its tapering tips are) and there the samples exceed the integral by over {HIDDEN_SIGMA}σ, mass the nodes may have missed; the checks that read no integral pass, so no verdict is drawn; fewer ",
             self.hidden_support_bins,
             if self.hidden_support_bins == 1 { "" } else { "s" }
-        ))
+        );
+        Err(Message::text(what).setting(Setting::Bins).then(" or fewer ").setting(Setting::Samples))
     }
 }
 

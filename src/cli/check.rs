@@ -203,6 +203,7 @@ fn input(e: CheckError) -> anyhow::Error {
         CheckError::Gpu(GpuError::TimedOut { .. }) => super::ChecksFailed(e.to_string()).into(),
         CheckError::Setting { setting, message } => usage(format!("--{}: {message}", flag(setting))),
         CheckError::Advised(m) => usage(m.render(&|s| format!("--{}", flag(s)))),
+        CheckError::NoVerdict(m) => anyhow::anyhow!("{}", m.render(&|s| format!("--{}", flag(s)))),
         e if e.is_input() => usage(e.to_string()),
         e => e.into(),
     }

@@ -59,7 +59,7 @@ fn run_error(e: CheckError) -> anyhow::Error {
         CheckError::Gpu(g) => anyhow::Error::new(g),
         // a setting, and the settings a message names, as the scene names them
         CheckError::Setting { setting, message } => anyhow::anyhow!("{}: {message}", scene_key(setting)),
-        CheckError::Advised(m) => anyhow::anyhow!("{}", m.render(&scene_key)),
+        CheckError::Advised(m) | CheckError::NoVerdict(m) => anyhow::anyhow!("{}", m.render(&scene_key)),
         other => other.into(),
     }
 }

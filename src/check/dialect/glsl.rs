@@ -15,7 +15,7 @@
 //! Several files given are one translation unit, in order. A `#version` other than 440, 450 or
 //! 460 (an OpenGL renderer's 330 or 430) is read as 450.
 
-use super::super::CheckError;
+use super::super::{CheckError, Message, Setting};
 use super::super::compose::Source;
 use super::super::composition::{Call, Composition, Dialect, UserCode};
 use super::front_end::FrontEnd;
@@ -66,7 +66,7 @@ struct Expanded {
     /// The texts of `files` (for the lines of messages).
     texts: Vec<String>,
     /// Lines of `text` that stand for an include no root holds, with the message.
-    missing: Vec<(usize, String)>,
+    missing: Vec<(usize, Message)>,
     /// Files with `#pragma once` already expanded.
     once: Vec<PathBuf>,
     /// OpenGL's loose uniforms, where they are declared ([`gl_uniforms`]).
@@ -87,13 +87,17 @@ impl Expanded {
 
     /// `file:line:column: message`, the user's line and a caret, for a location in `text`.
     fn diagnostic(&self, loc: Option<naga::SourceLocation>, message: &str) -> String {
-        let Some(loc) = loc else { return format!("{}: error: {message}", self.files.join(", ")) };
-        let Some(at) = self.lines.get(loc.line_number.saturating_sub(1) as usize) else {
-            return format!("{}: error: {message}", self.files.join(", "));
+        self.advice(loc, Message::text(message)).to_string()
+    }
+
+    /// [`Expanded::diagnostic`] of a message that may name settings.
+    fn advice(&self, loc: Option<naga::SourceLocation>, message: Message) -> Message {
+        let Some((loc, at)) = loc.and_then(|l| Some((l, self.lines.get(l.line_number.saturating_sub(1) as usize)?))) else {
+            return Message::text(format!("{}: error: ", self.files.join(", "))).append(message);
         };
         let src = self.texts[at.file].lines().nth(at.line as usize - 1).unwrap_or("");
         let caret = " ".repeat(loc.line_position.saturating_sub(1) as usize) + &"^".repeat((loc.length as usize).clamp(1, 60));
-        format!("{}:{}:{}: error: {message}\n    {src}\n    {caret}", self.files[at.file], at.line, loc.line_position)
+        Message::text(format!("{}:{}:{}: error: ", self.files[at.file], at.line, loc.line_position)).append(message).then(format!("\n    {src}\n    {caret}"))
     }
 }
 
@@ -125,9 +129,10 @@ pub(super) fn translate(sources: &[Source], c: &Composition) -> Result<Translati
         other => other,
     };
     let mut module = module.map_err(|errors| {
-        let mut messages: Vec<String> = errors.iter().map(|e| message(&x, e)).collect();
+        let mut messages: Vec<Message> = errors.iter().map(|e| message(&x, e)).collect();
         messages.dedup();
-        CheckError::Wgsl(messages.into_iter().take(8).collect::<Vec<_>>().join("\n"))
+        let all = messages.into_iter().take(8).reduce(|all, m| all.then("\n").append(m)).unwrap_or_else(|| Message::text("naga's GLSL reader failed and said nothing"));
+        if all.names_settings() { CheckError::Advised(all) } else { CheckError::Wgsl(all.to_string()) }
     })?;
     if let Some((span, f)) = fall_through(&mut module) {
         let m = format!("in `{f}`, a `switch` case falls through into the next one, which WGSL (what lobes runs) cannot express; end each case that has statements with `break` or `return` (repeat the next case's statements in it if it meant to fall through)");
@@ -157,23 +162,24 @@ fn is_missing_entry_point(e: &naga::front::glsl::Error) -> bool {
 
 /// One error of naga's GLSL front end at the user's file and line (an `#error` lobes wrote for
 /// a missing include: that include's message).
-fn message(x: &Expanded, e: &naga::front::glsl::Error) -> String {
+fn message(x: &Expanded, e: &naga::front::glsl::Error) -> Message {
     let loc = e.location(&x.text);
     match loc.and_then(|l| x.missing.iter().find(|(line, _)| *line + 1 == l.line_number as usize)) {
         // the include line as the user wrote it, from its start
-        Some((line, m)) => x.diagnostic(Some(naga::SourceLocation { line_number: *line as u32 + 1, line_position: 1, offset: 0, length: 0 }), m),
-        None => x.diagnostic(loc, &left_out(x, e).unwrap_or_else(|| e.kind.to_string())),
+        Some((line, m)) => x.advice(Some(naga::SourceLocation { line_number: *line as u32 + 1, line_position: 1, offset: 0, length: 0 }), m.clone()),
+        None => x.advice(loc, left_out(x, e).unwrap_or_else(|| Message::text(e.kind.to_string()))),
     }
 }
 
 /// The message for a use of an opaque loose uniform that lobes left out ([`gl_uniforms`]).
-fn left_out(x: &Expanded, e: &naga::front::glsl::Error) -> Option<String> {
+fn left_out(x: &Expanded, e: &naga::front::glsl::Error) -> Option<Message> {
     let naga::front::glsl::ErrorKind::UnknownVariable(name) = &e.kind else { return None };
     let (_, at) = x.uniforms.iter().find(|(u, _)| u.opaque && &u.name == name)?;
-    Some(format!(
-        "`{name}` is an OpenGL uniform sampler or image ({}), which naga's GLSL reader cannot take, so lobes left it out; the function here uses it: give lobes the files that define the sampler without this one (or this function behind an #ifdef that --define leaves off)",
+    let what = format!(
+        "`{name}` is an OpenGL uniform sampler or image ({}), which naga's GLSL reader cannot take, so lobes left it out; the function here uses it: give lobes the files that define the sampler without this one (or this function behind an #ifdef that ",
         x.place(*at)
-    ))
+    );
+    Some(Message::text(what).setting(Setting::Define).then(" leaves off)"))
 }
 
 /// `#include "x"` or `#include <x>` on this line: (x, whether quoted).
@@ -230,10 +236,8 @@ fn expand(x: &mut Expanded, s: &Source, roots: &[PathBuf], stack: &mut Vec<PathB
         let candidates: Vec<PathBuf> = quoted.then(|| here.join(name)).into_iter().chain(roots.iter().map(|r| r.join(name))).collect();
         let Some(found) = candidates.iter().find(|p| p.is_file()) else {
             let searched: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
-            x.missing.push((x.lines.len(), format!(
-                "#include \"{name}\": no such file ({} searched); give the folder that holds it with --shader-root",
-                searched.join(", ")
-            )));
+            let what = format!("#include \"{name}\": no such file ({} searched); give the folder that holds it with ", searched.join(", "));
+            x.missing.push((x.lines.len(), Message::text(what).setting(Setting::ShaderRoot)));
             x.push("#error lobes: include not found", at);
             continue;
         };

@@ -99,7 +99,7 @@ fn wesl_tree(sources: &[Source], c: &Composition) -> Result<WeslTree, CheckError
     let result = compiler.compile(&root_path);
     seen.borrow().refusal(c, &sources[0].name)?;
     let files = resolver(Vec::new());
-    let result = result.map_err(|e| wesl_error(&e, &sources[0], &files))?;
+    let result = result.map_err(|e| seen.borrow().advised(wesl_error(&e, &sources[0], &files)))?;
     wesl_origins(&result, &root_path.to_string(), &files, &sources[0])
 }
 

@@ -3,7 +3,7 @@
 //! stub where one is given; what it refuses (a module reachable two ways, one that imports
 //! itself) and why an import is not found (the closest modules under the roots).
 
-use super::super::{CheckError, Setting};
+use super::super::{CheckError, Message, Setting};
 use super::super::compose::Source;
 use super::super::composition::Composition;
 use super::roots::{scan, show_roots};
@@ -27,19 +27,28 @@ pub(super) struct Roots {
     pub seen: std::rc::Rc<std::cell::RefCell<Resolved>>,
 }
 
-/// What lobes' resolver saw of a WESL tree: the stubs used, and an input error of its own (a
-/// module reachable two ways, one that imports itself), which the wesl crate's error would hide.
+/// What lobes' resolver saw of a WESL tree: the stubs used, an input error of its own (a
+/// module reachable two ways, one that imports itself), which the wesl crate's error would hide,
+/// and why each import it could not find is not found (the wesl crate's error holds a
+/// [`marker`] in its place, [`Resolved::advised`] puts it back).
 #[derive(Default)]
 pub(super) struct Resolved {
     stubs_used: Vec<String>,
-    error: Option<String>,
+    error: Option<Message>,
+    not_found: Vec<Message>,
+}
+
+/// What the wesl crate's error holds in place of the `i`th message of [`Resolved::not_found`]
+/// (a message that names settings cannot travel as its text).
+fn marker(i: usize) -> String {
+    format!("⟦lobes {i}⟧")
 }
 
 impl Resolved {
     /// The resolver's own error, else a `--stub` that no import reached.
     pub(super) fn refusal(&self, c: &Composition, root: &str) -> Result<(), CheckError> {
         if let Some(why) = &self.error {
-            return Err(CheckError::Input(why.clone()));
+            return Err(CheckError::Advised(why.clone()));
         }
         match c.stubs.iter().find(|(m, _)| !self.stubs_used.contains(m)) {
             Some((m, _)) => Err(CheckError::setting(
@@ -48,6 +57,25 @@ impl Resolved {
             )),
             None => Ok(()),
         }
+    }
+
+    /// `e` with the messages of the imports not found back where the wesl crate's text holds
+    /// their markers: advice naming settings ([`CheckError::Advised`]).
+    pub(super) fn advised(&self, e: CheckError) -> CheckError {
+        let text = match &e {
+            CheckError::Wgsl(t) | CheckError::Input(t) if t.contains("⟦lobes ") => t.clone(),
+            _ => return e,
+        };
+        let mut message = Message::text("");
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("⟦lobes ") {
+            let (before, after) = rest.split_at(at);
+            let Some((index, tail)) = after["⟦lobes ".len()..].split_once('⟧') else { break };
+            let Some(m) = index.parse::<usize>().ok().and_then(|i| self.not_found.get(i)) else { break };
+            message = message.then(before).append(m.clone());
+            rest = tail;
+        }
+        CheckError::Advised(message.then(rest))
     }
 }
 
@@ -84,39 +112,48 @@ impl Roots {
         let shown = path.to_string();
         self.stubs.iter().find(|(m, _)| *m == shown || format!("package::{m}") == shown)
     }
-    /// Why no file holds `path`: where lobes looked, the closest modules it found, and the flags
-    /// that say where the module is.
+    /// Why no file holds `path`: where lobes looked, the closest modules it found, and the
+    /// settings that say where the module is; kept in [`Resolved`], its [`marker`] returned.
     fn not_found(&self, path: &wesl::ModulePath) -> String {
         let shown = path.to_string();
         let rel = path.components.join("/");
+        let package = |name: &str| Message::text("").setting(Setting::Package).then(format!(" {name}"));
         let (looked, hint) = match &path.origin {
             wesl::syntax::PathOrigin::Package(name) => match self.packages.iter().find(|(n, _)| n == name) {
-                Some((_, dir)) => (format!("no file {rel}.wesl or .wgsl in {} (--package {name})", dir.display()), format!("Check the folder of --package {name}=DIR (it holds {name}'s modules: {name}::a::b is DIR/a/b.wesl), ")),
+                Some((_, dir)) => (
+                    Message::text(format!("no file {rel}.wesl or .wgsl in {} (", dir.display())).append(package(name)).then(")"),
+                    Message::text("Check the folder of ").append(package(name)).then(format!("=DIR (it holds {name}'s modules: {name}::a::b is DIR/a/b.wesl), ")),
+                ),
                 None => (
-                    format!("no package {name} given (--package), and no file {rel}.wesl or .wgsl under the shader roots ({}), where lobes looks for it without its name", show_roots(&self.roots)),
-                    format!("Say where {name} is with --package {name}=DIR, "),
+                    Message::text(format!("no package {name} given (")).setting(Setting::Package).then(format!("), and no file {rel}.wesl or .wgsl under the shader roots ({}), where lobes looks for it without its name", show_roots(&self.roots))),
+                    Message::text(format!("Say where {name} is with ")).append(package(name)).then("=DIR, "),
                 ),
             },
-            _ => (format!("no file {rel}.wesl or .wgsl under the shader roots ({})", show_roots(&self.roots)), String::new()),
+            _ => (
+                Message::text(format!("no file {rel}.wesl or .wgsl under the shader roots ({})", show_roots(&self.roots))),
+                Message::text("Add its folder with ").setting(Setting::ShaderRoot).then(", "),
+            ),
         };
         let close = closest_modules(&shown, &self.known);
         let close = match close.is_empty() {
             true => format!("none of the {} modules found is close", self.known.len()),
             false => format!("closest: {} of the {} modules found", close.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", "), self.known.len()),
         };
-        let hint = if hint.is_empty() { "Add its folder with --shader-root, ".to_string() } else { hint };
-        format!("unresolved import: {looked} ({close}). {hint}or stand in for it with --stub {shown}=FILE")
+        let why = Message::text("unresolved import: ").append(looked).then(format!(" ({close}). ")).append(hint).then("or stand in for it with ").setting(Setting::Stub).then(format!(" {shown}=FILE"));
+        let mut seen = self.seen.borrow_mut();
+        seen.not_found.push(why);
+        marker(seen.not_found.len() - 1)
     }
     /// `text` (the file `name`) with its `@if` blocks resolved; a malformed condition is an
     /// error at its file, line and column.
     fn conditional_blocks(&self, path: &wesl::ModulePath, name: &str, text: &str) -> Result<String, wesl::ResolveError> {
         super::wesl_blocks::resolve(text, &self.features).map_err(|e| {
             let (line, col) = line_col(text, e.at);
-            self.refuse(path, format!("{name}:{line}:{col}: {}", e.message))
+            self.refuse(path, Message::text(format!("{name}:{line}:{col}: {}", e.message)))
         })
     }
     /// An error of the resolver's own, kept for the tree's caller (and a short one for wesl).
-    fn refuse(&self, path: &wesl::ModulePath, why: String) -> wesl::ResolveError {
+    fn refuse(&self, path: &wesl::ModulePath, why: Message) -> wesl::ResolveError {
         self.seen.borrow_mut().error.get_or_insert(why);
         wesl::ResolveError::ModuleNotFound(path.clone(), "see above".into())
     }
@@ -156,17 +193,15 @@ impl wesl::Resolver for Roots {
         };
         if files.len() > 1 {
             let names: Vec<String> = files.iter().map(|f| f.display().to_string()).collect();
-            return Err(self.refuse(path, format!(
-                "the module {shown} is reachable two ways: {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with --stub {shown}=FILE",
-                names.join(" and ")
-            )));
+            let why = format!("the module {shown} is reachable two ways: {}; which one the renderer composes is not for lobes to guess. Remove or rename the stale copy, or give the right one with ", names.join(" and "));
+            return Err(self.refuse(path, Message::text(why).setting(Setting::Stub).then(format!(" {shown}=FILE"))));
         }
         let text = std::fs::read_to_string(f).map_err(|e| wesl::ResolveError::ModuleNotFound(path.clone(), format!("{}: {e}", f.display())))?;
         if let Some((line, stmt)) = self_import(&text, path) {
-            return Err(self.refuse(path, format!(
+            return Err(self.refuse(path, Message::text(format!(
                 "{}:{line}: the module {shown} imports itself (`{stmt}`); a module names its own declarations without an import: remove the line",
                 f.display()
-            )));
+            ))));
         }
         self.conditional_blocks(path, &f.display().to_string(), &text).map(Into::into)
     }
@@ -206,4 +241,17 @@ pub(super) fn wesl_known(roots: &[PathBuf], packages: &[(String, PathBuf)]) -> V
         }
     }
     known
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_marker_is_its_message_naming_settings() {
+        let r = Resolved { not_found: vec![Message::text("stand in with ").setting(Setting::Stub)], ..Default::default() };
+        let CheckError::Advised(m) = r.advised(CheckError::Wgsl(format!("a.wesl:1:2: module not found: `x` ({})", marker(0)))) else { panic!() };
+        assert_eq!(m.render(&|s| format!("--{}", s.key())), "a.wesl:1:2: module not found: `x` (stand in with --stub)");
+        assert!(matches!(r.advised(CheckError::Wgsl("a.wesl:1:2: x".into())), CheckError::Wgsl(_)), "no marker: left as it is");
+    }
 }

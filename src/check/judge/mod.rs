@@ -224,7 +224,10 @@ fn integrate(run: &Run, evidence: &quadrature::Evidence, width: f64) -> Result<(
 /// expected counts the quadrature could not resolve give no verdict.
 pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckError> {
     if m.integrals.bad_parts == 0 {
-        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(e + &super::half_vector_pole(&run.sampler, run.settings, None).unwrap_or_default()))?;
+        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(match super::half_vector_pole(&run.sampler, run.settings, None) {
+            Some(pole) => e.append(pole),
+            None => e,
+        }))?;
     }
     Ok(())
 }

@@ -4,7 +4,7 @@
 
 use super::{Measured, Run};
 use crate::check::report::{Check, Figures, NormalizationFigures};
-use crate::check::invalid_expectation;
+use crate::check::{Message, Setting, invalid_expectation};
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Check {
     let (n, total) = (run.samples(), m.pdf_total());
@@ -48,14 +48,15 @@ pub const F32_MOVED_SIGMA: f64 = 1.0;
 /// failed `chi2` at 2 of 3 seeds of 2¹⁶ samples with ∫pdf 1.0129, its f32 evaluation moving ∫pdf
 /// by about 10⁻² (normalization passing within that; the Jacobian unresolved in f32 at 4083 of
 /// 4096 samples).
-pub(crate) fn rounding_resolved(run: &Run, m: &Measured, chi2_passed: bool) -> Result<(), String> {
+pub(crate) fn rounding_resolved(run: &Run, m: &Measured, chi2_passed: bool) -> Result<(), Message> {
     let n = run.samples();
     if chi2_passed || n * m.f32_moved <= F32_MOVED_SIGMA * n.sqrt() {
         return Ok(());
     }
-    Err(format!(
-        "the pdf's f32 evaluation alone moves ∫pdf by {:.1e} (its inputs an ulp off), more than {F32_MOVED_SIGMA} × the count's standard deviation at {n} samples ({:.1e} of ∫pdf): chi2 fails, but cannot tell that rounding from a defect, and the checks that read no integral pass, so no verdict is drawn; evaluate the pdf in a stabler form, or fewer --samples",
+    let what = format!(
+        "the pdf's f32 evaluation alone moves ∫pdf by {:.1e} (its inputs an ulp off), more than {F32_MOVED_SIGMA} × the count's standard deviation at {n} samples ({:.1e} of ∫pdf): chi2 fails, but cannot tell that rounding from a defect, and the checks that read no integral pass, so no verdict is drawn; evaluate the pdf in a stabler form, or fewer ",
         m.f32_moved,
         F32_MOVED_SIGMA / n.sqrt()
-    ))
+    );
+    Err(Message::text(what).setting(Setting::Samples))
 }

@@ -8,7 +8,7 @@ use crate::check::conventions::Conventions;
 use crate::check::gpu::{Params, Passes};
 use crate::check::hard::show;
 use crate::check::report::{Check, Figures, PdfValuesFigures};
-use crate::check::{CheckError, Domain};
+use crate::check::{CheckError, Domain, Message};
 
 /// The grid's cells per cell of the domain's default histogram, along each axis (256 × 512 on
 /// the sphere, 256 × 256 on the plane).
@@ -81,7 +81,7 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
         && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
     {
         let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), s.domain));
-        return Err(CheckError::NoVerdict(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}{pole}", run.pdf())));
+        return Err(CheckError::NoVerdict(Message::text(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}", run.pdf())).append(pole)));
     }
     let worst = worst.map(|w| w.describe(&run.pdf(), s.domain));
     let summary = if bad == 0 {
