@@ -84,9 +84,10 @@ fn bad_patterns_and_values_are_bad_input() {
     let dir = scratch("scene-bad");
     std::fs::write(dir.join("sweep.toml"), SWEEP).unwrap();
     let bad = [
-        (&["run", "sweep.toml", "--cpu", "--case", "g-vnfd-*"][..], "matches no case of sweep.toml"),
+        (&["run", "sweep.toml", "--cpu", "--case", "g-vnfd-*"][..], "--case \"g-vnfd-*\" matches no case of sweep.toml"),
         (&["run", "sweep.toml", "--cpu", "--case", "w-ax0.33"][..], "(did you mean 'w-ax0.3'?)"),
-        (&["run", "sweep.toml", "--cpu", "--case", "[g"][..], "not a valid pattern"),
+        (&["run", "sweep.toml", "--cpu", "--case", "[g"][..], "--case \"[g\" is not a valid pattern"),
+        (&["run", "sweep.toml", "--cpu", "--shard", "2/2"][..], "is not in 0..2; give I/N with 0 ≤ I < N, e.g. 0/4"),
         (&["run", "sweep.toml", "--cpu", "--samples", "0"][..], "--samples"),
         (&["run", "sweep.toml", "--cpu", "--seed", "-1"][..], "--seed"),
         (&["run", "sweep.toml", "--shard", "0/2", "--case", "w-*"][..], "cannot be used with"),

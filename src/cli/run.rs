@@ -185,7 +185,7 @@ impl PlainProgress {
 /// The scene to run and the backend to run it on, or why the run cannot start.
 fn start(args: &RunArgs) -> anyhow::Result<(Scene, Backend)> {
     let overrides = Overrides { samples: args.samples, seed: args.seed };
-    let scene = read_scene(args.scene.as_ref(), overrides)?.1.select(&args.cases).map_err(usage)?;
+    let scene = read_scene(args.scene.as_ref(), overrides)?.1.select(&args.cases).map_err(|e| usage(format!("--case {e}")))?;
     if args.cpu
         && let Some((name, at)) = first_user_case(&scene)
     {

@@ -91,7 +91,7 @@ impl Shard {
     /// assert!(Shard::parse("1").is_err());
     /// ```
     pub fn parse(s: &str) -> Result<Shard, String> {
-        let hint = "give I/N with 0 ≤ I < N, e.g. --shard 0/4 (I counts from 0, like SLURM_ARRAY_TASK_ID with --array=0-(N-1) or JOB_COMPLETION_INDEX)";
+        let hint = "give I/N with 0 ≤ I < N, e.g. 0/4 (I counts from 0, like SLURM_ARRAY_TASK_ID with --array=0-(N-1) or JOB_COMPLETION_INDEX)";
         let (i, n) = s.split_once('/').ok_or_else(|| format!("'{s}' is not a shard; {hint}"))?;
         let parse = |x: &str| x.trim().parse::<u64>().map_err(|_| format!("'{s}' is not a shard: '{x}' is not a whole number; {hint}"));
         let (index, count) = (parse(i)?, parse(n)?);

@@ -26,10 +26,10 @@ impl Scene {
         let names: Vec<&str> = self.entries().map(|(e, _)| e.name()).collect();
         let mut compiled = Vec::new();
         for p in patterns {
-            let pattern = Pattern::new(p).map_err(|e| format!("--case {p:?} is not a valid pattern: {e}"))?;
+            let pattern = Pattern::new(p).map_err(|e| format!("{p:?} is not a valid pattern: {e}"))?;
             if !names.iter().any(|n| pattern.matches_with(n, OPTIONS)) {
                 let hint = did_you_mean(p, names.iter().copied());
-                return Err(format!("--case {p:?} matches no case of {}{hint}; its cases: {}", self.file, names.join(", ")));
+                return Err(format!("{p:?} matches no case of {}{hint}; its cases: {}", self.file, names.join(", ")));
             }
             compiled.push(pattern);
         }
