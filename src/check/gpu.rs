@@ -389,34 +389,7 @@ fn glue_text(sampler: &UserSampler, sample: String, order: [u32; 4], reach: bool
          var<private> lobes_rand_u: vec4<f32>;\n\
          var<private> lobes_rand_next: u32;\n\
          const LOBES_RAND_ORDER = array<u32, 4>({o0}u, {o1}u, {o2}u, {o3}u);\n\
-         // The next n uniforms of the queue u[LOBES_RAND_ORDER[0]], u[LOBES_RAND_ORDER[1]], …: the\n\
-         // bodies of the user's --rand functions. Past the fourth it hands out a hash of u and the\n\
-         // draw's index (never 0 for ever: a loop that redraws until it gets a nonzero number ends),\n\
-         // and the host refuses a sampler that draws more (lobes_user_draws).\n\
-         fn lobes_rand_take(n: u32) -> vec4<f32> {{\n\
-         \x20   var r = vec4<f32>(0.0);\n\
-         \x20   for (var k = 0u; k < n; k++) {{\n\
-         \x20       let i = lobes_rand_next + k;\n\
-         \x20       if (i < 4u) {{\n\
-         \x20           r[k] = lobes_rand_u[LOBES_RAND_ORDER[i]];\n\
-         \x20       }} else {{\n\
-         \x20           r[k] = f32(lobes_pcg(i ^ lobes_rng_seed(lobes_rand_u)) >> 8u) / 16777216.0;\n\
-         \x20       }}\n\
-         \x20   }}\n\
-         \x20   lobes_rand_next += n;\n\
-         \x20   return r;\n\
-         }}\n\
-         // PCG hash (Jarzynski & Olano 2020, \"Hash Functions for GPU Rendering\"), and the state of\n\
-         // `rng` from the bits of the uniforms: the same u gives the same draws.\n\
-         fn lobes_pcg(v: u32) -> u32 {{\n\
-         \x20   let s = v * 747796405u + 2891336453u;\n\
-         \x20   let w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;\n\
-         \x20   return (w >> 22u) ^ w;\n\
-         }}\n\
-         fn lobes_rng_seed(u: vec4<f32>) -> u32 {{\n\
-         \x20   let b = bitcast<vec4<u32>>(u);\n\
-         \x20   return lobes_pcg(b.x ^ lobes_pcg(b.y ^ lobes_pcg(b.z ^ lobes_pcg(b.w))));\n\
-         }}\n\
+         {queue}\
          fn lobes_glue_sample(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32> {{\n\
          \x20   lobes_rand_u = u;\n\
          \x20   lobes_rand_next = 0u;\n\
@@ -428,6 +401,7 @@ fn glue_text(sampler: &UserSampler, sample: String, order: [u32; 4], reach: bool
         o1 = order[1],
         o2 = order[2],
         o3 = order[3],
+        queue = include_str!("../../shaders/check/rand_queue.wgsl"),
         pdf = density(Call::Pdf, Some(&sampler.pdf)),
         eval = density(Call::Eval, sampler.eval.as_deref()),
         light = light_cos(sampler),
