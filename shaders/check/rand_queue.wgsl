@@ -1,4 +1,4 @@
-// The --rand queue of a user's sampler (src/check/gpu.rs's glue, after the constant
+// The --rand queue of a user's sampler (src/check/glue.rs, after the constant
 // LOBES_RAND_ORDER and the private lobes_rand_u and lobes_rand_next it declares): the user's
 // random functions, their bodies replaced, take the sample's uniforms in turn.
 

@@ -42,6 +42,7 @@ pub mod composition;
 pub mod conventions;
 pub mod dialect;
 mod exr;
+mod glue;
 mod gpu;
 pub mod hard;
 pub mod modules;
@@ -331,7 +332,7 @@ impl UserSampler {
             )));
         }
         // the glue's own errors (a call expression's, a --rand function's) now, not at the GPU
-        gpu::prepare(self, gpu::default_order(self))?;
+        glue::prepare(self, gpu::default_order(self))?;
         Ok(())
     }
 
