@@ -19,7 +19,8 @@ pub(super) enum Returned {
     Vec4,
 }
 
-/// The path of the generated glue in messages: errors in a call expression point here.
+/// The path in messages of the generated glue and of the module `lobes::user` that holds it:
+/// errors in a call expression point here.
 pub(super) const GLUE: &str = "<lobes check glue>";
 
 /// lobes' names for call expressions: `wi`, `u`, `d`, `params`, `p0` … `p15` and `rng`, a
@@ -182,9 +183,6 @@ pub(super) fn contract_glue(sampler: &UserSampler) -> String {
         conventions = sampler.conventions.wgsl(),
     )
 }
-
-/// The path of the generated module `lobes::user` in messages.
-pub(super) const USER_MODULE: &str = "<lobes check glue>";
 
 /// The type of a `call` expression over the user's code (naga's type of it in a probe function);
 /// an expression that does not parse or validate is an error keyed by its setting.

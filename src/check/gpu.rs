@@ -4,7 +4,7 @@
 
 use super::compose::Composed;
 use super::composition::Draw;
-use super::glue::{USER_MODULE, contract_glue, prepare};
+use super::glue::{GLUE, contract_glue, prepare};
 use super::probe::Probe;
 use super::{CheckError, Message, Setting, UserSampler, shaders};
 use crate::reference::Invalid;
@@ -295,25 +295,25 @@ fn compose_roots(sampler: &UserSampler, order: [u32; 4], roots: &[&str], mut cho
     let user: String = parts.iter().map(|s| format!("{}\n", s.text)).collect();
     let module = format!("#define_import_path lobes::user\n#import lobes::params::lobes_params\n{user}{glue}");
     let reasons = format!("#define_import_path lobes::invalid\n{}", Invalid::wgsl_consts("LOBES_REASON"));
-    chosen.extend([File::generated(USER_MODULE, module), shaders::domain_file(sampler.domain), File::generated("lobes::invalid", reasons)]);
+    chosen.extend([File::generated(GLUE, module), shaders::domain_file(sampler.domain), File::generated("lobes::invalid", reasons)]);
     // lobes' files each a naga_oil root of its own (which refuses a name used without its
     // #import), as the engine's compositions are checked: in the unit tests, which compose the
     // passes and the histogram; a run validates the joined module (below, its errors at each
     // file's line) and saves the 40 ms this takes per composition
     #[cfg(test)]
     match library::validate_files(roots, &chosen) {
-        Err(crate::engine::gpu::GpuError::Shader { what, .. }) if what == USER_MODULE => {}
+        Err(crate::engine::gpu::GpuError::Shader { what, .. }) if what == GLUE => {}
         other => other?,
     }
     let pieces = library::pieces(roots, &chosen)?;
     let own = lobes_own_names(&pieces);
     let mut c = Composed::default();
     for (path, text) in &pieces {
-        if path == USER_MODULE {
+        if path == GLUE {
             for s in &parts {
                 c.push(&s.name, &s.text);
             }
-            c.push(USER_MODULE, &glue);
+            c.push(GLUE, &glue);
         } else {
             c.push(path, &crate::embed::rename(text, |t| own.contains(&t).then(|| format!("lobes_{t}"))));
         }
@@ -458,7 +458,7 @@ pub(super) fn reserved(name: &str) -> bool {
 /// α-renaming): a renderer's files hold `PI`, `Real` or `pcg4d` too (GLSL-PathTracer's RNG is a
 /// `pcg4d`), and a composed check holds both.
 fn lobes_own_names(pieces: &[(String, String)]) -> Vec<&str> {
-    let own = pieces.iter().filter(|(path, _)| path != USER_MODULE);
+    let own = pieces.iter().filter(|(path, _)| path != GLUE);
     own.flat_map(|(_, text)| crate::embed::declared(text)).filter(|n| !reserved(n)).collect()
 }
 
