@@ -382,7 +382,7 @@ fn bind_resources(c: &mut Composed, module: &naga::Module, info: &naga::valid::M
         let span = module.global_variables.get_span(h);
         let global = g.name.as_deref().unwrap_or("?");
         let Some((name, resource)) = given.iter().find(|(n, _)| resources::names(global, n)) else {
-            let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or_else(|| g.binding).expect("a binding");
+            let as_declared = declared.iter().find(|(n, _)| n == global).map(|(_, b)| *b).or(g.binding).expect("a binding");
             return Err(CheckError::Advised(unbound(c.diagnostic_at(span, &unbound_message(g, &as_declared, module)), g)));
         };
         // a file another composition of the same files read and held to this declaration is not read again

@@ -203,12 +203,15 @@ fn largest_step(at: &[[f32; 4]], domain: Domain) -> Option<(usize, f64)> {
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
+/// The sample map at a list of uniforms, as the check's map pass evaluates it.
+pub type MapPass<'a> = dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::CheckError> + 'a;
+
 /// Whether the sample map jumps along u.x or u.y: on the lines through the first [`JUMP_LINES`]
 /// of `probes` (u with a valid sample) along each axis, the largest step of d over
 /// [`JUMP_NODES`] nodes, refined twice around its largest sub-step; `map` evaluates the sampler
 /// at uniforms (the check's map pass). A smooth map's largest sub-step shrinks with the step; a
 /// jump's stays.
-pub fn find_jump(probes: &[[f32; 4]], domain: Domain, map: &dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::CheckError>) -> Result<Option<Jump>, super::CheckError> {
+pub fn find_jump(probes: &[[f32; 4]], domain: Domain, map: &MapPass) -> Result<Option<Jump>, super::CheckError> {
     let margin = 2.0 * EPS as f64;
     for axis in 0..2 {
         // (u, the interval [lo, hi] of the largest step, that step) per line

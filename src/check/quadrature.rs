@@ -212,6 +212,9 @@ pub(super) fn initial_width(p_max: f64, domain: Domain, rows: u32) -> f64 {
     width.min(MAX_SPHERE_WIDTH).min(row)
 }
 
+/// A bin's piece before its split: (a range, b range, hemisphere, initial split per axis).
+type Piece = ((f64, f64), (f64, f64), f32, u32);
+
 /// The parts a bin starts as: on the sphere its (a, φ) rectangle per hemisphere it touches,
 /// each split `m × m` where `m` is its angular extent over `width`, at most `cap`; only the
 /// bins `only` marks, where given.
@@ -223,8 +226,7 @@ fn initial_parts(domain: &Domain, rows: u32, cols: u32, width: f64, cap: u32, on
         if only.is_some_and(|o| !o[bin as usize]) {
             continue;
         }
-        // (a range, b range, hemisphere, initial split per axis)
-        let mut pieces: Vec<((f64, f64), (f64, f64), f32, u32)> = Vec::new();
+        let mut pieces: Vec<Piece> = Vec::new();
         match grid.cell(bin as usize) {
             Cell::Plane { x, y } => pieces.push((x, y, 0.0, m((x.1 - x.0).max(y.1 - y.0)))),
             Cell::Sphere { row, phi } => {

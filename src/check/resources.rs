@@ -202,7 +202,7 @@ fn read_table(path: &Path, bytes: &[u8]) -> Result<Data, String> {
 
 /// Raw little-endian 32-bit words: a whole, non-zero number of them.
 fn read_raw(bytes: &[u8]) -> Result<Vec<u32>, String> {
-    if bytes.is_empty() || bytes.len() % 4 != 0 {
+    if bytes.is_empty() || !bytes.len().is_multiple_of(4) {
         return Err(format!("raw table of {} bytes: expected a non-zero multiple of 4 (32-bit little-endian words)", bytes.len()));
     }
     Ok(bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect())

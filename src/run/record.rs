@@ -23,9 +23,10 @@ pub struct CaseDescription {
     pub cols: usize,
 }
 
-/// A case's parameters.
+/// A case's parameters (one per case of a run: the user's variant's size costs nothing).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
+#[allow(clippy::large_enum_variant)]
 pub enum Params {
     Lobe {
         alpha_x: f64,

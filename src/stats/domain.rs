@@ -509,7 +509,7 @@ impl Grid {
             Domain::Cap { axis, height } => {
                 let d = DVec3::from(p);
                 let (a, x, y) = Frame::of(axis).local(d);
-                if (d.length() - 1.0).abs() > 1e-3 || !(a <= height) {
+                if (d.length() - 1.0).abs() > 1e-3 || a.is_nan() || a > height {
                     return None;
                 }
                 let row = ((a / height * self.rows as f64) as u32).min(self.rows - 1);

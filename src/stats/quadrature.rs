@@ -361,7 +361,7 @@ impl Round<'_> {
         let fine_e: f64 = group.iter().map(|v| v[2]).sum();
         let agree = self.agree(fine, cp) && self.agree(fine_e, ce);
         let edge = (i..i + 4).any(|k| self.edged(k) || self.witnessed(k));
-        if (agree && !edge) || (part.depth >= self.settings.max_depth && !edge) || next.len() + 16 > self.settings.max_parts {
+        if (!edge && (agree || part.depth >= self.settings.max_depth)) || next.len() + 16 > self.settings.max_parts {
             out.accept(&part, fine, fine_e, (fine - cp).abs(), agree, squares);
             if self.settings.keep_leaves {
                 let edges = &self.edges[i..i + 4];
