@@ -69,9 +69,9 @@ pub struct Cli {
     pub command: Command,
 }
 
-/// The subcommands (parsed once: the size of the largest, `check`'s, costs nothing).
+/// The subcommands.
 #[derive(Debug, Subcommand)]
-#[allow(clippy::large_enum_variant)]
+#[allow(clippy::large_enum_variant)] // parsed once: the size of the largest, check's, costs nothing
 pub enum Command {
     // The tutorial's worked examples (docs/tutorial.md): listed after the main commands.
     /// Sample a discrete distribution by CDF inversion or an alias table (tutorial part 1).

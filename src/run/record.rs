@@ -23,10 +23,10 @@ pub struct CaseDescription {
     pub cols: usize,
 }
 
-/// A case's parameters (one per case of a run: the user's variant's size costs nothing).
+/// A case's parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(untagged)]
-#[allow(clippy::large_enum_variant)]
+#[allow(clippy::large_enum_variant)] // one per case of a run: the user's variant's size costs nothing
 pub enum Params {
     Lobe {
         alpha_x: f64,
