@@ -334,7 +334,7 @@ impl<'g> SamplingPasses<'g> {
         Self { gpu, params, stride, chunk, per_submit }
     }
 
-    /// The uniform buffer to bind at binding 0 ([`Params::bind_entry`]).
+    /// The uniform buffer to bind at `binding::PARAMS` ([`Params::bind_entry`]).
     pub fn params(&self) -> &wgpu::Buffer {
         &self.params
     }

@@ -187,7 +187,8 @@ impl GpuEngine {
         Ok(kernel)
     }
 
-    /// The discrete tables (binding 3: f32 CDF or thresholds, binding 4: u32 aliases).
+    /// The discrete tables (`binding::INPUT`: f32 CDF or thresholds, `binding::ALIASES`: u32
+    /// aliases).
     fn tables(&self, job: &Job) -> (wgpu::Buffer, wgpu::Buffer) {
         let (f, u): (Vec<f32>, Vec<u32>) = match job {
             Job::Discrete { dist, method: DiscreteMethod::Cdf } if dist.len() > discrete::BLOCK => {
@@ -350,7 +351,7 @@ impl GpuEngine {
         Ok(out.iter().map(|v| v[0] as u32).collect())
     }
 
-    /// Runs a one-thread-per-sample entry point over `range`, reading `input` at binding 3 and
+    /// Runs a one-thread-per-sample entry point over `range`, reading `input` at `binding::INPUT` and
     /// writing `per` vec4s per sample.
     fn per_sample(&self, pipeline: &wgpu::ComputePipeline, job: &Job, range: SampleRange, input: &wgpu::Buffer, per: u64) -> Result<Vec<[f32; 4]>, GpuError> {
         let gpu = &self.gpu;

@@ -1,5 +1,5 @@
 //! The uniform block every pass reads (`LobesParams` in `shaders/passes/params.wgsl`, bound at
-//! binding 0): `lobes run`'s sampling kernels (the counting and the weighted layouts) and `lobes
+//! `binding::PARAMS`): `lobes run`'s sampling kernels (the counting and the weighted layouts) and `lobes
 //! check`'s passes, and the layout entries those share.
 
 use super::layout::binding;
@@ -100,7 +100,7 @@ impl Params {
 }
 
 /// One element of the per-sample passes' input (`ExplicitInput` in
-/// `shaders/passes/lobe_kernel.wgsl`, binding 3; `tests::explicit_input_layout` checks the two
+/// `shaders/passes/lobe_kernel.wgsl`, at `binding::INPUT`; `tests::explicit_input_layout` checks the two
 /// layouts agree): a sample's uniforms u.xyz (`explicit_samples`: u.xy draw h, u.z a dielectric's
 /// event) or a direction (`bin_explicit`).
 #[repr(C, align(16))]
