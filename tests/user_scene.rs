@@ -21,6 +21,15 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The scene `text` written to `dir/name`, beside a copy of the repository's file `from`
+/// named `to`.
+fn scene_beside(dir: &Path, (from, to): (&str, &str), name: &str, text: &str) -> PathBuf {
+    std::fs::copy(root().join(from), dir.join(to)).unwrap();
+    let scene = dir.join(name);
+    std::fs::write(&scene, text).unwrap();
+    scene
+}
+
 fn lobes(args: &[&str]) -> Output {
     let out = Command::new(LOBES).current_dir(root()).args(args).output().expect("run lobes");
     let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
@@ -169,9 +178,7 @@ fn a_user_sampler_that_rejects_every_sample_fails_the_run() {
 #[test]
 fn a_budget_picks_the_cases_sample_count() {
     let dir = scratch("budget");
-    std::fs::copy(root().join("examples/samplers/ggx_vndf.wgsl"), dir.join("ggx.wgsl")).unwrap();
-    let scene = dir.join("s.toml");
-    std::fs::write(&scene, "[[case]]\nname = \"timed\"\nsampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\nparams = [0.3, 0.3]\nbudget = 4\n").unwrap();
+    let scene = scene_beside(&dir, ("examples/samplers/ggx_vndf.wgsl", "ggx.wgsl"), "s.toml", "[[case]]\nname = \"timed\"\nsampler = { wgsl = [\"ggx.wgsl\"], sample = \"ggx_sample\", pdf = \"ggx_pdf\" }\nparams = [0.3, 0.3]\nbudget = 4\n");
     let out_dir = dir.join("out");
     let out = lobes(&["run", scene.to_str().unwrap(), "--out", out_dir.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
@@ -225,10 +232,7 @@ fn built_in_light_cases_pass_and_bad_ones_are_refused() {
 
 /// Writes a scene whose case uses ggx_vndf.wgsl through a path relative to the scene file.
 fn bad_scene(dir: &Path, case_lines: &str) -> PathBuf {
-    let scene = dir.join("bad.toml");
-    std::fs::copy(root().join("examples/samplers/ggx_vndf.wgsl"), dir.join("ggx.wgsl")).unwrap();
-    std::fs::write(&scene, format!("[defaults]\nsamples = 1000\n\n[[case]]\nname = \"mine\"\n{case_lines}")).unwrap();
-    scene
+    scene_beside(dir, ("examples/samplers/ggx_vndf.wgsl", "ggx.wgsl"), "bad.toml", &format!("[defaults]\nsamples = 1000\n\n[[case]]\nname = \"mine\"\n{case_lines}"))
 }
 
 /// Bad user-sampler cases: exit 2, the message at the scene's file:line, and no case runs.
@@ -298,9 +302,7 @@ fn bad_user_sampler_cases_are_refused_at_the_scene_line() {
 #[test]
 fn advice_names_the_scene_keys() {
     let dir = scratch("advice");
-    std::fs::copy(root().join("examples/envmap/envmap.wgsl"), dir.join("envmap.wgsl")).unwrap();
-    let scene = dir.join("s.toml");
-    std::fs::write(&scene, "[defaults]\nsamples = 65536\n\n[[case]]\nname = \"env\"\nsampler = { wgsl = [\"envmap.wgsl\"], sample = \"env_sample\", pdf = \"env_pdf\" }\nparams = [1]\n").unwrap();
+    let scene = scene_beside(&dir, ("examples/envmap/envmap.wgsl", "envmap.wgsl"), "s.toml", "[defaults]\nsamples = 65536\n\n[[case]]\nname = \"env\"\nsampler = { wgsl = [\"envmap.wgsl\"], sample = \"env_sample\", pdf = \"env_pdf\" }\nparams = [1]\n");
     let out = lobes(&["run", scene.to_str().unwrap(), "--out", dir.join("out").to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("nothing is bound to it") && stderr.contains("(sampler.texture env_radiance=FILE.hdr for a texture_2d<f32>") && stderr.contains("(sampler.stub MODULE=FILE"), "{stderr}");

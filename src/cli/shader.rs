@@ -30,6 +30,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
     // storage, the storage binding size):
     // use the adapter `lobes run` would use, or wgpu's default limits without one.
     let engine = GpuEngine::open().map_err(|e| crate::console::say(format_args!("lobes: note: {e}\nlobes: note: composing for wgpu's default limits"))).ok();
+    let (device, limits) = engine.as_ref().map_or((wgpu::DeviceType::Other, wgpu::Limits::default()), |e| (e.gpu.info.device_type, e.gpu.limits.clone()));
     let mut modules: Vec<(PipelineSource, Vec<&str>)> = Vec::new();
     for entry in entries {
         let ms = match entry {
@@ -48,10 +49,7 @@ pub fn run(args: &ShaderArgs) -> anyhow::Result<()> {
             // uniforms)
             Entry::User(case) => {
                 let (rows, cols) = case.settings.grid(&case.sampler.domain);
-                let histogram = match &engine {
-                    Some(e) => case.sampler.composed_histogram(e.gpu.info.device_type, &e.gpu.limits, rows, cols)?,
-                    None => case.sampler.composed_histogram(wgpu::DeviceType::Other, &wgpu::Limits::default(), rows, cols)?,
-                };
+                let histogram = case.sampler.composed_histogram(device, &limits, rows, cols)?;
                 [case.sampler.composed()?, histogram].map(|source| PipelineSource { source, constants: Vec::new() }).into()
             }
         };
