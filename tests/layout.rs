@@ -250,7 +250,8 @@ fn named_paths(tokens: &[String]) -> Vec<NamedPath> {
                 found.extend(leaves.into_iter().map(|(segments, alias)| NamedPath { segments, alias, inline: inline_names(&inline), top_use }));
                 continue;
             }
-            "crate" | "super" | "self" if tokens.get(i + 1).is_some_and(|t| t == "::") && (i == 0 || tokens[i - 1] != "::") => {
+            // a path after `::` continues one; after `in`, it is a visibility (`pub(in crate::check)`), not a use
+            "crate" | "super" | "self" if tokens.get(i + 1).is_some_and(|t| t == "::") && (i == 0 || !["::", "in"].contains(&tokens[i - 1].as_str())) => {
                 let mut segments = vec![t.to_string()];
                 i += 1;
                 while tokens.get(i).is_some_and(|t| t == "::") && tokens.get(i + 1).is_some_and(|t| t.chars().all(|c| c.is_alphanumeric() || c == '_')) {
@@ -466,16 +467,6 @@ fn submodule_circles(src: &Path) -> Vec<String> {
     found
 }
 
-/// The circles left, each with why: all go through a module's own file (`mod.rs`), which
-/// defines types its children use and calls those children back; taking the types out of the
-/// `mod.rs` into files of their own is a larger move than this one (issue 32 item 4).
-const KNOWN_CIRCLES: &[(&str, &str)] = &[
-    ("check: compose → mod.rs → compose", "check/mod.rs holds CheckError and the Settings its children use, and calls them"),
-    ("embed: glsl → mod.rs → glsl", "embed/mod.rs holds Module and wgsl_with, which glsl uses, and re-exports glsl::glsl"),
-    ("reference: mod.rs → sampler → mod.rs", "reference/mod.rs holds Lobe, LobeKind and Method, which sampler uses, and uses SAMPLERS"),
-    ("scene: mod.rs → sweep → mod.rs", "scene/mod.rs holds Val and the key helpers sweep and user use, and runs their sweeps"),
-];
-
 #[test]
 fn no_submodule_imports_a_module_that_imports_it_back() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -486,8 +477,7 @@ fn no_submodule_imports_a_module_that_imports_it_back() {
     // `super::SampleReturns` in check/gpu.rs is `check::composition`'s, through check/mod.rs
     assert!(graphs[&vec!["check".to_string()]]["gpu"].contains("composition"));
     let found = submodule_circles(&src);
-    let known: Vec<&str> = KNOWN_CIRCLES.iter().map(|(circle, _)| *circle).collect();
-    assert_eq!(found, known, "circles among submodules (an import that closes one moves the shared piece down a layer)");
+    assert!(found.is_empty(), "circles among submodules (an import that closes one moves the shared piece down a layer): {found:#?}");
 }
 
 #[test]
@@ -496,6 +486,7 @@ fn the_submodule_parser_resolves_paths_and_skips_strings_and_inline_modules() {
         "use super::{a::{self, X}, b::Y as Z};\n\
          /* crate::c::hidden /* nested */ */ let s = r#\"crate::d::f \"{\"#; let c = '{';\n\
          fn f<'a>(x: &'a str) { crate::e::g(super::super::h::I); }\n\
+         pub(in crate::m) fn v() {}\n\
          #[cfg(test)]\nmod tests { use super::*; use super::super::j::K; }\n",
     );
     let paths = named_paths(&tokens(&code));

@@ -6,7 +6,7 @@ use super::compose::Composed;
 use super::composition::Draw;
 use super::glue::{GLUE, contract_glue, prepare};
 use super::probe::Probe;
-use super::{CheckError, Message, Setting, UserSampler, shaders};
+use super::{CheckError, Message, Setting, Settings, UserSampler, shaders};
 use crate::reference::Invalid;
 use crate::engine::gpu::library::{self, File};
 use crate::engine::gpu::compose::grid_counting_kernel;
@@ -784,6 +784,53 @@ pub(super) fn split(v: u64) -> [u32; 2] {
     [v as u32, (v >> 32) as u32]
 }
 
+/// Pointwise comparisons of the pdf (`pdf_consistency`, `jacobian`, `weights`) allow, on top of
+/// their limit, this many times the pdf's f32 conditioning at the point: the largest relative
+/// change of pdf(d) under a change of one component of d by 2⁻²³ |d|∞, measured on the GPU
+/// (`lobes_conditioning_at` in shaders/check/user_passes.wgsl). A narrow lobe amplifies an ulp:
+/// GGX's D(m) in the form α² / (π ((α² − 1) m.z² + 1)²) turns an ulp of m.z into ≈ 4/α² ulps of
+/// D (0.4 % at α = 0.008), so a correct sampler and its pdf, the same f32 code compiled at two
+/// call sites, differ by that much. A sampler's d carries a few ulps of rounding: 4 of them.
+pub const CONDITIONING_ULPS: f64 = 4.0;
+
+/// The passes' parameters of a check: the user's numbers, the incident direction, the seed and
+/// the grid.
+pub(super) fn params_of(sampler: &UserSampler, settings: &Settings) -> Params {
+    let (rows, cols) = settings.grid(&sampler.domain);
+    let mut user = [[0f32; 4]; 4];
+    for (i, p) in settings.params.iter().enumerate() {
+        user[i / 4][i % 4] = *p as f32;
+    }
+    let wi = super::incident(settings.incident_theta, settings.incident_phi);
+    let bounds = sampler.domain.uniform_bounds();
+    Params {
+        user,
+        wi: [wi[0], wi[1], wi[2], 0.0],
+        bounds,
+        seed: split(settings.seed),
+        eps: super::jacobian::EPS,
+        samples_per_thread: 1,
+        rows,
+        cols,
+        ..bytemuck::Zeroable::zeroed()
+    }
+}
+
+/// The sampler's passes, with the user's --rand draws (at most four) in the order lobes' probe
+/// finds them unless --rand-order gave it, and the note on that order for the report.
+pub(super) fn compose_passes<'g>(gpu: &'g Gpu, sampler: &UserSampler, settings: &Settings, params: &Params) -> Result<(Passes<'g>, String), CheckError> {
+    let mut passes = Passes::new(gpu, sampler)?;
+    let mut draws = String::new();
+    if !sampler.composition.rand.is_empty() {
+        let (order, note) = rand_order(&passes, params, sampler, settings.seed)?;
+        if sampler.composition.rand_order.is_none() && order != Draw::components(&[]) {
+            passes = Passes::ordered(gpu, sampler, order)?;
+        }
+        draws = note;
+    }
+    Ok((passes, draws))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -797,7 +844,7 @@ mod tests {
             line.split('=').nth(1).unwrap().trim().trim_end_matches(';').parse().unwrap()
         };
         assert_eq!(value("LOBES_WEIGHT_LIMIT") as f32, crate::stats::weighted::WEIGHT_ERROR_LIMIT);
-        assert_eq!(value("LOBES_CONDITIONING_ULPS"), super::super::CONDITIONING_ULPS);
+        assert_eq!(value("LOBES_CONDITIONING_ULPS"), super::CONDITIONING_ULPS);
     }
 
     fn sampler(text: &str) -> UserSampler {

@@ -2,7 +2,7 @@
 //! --shader-root"): the command line names a setting by its flag, a scene by its key, so the
 //! message holds the [`Setting`] and whoever shows it names it.
 
-use super::Setting;
+use super::resources;
 
 /// Text and settings in turn.
 ///
@@ -66,5 +66,84 @@ impl std::fmt::Display for Message {
     /// Each setting by its key ([`Setting::key`]).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(&self.render(&|s| s.key().to_string()))
+    }
+}
+
+/// A field of [`Settings`], of a sampler's [`Composition`] or one of its call expressions
+/// ([`super::composition::Call`]), as errors name it: the command line by its flag, a scene by its key
+/// ([`Setting::key`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Setting {
+    Params,
+    IncidentTheta,
+    IncidentPhi,
+    Samples,
+    Timeout,
+    Bins,
+    Significance,
+    ShaderRoot,
+    Define,
+    Stub,
+    Package,
+    RandOrder,
+    Sample,
+    Pdf,
+    Eval,
+    Normal,
+    Incident,
+    ReflectionOnly,
+    Measure,
+    Frame,
+    Bounds,
+    SampleReturns,
+    Rand,
+    Texture,
+    Buffer,
+    Filter,
+    Budget,
+}
+
+impl Setting {
+    /// Its name as a field and as a scene's key: `incident_theta`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Setting::Params => "params",
+            Setting::IncidentTheta => "incident_theta",
+            Setting::IncidentPhi => "incident_phi",
+            Setting::Samples => "samples",
+            Setting::Timeout => "timeout",
+            Setting::Bins => "bins",
+            Setting::Significance => "significance",
+            Setting::ShaderRoot => "shader_root",
+            Setting::Define => "define",
+            Setting::Stub => "stub",
+            Setting::Package => "package",
+            Setting::RandOrder => "rand_order",
+            Setting::Sample => "sample",
+            Setting::Pdf => "pdf",
+            Setting::Eval => "eval",
+            Setting::Normal => "normal",
+            Setting::Incident => "incident",
+            Setting::ReflectionOnly => "reflection_only",
+            Setting::Measure => "measure",
+            Setting::Frame => "frame",
+            Setting::Bounds => "bounds",
+            Setting::SampleReturns => "sample_returns",
+            Setting::Rand => "rand",
+            Setting::Texture => "texture",
+            Setting::Buffer => "buffer",
+            Setting::Filter => "filter",
+            Setting::Budget => "budget",
+        }
+    }
+}
+
+impl From<resources::ResourceKind> for Setting {
+    fn from(kind: resources::ResourceKind) -> Self {
+        match kind {
+            resources::ResourceKind::Texture => Setting::Texture,
+            resources::ResourceKind::Buffer => Setting::Buffer,
+            resources::ResourceKind::Sampler => Setting::Filter,
+        }
     }
 }

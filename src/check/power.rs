@@ -172,7 +172,7 @@ pub fn power(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Po
         .into_iter()
         .map(|samples| Ok(PowerPoint::of(samples, &check(gpu, sampler, &Settings { samples, ..settings.clone() })?)))
         .collect::<Result<Vec<_>, CheckError>>()?;
-    Ok(PowerSweep::new(super::describe(sampler), points))
+    Ok(PowerSweep::new(sampler.describe(), points))
 }
 
 impl PowerPoint {

@@ -17,50 +17,11 @@
 //! fail, as they should).
 
 use super::gpu::Passes;
+pub use super::settings::{FIT_HEIGHT, Fit};
 use super::{CheckError, Domain, Settings, UserSampler};
 use crate::check::probe::Probe;
 use crate::reference::Invalid;
 use glam::DVec3;
-
-/// Whether to fit the grid to a small support.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Fit {
-    /// Where the samples fall within a cap of height [`FIT_HEIGHT`] (about 0.1 sr).
-    #[default]
-    Auto,
-    /// Never: the sampler's declared domain, as lobes did before.
-    Never,
-    /// Wherever the samples fall within a hemisphere.
-    Always,
-}
-
-impl Fit {
-    /// The names `--fit` takes.
-    pub const NAMES: [&'static str; 3] = ["auto", "never", "always"];
-
-    pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "auto" => Some(Fit::Auto),
-            "never" => Some(Fit::Never),
-            "always" => Some(Fit::Always),
-            _ => None,
-        }
-    }
-
-    /// The largest cap height fitted: [`FIT_HEIGHT`], or a hemisphere's 1 with `Always`.
-    pub fn limit(self) -> Option<f64> {
-        match self {
-            Fit::Auto => Some(FIT_HEIGHT),
-            Fit::Always => Some(1.0),
-            Fit::Never => None,
-        }
-    }
-}
-
-/// The largest cap `Fit::Auto` fits, as 1 − cos ρ: 1/64, a cap of π/32 ≈ 0.098 sr (ρ 10.1°),
-/// which holds 64 cells of the sphere's default 64 × 128 grid; a larger support already gets
-/// that many cells there.
-pub const FIT_HEIGHT: f64 = 1.0 / 64.0;
 
 /// Rows of the fitting count: the farthest sample is placed to 1/4096 of the tried height.
 pub const FIT_ROWS: u32 = 4096;
@@ -104,8 +65,8 @@ pub(super) fn fit<'g>(gpu: &'g crate::engine::gpu::Gpu, sampler: &UserSampler, s
     let Some((axis, first)) = probed_cap(probes, limit) else { return Ok(None) };
     let trial = UserSampler { domain: Domain::cap(axis, first).expect("a cap"), ..sampler.clone() };
     let counting = Settings { bins: Some((FIT_ROWS, 1)), ..settings.clone() };
-    let params = super::params_of(&trial, &counting);
-    let (passes, draws) = super::compose_passes(gpu, &trial, settings, &params)?;
+    let params = super::gpu::params_of(&trial, &counting);
+    let (passes, draws) = super::gpu::compose_passes(gpu, &trial, settings, &params)?;
     let tries = if first < limit { vec![first, limit] } else { vec![first] };
     for height in tries {
         let bounds = [axis[0] as f32, axis[1] as f32, axis[2] as f32, height as f32];

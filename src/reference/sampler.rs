@@ -8,8 +8,56 @@
 //! Adding a sampler is one entry here plus its files.
 
 use super::microfacet::{Microfacet, pdf_ndf, pdf_vndf};
-use super::{Lobe, LobeKind, Method, ward};
+use super::ward;
+use super::beckmann::Beckmann;
+use super::ggx::Ggx;
+use serde::{Deserialize, Serialize};
 use glam::DVec3;
+
+/// Which lobe.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LobeKind {
+    Ward,
+    Beckmann,
+    Ggx,
+}
+
+/// How the half vector is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The lobe's own distribution: Ward's p(h), or D(h) cos θh for microfacets.
+    Ndf,
+    /// Visible normals: spherical caps for GGX, Heitz & d'Eon for Beckmann.
+    Vndf,
+    /// Bounded VNDF (Eto & Tokuyoshi 2023), GGX only.
+    Bounded,
+}
+
+impl LobeKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LobeKind::Ward => "ward",
+            LobeKind::Beckmann => "beckmann",
+            LobeKind::Ggx => "ggx",
+        }
+    }
+    /// Whether this lobe has a sampler for `method`.
+    pub fn supports(self, method: Method) -> bool {
+        of_kind(self).any(|s| s.method == method)
+    }
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Ndf => "ndf",
+            Method::Vndf => "vndf",
+            Method::Bounded => "bounded",
+        }
+    }
+}
 
 /// One sampler: a lobe and the method that draws its half vectors.
 #[derive(Debug, Clone, Copy)]
@@ -67,15 +115,18 @@ pub struct DielectricEval {
 }
 
 /// The f64 reference of a sampler (`src/reference`).
+/// A lobe's roughness (αx, αy), along the axes of its tangent frame.
+pub type Alpha = (f64, f64);
+
 #[derive(Debug, Clone, Copy)]
 pub struct Reference {
     /// The half vector drawn for uniforms `u`.
-    pub sample_h: fn(&Lobe, DVec3, [f64; 2]) -> DVec3,
+    pub sample_h: fn(Alpha, DVec3, [f64; 2]) -> DVec3,
     /// The density of h, per unit solid angle.
-    pub pdf_h: fn(&Lobe, DVec3, DVec3) -> f64,
+    pub pdf_h: fn(Alpha, DVec3, DVec3) -> f64,
     /// p(ωr) given h, where the method defines its own reflected density rather than
     /// p(h) / (4 |ωr·h|) (bounded VNDF).
-    pub pdf_r: Option<fn(&Lobe, DVec3, DVec3) -> f64>,
+    pub pdf_r: Option<fn(Alpha, DVec3, DVec3) -> f64>,
 }
 
 const MICROFACET_NDF_WEIGHT: &str = "microfacet_ndf_weight(wi, s.h)";
@@ -102,8 +153,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: None,
         },
         reference: Some(Reference {
-            sample_h: |l, _, u| ward::sample_h(l.alpha_x, l.alpha_y, u),
-            pdf_h: |l, _, h| ward::pdf_h(l.alpha_x, l.alpha_y, h),
+            sample_h: |(ax, ay), _, u| ward::sample_h(ax, ay, u),
+            pdf_h: |(ax, ay), _, h| ward::pdf_h(ax, ay, h),
             pdf_r: None,
         }),
     },
@@ -123,8 +174,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: Some(DielectricEval { pdf: "dielectric_beckmann_ndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_BECKMANN_EVAL, weight: MICROFACET_NDF_WEIGHT }),
         },
         reference: Some(Reference {
-            sample_h: |l, _, u| l.beckmann().sample_ndf(u),
-            pdf_h: |l, _, h| pdf_ndf(&l.beckmann(), h),
+            sample_h: |(ax, ay), _, u| Beckmann { ax, ay }.sample_ndf(u),
+            pdf_h: |(ax, ay), _, h| pdf_ndf(&Beckmann { ax, ay }, h),
             pdf_r: None,
         }),
     },
@@ -144,8 +195,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: Some(DielectricEval { pdf: "dielectric_beckmann_vndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_BECKMANN_EVAL, weight: "dielectric_beckmann_vndf_weight(a, wi)" }),
         },
         reference: Some(Reference {
-            sample_h: |l, wi, u| l.beckmann().sample_vndf(wi, u),
-            pdf_h: |l, wi, h| pdf_vndf(&l.beckmann(), wi, h),
+            sample_h: |(ax, ay), wi, u| Beckmann { ax, ay }.sample_vndf(wi, u),
+            pdf_h: |(ax, ay), wi, h| pdf_vndf(&Beckmann { ax, ay }, wi, h),
             pdf_r: None,
         }),
     },
@@ -165,8 +216,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: Some(DielectricEval { pdf: "dielectric_ggx_ndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_GGX_EVAL, weight: MICROFACET_NDF_WEIGHT }),
         },
         reference: Some(Reference {
-            sample_h: |l, _, u| l.ggx().sample_ndf(u),
-            pdf_h: |l, _, h| pdf_ndf(&l.ggx(), h),
+            sample_h: |(ax, ay), _, u| Ggx { ax, ay }.sample_ndf(u),
+            pdf_h: |(ax, ay), _, h| pdf_ndf(&Ggx { ax, ay }, h),
             pdf_r: None,
         }),
     },
@@ -186,8 +237,8 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: Some(DielectricEval { pdf: "dielectric_ggx_vndf_pdf(a, wi, wr, lobe_eta())", eval: DIELECTRIC_GGX_EVAL, weight: "dielectric_ggx_vndf_weight(a, wi)" }),
         },
         reference: Some(Reference {
-            sample_h: |l, wi, u| l.ggx().sample_vndf(wi, u),
-            pdf_h: |l, wi, h| pdf_vndf(&l.ggx(), wi, h),
+            sample_h: |(ax, ay), wi, u| Ggx { ax, ay }.sample_vndf(wi, u),
+            pdf_h: |(ax, ay), wi, h| pdf_vndf(&Ggx { ax, ay }, wi, h),
             pdf_r: None,
         }),
     },
@@ -207,13 +258,13 @@ pub const REGISTRY: [SamplerSpec; 6] = [
             dielectric_eval: None,
         },
         reference: Some(Reference {
-            sample_h: |l, wi, u| l.ggx().sample_bounded(wi, u),
+            sample_h: |(ax, ay), wi, u| Ggx { ax, ay }.sample_bounded(wi, u),
             // the reflected density (Eto & Tokuyoshi 2023, listing 2) through the reflection Jacobian
-            pdf_h: |l, wi, h| {
+            pdf_h: |(ax, ay), wi, h| {
                 let wr = super::reflect::reflect(wi, h);
-                if wr.z > 0.0 { l.ggx().pdf_bounded_r(wi, h) * 4.0 * wi.dot(h).abs() } else { 0.0 }
+                if wr.z > 0.0 { Ggx { ax, ay }.pdf_bounded_r(wi, h) * 4.0 * wi.dot(h).abs() } else { 0.0 }
             },
-            pdf_r: Some(|l, wi, h| l.ggx().pdf_bounded_r(wi, h)),
+            pdf_r: Some(|(ax, ay), wi, h| Ggx { ax, ay }.pdf_bounded_r(wi, h)),
         }),
     },
 ];

@@ -39,12 +39,14 @@
 //! `[defaults]` sets it). Parsing never panics, whatever the bytes (`tests/bad_input.rs`
 //! fuzzes it).
 
+mod raw;
 mod select;
 /// "Did you mean" ([`crate::suggest`], here too for the scene's messages).
 pub use crate::suggest;
 mod sweep;
 pub mod template;
 pub(crate) mod user;
+mod value;
 
 pub use sweep::MAX_CASES;
 pub use user::UserCase;
@@ -57,10 +59,12 @@ use crate::reference::masking::Masking;
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use crate::stats::expected::MIN_ALPHA;
-use serde::Deserialize;
 use std::collections::HashMap;
 use suggest::did_you_mean;
-use sweep::{Point, Sweep};
+use raw::{RawCase, RawScene};
+use sweep::{Point, Val};
+use value::{Common, Ctx, Defaults, grid, line_column, incident_phi, kind_of, number, reject_keys, roughness_keys, effect_keys, string, whole};
+pub use value::{DEFAULT_INCIDENT_PHI, MAX_BINS, Overrides, SceneError};
 use std::ops::Range;
 use toml::{Spanned, Value};
 
@@ -70,10 +74,6 @@ pub const DEFAULT_SCENE: &str = include_str!("../../scenes/all-lobes.toml");
 pub const TUTORIAL_SCENE: &str = include_str!("../../scenes/tutorial.toml");
 
 pub use crate::engine::job::MAX_SAMPLES;
-/// The most bins (rows × cols, or discrete items) a case may have: 2^24. The GPU engine splits
-/// larger histograms into tiles that fit the adapter; this cap bounds the f64 quadrature, the
-/// heat maps and `histogram.json`.
-pub const MAX_BINS: u64 = 1 << 24;
 /// The largest sample count of a weighted case (its 64-bit fixed-point sums hold 2^32 samples
 /// of mean weight up to 4096).
 pub const MAX_WEIGHTED_SAMPLES: u64 = 1 << 32;
@@ -91,126 +91,10 @@ pub const DEFAULT_DISCRETE_METHOD: DiscreteMethod = DiscreteMethod::Cdf;
 /// A lobe case's incident polar angle in degrees unless given (a user sampler's is
 /// [`crate::check::Settings`]'s).
 pub const DEFAULT_INCIDENT_THETA: f64 = 0.0;
-/// A case's incident azimuth in degrees unless given.
-pub const DEFAULT_INCIDENT_PHI: f64 = 0.0;
 /// The turn of a lobe's tangent frame, degrees (`alpha_angle`).
 pub const DEFAULT_ALPHA_ANGLE: f64 = 0.0;
 /// The longest case name (it names a folder).
 pub const MAX_NAME_LEN: usize = 100;
-
-/// A scene error with its location (1-based line and column, the column in characters).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: {message}")]
-pub struct SceneError {
-    pub file: String,
-    pub line: usize,
-    pub column: usize,
-    pub message: String,
-}
-
-type Val = Spanned<Value>;
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawScene {
-    defaults: Option<Spanned<RawDefaults>>,
-    #[serde(default)]
-    case: Vec<Spanned<RawCase>>,
-}
-
-#[derive(Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawDefaults {
-    samples: Option<Val>,
-    bins: Option<Val>,
-    seed: Option<Val>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawCase {
-    name: Option<Val>,
-    lobe: Option<Val>,
-    method: Option<Sweep>,
-    alpha: Option<Sweep>,
-    alpha_x: Option<Sweep>,
-    alpha_y: Option<Sweep>,
-    alpha_angle: Option<Sweep>,
-    incident_theta: Option<Sweep>,
-    incident_phi: Option<Sweep>,
-    weights: Option<Spanned<Weights>>,
-    samples: Option<Sweep>,
-    bins: Option<Sweep>,
-    seed: Option<Sweep>,
-    weighted: Option<Val>,
-    fresnel: Option<Sweep>,
-    f0: Option<Sweep>,
-    eta: Option<Sweep>,
-    k: Option<Sweep>,
-    masking: Option<Sweep>,
-    scatter: Option<Sweep>,
-    sampler: Option<Spanned<user::RawSampler>>,
-    params: Option<Sweep>,
-    domain: Option<Val>,
-    bounds: Option<Val>,
-    timeout: Option<Val>,
-    budget: Option<Val>,
-}
-
-impl RawCase {
-    /// The sweepable keys' values, in the order of [`sweep::KEYS`].
-    fn sweeps(&self) -> [Option<&Sweep>; sweep::KEYS.len()] {
-        [
-            &self.method,
-            &self.alpha,
-            &self.alpha_x,
-            &self.alpha_y,
-            &self.alpha_angle,
-            &self.incident_theta,
-            &self.incident_phi,
-            &self.fresnel,
-            &self.f0,
-            &self.eta,
-            &self.k,
-            &self.masking,
-            &self.scatter,
-            &self.params,
-            &self.bins,
-            &self.samples,
-            &self.seed,
-        ]
-        .map(Option::as_ref)
-    }
-}
-
-/// `weights = [...]`, each item with its own span (so an error points at the bad weight).
-#[derive(Debug)]
-struct Weights(Vec<Val>);
-
-impl<'de> Deserialize<'de> for Weights {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> serde::de::Visitor<'de> for V {
-            type Value = Weights;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("an array of weights such as [15, 5, 25]")
-            }
-            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Weights, A::Error> {
-                spanned_items(seq).map(Weights)
-            }
-        }
-        d.deserialize_seq(V)
-    }
-}
-
-/// The items of a TOML array, each with its span.
-fn spanned_items<'de, A: serde::de::SeqAccess<'de>>(mut seq: A) -> Result<Vec<Val>, A::Error> {
-    let mut items = Vec::new();
-    while let Some(item) = seq.next_element::<Val>()? {
-        items.push(item);
-    }
-    Ok(items)
-}
 
 /// One validated case.
 #[derive(Debug, Clone)]
@@ -274,74 +158,6 @@ enum Parsed {
     User(UserCase),
 }
 
-struct Ctx<'a> {
-    file: &'a str,
-    text: &'a str,
-}
-
-/// 1-based line and column (in characters) of byte offset `at` in `text`.
-fn line_column(text: &str, at: usize) -> (usize, usize) {
-    let mut at = at.min(text.len());
-    while !text.is_char_boundary(at) {
-        at -= 1;
-    }
-    let before = &text[..at];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
-
-impl Ctx<'_> {
-    fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
-        let (line, column) = line_column(self.text, span.start);
-        SceneError { file: self.file.to_string(), line, column, message: message.into() }
-    }
-}
-
-/// "a string", "an integer", … for messages.
-fn kind_of(v: &Value) -> &'static str {
-    match v {
-        Value::String(_) => "a string",
-        Value::Integer(_) => "an integer",
-        Value::Float(_) => "a floating-point number",
-        Value::Boolean(_) => "a boolean",
-        Value::Datetime(_) => "a date-time",
-        Value::Array(_) => "an array",
-        Value::Table(_) => "a table",
-    }
-}
-
-/// A number (TOML integer or float), finite and accepted by `ok`.
-fn number(ctx: &Ctx, v: &Val, key: &str, ok: impl Fn(f64) -> bool, allowed: &str) -> Result<f64, SceneError> {
-    let x = match v.get_ref() {
-        Value::Integer(i) => *i as f64,
-        Value::Float(f) => *f,
-        other => return Err(ctx.err(v.span(), format!("{key} must be a number, got {}; {allowed}", kind_of(other)))),
-    };
-    if !x.is_finite() || !ok(x) {
-        return Err(ctx.err(v.span(), format!("{key} = {x} is not allowed; {allowed}")));
-    }
-    Ok(x)
-}
-
-/// A whole number in `lo ..= hi`.
-fn whole(ctx: &Ctx, v: &Val, key: &str, lo: u64, hi: u64, allowed: &str) -> Result<u64, SceneError> {
-    match v.get_ref() {
-        Value::Integer(i) if *i >= 0 && (lo..=hi).contains(&(*i as u64)) => Ok(*i as u64),
-        Value::Integer(i) => Err(ctx.err(v.span(), format!("{key} = {i} is not allowed; {allowed}"))),
-        Value::Float(f) => Err(ctx.err(v.span(), format!("{key} must be a whole number (an integer literal), got the floating-point number {f:?}; {allowed}"))),
-        other => Err(ctx.err(v.span(), format!("{key} must be a whole number, got {}; {allowed}", kind_of(other)))),
-    }
-}
-
-/// A string.
-fn string<'v>(ctx: &Ctx, v: &'v Val, key: &str, allowed: &str) -> Result<&'v str, SceneError> {
-    match v.get_ref() {
-        Value::String(s) => Ok(s),
-        other => Err(ctx.err(v.span(), format!("{key} must be a string, got {}; {allowed}", kind_of(other)))),
-    }
-}
-
 const SAMPLES_ALLOWED: &str = "give a whole number of samples from 1 to 2^40 (1099511627776), e.g. 10_000_000";
 const SEED_ALLOWED: &str = "give a whole number ≥ 0";
 const BINS_ALLOWED: &str = "give [rows, cols]: whole numbers ≥ 1, rows even (the horizon is a row edge), rows × cols ≤ 2^24 (16777216)";
@@ -356,42 +172,6 @@ fn seed(ctx: &Ctx, v: &Val) -> Result<u64, SceneError> {
 
 fn bins(ctx: &Ctx, v: &Val) -> Result<SphereGrid, SceneError> {
     grid(ctx, v, true, BINS_ALLOWED)
-}
-
-/// `[rows, cols]` with at most [`MAX_BINS`] bins (and an even number of rows where `even_rows`).
-fn grid(ctx: &Ctx, v: &Val, even_rows: bool, allowed: &str) -> Result<SphereGrid, SceneError> {
-    let bad = |what: String| ctx.err(v.span(), format!("bins {what}; {allowed}"));
-    let Value::Array(items) = v.get_ref() else { return Err(bad(format!("must be an array, got {}", kind_of(v.get_ref())))) };
-    let [rows, cols] = items.as_slice() else { return Err(bad(format!("has {} items, not 2", items.len()))) };
-    let dim = |x: &Value| match x {
-        Value::Integer(i) if *i >= 1 && *i <= u32::MAX as i64 => Ok(*i as u32),
-        Value::Integer(i) => Err(bad(format!("= [{rows}, {cols}] is not allowed ({i} is out of range)"))),
-        other => Err(bad(format!("must hold whole numbers, got {}", kind_of(other)))),
-    };
-    let (r, c) = (dim(rows)?, dim(cols)?);
-    if even_rows && r % 2 == 1 {
-        return Err(bad(format!("= [{r}, {c}] is not allowed: {r} rows is odd")));
-    }
-    if r as u64 * c as u64 > MAX_BINS {
-        return Err(bad(format!("= [{r}, {c}] is not allowed: {} bins is more than 2^24", r as u64 * c as u64)));
-    }
-    Ok(SphereGrid { rows: r, cols: c })
-}
-
-/// `[defaults]`, each value validated where it is written, and the command line's overrides.
-struct Defaults<'a> {
-    samples: Option<(u64, &'a Val)>,
-    bins: Option<SphereGrid>,
-    seed: Option<u64>,
-    overrides: Overrides,
-}
-
-/// Values that replace those of every case (`lobes run --samples N --seed S`).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Overrides {
-    /// Samples of every case, 1 ..= [`MAX_SAMPLES`] (a weighted case: ..= [`MAX_WEIGHTED_SAMPLES`]).
-    pub samples: Option<u64>,
-    pub seed: Option<u64>,
 }
 
 impl Scene {
@@ -528,21 +308,6 @@ fn check_name(ctx: &Ctx, c: &Spanned<RawCase>) -> Result<String, SceneError> {
         return Err(ctx.err(v.span(), format!("case name {name:?} is not allowed; {allowed}")));
     }
     Ok(name.to_string())
-}
-
-/// An error on the first of `keys` present: it does not apply to a case of this kind.
-fn reject_keys(ctx: &Ctx, keys: &[(&str, Option<&Val>)], why: &str) -> Result<(), SceneError> {
-    match keys.iter().find_map(|(k, v)| v.map(|v| (k, v))) {
-        Some((k, v)) => Err(ctx.err(v.span(), format!("{k} {why}"))),
-        None => Ok(()),
-    }
-}
-
-/// A case's name, sample count and seed (the name with its sweep suffix).
-struct Common {
-    name: String,
-    samples: u64,
-    seed: u64,
 }
 
 /// The cases of one `[[case]]` table: one, or one per point of its sweeps, of which the scene
@@ -807,22 +572,6 @@ fn scatter(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, method: Method, lo
         None => return Err(ctx.err(form.span(), format!("scatter = \"dielectric\" needs eta; add eta = ... ({eta_allowed})"))),
     };
     Ok(Scatter::Dielectric { eta })
-}
-
-/// `incident_phi` of a case (0 unless given).
-fn incident_phi(ctx: &Ctx, point: &Point) -> Result<f64, SceneError> {
-    match point.get("incident_phi") {
-        Some(p) => number(ctx, p, "incident_phi", |x| (-360.0..=360.0).contains(&x), "incident_phi is in degrees, −360 ≤ φ ≤ 360"),
-        None => Ok(DEFAULT_INCIDENT_PHI),
-    }
-}
-
-fn roughness_keys(p: &Point) -> [(&'static str, Option<&Val>); 4] {
-    ["alpha", "alpha_x", "alpha_y", "alpha_angle"].map(|k| (k, p.get(k)))
-}
-
-fn effect_keys<'a>(c: &'a RawCase, p: &'a Point) -> [(&'static str, Option<&'a Val>); 6] {
-    [("weighted", c.weighted.as_ref()), ("fresnel", p.get("fresnel")), ("f0", p.get("f0")), ("eta", p.get("eta")), ("k", p.get("k")), ("masking", p.get("masking"))]
 }
 
 /// The effects of a lobe case: `None` unless it asks for a weighted histogram. A rough

@@ -6,10 +6,21 @@
 //! `samples` and `seed`; keys whose value is a list sweep over an array of lists: `params`
 //! (user samplers, `params = [[0.3, 0.3], [0.1, 0.1]]`) and `bins` (`bins = [[32, 64], [64, 128]]`).
 
-use super::Val;
 use serde::Deserialize;
 use std::ops::Range;
 use toml::{Spanned, Value};
+
+/// A TOML value with its span in the file.
+pub(super) type Val = Spanned<Value>;
+
+/// The items of a TOML array, each with its span.
+pub(super) fn spanned_items<'de, A: serde::de::SeqAccess<'de>>(mut seq: A) -> Result<Vec<Val>, A::Error> {
+    let mut items = Vec::new();
+    while let Some(item) = seq.next_element::<Val>()? {
+        items.push(item);
+    }
+    Ok(items)
+}
 
 /// A key's value as written: one value, or an array of values each with its own span.
 #[derive(Debug)]
@@ -51,7 +62,7 @@ impl<'de> Deserialize<'de> for Values {
                 Ok(Values::One(Value::String(v.into())))
             }
             fn visit_seq<A: serde::de::SeqAccess<'de>>(self, seq: A) -> Result<Values, A::Error> {
-                super::spanned_items(seq).map(Values::Many)
+                spanned_items(seq).map(Values::Many)
             }
             fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<Values, A::Error> {
                 Value::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(Values::One)

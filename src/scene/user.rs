@@ -4,47 +4,15 @@
 //! checked against the contract while the scene is parsed, so that a missing file, function or
 //! signature is a [`SceneError`] at the case's `sampler` before any case runs.
 
-use super::sweep::Point;
-use super::{Common, Ctx, Defaults, RawCase, SceneError, Val, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
+use super::raw::{RawCase, RawSampler};
+use super::sweep::{Point, Val};
+use super::value::{Common, Ctx, Defaults, SceneError, effect_keys, grid, incident_phi, kind_of, number, reject_keys, roughness_keys, string};
 use crate::check::budget::Budget;
 use crate::check::resources::{Resource, ResourceKind};
 use crate::check::{Conventions, DEFAULT_TIMEOUT, Domain, MAX_PARAMS, MAX_TIMEOUT_SECONDS, Settings, UserSampler};
-use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;
 use toml::{Spanned, Value};
-
-/// `sampler = { ... }` as written.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawSampler {
-    /// One of lobes' built-in lights (`crate::reference::light::registry::LIGHTS`), instead of
-    /// WGSL files: `sampler = { light = "sphere" }`, the geometry in the case's `params`.
-    light: Option<Val>,
-    wgsl: Option<Val>,
-    sample: Option<Val>,
-    pdf: Option<Val>,
-    eval: Option<Val>,
-    // the sampler's conventions (crate::check::conventions), as `lobes check`'s flags
-    incident: Option<Val>,
-    reflection_only: Option<Val>,
-    u_open: Option<Val>,
-    measure: Option<Val>,
-    frame: Option<Val>,
-    rand: Option<Val>,
-    rand_order: Option<Val>,
-    shader_root: Option<Val>,
-    define: Option<Val>,
-    stub: Option<Val>,
-    package: Option<Val>,
-    texture: Option<Val>,
-    buffer: Option<Val>,
-    /// The renderer's samplers, `NAME = "linear"` or `"nearest"` (`--sampler`; the key
-    /// `sampler` is this table's own).
-    filter: Option<Val>,
-    sample_returns: Option<Val>,
-    normal: Option<Val>,
-}
 
 /// One validated case of a user's sampler: the sampler (shared by the cases of a sweep) and the
 /// settings of its check (the significance is the run's, per case).

@@ -17,7 +17,7 @@ pub mod weights;
 use super::gpu::{CHUNK, Params, Passes, histogram};
 use super::probe::Probe;
 use super::quadrature::{self, Integrals, Integrand};
-use super::{CheckError, Settings, UserSampler, jacobian as map};
+use super::{CheckError, Message, SampleReturns, Setting, Settings, UserSampler, jacobian as map};
 use crate::stats::domain::Grid;
 use crate::engine::gpu::Gpu;
 use crate::reference::rng;
@@ -41,8 +41,8 @@ impl<'a, 'g> Run<'a, 'g> {
     /// The run of `sampler`, on a grid fitted to its support where the settings and its samples
     /// call for one ([`super::support::fit`]).
     pub fn new(gpu: &'g Gpu, sampler: &'a UserSampler, settings: &'a Settings) -> Result<Self, CheckError> {
-        let params = super::params_of(sampler, settings);
-        let (passes, draws) = super::compose_passes(gpu, sampler, settings, &params)?;
+        let params = super::gpu::params_of(sampler, settings);
+        let (passes, draws) = super::gpu::compose_passes(gpu, sampler, settings, &params)?;
         let run = Self::on(std::borrow::Cow::Borrowed(sampler), settings, passes, draws);
         if settings.fit.limit().is_none() || !sampler.domain.is_sphere() {
             return Ok(run);
@@ -56,7 +56,7 @@ impl<'a, 'g> Run<'a, 'g> {
 
     fn on(sampler: std::borrow::Cow<'a, UserSampler>, settings: &'a Settings, passes: Passes<'g>, draws: String) -> Self {
         let (rows, cols) = settings.grid(&sampler.domain);
-        let params = super::params_of(&sampler, settings);
+        let params = super::gpu::params_of(&sampler, settings);
         let wi = super::incident(settings.incident_theta, settings.incident_phi);
         Self { sampler, settings, passes, params, draws, wi, rows, cols }
     }
@@ -224,7 +224,7 @@ fn integrate(run: &Run, evidence: &quadrature::Evidence, width: f64) -> Result<(
 /// expected counts the quadrature could not resolve give no verdict.
 pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckError> {
     if m.integrals.bad_parts == 0 {
-        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(match super::half_vector_pole(&run.sampler, run.settings, None) {
+        m.integrals.converged(run.settings.samples).map_err(|e| CheckError::NoVerdict(match half_vector_pole(&run.sampler, run.settings, None) {
             Some(pole) => e.append(pole),
             None => e,
         }))?;
@@ -232,3 +232,29 @@ pub(crate) fn require_converged(run: &Run, m: &Measured) -> Result<(), CheckErro
     Ok(())
 }
 
+/// Why a half-vector sampler's pdf may defeat the quadrature without a fault of its own, for a
+/// no-verdict message: with `--sample-returns half-vector` and reflections below the surface kept,
+/// the density of d = 2 (wi·h) h − wi is p(h) / (4 wi·h) with h = normalize(wi + d), which has an
+/// integrable pole at d = −wi wherever p(h) is not 0 for h ⊥ wi (NDF sampling: D(h) cos θh at
+/// θi > 0); no f32 quadrature resolves it, and the f32 pdf may be ∞ or NaN beside it. `bad_at`:
+/// for bad pdf values, the (θ, φ) in degrees of the worst one (None: between a fine grid's
+/// points), which must lie within 1° of −wi; None for an unconverged quadrature.
+fn half_vector_pole(sampler: &UserSampler, settings: &Settings, bad_at: Option<Option<(f64, f64)>>) -> Option<Message> {
+    if sampler.composition.sample_returns != SampleReturns::HalfVector || sampler.conventions.reflection_only || !sampler.domain.directions() {
+        return None;
+    }
+    let pole = crate::reference::reflect::spherical((180.0 - settings.incident_theta).to_radians(), (settings.incident_phi + 180.0).to_radians());
+    if let Some(Some((theta, phi))) = bad_at
+        && crate::reference::reflect::spherical(theta.to_radians(), phi.to_radians()).dot(pole).clamp(-1.0, 1.0).acos() > 1f64.to_radians()
+    {
+        return None;
+    }
+    let (t, p) = (pole.z.clamp(-1.0, 1.0).acos().to_degrees(), pole.y.atan2(pole.x).to_degrees());
+    Some(
+        Message::text("; with ")
+            .setting(Setting::SampleReturns)
+            .then(format!(" half-vector the density of the reflected d, p(h) / (4 wi·h), has an integrable pole at d = −wi (θ {t:.1}°, φ {p:.1}°) where p(h) is not 0 for h ⊥ wi (NDF sampling), which no f32 quadrature resolves: no verdict. A sampler whose renderer discards reflections under the surface is checked with "))
+            .setting(Setting::ReflectionOnly)
+            .then(" (they are then rejections, and d = −wi is one of them)"),
+    )
+}

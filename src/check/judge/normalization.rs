@@ -4,7 +4,7 @@
 
 use super::{Measured, Run};
 use crate::check::report::{Check, Figures, NormalizationFigures};
-use crate::check::{Message, Setting, invalid_expectation};
+use crate::check::{Message, Setting};
 
 pub(crate) fn check(run: &Run, m: &Measured) -> Check {
     let (n, total) = (run.samples(), m.pdf_total());
@@ -59,4 +59,29 @@ pub(crate) fn rounding_resolved(run: &Run, m: &Measured, chi2_passed: bool) -> R
         F32_MOVED_SIGMA / n.sqrt()
     );
     Err(Message::text(what).setting(Setting::Samples))
+}
+
+/// The invalid cell's expected count, for `invalid` of N = `samples` samples where the pdf
+/// integrates to `pdf_total` over the domain, known to `resolution`: N × the observed invalid
+/// fraction clamped into 1 − ∫pdf ± 2 × resolution, the value within that band closest to what
+/// was observed, so that neither a rejection the pdf allows nor the quadrature's own error reads
+/// as a sampler's fault (a rejection rate under the band is below what the test can see, even
+/// where the pdf integrates to more than 1). Twice the resolution, as `normalization`'s
+/// tolerance: the error estimate is the coarse rule's, and across a jump of the pdf the accepted
+/// finer value is off by as much (a uniform cone of half-angle 0.3 rad about the normal: ∫pdf
+/// 0.999830 with an error estimate of 1.65·10⁻⁴; within 1× the cell expected 12 samples where
+/// none can be, a false fail at 2 of 3 seeds).
+///
+/// ```
+/// // a pdf that integrates to 0.9998 known to 10⁻⁴ leaves 2·10⁻⁴ ± 2·10⁻⁴ to rejections:
+/// // 0 or 300 rejected of 10⁶ both read as allowed
+/// assert_eq!(lobes::check::invalid_expectation(1_000_000, 0, 0.9998, 1e-4), 0.0);
+/// assert!((lobes::check::invalid_expectation(1_000_000, 300, 0.9998, 1e-4) - 300.0).abs() < 1e-6);
+/// // 2 000 rejected is beyond 4·10⁻⁴: the cell expects 400
+/// assert!((lobes::check::invalid_expectation(1_000_000, 2_000, 0.9998, 1e-4) - 400.0).abs() < 1e-6);
+/// ```
+pub fn invalid_expectation(samples: u64, invalid: u64, pdf_total: f64, resolution: f64) -> f64 {
+    let n = samples.max(1) as f64;
+    let (missing, band) = (1.0 - pdf_total, 2.0 * resolution);
+    n * (invalid as f64 / n).clamp((missing - band).max(0.0), (missing + band).max(band))
 }

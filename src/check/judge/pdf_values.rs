@@ -78,7 +78,7 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Result<Check, CheckError> {
     let s = &*run.sampler;
     let worst = if bad > 0 { worst(&run.passes, &run.params, &s.domain, &s.conventions)? } else { None };
     if bad > 0
-        && let Some(pole) = crate::check::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
+        && let Some(pole) = super::half_vector_pole(s, run.settings, Some(worst.as_ref().map(|w| w.angles)))
     {
         let at = worst.as_ref().map_or("between the points of a fine grid".into(), |w| w.describe(&run.pdf(), s.domain));
         return Err(CheckError::NoVerdict(Message::text(format!("{} returned NaN, ∞ or a negative value in {bad} of {parts} quadrature parts, {at}", run.pdf())).append(pole)));
