@@ -254,45 +254,25 @@ pub fn emit_json(value: &impl serde::Serialize) -> anyhow::Result<()> {
     emit(&text)
 }
 
-/// A lobe, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum LobeChoice {
-    /// Ward's lobe with Walter's pdf (NDF sampling only).
-    Ward,
-    /// Beckmann microfacets.
-    Beckmann,
-    /// GGX (Trowbridge–Reitz) microfacets.
-    Ggx,
-}
-
-impl From<LobeChoice> for LobeKind {
-    fn from(c: LobeChoice) -> Self {
-        match c {
-            LobeChoice::Ward => LobeKind::Ward,
-            LobeChoice::Beckmann => LobeKind::Beckmann,
-            LobeChoice::Ggx => LobeKind::Ggx,
-        }
+/// `--lobe`'s values: the registry's lobes, each with its methods.
+impl ValueEnum for LobeKind {
+    fn value_variants<'a>() -> &'a [Self] {
+        &LobeKind::ALL
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let methods: Vec<&str> = self.methods().map(Method::name).collect();
+        Some(clap::builder::PossibleValue::new(self.name()).help(format!("{} (--method {})", self.about(), methods.join("|"))))
     }
 }
 
-/// A half-vector sampling method, as named on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MethodChoice {
-    /// The lobe's own distribution (Ward's p(h), or D(h) cos θh).
-    Ndf,
-    /// Visible normals (Beckmann, GGX).
-    Vndf,
-    /// Bounded VNDF (GGX only).
-    Bounded,
-}
-
-impl From<MethodChoice> for Method {
-    fn from(c: MethodChoice) -> Self {
-        match c {
-            MethodChoice::Ndf => Method::Ndf,
-            MethodChoice::Vndf => Method::Vndf,
-            MethodChoice::Bounded => Method::Bounded,
-        }
+/// `--method`'s values, each with the lobes that have it.
+impl ValueEnum for Method {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Method::ALL
+    }
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        let lobes: Vec<&str> = LobeKind::ALL.into_iter().filter(|k| k.supports(*self)).map(LobeKind::name).collect();
+        Some(clap::builder::PossibleValue::new(self.name()).help(format!("{}; lobes: {}", self.about(), lobes.join(", "))))
     }
 }
 
@@ -302,10 +282,10 @@ impl From<MethodChoice> for Method {
 pub struct LobeArgs {
     /// The lobe.
     #[arg(long, value_enum)]
-    pub lobe: LobeChoice,
-    /// How the half vector is drawn; ward supports only ndf, bounded is GGX only.
+    pub lobe: LobeKind,
+    /// How the half vector is drawn (each lobe's methods are listed under --lobe).
     #[arg(long, value_enum, default_value = "ndf")]
-    pub method: MethodChoice,
+    pub method: Method,
     /// Isotropic roughness α: a finite number > 0.
     #[arg(long, value_name = "A", value_parser = parse_alpha, allow_hyphen_values = true,
           conflicts_with_all = ["alpha_x", "alpha_y"])]
@@ -321,14 +301,9 @@ pub struct LobeArgs {
 impl LobeArgs {
     /// The reference lobe, or a [`UsageError`] if the lobe has no sampler for the method.
     pub fn lobe(&self) -> anyhow::Result<crate::reference::Lobe> {
-        let kind = LobeKind::from(self.lobe);
-        let method = Method::from(self.method);
+        let (kind, method) = (self.lobe, self.method);
         if !kind.supports(method) {
-            let supported: Vec<&str> = [Method::Ndf, Method::Vndf, Method::Bounded]
-                .into_iter()
-                .filter(|&m| kind.supports(m))
-                .map(Method::name)
-                .collect();
+            let supported: Vec<&str> = kind.methods().map(Method::name).collect();
             return Err(usage(format!(
                 "--method {} is not available for --lobe {}; {} supports --method {}",
                 method.name(),

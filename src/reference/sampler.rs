@@ -36,6 +36,10 @@ pub enum Method {
 }
 
 impl LobeKind {
+    /// Every lobe, in the registry's order: what a scene's `lobe` and `--lobe` accept.
+    pub const ALL: [LobeKind; 3] = [LobeKind::Ward, LobeKind::Beckmann, LobeKind::Ggx];
+
+    /// Its name in scenes, on the command line and in outputs.
     pub fn name(self) -> &'static str {
         match self {
             LobeKind::Ward => "ward",
@@ -43,19 +47,57 @@ impl LobeKind {
             LobeKind::Ggx => "ggx",
         }
     }
+    /// One line on the lobe (the command line's help).
+    pub fn about(self) -> &'static str {
+        match self {
+            LobeKind::Ward => "Ward's lobe with Walter's pdf",
+            LobeKind::Beckmann => "Beckmann microfacets",
+            LobeKind::Ggx => "GGX (Trowbridge–Reitz) microfacets",
+        }
+    }
+    /// The lobe called `name` ([`LobeKind::name`]).
+    ///
+    /// ```
+    /// use lobes::reference::LobeKind;
+    /// assert_eq!(LobeKind::from_name("ggx"), Some(LobeKind::Ggx));
+    /// assert_eq!(LobeKind::from_name("GGX"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
     /// Whether this lobe has a sampler for `method`.
     pub fn supports(self, method: Method) -> bool {
         of_kind(self).any(|s| s.method == method)
     }
+    /// The methods it has a sampler for, in [`Method::ALL`]'s order.
+    pub fn methods(self) -> impl Iterator<Item = Method> {
+        Method::ALL.into_iter().filter(move |&m| self.supports(m))
+    }
 }
 
 impl Method {
+    /// Every method: what a scene's `method` and `--method` accept for a lobe.
+    pub const ALL: [Method; 3] = [Method::Ndf, Method::Vndf, Method::Bounded];
+
+    /// Its name in scenes, on the command line and in outputs.
     pub fn name(self) -> &'static str {
         match self {
             Method::Ndf => "ndf",
             Method::Vndf => "vndf",
             Method::Bounded => "bounded",
         }
+    }
+    /// One line on the method (the command line's help).
+    pub fn about(self) -> &'static str {
+        match self {
+            Method::Ndf => "The lobe's own distribution (Ward's p(h), or D(h) cos θh)",
+            Method::Vndf => "Visible normals",
+            Method::Bounded => "Bounded VNDF (Eto & Tokuyoshi 2023)",
+        }
+    }
+    /// The method called `name` ([`Method::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
     }
 }
 
@@ -325,5 +367,18 @@ mod tests {
             assert_eq!(s.id() as usize, i, "{} listed twice", s.name());
             assert_eq!(find(s.kind, s.method).name(), s.name());
         }
+    }
+
+    #[test]
+    fn every_lobe_and_method_named_has_a_sampler() {
+        for kind in LobeKind::ALL {
+            assert!(kind.methods().next().is_some() && LobeKind::from_name(kind.name()) == Some(kind), "{kind:?}");
+        }
+        for method in Method::ALL {
+            assert!(LobeKind::ALL.iter().any(|k| k.supports(method)) && Method::from_name(method.name()) == Some(method), "{method:?}");
+        }
+        assert!(REGISTRY.iter().all(|s| LobeKind::ALL.contains(&s.kind) && Method::ALL.contains(&s.method)));
+        assert_eq!(LobeKind::Ward.methods().collect::<Vec<_>>(), [Method::Ndf]);
+        assert_eq!(LobeKind::Ggx.methods().collect::<Vec<_>>(), Method::ALL);
     }
 }

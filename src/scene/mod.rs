@@ -468,30 +468,33 @@ fn discrete_job(ctx: &Ctx, c: &RawCase, point: &Point, lobe_v: &Val, method: Opt
 /// A lobe case's lobe and method (the default method unless given), and where the method was
 /// said (the lobe's span when it was not).
 fn lobe_method(ctx: &Ctx, lobe_name: &str, lobe_v: &Val, method: Option<(&str, Range<usize>)>) -> Result<(LobeKind, Method, Range<usize>), SceneError> {
-    const LOBES: [&str; 4] = ["ward", "beckmann", "ggx", "discrete"];
-    let kind = match lobe_name {
-        "ward" => LobeKind::Ward,
-        "beckmann" => LobeKind::Beckmann,
-        "ggx" => LobeKind::Ggx,
-        other => return Err(ctx.err(lobe_v.span(), format!("lobe '{other}' is unknown; use ward, beckmann, ggx or discrete{}", did_you_mean(other, LOBES)))),
+    let lobes: Vec<&str> = LobeKind::ALL.iter().map(|k| k.name()).chain(["discrete"]).collect();
+    let Some(kind) = LobeKind::from_name(lobe_name) else {
+        let hint = did_you_mean(lobe_name, lobes.iter().copied());
+        return Err(ctx.err(lobe_v.span(), format!("lobe '{lobe_name}' is unknown; use {}{hint}", either(&lobes))));
     };
     let method_span = method.as_ref().map_or(lobe_v.span(), |m| m.1.clone());
-    let method = match method.map_or(DEFAULT_METHOD.name(), |m| m.0) {
-        "ndf" => Method::Ndf,
-        "vndf" => Method::Vndf,
-        "bounded" => Method::Bounded,
-        other => {
-            let hint = did_you_mean(other, ["ndf", "vndf", "bounded"]);
-            return Err(ctx.err(method_span, format!("method '{other}' is unknown for a lobe; use ndf, vndf or bounded (cdf and alias are for lobe = \"discrete\"){hint}")));
-        }
+    let method_name = method.map_or(DEFAULT_METHOD.name(), |m| m.0);
+    let Some(method) = Method::from_name(method_name) else {
+        let methods: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+        let hint = did_you_mean(method_name, methods.iter().copied());
+        let use_ = either(&methods);
+        return Err(ctx.err(method_span, format!("method '{method_name}' is unknown for a lobe; use {use_} (cdf and alias are for lobe = \"discrete\"){hint}")));
     };
     if !kind.supports(method) {
-        return Err(ctx.err(
-            method_span,
-            format!("{} has no '{}' sampler; ward: ndf; beckmann: ndf, vndf; ggx: ndf, vndf, bounded", kind.name(), method.name()),
-        ));
+        let each: Vec<String> = LobeKind::ALL.iter().map(|k| format!("{}: {}", k.name(), k.methods().map(Method::name).collect::<Vec<_>>().join(", "))).collect();
+        return Err(ctx.err(method_span, format!("{} has no '{}' sampler; {}", kind.name(), method.name(), each.join("; "))));
     }
     Ok((kind, method, method_span))
+}
+
+/// "a, b or c".
+fn either(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+    }
 }
 
 /// (αx, αy) from `alpha`, or from `alpha_x` and `alpha_y`, each ≥ [`MIN_ALPHA`].
