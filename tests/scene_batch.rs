@@ -103,6 +103,6 @@ fn bad_patterns_and_values_are_bad_input() {
     let weighted = "[[case]]\nname = \"f\"\nlobe = \"ggx\"\nalpha = 0.3\nfresnel = \"schlick\"\nf0 = 0.04\n";
     let out = lobes(&dir, &["run", "-", "--cpu", "--samples", "5000000000"], weighted);
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("samples = 5000000000 (--samples) is too many for a weighted case"), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("samples = 5000000000 (the command line's, for every case) is too many for a weighted case"), "{}", text(&out.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -420,7 +420,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
     let effects = effects(ctx, c, point, kind, scatter)?;
     if effects.is_some() && samples > MAX_WEIGHTED_SAMPLES {
         let (span, given) = match (d.overrides.samples, point.get("samples").or(d.samples.map(|(_, v)| v))) {
-            (Some(_), _) => (spanned.span(), " (--samples)"),
+            (Some(_), _) => (spanned.span(), " (the command line's, for every case)"),
             (None, v) => (v.map_or(spanned.span(), |v| v.span()), ""),
         };
         return Err(ctx.err(span, format!("samples = {samples}{given} is too many for a weighted case; at most 2^32 (4294967296)")));

@@ -24,7 +24,7 @@ pub(crate) fn check(run: &Run, m: &Measured) -> Check {
 }
 
 /// What a light sampled by area most often gets wrong, said where the densities disagree.
-const AREA_HINT: &str = "; with --measure area, lobes turns the sample's density per unit area into one per solid angle, pdf_A·|p|²/|n·d| (pbrt-v4 eq. 4.9): the pdf function must be per solid angle too (one left per unit area, or converted without |n·d|, is the classic MIS bug)";
+const AREA_HINT: &str = "; with the area measure, lobes turns the sample's density per unit area into one per solid angle, pdf_A·|p|²/|n·d| (pbrt-v4 eq. 4.9): the pdf function must be per solid angle too (one left per unit area, or converted without |n·d|, is the classic MIS bug)";
 
 fn figures(m: &Measured) -> ConsistencyFigures {
     let mut c = ConsistencyFigures {

@@ -43,7 +43,7 @@ pub fn sweep_table(sweep: &Sweep) -> String {
         }
         for k in sweep.skipped.iter().filter(|k| k.sampler == name) {
             t += &format!(
-                "| {} | {} | {} | skipped: ~{:.0} s predicted, over --max-seconds | | | | | | | |\n",
+                "| {} | {} | {} | skipped: ~{:.0} s predicted, over the time limit per point | | | | | | | |\n",
                 k.sampler,
                 k.precision.name(),
                 pow2(k.samples),
