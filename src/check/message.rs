@@ -69,7 +69,7 @@ impl std::fmt::Display for Message {
     }
 }
 
-/// A field of [`Settings`], of a sampler's [`Composition`] or one of its call expressions
+/// A field of [`super::Settings`], of a sampler's [`super::Composition`] or one of its call expressions
 /// ([`super::composition::Call`]), as errors name it: the command line by its flag, a scene by its key
 /// ([`Setting::key`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
