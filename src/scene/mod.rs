@@ -393,7 +393,7 @@ fn validate_case(ctx: &Ctx, spanned: &Spanned<RawCase>, d: &Defaults, point: &Po
     };
     let lobe_name = string(ctx, lobe_v, "lobe", lobes_allowed)?;
     let method = point.get("method").map(|m| Ok::<_, SceneError>((string(ctx, m, "method", "use ndf, vndf or bounded (lobes), cdf or alias (discrete)")?, m.span()))).transpose()?;
-    if lobe_name == "discrete" {
+    if lobe_name == DISCRETE {
         let job = discrete_job(ctx, c, point, lobe_v, method)?;
         return Ok(Case { name, job, samples, seed, incident_deg: (0.0, 0.0), effects: None });
     }
@@ -465,11 +465,14 @@ fn discrete_job(ctx: &Ctx, c: &RawCase, point: &Point, lobe_v: &Val, method: Opt
     Ok(Job::Discrete { dist, method })
 }
 
+/// The `lobe` of a case that draws from a discrete distribution, not a lobe.
+const DISCRETE: &str = "discrete";
+
 /// A lobe case's lobe and method (the default method unless given), and where the method was
 /// said (the lobe's span when it was not).
 fn lobe_method(ctx: &Ctx, lobe_name: &str, lobe_v: &Val, method: Option<(&str, Range<usize>)>) -> Result<(LobeKind, Method, Range<usize>), SceneError> {
-    let lobes: Vec<&str> = LobeKind::ALL.iter().map(|k| k.name()).chain(["discrete"]).collect();
     let Some(kind) = LobeKind::from_name(lobe_name) else {
+        let lobes: Vec<&str> = LobeKind::ALL.iter().map(|k| k.name()).chain([DISCRETE]).collect();
         let hint = did_you_mean(lobe_name, lobes.iter().copied());
         return Err(ctx.err(lobe_v.span(), format!("lobe '{lobe_name}' is unknown; use {}{hint}", either(&lobes))));
     };
@@ -479,7 +482,7 @@ fn lobe_method(ctx: &Ctx, lobe_name: &str, lobe_v: &Val, method: Option<(&str, R
         let methods: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
         let hint = did_you_mean(method_name, methods.iter().copied());
         let use_ = either(&methods);
-        return Err(ctx.err(method_span, format!("method '{method_name}' is unknown for a lobe; use {use_} (cdf and alias are for lobe = \"discrete\"){hint}")));
+        return Err(ctx.err(method_span, format!("method '{method_name}' is unknown for a lobe; use {use_} (cdf and alias are for lobe = \"{DISCRETE}\"){hint}")));
     };
     if !kind.supports(method) {
         let each: Vec<String> = LobeKind::ALL.iter().map(|k| format!("{}: {}", k.name(), k.methods().map(Method::name).collect::<Vec<_>>().join(", "))).collect();
