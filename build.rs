@@ -20,90 +20,117 @@ mod text;
 #[allow(dead_code)]
 mod wgsl_tokens;
 
-/// lobes::embed's modules in dependency order (each after those it imports), with their files
-/// under `shaders/`: the order and names of `embed::Module::ALL` (a unit test holds the two
-/// together). A module is what a renderer imports as one: a lobe's sampler, densities and BRDF.
-const MODULES: [(&str, &[&str]); 17] = [
-    ("rng", &["lib/rng.wgsl"]),
-    ("math", &["math/f32.wgsl"]),
-    ("reflect", &["lib/reflect.wgsl"]),
-    ("microfacet", &["lib/microfacet.wgsl", "lib/microfacet_eval.wgsl"]),
-    ("ward", &["lib/ward.wgsl", "lib/ward_eval.wgsl"]),
-    ("ggx", &["lib/ggx.wgsl", "lib/ggx_eval.wgsl"]),
-    ("beckmann", &["math/erf_f32.wgsl", "lib/beckmann.wgsl", "lib/beckmann_eval.wgsl"]),
-    ("fresnel", &["lib/fresnel.wgsl"]),
-    ("masking", &["lib/masking.wgsl"]),
-    ("dielectric", &["lib/dielectric.wgsl", "lib/dielectric_eval.wgsl"]),
-    ("discrete", &["lib/discrete.wgsl"]),
-    ("light", &["lib/light.wgsl"]),
-    ("sphere_light", &["lib/sphere_light.wgsl"]),
-    ("disk_light", &["lib/disk_light.wgsl"]),
-    ("triangle_light", &["lib/triangle_light.wgsl"]),
-    ("triangle_area_light", &["lib/triangle_area_light.wgsl"]),
-    ("rect_light", &["lib/rect_light.wgsl"]),
-];
-
-/// The names each module offers a renderer, in `MODULES`' order: its API, which
-/// `embed::Module`'s documentation and docs/embedding.md's module table list (a unit test holds
-/// the table to it). Every other name a module's files declare is an internal helper: the
-/// naga_oil and WESL forms put those in the submodule `lobes::NAME::internal` (neither module
-/// system hides names), so that `lobes::NAME` holds only these.
-const API: [&[&str]; 17] = [
-    &["rng_uniforms", "pcg4d", "rng_to_unit", "add64"],
-    &["math_log", "math_exp", "math_sin", "math_cos", "math_atan2", "math_is_finite", "neg_ln", "UNDERFLOW_EXPONENT"],
-    &[
-        "PI", "LobeSample", "lobe_sample", "reflect_about", "reflect_sample", "reflection_half_vector", "from_tan_theta", "frame_to_local", "frame_to_world",
-        "sample_to_local", "sample_to_world",
-    ],
-    &["stretch", "microfacet_ndf_weight", "microfacet_eval", "microfacet_pdf_ndf", "microfacet_pdf_vndf"],
-    &["ward_sample", "ward_pdf", "ward_eval", "ward_weight", "ward_pdf_h", "ward_sample_h"],
-    &[
-        "ggx_sample_ndf", "ggx_sample_vndf", "ggx_sample_bounded", "ggx_pdf_ndf", "ggx_pdf_vndf", "ggx_pdf_bounded", "ggx_eval", "ggx_d", "ggx_g1", "ggx_lambda",
-        "ggx_g2", "ggx_vndf_weight", "ggx_bounded_weight",
-    ],
-    &[
-        "beckmann_sample_ndf", "beckmann_sample_vndf", "beckmann_pdf_ndf", "beckmann_pdf_vndf", "beckmann_eval", "beckmann_d", "beckmann_g1", "beckmann_lambda",
-        "beckmann_g2", "beckmann_vndf_weight",
-    ],
-    &["fresnel_schlick", "fresnel_dielectric", "fresnel_dielectric_transmittance", "fresnel_cos_transmitted", "fresnel_conductor"],
-    &["masking_separable", "masking_height_correlated", "masking_height_correlated_transmitted", "masking_ln_beta"],
-    &[
-        "dielectric_ggx_ndf", "dielectric_ggx_vndf", "dielectric_beckmann_ndf", "dielectric_beckmann_vndf", "dielectric_ggx_ndf_pdf", "dielectric_ggx_vndf_pdf",
-        "dielectric_beckmann_ndf_pdf", "dielectric_beckmann_vndf_pdf", "dielectric_ggx_eval", "dielectric_beckmann_eval", "dielectric_ggx_vndf_weight",
-        "dielectric_beckmann_vndf_weight",
-    ],
-    &["discrete_f", "discrete_u", "DISCRETE_BLOCK", "discrete_sample_cdf", "discrete_sample_cdf_blocks", "discrete_sample_alias", "discrete_search"],
-    &["LightSample", "LIGHT_PI", "light_to_world", "light_triangle_solid_angle", "light_area_to_solid_angle"],
-    &["sphere_light_sample", "sphere_light_pdf", "sphere_light_solid_angle"],
-    &["disk_light_sample", "disk_light_pdf"],
-    &["triangle_light_sample", "triangle_light_pdf", "triangle_light_solid_angle"],
-    &["triangle_area_light_sample", "triangle_area_light_pdf"],
-    &["rect_light_sample", "rect_light_pdf", "rect_light_solid_angle"],
-];
+/// The folders whose files are lobes' WGSL library; `shaders/passes` holds the engine's passes.
+const LIBRARY: [&str; 3] = ["lib", "math", "passes"];
 
 struct File {
     path: String,
     source: String,
 }
 
+/// One module of `lobes::embed`: what a renderer imports as one (a lobe's sampler, densities and
+/// BRDF). Its files say so with the line `//! embed: NAME`; the one whose import path is
+/// `lobes::NAME` holds the module's documentation in its other `//!` lines, and every file marks
+/// the declarations a renderer may use (its API) with `///` comments.
+struct Module {
+    name: String,
+    files: Vec<File>,
+}
+
+/// Every `.wgsl` file under `shaders/DIR` for DIR in [`LIBRARY`], by path.
+fn library_files() -> Vec<File> {
+    let mut paths: Vec<String> = Vec::new();
+    for dir in LIBRARY {
+        println!("cargo:rerun-if-changed=shaders/{dir}");
+        for entry in std::fs::read_dir(format!("shaders/{dir}")).unwrap_or_else(|e| panic!("shaders/{dir}: {e}")) {
+            let name = entry.unwrap().file_name().into_string().unwrap();
+            if name.ends_with(".wgsl") {
+                paths.push(format!("shaders/{dir}/{name}"));
+            }
+        }
+    }
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|path| {
+            println!("cargo:rerun-if-changed={path}");
+            let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+            File { path, source }
+        })
+        .collect()
+}
+
+/// The module a file belongs to, from its `//! embed: NAME` line.
+fn embed_tag(source: &str) -> Option<&str> {
+    source.lines().find_map(|l| l.strip_prefix("//! embed:")).map(str::trim)
+}
+
+/// `items` ordered so that each comes after those `needs` names (ties by their order in
+/// `items`); panics on a circle.
+fn after_needs<T>(mut items: Vec<T>, needs: impl Fn(&T, &T) -> bool, what: impl Fn(&T) -> String) -> Vec<T> {
+    let mut out: Vec<T> = Vec::new();
+    while !items.is_empty() {
+        let ready = (0..items.len())
+            .find(|&i| !items.iter().enumerate().any(|(j, other)| j != i && needs(&items[i], other)))
+            .unwrap_or_else(|| panic!("a circle of imports among {}", items.iter().map(&what).collect::<Vec<_>>().join(", ")));
+        out.push(items.remove(ready));
+    }
+    out
+}
+
+/// The embedded modules, each after the modules it imports (by depth, then name), each module's
+/// files after the files they import (ties by path).
+fn embedded_modules(files: &[File]) -> Vec<Module> {
+    let mut modules: Vec<Module> = Vec::new();
+    for f in files {
+        let Some(name) = embed_tag(&f.source) else { continue };
+        let file = File { path: f.path.clone(), source: f.source.clone() };
+        match modules.iter_mut().find(|m| m.name == name) {
+            Some(m) => m.files.push(file),
+            None => modules.push(Module { name: name.to_string(), files: vec![file] }),
+        }
+    }
+    let imports = |f: &File, g: &File| text::imports(&f.source).iter().any(|(p, _)| Some(*p) == text::import_path(&g.source));
+    for m in &mut modules {
+        m.files = after_needs(std::mem::take(&mut m.files), imports, |f| f.path.clone());
+    }
+    let needs = |m: &Module, other: &Module| m.files.iter().any(|f| other.files.iter().any(|g| imports(f, g)));
+    let ordered = after_needs(modules, needs, |m| m.name.clone());
+    // by depth (the longest chain of imports below), then name: the foundations first
+    let mut depth: Vec<(usize, Module)> = Vec::new();
+    for m in ordered {
+        let d = depth.iter().filter(|(_, o)| needs(&m, o)).map(|(d, _)| d + 1).max().unwrap_or(0);
+        depth.push((d, m));
+    }
+    depth.sort_by(|(d, a), (e, b)| (d, &a.name).cmp(&(e, &b.name)));
+    depth.into_iter().map(|(_, m)| m).collect()
+}
+
+/// The module's documentation: the `//!` lines of its head file, `lobes::NAME`, but the tag.
+fn module_doc(m: &Module) -> String {
+    let head = m.files.iter().find(|f| text::import_path(&f.source) == Some(&format!("lobes::{}", m.name)));
+    let head = head.unwrap_or_else(|| panic!("embed module {}: no file has the import path lobes::{0}", m.name));
+    let doc: Vec<&str> = head.source.lines().filter_map(|l| l.strip_prefix("//!")).map(str::trim).filter(|l| !l.starts_with("embed:")).collect();
+    assert!(!doc.is_empty(), "{}: lobes::{} has no //! documentation", head.path, m.name);
+    doc.join("\n")
+}
+
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=src/embed/text.rs");
     println!("cargo:rerun-if-changed=src/embed/namespace.rs");
-    let read = |f: &str| {
-        let path = format!("shaders/{f}");
-        println!("cargo:rerun-if-changed={path}");
-        let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-        File { path, source }
-    };
-    let files: Vec<Vec<File>> = MODULES.iter().map(|(_, fs)| fs.iter().map(|f| read(f)).collect()).collect();
+    let library = library_files();
+    write_library_list(&library);
+    let modules = embedded_modules(&library);
+    let files: Vec<&[File]> = modules.iter().map(|m| m.files.as_slice()).collect();
+    let api: Vec<Vec<String>> = modules.iter().map(|m| files_api(m).into_iter().filter_map(|d| d.name).collect()).collect();
     let owner = |import_path: &str| -> usize {
         files
             .iter()
             .position(|fs| fs.iter().any(|f| text::import_path(&f.source) == Some(import_path)))
             .unwrap_or_else(|| panic!("no embedded module holds the import path {import_path}"))
     };
-    let n = MODULES.len();
+    let n = modules.len();
     // the modules each imports from (by any name, `Real` included: the plain text needs its alias)
     let mut deps: Vec<Vec<usize>> = Vec::new();
     // the names it imports, by module, without `Real` (the naga_oil and WESL forms spell it f32)
@@ -111,13 +138,13 @@ fn main() {
     for (m, fs) in files.iter().enumerate() {
         let mut d: Vec<usize> = Vec::new();
         let mut by_module: Vec<(usize, Vec<String>)> = Vec::new();
-        for f in fs {
+        for f in fs.iter() {
             for (path, names) in text::imports(&f.source) {
                 let o = owner(path);
                 if o == m {
                     continue;
                 }
-                assert!(o < m, "{} imports {path}, which comes later in MODULES", f.path);
+                assert!(o < m, "{} imports {path}, which comes later", f.path);
                 if !d.contains(&o) {
                     d.push(o);
                 }
@@ -160,11 +187,11 @@ fn main() {
     let list = |v: Vec<String>| format!("&[{}]", v.join(", "));
     let strs = |v: &[String]| list(v.iter().map(|s| format!("{s:?}")).collect());
     let array = |name: &str, ty: &str, v: Vec<String>| format!("pub(super) const {name}: [{ty}; {n}] = [\n    {},\n];\n", v.join(",\n    "));
-    out += &array("NAMES", "&str", MODULES.iter().map(|(name, _)| format!("{name:?}")).collect());
+    out += &array("NAMES", "&str", modules.iter().map(|m| format!("{:?}", m.name)).collect());
     out += &array("DEPENDENCIES", "&[usize]", deps.iter().map(|d| list(d.iter().map(usize::to_string).collect())).collect());
     out += &array("FILES", "&[&str]", files.iter().map(|fs| strs(&fs.iter().map(|f| f.path.clone()).collect::<Vec<_>>())).collect());
     out += &array("SHORT_NAMES", "&[&str]", short_names.iter().map(|v| strs(v)).collect());
-    out += &array("API", "&[&str]", API.iter().map(|v| strs(&v.iter().map(|s| s.to_string()).collect::<Vec<_>>())).collect());
+    out += &array("API", "&[&str]", api.iter().map(|v| strs(v)).collect());
     out += &array("SYMBOLS", "&[&str]", short_names.iter().map(|v| strs(&v.iter().map(|s| namespace::prefixed("lobes", s)).collect::<Vec<_>>())).collect());
     // plain WGSL: each file with its directive lines blanked, after a marker line (as the
     // engine's composition writes them), under its short names and with every name prefixed
@@ -179,11 +206,6 @@ fn main() {
     out += &array("WGSL", "&str", prefixed.iter().map(|s| format!("{s:?}")).collect());
     // naga_oil and WESL, in f32: per module the unit `lobes::NAME`, its API, and where it has
     // internal helpers the unit `lobes::NAME::internal` before it; each imports what its code uses
-    for (m, names) in short_names.iter().enumerate() {
-        for a in API[m] {
-            assert!(names.iter().any(|n| n == a), "build.rs API: {} declares no {a}", MODULES[m].0);
-        }
-    }
     // where each module's files import a name from another module: name -> that module
     let imported: Vec<Vec<(String, usize)>> = items.iter().map(|by| by.iter().flat_map(|(k, names)| names.iter().map(|n| (n.clone(), *k))).collect()).collect();
     struct Unit {
@@ -195,17 +217,17 @@ fn main() {
     let mut units: Vec<Unit> = Vec::new();
     for (m, fs) in files.iter().enumerate() {
         let (mut public, mut internal) = (Unit { module: m, internal: false, code: String::new(), names: Vec::new() }, Unit { module: m, internal: true, code: String::new(), names: Vec::new() });
-        for f in fs {
+        for f in fs.iter() {
             let (mut p, mut q, mut opening) = (String::new(), String::new(), String::new());
-            for (name, chunk) in declarations(&text::in_f32(&f.source)) {
-                match name {
-                    None => opening = chunk,
-                    Some(n) if API[m].contains(&n.as_str()) => {
-                        p += &chunk;
+            for d in declarations(&text::in_f32(&f.source)) {
+                match d.name {
+                    None => opening = d.text,
+                    Some(n) if api[m].contains(&n) => {
+                        p += &d.text;
                         public.names.push(n);
                     }
                     Some(n) => {
-                        q += &chunk;
+                        q += &d.text;
                         internal.names.push(n);
                     }
                 }
@@ -227,7 +249,7 @@ fn main() {
         units.push(public);
     }
     let unit_of = |m: usize, name: &str| -> usize {
-        let internal = !API[m].contains(&name);
+        let internal = !api[m].iter().any(|a| a == name);
         units.iter().position(|u| u.module == m && u.internal == internal).unwrap()
     };
     // per unit: the units it imports from, with the names
@@ -246,7 +268,7 @@ fn main() {
         }
         for other in units.iter().filter(|o| o.module == u.module && o.internal != u.internal) {
             for n in other.names.iter().filter(|n| used.contains(*n)) {
-                assert!(!u.internal, "{}: the internal helpers use {n}, which is its API: add their names to build.rs's API, or take {n} out of it", MODULES[u.module].0);
+                assert!(!u.internal, "{}: the internal helpers use {n}, which is its API: mark their declarations `///` too, or take the `///` off {n}", modules[u.module].name);
                 add(unit_of(u.module, n), n);
             }
         }
@@ -257,11 +279,11 @@ fn main() {
         }
         unit_imports.push(by_unit);
     }
-    let path = |u: &Unit| format!("{}{}", MODULES[u.module].0, if u.internal { "::internal" } else { "" });
+    let path = |u: &Unit| format!("{}{}", modules[u.module].name, if u.internal { "::internal" } else { "" });
     let header = |u: &Unit, form: &str| {
         let fs: Vec<&str> = files[u.module].iter().map(|f| f.path.as_str()).collect();
         let what = if u.internal {
-            format!("{form}: the internal helpers of lobes::{}, not its API; they may change in any release", MODULES[u.module].0)
+            format!("{form}: the internal helpers of lobes::{}, not its API; they may change in any release", modules[u.module].name)
         } else {
             format!("{form}, lobes {version}")
         };
@@ -296,7 +318,7 @@ fn main() {
     // the WESL package for the `wesl` crate (feature wesl): module NAME with its submodule internal
     let mut package = String::from("// Generated by build.rs: lobes::embed::WESL_PACKAGE's modules.\n");
     let mut refs = Vec::new();
-    for (m, (name, _)) in MODULES.iter().enumerate() {
+    for (m, name) in modules.iter().map(|m| &m.name).enumerate() {
         let public = units.iter().position(|u| u.module == m && !u.internal).unwrap();
         let submodules = match units.iter().position(|u| u.module == m && u.internal) {
             Some(i) => {
@@ -309,32 +331,95 @@ fn main() {
         refs.push(format!("&MODULE_{m}"));
     }
     writeln!(package, "static MODULES: [&CodegenModule; {n}] = [{}];", refs.join(", ")).unwrap();
+    let docs: Vec<String> = modules.iter().enumerate().map(|(m, module)| variant_doc(module, &files_api(module), &deps[m].iter().map(|&d| modules[d].name.as_str()).collect::<Vec<_>>())).collect();
+    out += &array("DESCRIPTIONS", "&str", docs.iter().map(|d| format!("{d:?}")).collect());
+    let mut variants = format!("modules! {{ {n};\n");
+    for (module, doc) in modules.iter().zip(&docs) {
+        writeln!(variants, "    #[doc = {doc:?}]\n    {},", camel(&module.name)).unwrap();
+    }
+    variants += "}\n";
     let dir = std::env::var("OUT_DIR").unwrap();
     std::fs::write(format!("{dir}/embed_generated.rs"), out).unwrap();
     std::fs::write(format!("{dir}/embed_wesl_package.rs"), package).unwrap();
+    std::fs::write(format!("{dir}/embed_modules.rs"), variants).unwrap();
 }
 
-/// A file's code cut before each module-scope declaration (with the comment lines right above
-/// it): (the name it declares, its text), the file's opening lines first, with no name.
-fn declarations(code: &str) -> Vec<(Option<String>, String)> {
+/// `sphere_light` → `SphereLight`: the module's variant of `embed::Module`.
+fn camel(name: &str) -> String {
+    name.split('_').map(|w| w[..1].to_uppercase() + &w[1..]).collect()
+}
+
+/// The module's API declarations, file by file.
+fn files_api(m: &Module) -> Vec<Declaration> {
+    m.files.iter().flat_map(|f| declarations(&text::in_f32(&f.source))).filter(|d| !d.doc.is_empty()).collect()
+}
+
+/// The rustdoc of `embed::Module`'s variant: the module's `//!` text, its files, its API with
+/// each declaration's `///` text, and the modules it needs.
+fn variant_doc(m: &Module, api: &[Declaration], needs: &[&str]) -> String {
+    let files: Vec<String> = m.files.iter().map(|f| format!("`{}`", f.path)).collect();
+    let mut doc = format!("{}\n\nIn {}.\n\n", module_doc(m), files.join(", "));
+    for d in api {
+        writeln!(doc, "- `{}`: {}", d.signature, d.doc.join(" ")).unwrap();
+    }
+    let needs: Vec<String> = needs.iter().map(|v| format!("`{v}`")).collect();
+    doc += &if needs.is_empty() { "\nNeeds no other module.".to_string() } else { format!("\nNeeds {}.", needs.join(", ")) };
+    doc
+}
+
+/// `LIBRARY`, the engine's list of every file of its library (`src/engine/gpu/library.rs`).
+fn write_library_list(files: &[File]) {
+    let mut out = format!("/// Every file of `shaders/lib`, `shaders/math` and `shaders/passes` (build.rs lists them).\nstatic LIBRARY: [File; {}] = [\n", files.len());
+    for f in files {
+        writeln!(out, "    shader!({:?}),", f.path.strip_prefix("shaders/").unwrap()).unwrap();
+    }
+    out += "];\n";
+    std::fs::write(format!("{}/library_files.rs", std::env::var("OUT_DIR").unwrap()), out).unwrap();
+}
+
+/// One module-scope declaration of a file, with the comment lines right above it.
+struct Declaration {
+    /// The name it declares; `None` for the file's opening lines.
+    name: Option<String>,
+    text: String,
+    /// Its `///` lines: the declaration is API, documented so.
+    doc: Vec<String>,
+    /// Its declaring text: a function's signature, a struct with its fields, a constant or
+    /// global with its type, on one line.
+    signature: String,
+}
+
+/// A file's code cut before each module-scope declaration, the file's opening lines first.
+fn declarations(code: &str) -> Vec<Declaration> {
     let lines: Vec<&str> = code.lines().collect();
-    let mut starts: Vec<(usize, String)> = Vec::new();
+    let mut starts: Vec<(usize, usize, String)> = Vec::new();
     for (i, line) in lines.iter().enumerate() {
         if let Some(name) = text::declared(line).first() {
             let mut s = i;
-            while s > 0 && lines[s - 1].starts_with("//") && starts.last().is_none_or(|(p, _)| *p < s - 1) {
+            while s > 0 && lines[s - 1].starts_with("//") && starts.last().is_none_or(|(p, _, _)| *p < s - 1) {
                 s -= 1;
             }
-            starts.push((s, name.to_string()));
+            starts.push((s, i, name.to_string()));
         }
     }
     let text = |a: usize, b: usize| lines[a..b].iter().map(|l| format!("{l}\n")).collect::<String>();
-    let mut out = vec![(None, text(0, starts.first().map_or(lines.len(), |(s, _)| *s)))];
-    for (j, (s, name)) in starts.iter().enumerate() {
-        let end = starts.get(j + 1).map_or(lines.len(), |(e, _)| *e);
-        out.push((Some(name.clone()), text(*s, end)));
+    let first = starts.first().map_or(lines.len(), |(s, _, _)| *s);
+    let mut out = vec![Declaration { name: None, text: text(0, first), doc: Vec::new(), signature: String::new() }];
+    for (j, (s, at, name)) in starts.iter().enumerate() {
+        let end = starts.get(j + 1).map_or(lines.len(), |(e, _, _)| *e);
+        let doc = lines[*s..*at].iter().filter_map(|l| l.strip_prefix("///")).map(|l| l.trim().to_string()).collect();
+        out.push(Declaration { name: Some(name.clone()), text: text(*s, end), doc, signature: signature(&lines[*at..end]) });
     }
     out
+}
+
+/// A declaration's text up to its body or value (a struct's up to its closing brace), on one
+/// line, without comments.
+fn signature(lines: &[&str]) -> String {
+    let code: Vec<&str> = lines.iter().map(|l| l.split("//").next().unwrap().trim()).collect();
+    let joined = code.join(" ");
+    let cut = if joined.starts_with("struct") { joined.find('}').map(|i| i + 1) } else { joined.find(['{', '=', ';']) };
+    joined[..cut.unwrap_or(joined.len())].split_whitespace().collect::<Vec<_>>().join(" ").replace(", }", " }")
 }
 
 /// The identifier tokens of WGSL code outside comments (`namespace::rename`'s reading).

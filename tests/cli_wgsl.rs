@@ -49,8 +49,31 @@ fn an_unknown_module_is_a_usage_error_that_lists_the_modules() {
     assert!(out.stdout.is_empty());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unknown module 'beckman' (did you mean 'beckmann'?)"), "{err}");
-    assert!(err.contains("rng, math, reflect, microfacet, ward, ggx, beckmann, fresnel, masking, dielectric, discrete, light, sphere_light, disk_light, triangle_light, triangle_area_light, rect_light"), "{err}");
+    assert!(err.contains("beckmann, dielectric, discrete, disk_light, fresnel, ggx, light, masking, math, microfacet, rect_light, reflect, rng, sphere_light, triangle_area_light, triangle_light, ward"), "{err}");
     assert_eq!(lobes(&["wgsl"]).status.code(), Some(2), "at least one module");
+}
+
+/// `--list` prints every module with its files and its API, each name with its signature and a
+/// line on it, and none of its internal helpers.
+#[test]
+fn list_prints_each_module_with_its_api() {
+    let out = lobes(&["wgsl", "--list"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    for m in Module::ALL {
+        let at = text.find(&format!("## {}\n", m.name())).unwrap_or_else(|| panic!("no {}:\n{text}", m.name()));
+        let section = text[at + 3..].split("\n## ").next().unwrap();
+        for f in m.files() {
+            assert!(section.contains(&format!("`{f}`")), "{f}");
+        }
+        for name in m.api() {
+            assert!(section.lines().any(|l| l.starts_with("- `") && l.contains(&format!(" {name}")) && l.contains("`: ")), "{}: {name}:\n{section}", m.name());
+        }
+    }
+    assert!(text.contains("- `fn ggx_pdf_vndf(a: vec2<f32>, wi: vec3<f32>, wr: vec3<f32>) -> f32`: The density of ωr under ggx_sample_vndf."), "{text}");
+    assert!(!text.contains("ggx_cap_sample"), "a helper is not API");
+    assert!(!text.lines().any(|l| l.starts_with("- `") && l.contains("Real")), "signatures are in f32");
+    assert_eq!(lobes(&["wgsl", "--list", "ggx"]).status.code(), Some(2), "--list takes no module");
 }
 
 /// A fresh folder under the target directory for one test's files.
@@ -115,7 +138,7 @@ fn wgsl_out_dir_files_combine_and_bindings_move() {
     assert!(all.contains("@group(1) @binding(0) var<storage, read> lobes_discrete_f") && all.contains("@group(1) @binding(1) var<storage, read> lobes_discrete_u"));
     embed::validate(&(all + "@group(0) @binding(3) var<storage, read_write> mine: array<f32>;\n")).unwrap();
     let ggx = std::fs::read_to_string(dir.join("ggx.wgsl")).unwrap();
-    assert!(ggx.lines().next().unwrap().contains("needs math.wgsl, reflect.wgsl, microfacet.wgsl"), "{ggx}");
+    assert!(ggx.lines().next().unwrap().contains("needs math.wgsl, microfacet.wgsl, reflect.wgsl"), "{ggx}");
     // two one-piece outputs concatenated are refused by name
     let a = String::from_utf8(lobes(&["wgsl", "ggx"]).stdout).unwrap();
     let b = String::from_utf8(lobes(&["wgsl", "fresnel"]).stdout).unwrap();

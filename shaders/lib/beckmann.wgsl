@@ -3,6 +3,9 @@
 #import lobes::erf::{INV_SQRT_PI, SLOPE_COMPLEMENT, SLOPE_GRAZING_TAN, SLOPE_NEWTON_STEPS, SLOPE_TOLERANCE, math_erfc, math_erfc_given, math_erfinv_refine, math_exp_neg_sq}
 #import lobes::reflect::{LobeSample, PI, from_tan_theta, lobe_sample, reflect_about, reflect_sample}
 #import lobes::microfacet::stretch
+//! embed: beckmann
+//! Beckmann microfacets. Samplers take `(a, wi, u: vec2<f32>)`; densities and the BRDF
+//! `(a, wi, wr)`, with a = (αx, αy).
 
 // Beckmann; CPU twin: src/reference/beckmann.rs.
 // D(h) = exp(-(hx^2/ax^2 + hy^2/ay^2)/hz^2) / (pi ax ay hz^4)                 (Heitz 2014, eq. 71)
@@ -58,6 +61,7 @@ fn erfinv_unit(u: Real) -> Real {
     return math_erfinv_refine(erfinv_guess(u), u);
 }
 
+/// Beckmann's D(h) (Heitz 2014, eq. 71).
 fn beckmann_d(a: vec2<Real>, h: vec3<Real>) -> Real {
     if (h.z <= 0.0) {
         return 0.0;
@@ -83,6 +87,7 @@ fn beckmann_g1_over_cos(a: vec2<Real>, w: vec3<Real>) -> Real {
     return 1.0 / (c - 0.5 * c * math_erfc(x) + aw * math_exp_neg_sq(x) * INV_SQRT_PI * 0.5);
 }
 
+/// A reflected direction with h drawn from D(h) cos θh (Walter et al. 2007, eqs. 28–29).
 fn beckmann_sample_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSample {
     let phi = 2.0 * PI * u.y;
     let d = a * vec2<Real>(math_cos(phi), math_sin(phi));
@@ -247,6 +252,7 @@ fn beckmann_sample_vndf_h(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> vec3<
 }
 
 // p(wr) = G1(wi) D(h) / (4 cos th_i), zero for light from below the surface.
+/// A reflected direction with h drawn from the visible normals of ωi (Heitz & d'Eon 2014).
 fn beckmann_sample_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSample {
     let c = beckmann_visible_case(a, wi);
     let h = beckmann_visible_h(a, c, u);

@@ -4,6 +4,10 @@
 #import lobes::fresnel::{fresnel_cos_transmitted, fresnel_dielectric, fresnel_dielectric_transmittance}
 #import lobes::ggx::{ggx_d, ggx_sample_ndf, ggx_sample_vndf}
 #import lobes::beckmann::{beckmann_d, beckmann_g1_over_cos, beckmann_sample_ndf, beckmann_sample_vndf_h}
+//! embed: dielectric
+//! The rough dielectric (Walter, Marschner, Li & Torrance 2007) on GGX or Beckmann, reflection
+//! and refraction, light from either side; `eta` = η below / η above. Samplers take
+//! `(a, wi, u: vec3<f32>, eta)`, densities and BSDFs `(a, wi, wo, eta)`.
 
 // The rough dielectric (Walter, Marschner, Li & Torrance 2007); f64 twin:
 // src/reference/dielectric.rs (RoughDielectric::sample), whose module notes give the equations.
@@ -83,24 +87,30 @@ fn dielectric_beckmann_vndf_pdf_h(a: vec2<Real>, i: vec3<Real>, h: vec3<Real>) -
     return beckmann_g1_over_cos(a, i) * max(dot(i, h), 0.0) * beckmann_d(a, h);
 }
 
+/// A scattered direction of the rough dielectric on GGX, h from the NDF: u.xy draw h, u.z
+/// chooses reflection (u.z < F) or refraction; `pdf_r` is 0 for a sample on the wrong side of
+/// its event.
 fn dielectric_ggx_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = ggx_sample_ndf(a, i, dielectric_u(u)).h;
     return dielectric_scatter(wi, h, dielectric_ggx_ndf_pdf_h(a, i, h), u.z, eta);
 }
 
+/// The same with h from GGX's visible normals.
 fn dielectric_ggx_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = ggx_sample_vndf(a, i, dielectric_u(u)).h;
     return dielectric_scatter(wi, h, dielectric_ggx_vndf_pdf_h(a, i, h), u.z, eta);
 }
 
+/// The same on Beckmann, h from the NDF.
 fn dielectric_beckmann_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = beckmann_sample_ndf(a, i, dielectric_u(u)).h;
     return dielectric_scatter(wi, h, dielectric_beckmann_ndf_pdf_h(a, i, h), u.z, eta);
 }
 
+/// The same on Beckmann, h from the visible normals.
 fn dielectric_beckmann_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec3<Real>, eta: Real) -> LobeSample {
     let i = dielectric_upper(wi);
     let h = beckmann_sample_vndf_h(a, i, dielectric_u(u));

@@ -4,6 +4,7 @@
 #import lobes::ggx::{ggx_d, ggx_g1}
 #import lobes::beckmann::{beckmann_d, beckmann_g1_over_cos}
 #import lobes::dielectric::{dielectric_upper, dielectric_jacobian_t, dielectric_ggx_ndf_pdf_h, dielectric_ggx_vndf_pdf_h, dielectric_beckmann_ndf_pdf_h, dielectric_beckmann_vndf_pdf_h}
+//! embed: dielectric
 
 // The rough dielectric's density, BSDF and estimator weight (the weighted pass,
 // shaders/passes/weighted.wgsl), as shaders/lib/dielectric.wgsl samples it; f64 twin:
@@ -74,32 +75,38 @@ fn dielectric_eval_of(p: DielectricPair, d: Real) -> Real {
     return 0.0;
 }
 
+/// The BSDF on GGX without G (multiply by a masking term, e.g. masking_height_correlated_transmitted).
 fn dielectric_ggx_eval(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_eval_of(p, ggx_d(a, p.h));
 }
 
+/// The BSDF on Beckmann without G.
 fn dielectric_beckmann_eval(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_eval_of(p, beckmann_d(a, p.h));
 }
 
 // The densities of the four samplers of shaders/lib/dielectric.wgsl.
+/// The density of ωo under dielectric_ggx_ndf.
 fn dielectric_ggx_ndf_pdf(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_pdf_of(p, dielectric_ggx_ndf_pdf_h(a, p.i, p.h));
 }
 
+/// The density of ωo under dielectric_ggx_vndf.
 fn dielectric_ggx_vndf_pdf(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_pdf_of(p, dielectric_ggx_vndf_pdf_h(a, p.i, p.h));
 }
 
+/// The density of ωo under dielectric_beckmann_ndf.
 fn dielectric_beckmann_ndf_pdf(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_pdf_of(p, dielectric_beckmann_ndf_pdf_h(a, p.i, p.h));
 }
 
+/// The density of ωo under dielectric_beckmann_vndf.
 fn dielectric_beckmann_vndf_pdf(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, eta: Real) -> Real {
     let p = dielectric_connect(wi, wo, eta);
     return dielectric_pdf_of(p, dielectric_beckmann_vndf_pdf_h(a, p.i, p.h));
@@ -109,10 +116,12 @@ fn dielectric_beckmann_vndf_pdf(a: vec2<Real>, wi: vec3<Real>, wo: vec3<Real>, e
 // probability F or 1 - F is in f and in p alike): by the NDF it is microfacet_ndf_weight
 // (shaders/lib/microfacet.wgsl, unchanged by the mirror); by visible normals 1 / G1(wi), here
 // with G1 of |wi.z| (ggx_vndf_weight's (wi.z + t) / (2 wi.z) is for wi above the surface only).
+/// The estimator weight f |cos θo| / p(ωo) of dielectric_ggx_vndf without G: 1 / G1(|ωi|).
 fn dielectric_ggx_vndf_weight(a: vec2<Real>, wi: vec3<Real>) -> Real {
     return 1.0 / ggx_g1(a, wi);
 }
 
+/// The same for dielectric_beckmann_vndf.
 fn dielectric_beckmann_vndf_weight(a: vec2<Real>, wi: vec3<Real>) -> Real {
     return 1.0 / (abs(wi.z) * beckmann_g1_over_cos(a, wi));
 }

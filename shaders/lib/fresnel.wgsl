@@ -1,10 +1,12 @@
 #define_import_path lobes::fresnel
 #import lobes::math::Real
+//! embed: fresnel
+//! Fresnel reflectance at cos θ = ωi·h (CPU twin: `lobes::reference::fresnel`), each in [0, 1].
 
 // Fresnel reflectance of the microfacet (or Ward half-vector) at cos th = wi.h; CPU twin:
 // src/reference/fresnel.rs. Every form returns a reflectance in [0, 1].
 
-// Schlick 1994, eq. 24: F0 + (1 - F0) (1 - cos th)^5.
+/// Schlick 1994, eq. 24: F0 + (1 - F0) (1 - cos th)^5.
 fn fresnel_schlick(c: f32, f0: f32) -> f32 {
     let m = clamp(1.0 - c, 0.0, 1.0);
     let m2 = m * m;
@@ -13,6 +15,8 @@ fn fresnel_schlick(c: f32, f0: f32) -> f32 {
 
 // Snell's cos th_t for cos th_i = c in [0, 1] and relative index eta = n_t / n_i, or -1 past the
 // critical angle (total internal reflection, eta < 1); CPU twin: reference::fresnel::cos_transmitted.
+/// Snell's cos θt for cos θi = c in [0, 1] and relative index η = nt / ni; −1 past the critical
+/// angle.
 fn fresnel_cos_transmitted(c: Real, eta: Real) -> Real {
     let sin2_t = (1.0 - c * c) / (eta * eta);
     if (sin2_t >= 1.0) {
@@ -25,6 +29,7 @@ fn fresnel_cos_transmitted(c: Real, eta: Real) -> Real {
 // 1 past the critical angle. Over Real: the rough dielectric (shaders/lib/dielectric.wgsl) also
 // runs in f64 kernels. The amplitudes are written as quotients by Snell's law, without the
 // cancellation of eta c - ct and c - eta ct as eta -> 1 (reference::fresnel::dielectric).
+/// A dielectric's reflectance at cos θi = c, relative index η = nt / ni; 1 past the critical angle.
 fn fresnel_dielectric(c: Real, eta: Real) -> Real {
     let ci = clamp(c, 0.0, 1.0);
     let ct = fresnel_cos_transmitted(ci, eta);
@@ -42,6 +47,7 @@ fn fresnel_dielectric(c: Real, eta: Real) -> Real {
 
 // T = 1 - F of fresnel_dielectric without its cancellation as F -> 1: 1 - r^2 = 4ab / (a + b)^2
 // for r = (a - b)/(a + b) (reference::fresnel::dielectric_transmittance).
+/// 1 − fresnel_dielectric without its cancellation near the critical angle.
 fn fresnel_dielectric_transmittance(c: Real, eta: Real) -> Real {
     let ci = clamp(c, 0.0, 1.0);
     let ct = fresnel_cos_transmitted(ci, eta);
@@ -79,6 +85,7 @@ fn complex_sqrt(z: vec2<f32>) -> vec2<f32> {
 // A conductor with complex index eta + i k (pbrt-v4 FrComplex, eq. 9.6 with complex eta):
 // cos th_t = sqrt(1 - sin^2 th / eta^2), r_parl = (eta c - cos th_t) / (eta c + cos th_t),
 // r_perp = (c - eta cos th_t) / (c + eta cos th_t), F = (|r_parl|^2 + |r_perp|^2) / 2.
+/// A conductor's reflectance at cos θi = c, complex index η + ik.
 fn fresnel_conductor(c: f32, eta: f32, k: f32) -> f32 {
     let ci = clamp(c, 0.0, 1.0);
     let e = vec2<f32>(eta, k);

@@ -2,6 +2,9 @@
 #import lobes::math::{Real, math_cos, math_sin}
 #import lobes::reflect::{LobeSample, PI, lobe_sample, reflect_about, reflect_sample}
 #import lobes::microfacet::stretch
+//! embed: ggx
+//! GGX (Trowbridge–Reitz) microfacets. Samplers take `(a, wi, u: vec2<f32>)`; densities and the
+//! BRDF `(a, wi, wr)`, with a = (αx, αy).
 
 // GGX (Trowbridge-Reitz); CPU twin: src/reference/ggx.rs.
 // D(h) = 1 / (pi ax ay (hx^2/ax^2 + hy^2/ay^2 + hz^2)^2)                (Heitz 2014, eq. 85)
@@ -10,17 +13,20 @@
 // Visible normals: spherical caps (Dupuy & Benyoub 2023, listing 3); bounded caps for reflection
 // (Eto & Tokuyoshi 2023, listings 1-2).
 
+/// GGX's D(h) (Heitz 2014, eq. 85).
 fn ggx_d(a: vec2<Real>, h: vec3<Real>) -> Real {
     let q = h.xy / a;
     let e = dot(q, q) + h.z * h.z;
     return 1.0 / (PI * a.x * a.y * e * e);
 }
 
+/// Smith's G1(w) for GGX (Heitz 2014, eq. 86).
 fn ggx_g1(a: vec2<Real>, w: vec3<Real>) -> Real {
     let z = abs(w.z);
     return 2.0 * z / (z + length(vec3<Real>(a * w.xy, w.z)));
 }
 
+/// A reflected direction with h drawn from D(h) cos θh (Walter et al. 2007, eq. 35).
 fn ggx_sample_ndf(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSample {
     let phi = 2.0 * PI * u.y;
     let r = sqrt(u.x);
@@ -60,6 +66,8 @@ fn ggx_cap_sample(a: vec2<Real>, wi: vec3<Real>, ws: vec3<Real>, b: Real, ws_min
 
 // p(wr) = G1(wi) D(h) / (4 cos th_i) (Heitz 2014, eq. 38 through the reflection Jacobian), with
 // G1/cos th_i = 2 / (cos th_i + t) so that it stays finite at grazing incidence: D / (2 (wi.z + t)).
+/// A reflected direction with h drawn from the visible normals of ωi, by spherical caps
+/// (Dupuy & Benyoub 2023).
 fn ggx_sample_vndf(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSample {
     let ws = stretch(a, wi);
     let h = ggx_cap_sample(a, wi, ws, ws.z, 0.0, u);
@@ -80,6 +88,7 @@ fn ggx_bounded_one_minus_k(a: vec2<Real>, wi: vec3<Real>) -> Real {
 
 // Eto & Tokuyoshi 2023, listing 2: p(wr) = D(h) / (2 (k wi.z + t)), t = |(ax wi.x, ay wi.y, wi.z)|,
 // for wi.z >= 0; D(h) (t - wi.z) / (2 |(ax wi.x, ay wi.y)|^2) below the horizon.
+/// A reflected direction by bounded visible normals (Eto & Tokuyoshi 2023).
 fn ggx_sample_bounded(a: vec2<Real>, wi: vec3<Real>, u: vec2<Real>) -> LobeSample {
     let ws = stretch(a, wi);
     let omk = ggx_bounded_one_minus_k(a, wi);

@@ -1,17 +1,20 @@
 #define_import_path lobes::masking
 #import lobes::math::{Real, math_log, math_exp}
+//! embed: masking
+//! Smith masking-shadowing G2 from the two masking terms G1(ωi), G1(ωr) (CPU twin:
+//! `lobes::reference::masking`).
 
 // Smith masking-shadowing from the two directions' masking terms G1(wi), G1(wr) (each in [0, 1]);
 // CPU twin: src/reference/masking.rs. Written with G1 = 1 / (1 + Lambda) rather than Lambda,
 // so that grazing directions (Lambda -> inf, G1 -> 0) stay finite.
 
-// Separable G2 = G1(wi) G1(wr) (Heitz 2014, eq. 98).
+/// Separable G2 = G1(wi) G1(wr) (Heitz 2014, eq. 98).
 fn masking_separable(gi: f32, gr: f32) -> f32 {
     return gi * gr;
 }
 
-// Height-correlated G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99)
-// = G1i G1r / (G1i + G1r - G1i G1r).
+/// Height-correlated G2 = 1 / (1 + Lambda(wi) + Lambda(wr)) (Heitz 2014, eq. 99)
+/// = G1i G1r / (G1i + G1r - G1i G1r).
 fn masking_height_correlated(gi: f32, gr: f32) -> f32 {
     if (gi <= 0.0 || gr <= 0.0) {
         return 0.0;
@@ -23,6 +26,8 @@ fn masking_height_correlated(gi: f32, gr: f32) -> f32 {
 // (Heitz 2014; the derivation is in src/reference/masking.rs), 1 + Lambda = 1 / G1; over Real
 // (f32 and f64 kernels). 0 where a G1 is below 1e-30: B(x, y) <= B(1, y) = 1/y, so G2 <= min(gi,
 // go) is below 1e-30 there, and 1/G1 stays within masking_ln_beta's range.
+/// Height-correlated G2 across a rough dielectric's surface, B(1 + Λ(ωi), 1 + Λ(ωo)), from
+/// G1(ωi) and G1(ωo).
 fn masking_height_correlated_transmitted(gi: Real, go: Real) -> Real {
     if (!(min(gi, go) >= 1.0e-30)) {
         return 0.0;
@@ -45,6 +50,7 @@ fn masking_height_correlated_transmitted(gi: Real, go: Real) -> Real {
 //    -(b - 1/2) ln(1 + a/b) - a ln s + a + d(b) - d(s), of size ~a ln s, and ln Gamma(a) from
 //    Gamma(c) = Gamma(a) a (a + 1) ... (c - 1), c in [8, 9). Raising a by B's own recurrence
 //    instead would add ~(8 - a) ln b and take it away again.
+/// ln B(x, y), Euler's Beta function, for 1 ≤ x, y ≤ 1e30, without cancellation in f32.
 fn masking_ln_beta(x: Real, y: Real) -> Real {
     let a = min(x, y);
     var b = max(x, y);

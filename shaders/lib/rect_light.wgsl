@@ -1,5 +1,8 @@
 #define_import_path lobes::rect_light
 #import lobes::light::{LightSample, light_triangle_solid_angle}
+//! embed: rect_light
+//! A rectangle light (corner s, perpendicular edges ex, ey), uniform over its spherical rectangle
+//! (Ureña, Fajardo & King 2013).
 
 // A rectangle light (corner s, perpendicular edges ex and ey) sampled uniformly over the
 // spherical rectangle it subtends (Ureña, Fajardo & King 2013, "An Area-Preserving
@@ -48,6 +51,7 @@ fn rect_light_frame(s: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>) -> RectFrame {
 
 // The solid angle of the rectangle seen from the origin: its two triangles (s, s + ex, s + ex + ey)
 // and (s, s + ex + ey, s + ey).
+/// The solid angle of the rectangle (corner s, perpendicular edges ex, ey) seen from the origin.
 fn rect_light_solid_angle(s: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>) -> f32 {
     return light_triangle_solid_angle(s, ex, ex + ey) + light_triangle_solid_angle(s, ex + ey, ey);
 }
@@ -102,6 +106,7 @@ fn rect_light_refine(f: RectFrame, x_start: f32, phi: f32) -> f32 {
 
 // d uniform over the spherical rectangle, density 1/Ω. A rectangle of zero solid angle (seen
 // edge-on, or an edge of length 0) gives its corner's direction with density 0.
+/// A direction uniform over the spherical rectangle (Ureña, Fajardo & King 2013), density 1/Ω.
 fn rect_light_sample(s: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>, u: vec2<f32>) -> LightSample {
     let omega = rect_light_solid_angle(s, ex, ey);
     if (!(omega > 0.0)) {
@@ -122,6 +127,7 @@ fn rect_light_sample(s: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>, u: vec2<f32>) -
 
 // The density of rect_light_sample at the unit direction d: 1/Ω where the ray t d (t > 0) meets
 // the rectangle, else 0.
+/// The density of rect_light_sample at the unit direction d: 1/Ω through the rectangle, else 0.
 fn rect_light_pdf(s: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>, d: vec3<f32>) -> f32 {
     let n = cross(ex, ey);
     let t = dot(n, s) / dot(n, d);

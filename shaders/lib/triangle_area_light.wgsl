@@ -1,5 +1,7 @@
 #define_import_path lobes::triangle_area_light
 #import lobes::light::{LightSample, light_area_to_solid_angle}
+//! embed: triangle_area_light
+//! A triangle light, uniform by area.
 
 // A triangle light (vertices p0, p1, p2) sampled uniformly by area and converted to solid angle,
 // pdf_ω = t² / (A |n·d|) at the point t d; CPU twin: src/reference/light/triangle_area.rs.
@@ -8,6 +10,7 @@
 
 // The barycentric point (1 − s, s (1 − u.y), s u.y), s = sqrt(u.x): uniform by area (Turk 1990;
 // Pharr et al., PBR 3rd ed., §13.6.5), with its density per unit solid angle.
+/// A direction toward a point uniform by area on the triangle (Turk 1990).
 fn triangle_area_light_sample(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, u: vec2<f32>) -> LightSample {
     let e1 = p1 - p0;
     let e2 = p2 - p0;
@@ -24,6 +27,7 @@ fn triangle_area_light_sample(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, u: ve
 // The density of triangle_area_light_sample at the unit direction d: where the ray t d meets
 // the triangle (Möller & Trumbore 1997: t and the barycentrics by Cramer's rule), the area
 // density converted, else 0.
+/// The density of triangle_area_light_sample at the unit direction d.
 fn triangle_area_light_pdf(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, d: vec3<f32>) -> f32 {
     let e1 = p1 - p0;
     let e2 = p2 - p0;

@@ -1,5 +1,7 @@
 #define_import_path lobes::triangle_light
 #import lobes::light::{LightSample, light_triangle_solid_angle}
+//! embed: triangle_light
+//! A triangle light, uniform over its spherical triangle (Arvo 1995).
 
 // A triangle light (vertices p0, p1, p2) sampled uniformly over the spherical triangle it
 // subtends (Arvo 1995, "Stratified Sampling of Spherical Triangles"): density 1/Ω, Ω the solid
@@ -20,7 +22,7 @@
 //   s sin α − t cos α = −cos Â and t sin α + s cos α = sin Â), and sin(arc aĉ) from it;
 // - 1 − ĉ·b = |ĉ − b|²/2, with ĉ − b = (a − b) − (1 − q) a + sin(arc aĉ) e.
 
-// The solid angle of the triangle seen from the origin.
+/// The solid angle of the triangle seen from the origin.
 fn triangle_light_solid_angle(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> f32 {
     return light_triangle_solid_angle(p0, p1 - p0, p2 - p0);
 }
@@ -49,6 +51,7 @@ fn triangle_light_c_hat_minus_b(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, big_a:
 // d uniform over the spherical triangle: Arvo's map at (u.x, u.y), density 1/Ω. A triangle of
 // zero solid angle (collinear vertices, seen edge-on) gives its first vertex's direction with
 // density 0.
+/// A direction uniform over the spherical triangle (Arvo 1995), density 1/Ω.
 fn triangle_light_sample(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, u: vec2<f32>) -> LightSample {
     let omega = triangle_light_solid_angle(p0, p1, p2);
     let a = normalize(p0);
@@ -70,6 +73,7 @@ fn triangle_light_sample(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, u: vec2<f3
 // The density of triangle_light_sample at the unit direction d: 1/Ω where d passes through the
 // triangle (the three triple products d·(p_i × p_j), over the edges, have the sign of the
 // triangle's orientation; −d has the opposite signs), else 0.
+/// The density of triangle_light_sample at the unit direction d: 1/Ω through the triangle, else 0.
 fn triangle_light_pdf(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, d: vec3<f32>) -> f32 {
     let omega = triangle_light_solid_angle(p0, p1, p2);
     let e0 = p1 - p0;

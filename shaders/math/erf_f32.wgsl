@@ -1,5 +1,6 @@
 #define_import_path lobes::erf
 #import lobes::math::{Real, math_exp}
+//! embed: beckmann
 
 // The Gaussian integrals of the Beckmann lobe in f32, for the f32 and the f32-fast kernels
 // (through their math_exp): e^{-x^2}, erfc, the refinement of erf^-1, and how far

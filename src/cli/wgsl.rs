@@ -13,11 +13,13 @@ use std::path::PathBuf;
 
 #[derive(Debug, Clone, Args)]
 pub struct WgslArgs {
-    /// Modules to print, with the modules they use: rng, math, reflect, microfacet, ward, ggx,
-    /// beckmann, fresnel, masking, dielectric, discrete, and the lights: light, sphere_light,
-    /// disk_light, triangle_light, triangle_area_light, rect_light.
-    #[arg(required = true, value_name = "MODULE")]
+    /// Modules to print, with the modules they use (--list names them: ggx, fresnel, rng, …).
+    #[arg(required_unless_present = "list", value_name = "MODULE")]
     pub modules: Vec<String>,
+    /// List every module: its files, its API (each name with one line on it) and the modules it
+    /// needs.
+    #[arg(long, exclusive = true)]
+    pub list: bool,
     /// The files as naga_oil modules (`#define_import_path lobes::ggx`, `#import`s, short
     /// names), each after those it imports, for a renderer that composes with naga_oil (Bevy
     /// 0.19 and earlier); without it, plain WGSL with every name prefixed `lobes_`.
@@ -55,6 +57,9 @@ enum Form {
 }
 
 pub fn run(args: &WgslArgs) -> anyhow::Result<()> {
+    if args.list {
+        return emit(&Module::ALL.iter().map(|m| format!("## {}\n\n{}\n\n", m.name(), m.description())).collect::<String>());
+    }
     let modules = parse(&args.modules)?;
     let resolved = embed::resolve(&modules);
     let bindings = bindings(args, &resolved)?;
@@ -137,7 +142,8 @@ fn bindings(args: &WgslArgs, resolved: &[Module]) -> anyhow::Result<DiscreteBind
 
 /// The modules named, or a usage error that lists them and suggests the closest.
 fn parse(names: &[String]) -> anyhow::Result<Vec<Module>> {
-    let known: Vec<&str> = Module::ALL.iter().map(|m| m.name()).collect();
+    let mut known: Vec<&str> = Module::ALL.iter().map(|m| m.name()).collect();
+    known.sort();
     names
         .iter()
         .map(|n| {

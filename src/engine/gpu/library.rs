@@ -77,49 +77,23 @@ macro_rules! shader {
 }
 pub(crate) use shader;
 
+include!(concat!(env!("OUT_DIR"), "/library_files.rs"));
+
+/// The alternatives (below): files of [`LIBRARY`] that replace a default of the same import path
+/// only where a composition asks for them.
+fn is_alternative(f: &File) -> bool {
+    ALTERNATIVES.iter().any(|a| a.path == f.path)
+}
+
+const ALTERNATIVES: [File; 8] = [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING];
+
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
-/// passes of `lobes run` (`shaders/passes`). Where a module has alternatives (below), this is its
+/// passes of `lobes run` (`shaders/passes`). Where a module has alternatives (above), this is its
 /// default. `lobes check` hands its own passes and domains (`shaders/check`) to each composition
 /// (`check::shaders`).
-static FILES: [File; 37] = [
-    shader!("lib/rng.wgsl"),
-    shader!("lib/reflect.wgsl"),
-    shader!("lib/microfacet.wgsl"),
-    shader!("lib/microfacet_eval.wgsl"),
-    shader!("lib/ward.wgsl"),
-    shader!("lib/ward_eval.wgsl"),
-    shader!("lib/ggx.wgsl"),
-    shader!("lib/ggx_eval.wgsl"),
-    shader!("lib/beckmann.wgsl"),
-    shader!("lib/beckmann_eval.wgsl"),
-    shader!("lib/dielectric.wgsl"),
-    shader!("lib/dielectric_eval.wgsl"),
-    shader!("lib/fresnel.wgsl"),
-    shader!("lib/masking.wgsl"),
-    shader!("lib/discrete.wgsl"),
-    shader!("lib/light.wgsl"),
-    shader!("lib/sphere_light.wgsl"),
-    shader!("lib/disk_light.wgsl"),
-    shader!("lib/triangle_light.wgsl"),
-    shader!("lib/triangle_area_light.wgsl"),
-    shader!("lib/rect_light.wgsl"),
-    shader!("lib/bins.wgsl"),
-    shader!("lib/histogram.wgsl"),
-    shader!("math/f32.wgsl"),
-    shader!("math/erf_f32.wgsl"),
-    shader!("passes/params.wgsl"),
-    shader!("passes/bindings.wgsl"),
-    shader!("passes/kernel.wgsl"),
-    shader!("passes/counting_workgroup.wgsl"),
-    shader!("passes/lobe_kernel.wgsl"),
-    shader!("passes/lobe_draw.wgsl"),
-    shader!("passes/effect_uniform.wgsl"),
-    shader!("passes/effect.wgsl"),
-    shader!("passes/effect_fresnel.wgsl"),
-    shader!("passes/effect_masking.wgsl"),
-    shader!("passes/weighted.wgsl"),
-    shader!("passes/quadrature.wgsl"),
-];
+fn files<'a>() -> impl Iterator<Item = &'a File> {
+    LIBRARY.iter().filter(|f| !is_alternative(f))
+}
 
 /// `lobes::math` as cheap approximations (instead of `shaders/math/f32.wgsl`, the builtins).
 pub const MATH_F32_FAST: File = shader!("math/f32_fast.wgsl");
@@ -151,12 +125,12 @@ pub fn precision_files(precision: Precision) -> Vec<File> {
 /// The file that provides import path `module`: the first of `chosen` that names it, else the
 /// built-in one.
 fn lookup<'a>(module: &str, chosen: &'a [File]) -> Option<&'a File> {
-    chosen.iter().chain(FILES.iter()).find(|f| f.import_path() == Some(module))
+    chosen.iter().chain(files()).find(|f| f.import_path() == Some(module))
 }
 
 /// The built-in file that defines import path `module` (`"lobes::ggx"`), or `None`.
 pub fn source(module: &str) -> Option<&'static str> {
-    FILES.iter().find(|f| f.import_path() == Some(module)).map(|f| match f.source {
+    files().find(|f| f.import_path() == Some(module)).map(|f| match f.source {
         Cow::Borrowed(s) => s,
         Cow::Owned(_) => unreachable!("built-in files are static"),
     })
@@ -279,7 +253,7 @@ pub fn imports(module: &str) -> Vec<String> {
 /// lobes::ggx::ggx_d` names an item of `lobes::ggx`).
 fn imports_of(source: &str, chosen: &[File]) -> Vec<String> {
     let (_, imports, _) = naga_oil::compose::get_preprocessor_data(source);
-    let known: Vec<&str> = chosen.iter().chain(FILES.iter()).filter_map(File::import_path).collect();
+    let known: Vec<&str> = chosen.iter().chain(files()).filter_map(File::import_path).collect();
     let mut out: Vec<String> = Vec::new();
     for import in imports {
         let target = known.iter().filter(|p| import.import == **p || import.import.starts_with(&format!("{p}::"))).max_by_key(|p| p.len());
@@ -374,13 +348,13 @@ mod tests {
     #[test]
     fn every_file_names_its_import_path_once() {
         let mut seen = Vec::new();
-        for f in FILES.iter() {
+        for f in files() {
             let p = f.import_path().unwrap_or_else(|| panic!("{} has no #define_import_path", f.path));
             assert!(!seen.contains(&p), "{p} twice");
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING] {
+        for alt in ALTERNATIVES {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }
