@@ -480,7 +480,7 @@ fn effects() {
     scene_error(&ggx("alpha = 0.2\nfresnel = \"dielectric\"\neta = 1.5\nk = ⟦2\n"), &["k does not apply to fresnel = \"dielectric\""]);
     scene_error(&ggx("alpha = 0.2\nf0 = ⟦0.04\n"), &["f0 does not apply to fresnel = \"none\""]);
     scene_error(&ggx("alpha = 0.2\nmasking = ⟦\"smith\"\n"), &["masking 'smith' is unknown", "height-correlated"]);
-    scene_error("[[case]]\nname = \"w\"\nlobe = \"ward\"\nalpha = 0.2\nmasking = ⟦\"g1\"\n", &["Ward's BRDF has no Smith masking"]);
+    scene_error("[[case]]\nname = \"w\"\nlobe = \"ward\"\nalpha = 0.2\nmasking = ⟦\"g1\"\n", &["lobe = \"ward\" has no Smith masking"]);
     scene_error(&ggx("alpha = 0.2\nweighted = false\nfresnel = ⟦\"schlick\"\nf0 = 0.1\n"), &["set weighted = true or remove them"]);
     scene_error(&ggx("alpha = 0.2\nweighted = ⟦1\n"), &["weighted must be true or false"]);
     scene_error(&discrete("weights = [1, 2]\nmasking = ⟦\"g1\"\n"), &["masking does not apply to lobe = \"discrete\""]);

@@ -26,8 +26,9 @@
 use super::effects::{Effects, d, g1};
 use super::fresnel;
 use super::masking::Masking;
+use super::sampler::Shape;
 use super::reflect::{pdf_reflected, reflect};
-use super::{Lobe, LobeKind, LobeSample, Method};
+use super::{Lobe, LobeSample, Method};
 use glam::DVec3;
 
 /// The least u₀, u₁ the h draw takes, 2⁻²⁵ (half a step of the RNG's lattice k·2⁻²⁴): u = 0 draws
@@ -116,11 +117,11 @@ pub fn jacobian_transmitted(c: f64, ct: f64, eta: f64) -> f64 {
 }
 
 impl RoughDielectric {
-    /// Checks that the lobe has a dielectric sampler (GGX or Beckmann, NDF or visible normals)
+    /// Checks that the lobe has a dielectric sampler (a microfacet lobe, NDF or visible normals)
     /// and η is finite, positive and not 1 (at η = 1 refraction is the delta ωt = −ωi).
     pub fn new(lobe: Lobe, eta: f64) -> Result<Self, String> {
-        if !matches!(lobe.kind, LobeKind::Ggx | LobeKind::Beckmann) {
-            return Err(format!("a rough dielectric needs a microfacet lobe (ggx or beckmann), not {}", lobe.kind.name()));
+        if !matches!(lobe.kind.spec().shape, Shape::Microfacet { .. }) {
+            return Err(format!("a rough dielectric needs a microfacet lobe, not {}", lobe.kind.name()));
         }
         if !matches!(lobe.method, Method::Ndf | Method::Vndf) {
             return Err(format!("a rough dielectric samples by ndf or vndf, not {}", lobe.method.name()));
@@ -303,6 +304,7 @@ impl RoughDielectric {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reference::LobeKind;
     use crate::reference::reflect::spherical;
 
     fn lobe(kind: LobeKind, method: Method, ax: f64, ay: f64) -> Lobe {

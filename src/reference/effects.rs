@@ -12,12 +12,11 @@
 //! F = 1 and G = G1(ωi)), while the weights of the bins estimate the directional albedo
 //! ∫ over the hemisphere of f cos θr.
 
-use super::beckmann::Beckmann;
 use super::fresnel::Fresnel;
 use super::ggx::Ggx;
 use super::masking::Masking;
-use super::microfacet::Microfacet;
-use super::{Lobe, LobeKind, LobeSample, Method, ward};
+use super::sampler::{Alpha, Shape};
+use super::{Lobe, LobeSample, Method};
 use glam::DVec3;
 use serde::Serialize;
 
@@ -45,30 +44,24 @@ impl Effects {
     pub const NONE: Effects = Effects { fresnel: Fresnel::None, masking: Masking::None };
 }
 
-fn ggx(l: &Lobe) -> Ggx {
-    Ggx { ax: l.alpha_x, ay: l.alpha_y }
-}
-fn beckmann(l: &Lobe) -> Beckmann {
-    Beckmann { ax: l.alpha_x, ay: l.alpha_y }
+/// D, G1 and Λ of a microfacet lobe at its roughness; `None` for a lobe of its own shape.
+fn microfacet(l: &Lobe) -> Option<(fn(Alpha, DVec3) -> f64, fn(Alpha, DVec3) -> f64, fn(Alpha, DVec3) -> f64)> {
+    match l.kind.spec().shape {
+        Shape::Microfacet { d, g1, lambda } => Some((d, g1, lambda)),
+        Shape::Own { .. } => None,
+    }
 }
 
 /// D(h) of a microfacet lobe.
 pub(crate) fn d(l: &Lobe, h: DVec3) -> f64 {
-    match l.kind {
-        LobeKind::Ggx => ggx(l).d(h),
-        LobeKind::Beckmann => beckmann(l).d(h),
-        LobeKind::Ward => unreachable!("Ward is not a microfacet lobe"),
-    }
+    let (d, _, _) = microfacet(l).unwrap_or_else(|| panic!("{} is not a microfacet lobe", l.kind.name()));
+    d((l.alpha_x, l.alpha_y), h)
 }
 
 /// Smith's G1(ω) of a microfacet lobe in its grazing-stable form (|cos θ| for ω below the
-/// horizon); 1 for Ward, which has no masking.
+/// horizon); 1 for a lobe without masking (Ward).
 pub(crate) fn g1(l: &Lobe, w: DVec3) -> f64 {
-    match l.kind {
-        LobeKind::Ggx => ggx(l).g1(w),
-        LobeKind::Beckmann => w.z.abs() * beckmann(l).g1_over_cos(w),
-        LobeKind::Ward => 1.0,
-    }
+    microfacet(l).map_or(1.0, |(_, g1, _)| g1((l.alpha_x, l.alpha_y), w))
 }
 
 impl Effects {
@@ -80,9 +73,9 @@ impl Effects {
         let (wi, wr) = (l.to_local(wi), l.to_local(wr));
         let h = (wi + wr).normalize();
         let f = self.fresnel.reflectance(wi.dot(h));
-        match l.kind {
-            LobeKind::Ward => f * ward::eval(l.alpha_x, l.alpha_y, wi, wr),
-            _ => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
+        match l.kind.spec().shape {
+            Shape::Own { .. } => f * (l.kind.spec().eval)((l.alpha_x, l.alpha_y), wi, wr),
+            Shape::Microfacet { .. } => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
         }
     }
 
@@ -95,15 +88,15 @@ impl Effects {
     pub fn weight(&self, l: &Lobe, wi: DVec3, s: &LobeSample) -> f64 {
         let (wi, h, wr) = (l.to_local(wi), l.to_local(s.h), l.to_local(s.omega_r));
         let f = self.fresnel.reflectance(wi.dot(h));
-        if l.kind == LobeKind::Ward {
-            return f * wi.dot(h).max(0.0) * h.z.powi(3) * (wr.z.abs() / wi.z).sqrt();
+        if let Shape::Own { weight } = l.kind.spec().shape {
+            return weight(f, wi, h, wr);
         }
         let g = self.masking.g(g1(l, wi), g1(l, wr));
         let base = match l.method {
             Method::Ndf => wi.dot(h).max(0.0) / (wi.z * h.z),
             Method::Vndf => 1.0 / g1(l, wi),
             Method::Bounded => {
-                let m = ggx(l);
+                let m = Ggx { ax: l.alpha_x, ay: l.alpha_y };
                 let t = DVec3::new(l.alpha_x * wi.x, l.alpha_y * wi.y, wi.z).length();
                 (m.bounded_k(wi) * wi.z + t) / (2.0 * wi.z)
             }
@@ -118,14 +111,12 @@ impl Effects {
     /// shrunk cap never draws some of the normals that reflect below the horizon (its sphere
     /// total falls short of the furnace by design; its hemisphere albedo does not).
     pub fn furnace(&self, l: &Lobe, wi: DVec3) -> Option<f64> {
-        if self.fresnel != Fresnel::None || l.kind == LobeKind::Ward || l.method == Method::Bounded {
+        let Some((_, _, lambda)) = microfacet(l) else { return None };
+        if self.fresnel != Fresnel::None || l.method == Method::Bounded {
             return None;
         }
         let wi = l.to_local(wi);
-        let lambda = || match l.kind {
-            LobeKind::Ggx => ggx(l).lambda(wi),
-            _ => beckmann(l).lambda(wi),
-        };
+        let lambda = || lambda((l.alpha_x, l.alpha_y), wi);
         match self.masking {
             Masking::G1 => Some(1.0),
             Masking::None => Some(1.0 + lambda()),
@@ -137,6 +128,7 @@ impl Effects {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reference::LobeKind;
     use crate::reference::reflect::spherical;
 
     #[test]

@@ -1,10 +1,8 @@
 //! A reflectance lobe with its roughness and method, sampled and evaluated in f64 through the
 //! registry's references ([`super::sampler`]).
 
-use super::beckmann::Beckmann;
-use super::ggx::Ggx;
 use super::sampler::{self, LobeKind, Method};
-use super::{Invalid, frame, microfacet, reflect, ward};
+use super::{Invalid, frame, reflect};
 use glam::DVec3;
 
 /// A reflectance lobe with its roughness and sampling method.
@@ -83,12 +81,6 @@ impl Lobe {
     fn alpha(&self) -> sampler::Alpha {
         (self.alpha_x, self.alpha_y)
     }
-    fn ggx(&self) -> Ggx {
-        Ggx { ax: self.alpha_x, ay: self.alpha_y }
-    }
-    fn beckmann(&self) -> Beckmann {
-        Beckmann { ax: self.alpha_x, ay: self.alpha_y }
-    }
 
     /// The f64 reference of this lobe's sampler (the registry's entry).
     fn reference(&self) -> sampler::Reference {
@@ -129,11 +121,6 @@ impl Lobe {
     /// The BRDF value f(ωi, ωr) without Fresnel: Ward's (ρs = 1), or the microfacet BRDF with
     /// height-correlated Smith G2.
     pub fn eval(&self, wi: DVec3, wr: DVec3) -> f64 {
-        let (wi, wr) = (self.to_local(wi), self.to_local(wr));
-        match self.kind {
-            LobeKind::Ward => ward::eval(self.alpha_x, self.alpha_y, wi, wr),
-            LobeKind::Beckmann => microfacet::eval(&self.beckmann(), wi, wr),
-            LobeKind::Ggx => microfacet::eval(&self.ggx(), wi, wr),
-        }
+        (self.kind.spec().eval)(self.alpha(), self.to_local(wi), self.to_local(wr))
     }
 }

@@ -7,7 +7,7 @@
 //! as WGSL) and whether its WGSL also composes in f64 (`lobes tradeoff`).
 //! Adding a sampler is one entry here plus its files.
 
-use super::microfacet::{Microfacet, pdf_ndf, pdf_vndf};
+use super::microfacet::{self, Microfacet, pdf_ndf, pdf_vndf};
 use super::ward;
 use super::beckmann::Beckmann;
 use super::ggx::Ggx;
@@ -36,24 +36,28 @@ pub enum Method {
 }
 
 impl LobeKind {
-    /// Every lobe, in the registry's order: what a scene's `lobe` and `--lobe` accept.
-    pub const ALL: [LobeKind; 3] = [LobeKind::Ward, LobeKind::Beckmann, LobeKind::Ggx];
+    /// Every lobe, in [`LOBES`]' order: what a scene's `lobe` and `--lobe` accept.
+    pub const ALL: [LobeKind; LOBES.len()] = {
+        let mut out = [LobeKind::Ward; LOBES.len()];
+        let mut i = 0;
+        while i < LOBES.len() {
+            out[i] = LOBES[i].kind;
+            i += 1;
+        }
+        out
+    };
 
+    /// Its entry in [`LOBES`].
+    pub fn spec(self) -> &'static LobeSpec {
+        LOBES.iter().find(|l| l.kind == self).expect("every lobe has an entry in LOBES")
+    }
     /// Its name in scenes, on the command line and in outputs.
     pub fn name(self) -> &'static str {
-        match self {
-            LobeKind::Ward => "ward",
-            LobeKind::Beckmann => "beckmann",
-            LobeKind::Ggx => "ggx",
-        }
+        self.spec().name
     }
     /// One line on the lobe (the command line's help).
     pub fn about(self) -> &'static str {
-        match self {
-            LobeKind::Ward => "Ward's lobe with Walter's pdf",
-            LobeKind::Beckmann => "Beckmann microfacets",
-            LobeKind::Ggx => "GGX (Trowbridge–Reitz) microfacets",
-        }
+        self.spec().about
     }
     /// The lobe called `name` ([`LobeKind::name`]).
     ///
@@ -170,6 +174,62 @@ pub struct Reference {
     /// p(h) / (4 |ωr·h|) (bounded VNDF).
     pub pdf_r: Option<fn(Alpha, DVec3, DVec3) -> f64>,
 }
+
+/// One lobe: its names and the f64 terms of its BRDF, which [`Effects`](super::effects::Effects)
+/// builds the BRDF, the estimator weight and the furnace test from.
+#[derive(Debug, Clone, Copy)]
+pub struct LobeSpec {
+    pub kind: LobeKind,
+    /// Its name in scenes, on the command line and in outputs.
+    pub name: &'static str,
+    /// One line on the lobe (the command line's help).
+    pub about: &'static str,
+    /// f(ωi, ωr) without Fresnel in the local frame, 0 unless both are above the horizon
+    /// (microfacets: with height-correlated Smith G2).
+    pub eval: fn(Alpha, DVec3, DVec3) -> f64,
+    pub shape: Shape,
+}
+
+/// What a lobe's BRDF is made of.
+#[derive(Debug, Clone, Copy)]
+pub enum Shape {
+    /// Microfacets, f = F D G / (4 cos θi cos θr) (Walter et al. 2007, eq. 20): D(h), Smith's
+    /// G1(ω) in its grazing-stable form (|cos θ| for ω below the horizon) and Λ(ω), G1 = 1 / (1 + Λ).
+    Microfacet { d: fn(Alpha, DVec3) -> f64, g1: fn(Alpha, DVec3) -> f64, lambda: fn(Alpha, DVec3) -> f64 },
+    /// A BRDF of its own, with no masking: the estimator weight F f cos θr / p(ωr) of its sampler,
+    /// given F, ωi, h and ωr in the local frame.
+    Own { weight: fn(f64, DVec3, DVec3, DVec3) -> f64 },
+}
+
+/// Every lobe.
+pub const LOBES: [LobeSpec; 3] = [
+    LobeSpec {
+        kind: LobeKind::Ward,
+        name: "ward",
+        about: "Ward's lobe with Walter's pdf",
+        eval: |(ax, ay), wi, wr| ward::eval(ax, ay, wi, wr),
+        // F (ωi·h)⁺ cos³θh √(|cos θr| / cos θi) (Walter 2005, eq. 10)
+        shape: Shape::Own { weight: |f, wi, h, wr| f * wi.dot(h).max(0.0) * h.z.powi(3) * (wr.z.abs() / wi.z).sqrt() },
+    },
+    LobeSpec {
+        kind: LobeKind::Beckmann,
+        name: "beckmann",
+        about: "Beckmann microfacets",
+        eval: |(ax, ay), wi, wr| microfacet::eval(&Beckmann { ax, ay }, wi, wr),
+        shape: Shape::Microfacet {
+            d: |(ax, ay), h| Beckmann { ax, ay }.d(h),
+            g1: |(ax, ay), w| w.z.abs() * Beckmann { ax, ay }.g1_over_cos(w),
+            lambda: |(ax, ay), w| Beckmann { ax, ay }.lambda(w),
+        },
+    },
+    LobeSpec {
+        kind: LobeKind::Ggx,
+        name: "ggx",
+        about: "GGX (Trowbridge–Reitz) microfacets",
+        eval: |(ax, ay), wi, wr| microfacet::eval(&Ggx { ax, ay }, wi, wr),
+        shape: Shape::Microfacet { d: |(ax, ay), h| Ggx { ax, ay }.d(h), g1: |(ax, ay), w| Ggx { ax, ay }.g1(w), lambda: |(ax, ay), w| Ggx { ax, ay }.lambda(w) },
+    },
+];
 
 const MICROFACET_NDF_WEIGHT: &str = "microfacet_ndf_weight(wi, s.h)";
 const GGX_EVAL: &str = "ggx_d(a, h) / (4.0 * wi.z * wr.z)";

@@ -56,6 +56,7 @@ use crate::reference::discrete::{Distribution, WeightsError};
 use crate::reference::effects::Effects;
 use crate::reference::fresnel::Fresnel;
 use crate::reference::masking::Masking;
+use crate::reference::sampler::{self, Shape};
 use crate::reference::{Lobe, LobeKind, Method, reflect};
 use crate::stats::histogram::SphereGrid;
 use crate::stats::expected::MIN_ALPHA;
@@ -560,12 +561,16 @@ fn scatter(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, method: Method, lo
         }
         return Ok(Scatter::Reflect);
     };
-    if crate::reference::sampler::find(kind, method).wgsl.dielectric.is_none() {
-        let (span, what) = match kind {
-            LobeKind::Ward => (lobe_v.span(), "ward has no dielectric sampler".to_string()),
-            _ => (method_span.clone(), format!("{} {} has no dielectric sampler", kind.name(), method.name())),
+    if sampler::find(kind, method).wgsl.dielectric.is_none() {
+        // the lobes and methods that have one, from the registry
+        let has = |k: LobeKind| sampler::of_kind(k).filter(|s| s.wgsl.dielectric.is_some()).map(|s| s.method).collect::<Vec<_>>();
+        let (span, what) = match has(kind).is_empty() {
+            true => (lobe_v.span(), format!("{} has no dielectric sampler", kind.name())),
+            false => (method_span.clone(), format!("{} {} has no dielectric sampler", kind.name(), method.name())),
         };
-        return Err(ctx.err(span, format!("{what}; scatter = \"dielectric\" needs lobe ggx or beckmann with method ndf or vndf")));
+        let lobes: Vec<&str> = LobeKind::ALL.into_iter().filter(|&k| !has(k).is_empty()).map(LobeKind::name).collect();
+        let methods: Vec<&str> = Method::ALL.into_iter().filter(|m| LobeKind::ALL.into_iter().any(|k| has(k).contains(m))).map(Method::name).collect();
+        return Err(ctx.err(span, format!("{what}; scatter = \"dielectric\" needs lobe {} with method {}", lobes.join(" or "), methods.join(" or "))));
     }
     reject_keys(
         ctx,
@@ -628,8 +633,9 @@ fn effects(ctx: &Ctx, c: &RawCase, p: &Point, kind: LobeKind, scatter: Scatter) 
                     return Err(ctx.err(v.span(), format!("masking '{other}' is unknown; {masking_allowed}{hint}")));
                 }
             };
-            if kind == LobeKind::Ward && m != Masking::None {
-                return Err(ctx.err(v.span(), "Ward's BRDF has no Smith masking; use masking = \"none\" (or leave it out) for lobe = \"ward\""));
+            if matches!(kind.spec().shape, Shape::Own { .. }) && m != Masking::None {
+                let e = format!("lobe = \"{}\" has no Smith masking (its BRDF is not a microfacet one); use masking = \"none\" (or leave it out)", kind.name());
+                return Err(ctx.err(v.span(), e));
             }
             m
         }

@@ -135,7 +135,7 @@ pub fn compose_effects(job: &Job, effects: &Effects, counting: Counting, how: Sp
         Specialisation::Specialised => {
             let spec = sampler::find(lobe.kind, lobe.method);
             let fresnel = effects.fresnel != Fresnel::None;
-            let masking = effects.masking != Masking::None && lobe.kind != LobeKind::Ward;
+            let masking = effects.masking != Masking::None && spec.wgsl.g1.is_some();
             let mut kernel = compose::lobe_kernel(job, counting, job.bins() as u32, Precision::F32Accurate, &[spec]);
             let mut constants = vec![("ANISOTROPIC", f64::from(u8::from(lobe.alpha_x != lobe.alpha_y)))];
             kernel.job.push("override ANISOTROPIC: bool = true;\n");
@@ -177,7 +177,7 @@ fn compose_uber(job: &Job, counting: Counting) -> String {
 
 /// The `effect` uniform of a case (`Effect` in `shaders/passes/weighted.wgsl`).
 pub fn effect_uniform(kind: LobeKind, method: Method, anisotropic: bool, effects: &Effects) -> ([u32; 4], [f32; 4]) {
-    let masking = if kind == LobeKind::Ward { 0 } else { effects.masking.mode() };
+    let masking = if sampler::find(kind, method).wgsl.g1.is_none() { 0 } else { effects.masking.mode() };
     ([sampler_id(kind, method), effects.fresnel.mode(), masking, u32::from(anisotropic)], effects.fresnel.params())
 }
 
