@@ -200,7 +200,7 @@ impl Gpu {
     }
 
     /// Bounds the device's work by `timeout` from now, until the guard drops: a wait still
-    /// unfinished then fails with [`GpuError::TimedOut`] and abandons the device ([`Bounds`]).
+    /// unfinished then fails with [`GpuError::TimedOut`] and abandons the device ([`Bounds`](super::context::Bounds)).
     pub fn deadline(&self, timeout: Duration) -> Bound<'_> {
         *self.bounds.deadline.lock().unwrap() = Some((Instant::now() + timeout, timeout));
         Bound { gpu: self, deadline: true }
