@@ -120,7 +120,7 @@ impl RoughDielectric {
     /// Checks that the lobe has a dielectric sampler (a microfacet lobe, NDF or visible normals)
     /// and η is finite, positive and not 1 (at η = 1 refraction is the delta ωt = −ωi).
     pub fn new(lobe: Lobe, eta: f64) -> Result<Self, String> {
-        if !matches!(lobe.kind.spec().shape, Shape::Microfacet { .. }) {
+        if !matches!(lobe.kind.spec().shape, Shape::Microfacet(_)) {
             return Err(format!("a rough dielectric needs a microfacet lobe, not {}", lobe.kind.name()));
         }
         if !matches!(lobe.method, Method::Ndf | Method::Vndf) {

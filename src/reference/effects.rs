@@ -15,7 +15,7 @@
 use super::fresnel::Fresnel;
 use super::ggx::Ggx;
 use super::masking::Masking;
-use super::sampler::{Alpha, Shape};
+use super::sampler::{MicrofacetTerms, Shape};
 use super::{Lobe, LobeSample, Method};
 use glam::DVec3;
 use serde::Serialize;
@@ -44,24 +44,24 @@ impl Effects {
     pub const NONE: Effects = Effects { fresnel: Fresnel::None, masking: Masking::None };
 }
 
-/// D, G1 and Λ of a microfacet lobe at its roughness; `None` for a lobe of its own shape.
-fn microfacet(l: &Lobe) -> Option<(fn(Alpha, DVec3) -> f64, fn(Alpha, DVec3) -> f64, fn(Alpha, DVec3) -> f64)> {
+/// The D, G1 and Λ of a microfacet lobe; `None` for a lobe of its own shape.
+fn microfacet(l: &Lobe) -> Option<MicrofacetTerms> {
     match l.kind.spec().shape {
-        Shape::Microfacet { d, g1, lambda } => Some((d, g1, lambda)),
+        Shape::Microfacet(terms) => Some(terms),
         Shape::Own { .. } => None,
     }
 }
 
 /// D(h) of a microfacet lobe.
 pub(crate) fn d(l: &Lobe, h: DVec3) -> f64 {
-    let (d, _, _) = microfacet(l).unwrap_or_else(|| panic!("{} is not a microfacet lobe", l.kind.name()));
-    d((l.alpha_x, l.alpha_y), h)
+    let terms = microfacet(l).unwrap_or_else(|| panic!("{} is not a microfacet lobe", l.kind.name()));
+    (terms.d)((l.alpha_x, l.alpha_y), h)
 }
 
 /// Smith's G1(ω) of a microfacet lobe in its grazing-stable form (|cos θ| for ω below the
 /// horizon); 1 for a lobe without masking (Ward).
 pub(crate) fn g1(l: &Lobe, w: DVec3) -> f64 {
-    microfacet(l).map_or(1.0, |(_, g1, _)| g1((l.alpha_x, l.alpha_y), w))
+    microfacet(l).map_or(1.0, |terms| (terms.g1)((l.alpha_x, l.alpha_y), w))
 }
 
 impl Effects {
@@ -75,7 +75,7 @@ impl Effects {
         let f = self.fresnel.reflectance(wi.dot(h));
         match l.kind.spec().shape {
             Shape::Own { .. } => f * (l.kind.spec().eval)((l.alpha_x, l.alpha_y), wi, wr),
-            Shape::Microfacet { .. } => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
+            Shape::Microfacet(_) => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
         }
     }
 
@@ -111,12 +111,12 @@ impl Effects {
     /// shrunk cap never draws some of the normals that reflect below the horizon (its sphere
     /// total falls short of the furnace by design; its hemisphere albedo does not).
     pub fn furnace(&self, l: &Lobe, wi: DVec3) -> Option<f64> {
-        let Some((_, _, lambda)) = microfacet(l) else { return None };
+        let terms = microfacet(l)?;
         if self.fresnel != Fresnel::None || l.method == Method::Bounded {
             return None;
         }
         let wi = l.to_local(wi);
-        let lambda = || lambda((l.alpha_x, l.alpha_y), wi);
+        let lambda = || (terms.lambda)((l.alpha_x, l.alpha_y), wi);
         match self.masking {
             Masking::G1 => Some(1.0),
             Masking::None => Some(1.0 + lambda()),

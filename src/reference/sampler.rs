@@ -193,12 +193,20 @@ pub struct LobeSpec {
 /// What a lobe's BRDF is made of.
 #[derive(Debug, Clone, Copy)]
 pub enum Shape {
-    /// Microfacets, f = F D G / (4 cos θi cos θr) (Walter et al. 2007, eq. 20): D(h), Smith's
-    /// G1(ω) in its grazing-stable form (|cos θ| for ω below the horizon) and Λ(ω), G1 = 1 / (1 + Λ).
-    Microfacet { d: fn(Alpha, DVec3) -> f64, g1: fn(Alpha, DVec3) -> f64, lambda: fn(Alpha, DVec3) -> f64 },
+    /// Microfacets, f = F D G / (4 cos θi cos θr) (Walter et al. 2007, eq. 20).
+    Microfacet(MicrofacetTerms),
     /// A BRDF of its own, with no masking: the estimator weight F f cos θr / p(ωr) of its sampler,
     /// given F, ωi, h and ωr in the local frame.
     Own { weight: fn(f64, DVec3, DVec3, DVec3) -> f64 },
+}
+
+/// The terms of a microfacet lobe at roughness α: D(h), Smith's G1(ω) in its grazing-stable
+/// form (|cos θ| for ω below the horizon) and Λ(ω), G1 = 1 / (1 + Λ).
+#[derive(Debug, Clone, Copy)]
+pub struct MicrofacetTerms {
+    pub d: fn(Alpha, DVec3) -> f64,
+    pub g1: fn(Alpha, DVec3) -> f64,
+    pub lambda: fn(Alpha, DVec3) -> f64,
 }
 
 /// Every lobe.
@@ -216,18 +224,18 @@ pub const LOBES: [LobeSpec; 3] = [
         name: "beckmann",
         about: "Beckmann microfacets",
         eval: |(ax, ay), wi, wr| microfacet::eval(&Beckmann { ax, ay }, wi, wr),
-        shape: Shape::Microfacet {
+        shape: Shape::Microfacet(MicrofacetTerms {
             d: |(ax, ay), h| Beckmann { ax, ay }.d(h),
             g1: |(ax, ay), w| w.z.abs() * Beckmann { ax, ay }.g1_over_cos(w),
             lambda: |(ax, ay), w| Beckmann { ax, ay }.lambda(w),
-        },
+        }),
     },
     LobeSpec {
         kind: LobeKind::Ggx,
         name: "ggx",
         about: "GGX (Trowbridge–Reitz) microfacets",
         eval: |(ax, ay), wi, wr| microfacet::eval(&Ggx { ax, ay }, wi, wr),
-        shape: Shape::Microfacet { d: |(ax, ay), h| Ggx { ax, ay }.d(h), g1: |(ax, ay), w| Ggx { ax, ay }.g1(w), lambda: |(ax, ay), w| Ggx { ax, ay }.lambda(w) },
+        shape: Shape::Microfacet(MicrofacetTerms { d: |(ax, ay), h| Ggx { ax, ay }.d(h), g1: |(ax, ay), w| Ggx { ax, ay }.g1(w), lambda: |(ax, ay), w| Ggx { ax, ay }.lambda(w) }),
     },
 ];
 
