@@ -12,9 +12,11 @@ use serde::{Deserialize, Serialize};
 /// What a case samples: `lobe`, `method`, `params`, and the histogram's `rows` × `cols`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct CaseDescription {
-    /// `ward`, `beckmann`, `ggx`, `discrete`, or `user` for a user's WGSL sampler.
+    /// A lobe's name as a scene names it (`ggx`, `ward`, …), `discrete`, or `user` for a user's
+    /// WGSL sampler.
     pub lobe: String,
-    /// `ndf`, `vndf`, `bounded`, for a discrete case `cdf` or `alias`, for a user's sampler `wgsl`.
+    /// A method's name as a scene names it (`vndf`, `ndf`, …), for a discrete case `cdf` or
+    /// `alias`, for a user's sampler `wgsl`.
     pub method: String,
     pub params: Params,
     /// Rows over cos θ (1 for a discrete case, over y on the plane).
