@@ -80,14 +80,13 @@ fn after_needs<T>(mut items: Vec<T>, needs: impl Fn(&T, &T) -> bool, what: impl 
 
 /// The embedded modules, each after the modules it imports (by depth, then name), each module's
 /// files after the files they import (ties by path).
-fn embedded_modules(files: &[File]) -> Vec<Module> {
+fn embedded_modules(files: Vec<File>) -> Vec<Module> {
     let mut modules: Vec<Module> = Vec::new();
     for f in files {
-        let Some(name) = embed_tag(&f.source) else { continue };
-        let file = File { path: f.path.clone(), source: f.source.clone() };
+        let Some(name) = embed_tag(&f.source).map(str::to_string) else { continue };
         match modules.iter_mut().find(|m| m.name == name) {
-            Some(m) => m.files.push(file),
-            None => modules.push(Module { name: name.to_string(), files: vec![file] }),
+            Some(m) => m.files.push(f),
+            None => modules.push(Module { name, files: vec![f] }),
         }
     }
     let imports = |f: &File, g: &File| text::imports(&f.source).iter().any(|(p, _)| Some(*p) == text::import_path(&g.source));
@@ -121,9 +120,10 @@ fn main() {
     println!("cargo:rerun-if-changed=src/embed/namespace.rs");
     let library = library_files();
     write_library_list(&library);
-    let modules = embedded_modules(&library);
+    let modules = embedded_modules(library);
     let files: Vec<&[File]> = modules.iter().map(|m| m.files.as_slice()).collect();
-    let api: Vec<Vec<String>> = modules.iter().map(|m| files_api(m).into_iter().filter_map(|d| d.name).collect()).collect();
+    let api_declarations: Vec<Vec<Declaration>> = modules.iter().map(files_api).collect();
+    let api: Vec<Vec<String>> = api_declarations.iter().map(|ds| ds.iter().filter_map(|d| d.name.clone()).collect()).collect();
     let owner = |import_path: &str| -> usize {
         files
             .iter()
@@ -331,7 +331,8 @@ fn main() {
         refs.push(format!("&MODULE_{m}"));
     }
     writeln!(package, "static MODULES: [&CodegenModule; {n}] = [{}];", refs.join(", ")).unwrap();
-    let docs: Vec<String> = modules.iter().enumerate().map(|(m, module)| variant_doc(module, &files_api(module), &deps[m].iter().map(|&d| modules[d].name.as_str()).collect::<Vec<_>>())).collect();
+    let needs = |m: usize| deps[m].iter().map(|&d| modules[d].name.as_str()).collect::<Vec<_>>();
+    let docs: Vec<String> = modules.iter().enumerate().map(|(m, module)| variant_doc(module, &api_declarations[m], &needs(m))).collect();
     out += &array("DESCRIPTIONS", "&str", docs.iter().map(|d| format!("{d:?}")).collect());
     let mut variants = format!("modules! {{ {n};\n");
     for (module, doc) in modules.iter().zip(&docs) {

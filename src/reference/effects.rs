@@ -55,13 +55,13 @@ fn microfacet(l: &Lobe) -> Option<MicrofacetTerms> {
 /// D(h) of a microfacet lobe.
 pub(crate) fn d(l: &Lobe, h: DVec3) -> f64 {
     let terms = microfacet(l).unwrap_or_else(|| panic!("{} is not a microfacet lobe", l.kind.name()));
-    (terms.d)((l.alpha_x, l.alpha_y), h)
+    (terms.d)(l.alpha(), h)
 }
 
 /// Smith's G1(ω) of a microfacet lobe in its grazing-stable form (|cos θ| for ω below the
 /// horizon); 1 for a lobe without masking (Ward).
 pub(crate) fn g1(l: &Lobe, w: DVec3) -> f64 {
-    microfacet(l).map_or(1.0, |terms| (terms.g1)((l.alpha_x, l.alpha_y), w))
+    microfacet(l).map_or(1.0, |terms| (terms.g1)(l.alpha(), w))
 }
 
 impl Effects {
@@ -73,9 +73,10 @@ impl Effects {
         let (wi, wr) = (l.to_local(wi), l.to_local(wr));
         let h = (wi + wr).normalize();
         let f = self.fresnel.reflectance(wi.dot(h));
-        match l.kind.spec().shape {
-            Shape::Own { .. } => f * (l.kind.spec().eval)((l.alpha_x, l.alpha_y), wi, wr),
-            Shape::Microfacet(_) => f * d(l, h) * self.masking.g(g1(l, wi), g1(l, wr)) / (4.0 * wi.z * wr.z),
+        let (spec, a) = (l.kind.spec(), l.alpha());
+        match spec.shape {
+            Shape::Own { .. } => f * (spec.eval)(a, wi, wr),
+            Shape::Microfacet(t) => f * (t.d)(a, h) * self.masking.g((t.g1)(a, wi), (t.g1)(a, wr)) / (4.0 * wi.z * wr.z),
         }
     }
 
@@ -88,13 +89,16 @@ impl Effects {
     pub fn weight(&self, l: &Lobe, wi: DVec3, s: &LobeSample) -> f64 {
         let (wi, h, wr) = (l.to_local(wi), l.to_local(s.h), l.to_local(s.omega_r));
         let f = self.fresnel.reflectance(wi.dot(h));
-        if let Shape::Own { weight } = l.kind.spec().shape {
-            return weight(f, wi, h, wr);
-        }
-        let g = self.masking.g(g1(l, wi), g1(l, wr));
+        let t = match l.kind.spec().shape {
+            Shape::Own { weight } => return weight(f, wi, h, wr),
+            Shape::Microfacet(t) => t,
+        };
+        let a = l.alpha();
+        let g1_i = (t.g1)(a, wi);
+        let g = self.masking.g(g1_i, (t.g1)(a, wr));
         let base = match l.method {
             Method::Ndf => wi.dot(h).max(0.0) / (wi.z * h.z),
-            Method::Vndf => 1.0 / g1(l, wi),
+            Method::Vndf => 1.0 / g1_i,
             Method::Bounded => {
                 let m = Ggx { ax: l.alpha_x, ay: l.alpha_y };
                 let t = DVec3::new(l.alpha_x * wi.x, l.alpha_y * wi.y, wi.z).length();
@@ -116,7 +120,7 @@ impl Effects {
             return None;
         }
         let wi = l.to_local(wi);
-        let lambda = || (terms.lambda)((l.alpha_x, l.alpha_y), wi);
+        let lambda = || (terms.lambda)(l.alpha(), wi);
         match self.masking {
             Masking::G1 => Some(1.0),
             Masking::None => Some(1.0 + lambda()),

@@ -78,7 +78,8 @@ impl Lobe {
         frame::Frame::new(self.alpha_angle.to_radians())
     }
 
-    fn alpha(&self) -> sampler::Alpha {
+    /// Its roughness (αx, αy), as the registry's functions take it.
+    pub(crate) fn alpha(&self) -> sampler::Alpha {
         (self.alpha_x, self.alpha_y)
     }
 

@@ -41,6 +41,8 @@ impl LobeKind {
         let mut out = [LobeKind::Ward; LOBES.len()];
         let mut i = 0;
         while i < LOBES.len() {
+            // LOBES is in the enum's order, so that `spec` is an index
+            assert!(LOBES[i].kind as usize == i, "LOBES lists the lobes in LobeKind's order");
             out[i] = LOBES[i].kind;
             i += 1;
         }
@@ -49,7 +51,7 @@ impl LobeKind {
 
     /// Its entry in [`LOBES`].
     pub fn spec(self) -> &'static LobeSpec {
-        LOBES.iter().find(|l| l.kind == self).expect("every lobe has an entry in LOBES")
+        &LOBES[self as usize]
     }
     /// Its name in scenes, on the command line and in outputs.
     pub fn name(self) -> &'static str {

@@ -85,7 +85,7 @@ fn is_alternative(f: &File) -> bool {
     ALTERNATIVES.iter().any(|a| a.path == f.path)
 }
 
-const ALTERNATIVES: [File; 8] = [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING];
+static ALTERNATIVES: [File; 8] = [MATH_F32_FAST, MATH_F64, ERF_F64, COUNTING_GLOBAL, COUNTING_SLABS, DISCRETE_DRAW, NO_FRESNEL, NO_MASKING];
 
 /// The built-in files, one per import path: the library (`shaders/lib`, `shaders/math`) and the
 /// passes of `lobes run` (`shaders/passes`). Where a module has alternatives (above), this is its
@@ -354,7 +354,7 @@ mod tests {
             seen.push(p);
         }
         // each alternative takes the place of a built-in file
-        for alt in ALTERNATIVES {
+        for alt in &ALTERNATIVES {
             assert!(seen.contains(&alt.import_path().unwrap()), "{}", alt.path);
         }
     }
