@@ -19,7 +19,7 @@ use lobes::check::report::NormalizationFigures;
 use lobes::check::{Settings, UserSampler, check};
 use lobes::embed::Module;
 use lobes::engine::gpu::Gpu;
-use lobes::experiments::light_stress::light_draws;
+use lobes::check::light::{LightDraw, draws};
 use lobes::reference::light::registry::{LIGHTS, LightParams, LightSpec, by_name};
 
 fn gpu() -> Gpu {
@@ -210,9 +210,9 @@ fn broken_lights_fail_by_the_checks_that_should_catch_them() {
     assert!(f.contains(&"jacobian"), "{f:?}");
 }
 
-/// The light's WGSL sample and pdf(sample) at each (params, u), on the GPU.
-fn wgsl_samples(gpu: &Gpu, spec: &LightSpec, items: &[(LightParams, [f64; 2])]) -> Vec<[[f32; 4]; 2]> {
-    light_draws(gpu, spec, items).unwrap_or_else(|e| panic!("{}: {e}", spec.name))
+/// The light's WGSL sample and pdf(sample) at each u, on the GPU.
+fn wgsl_samples(gpu: &Gpu, spec: &LightSpec, params: &LightParams, us: &[[f64; 2]]) -> Vec<LightDraw> {
+    draws(gpu, spec, params, us).unwrap_or_else(|e| panic!("{}: {e}", spec.name))
 }
 
 /// The geometry as the GPU received it (rounded to f32).
@@ -224,25 +224,18 @@ fn in_f32(p: &LightParams) -> LightParams {
 fn wgsl_samples_equal_the_f64_twins() {
     let gpu = gpu();
     for spec in &LIGHTS {
-        let mut items = Vec::new();
+        let us: Vec<[f64; 2]> = (0..24 * 24).map(|k| [(k / 24) as f64 + 0.5, (k % 24) as f64 + 0.5].map(|x| x / 24.0)).collect();
+        let (mut worst_d, mut worst_pdf, mut worst_fn) = (0f64, 0f64, 0f64);
         for (omega, elevation) in SIZES {
             let p = in_f32(&spec.sized(omega, elevation));
-            for i in 0..24 {
-                for j in 0..24 {
-                    items.push((p, [(i as f64 + 0.5) / 24.0, (j as f64 + 0.5) / 24.0]));
-                }
+            for (u, s) in us.iter().zip(wgsl_samples(&gpu, spec, &p, &us)) {
+                let want = (spec.sample_f64)(&p, *u);
+                // the direction's error in units of the light's angular radius, sqrt(Ω/π)
+                let radius = (1.0 / (std::f64::consts::PI * (spec.pdf_f64)(&p, want.d).max(1e-300))).sqrt().min(1.0);
+                worst_d = worst_d.max((s.d - want.d).length() / radius.max(f64::MIN_POSITIVE));
+                worst_pdf = worst_pdf.max((s.pdf / want.pdf - 1.0).abs());
+                worst_fn = worst_fn.max((s.pdf_at_d / s.pdf - 1.0).abs());
             }
-        }
-        let got = wgsl_samples(&gpu, spec, &items);
-        let (mut worst_d, mut worst_pdf, mut worst_fn) = (0f64, 0f64, 0f64);
-        for ((p, u), [s, f]) in items.iter().zip(&got) {
-            let want = (spec.sample_f64)(p, *u);
-            let d = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
-            // the direction's error in units of the light's angular radius, sqrt(Ω/π)
-            let radius = (1.0 / (std::f64::consts::PI * (spec.pdf_f64)(p, want.d).max(1e-300))).sqrt().min(1.0);
-            worst_d = worst_d.max((d - want.d).length() / radius.max(f64::MIN_POSITIVE));
-            worst_pdf = worst_pdf.max((s[3] as f64 / want.pdf - 1.0).abs());
-            worst_fn = worst_fn.max((f[0] as f64 / s[3] as f64 - 1.0).abs());
         }
         eprintln!("{}: worst |Δd| / angular radius {worst_d:.2e}, pdf vs f64 {worst_pdf:.2e}, pdf fn vs sample {worst_fn:.2e}", spec.name);
         assert!(worst_d < 1e-3 && worst_pdf < 1e-4 && worst_fn < 1e-4, "{}: Δd {worst_d:.2e}, pdf {worst_pdf:.2e}, pdf fn {worst_fn:.2e}", spec.name);

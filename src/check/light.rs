@@ -9,9 +9,12 @@
 //! direction is not used (the shading point is the origin).
 
 use super::compose::Source;
-use super::{Domain, UserSampler};
+use super::gpu::Passes;
+use super::{CheckError, Domain, UserSampler};
+use crate::engine::gpu::Gpu;
+use crate::engine::gpu::params::Params;
 use crate::engine::gpu::precision::Precision;
-use crate::reference::light::registry::LightSpec;
+use crate::reference::light::registry::{LightParams, LightSpec};
 
 /// The names of the wrapper's functions.
 pub const SAMPLE: &str = "light_sample";
@@ -51,4 +54,29 @@ impl UserSampler {
         s.validate().unwrap_or_else(|e| panic!("lobes' {} light does not meet the contract: {e}", spec.name));
         s
     }
+}
+
+/// One draw of a light's WGSL: the direction and the pdf the sampler reported, and the pdf
+/// function at that direction.
+#[derive(Debug, Clone, Copy)]
+pub struct LightDraw {
+    pub d: glam::DVec3,
+    pub pdf: f64,
+    pub pdf_at_d: f64,
+}
+
+/// The light's WGSL (its library module, f32) with geometry `params` at each u, on `gpu`, by the
+/// passes `lobes check` runs on it: the sample map (`lobes_map`), then the pdf at the drawn
+/// directions (`lobes_conditioning`).
+pub fn draws(gpu: &Gpu, spec: &LightSpec, params: &LightParams, us: &[[f64; 2]]) -> Result<Vec<LightDraw>, CheckError> {
+    let passes = Passes::new(gpu, &UserSampler::light(spec))?;
+    let mut user = [[0f32; 4]; 4];
+    for (i, x) in params.iter().enumerate() {
+        user[i / 4][i % 4] = *x as f32;
+    }
+    let p = Params { user, ..bytemuck::Zeroable::zeroed() };
+    let drawn = passes.map(&p, &us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0, 0.0]).collect::<Vec<_>>())?;
+    let at = passes.conditioning(&p, &drawn.iter().map(|s| [s[0], s[1], s[2]]).collect::<Vec<_>>())?;
+    let f64s = |s: &[f32; 4]| s.map(f64::from);
+    Ok(drawn.iter().zip(&at).map(|(s, a)| LightDraw { d: glam::DVec3::from_slice(&f64s(s)[..3]), pdf: s[3] as f64, pdf_at_d: a[0] as f64 }).collect())
 }

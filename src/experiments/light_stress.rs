@@ -3,7 +3,7 @@
 //! a sliver triangle of near-zero and of zero area, a rectangle and a disk seen edge-on and
 //! nearly so, a shading point inside the sphere and on its surface — drawn at the stress
 //! uniforms ([`super::stress::uniforms`]: 0, 1 and their neighbours) on the GPU in f32 (the
-//! library's WGSL in a small kernel, [`light_draws`]) and on the CPU in f64 (the twins).
+//! library's WGSL through `lobes check`'s passes, [`draws`]) and on the CPU in f64 (the twins).
 //!
 //! Per sample: no NaN or infinity in d or the pdf, no negative pdf, d a unit vector where the
 //! pdf is positive; a non-degenerate light's every sample valid; and the pdf function at the
@@ -12,14 +12,12 @@
 //! the light's very edge, where f32 rounds either way).
 
 use super::stress::{UNIT_BOUND_F32, UNIT_BOUND_F64, uniforms};
+use crate::check::CheckError;
+use crate::check::light::draws;
 use crate::engine::gpu::Gpu;
-use crate::engine::gpu::GpuError;
-use crate::engine::gpu::library;
-use crate::engine::gpu::precision::Precision;
 use crate::reference::light::registry::{LIGHTS, LightParams, LightSpec, by_name};
 use glam::DVec3;
 use serde::Serialize;
-use wgpu::util::DeviceExt;
 
 /// The share of a non-degenerate light's interior samples whose pdf function may disagree with
 /// the reported pdf (a sample next to the light's edge, where f32 rounds either way).
@@ -104,60 +102,6 @@ pub fn light_cases() -> Vec<LightCase> {
     v
 }
 
-const KERNEL: &str = "
-struct LightsItem { params: array<vec4<f32>, 4>, u: vec4<f32> }
-@group(0) @binding(0) var<storage, read> lights_items: array<LightsItem>;
-@group(0) @binding(1) var<storage, read_write> lights_out: array<vec4<f32>>;
-@compute @workgroup_size(64)
-fn lights_draw(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= arrayLength(&lights_items)) { return; }
-    let params = lights_items[i].params;
-    let u = lights_items[i].u.xy;
-    let s = SAMPLE;
-    let d = s.d;
-    lights_out[2u * i] = vec4<f32>(s.d, s.pdf);
-    lights_out[2u * i + 1u] = vec4<f32>(PDF, 0.0, 0.0, 0.0);
-}
-";
-
-/// The light's WGSL (its library module, f32) at each (params, u) on the GPU: per item
-/// [(d, reported pdf), (pdf function at d, 0, 0, 0)].
-pub fn light_draws(gpu: &Gpu, spec: &LightSpec, items: &[(LightParams, [f64; 2])]) -> Result<Vec<[[f32; 4]; 2]>, GpuError> {
-    let source = library::wgsl(&[spec.module], Precision::F32Accurate)? + &KERNEL.replace("SAMPLE", spec.sample).replace("PDF", spec.pdf);
-    let input: Vec<f32> = items.iter().flat_map(|(p, u)| p.iter().copied().chain([u[0], u[1], 0.0, 0.0])).map(|x| x as f32).collect();
-    let d = &gpu.device;
-    let buffer = d.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("light items"), contents: bytemuck::cast_slice(&input), usage: wgpu::BufferUsages::STORAGE });
-    let size = items.len() as u64 * 32;
-    let out = d.create_buffer(&wgpu::BufferDescriptor { label: Some("light draws"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-    let read = d.create_buffer(&wgpu::BufferDescriptor { label: None, size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(spec.name), source: wgpu::ShaderSource::Wgsl(source.into()) });
-    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor { label: Some("lights_draw"), layout: None, module: &module, entry_point: Some("lights_draw"), compilation_options: Default::default(), cache: None });
-    let entries = [wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }, wgpu::BindGroupEntry { binding: 1, resource: out.as_entire_binding() }];
-    let group = d.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &pipeline.get_bind_group_layout(0), entries: &entries });
-    let mut encoder = d.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((items.len() as u32).div_ceil(64), 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&out, 0, &read, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    read.map_async(wgpu::MapMode::Read, 0..size, move |r| {
-        let _ = tx.send(r);
-    });
-    let _ = d.poll(wgpu::PollType::wait_indefinitely());
-    match rx.recv() {
-        Ok(Ok(())) => {}
-        _ => return Err(GpuError::Readback("the light draws of lobes stress".into())),
-    }
-    let bytes = read.get_mapped_range(0..size).map(|m| m.to_vec()).unwrap_or_default();
-    read.unmap();
-    Ok(bytemuck::cast_slice(&bytes).to_vec())
-}
-
 /// Judges one sample (d, reported pdf, pdf function at d; u in the interior) into `row`.
 fn judge(row: &mut LightRow, (d, pdf, pdf_fn): (DVec3, f64, f64), interior: bool) {
     if !(d.is_finite() && pdf.is_finite() && pdf_fn.is_finite()) || pdf < 0.0 || pdf_fn < 0.0 {
@@ -181,7 +125,7 @@ fn verdict(case: &LightCase, mut row: LightRow, unit_bound: f64) -> LightRow {
 }
 
 /// The case's rows: the f64 twin on the CPU, and the WGSL on `gpu` if given.
-pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRow>, GpuError> {
+pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRow>, CheckError> {
     let us = uniforms();
     // the last 64 of the stress uniforms are the RNG's, away from 0 and 1
     let interior = |i: usize| i + 64 >= us.len();
@@ -193,10 +137,9 @@ pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRo
     }
     let mut rows = vec![verdict(case, cpu, UNIT_BOUND_F64)];
     if let Some(gpu) = gpu {
-        let items: Vec<(LightParams, [f64; 2])> = us.iter().map(|u| (case.params, *u)).collect();
         let mut row = new("gpu f32");
-        for (i, [s, f]) in light_draws(gpu, case.light, &items)?.into_iter().enumerate() {
-            judge(&mut row, (DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64), s[3] as f64, f[0] as f64), interior(i));
+        for (i, s) in draws(gpu, case.light, &case.params, &us)?.into_iter().enumerate() {
+            judge(&mut row, (s.d, s.pdf, s.pdf_at_d), interior(i));
         }
         rows.push(verdict(case, row, UNIT_BOUND_F32));
     }
@@ -204,7 +147,7 @@ pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRo
 }
 
 /// Every case of [`light_cases`].
-pub fn run_all_lights(gpu: Option<&Gpu>) -> Result<Vec<LightRow>, GpuError> {
+pub fn run_all_lights(gpu: Option<&Gpu>) -> Result<Vec<LightRow>, CheckError> {
     let mut rows = Vec::new();
     for case in light_cases() {
         rows.extend(run_light_case(&case, gpu)?);
