@@ -158,6 +158,8 @@ fn merge_refuses_gaps_overlaps_and_mixed_scenes() {
     let missing = lobes(&dir, &["merge", "p0", "p2", "--out", "m"]);
     assert_eq!(missing.status.code(), Some(2));
     assert!(stderr(&missing).contains("samples 10000..20000 are missing"), "{}", stderr(&missing));
+    // the command line names the command that writes the missing shard
+    assert!(stderr(&missing).contains("`lobes run SCENE --shard I/N`"), "{}", stderr(&missing));
 
     let overlap = lobes(&dir, &["merge", "p0", "p1", "p2", "half", "--out", "m"]);
     assert_eq!(overlap.status.code(), Some(2));
@@ -170,6 +172,10 @@ fn merge_refuses_gaps_overlaps_and_mixed_scenes() {
 
     let empty = lobes(&dir, &["merge", "nowhere", "--out", "m"]);
     assert_eq!(empty.status.code(), Some(2));
+    std::fs::create_dir_all(dir.join("no-shards")).unwrap();
+    let none = lobes(&dir, &["merge", "no-shards", "--out", "m"]);
+    assert_eq!(none.status.code(), Some(2));
+    assert!(stderr(&none).contains("no-shards: no shard files") && stderr(&none).contains("--shard I/N --out no-shards`"), "{}", stderr(&none));
 
     let bad = lobes(&dir, &["run", "scene.toml", "--shard", "3/3", "--out", "x"]);
     assert_eq!(bad.status.code(), Some(2));

@@ -9,6 +9,7 @@ use crate::report::outcome::Outcome;
 use crate::report::output::{self, CaseSummary, RunSummary};
 use crate::run::{Expected, judge};
 use crate::run::merge::{merge, read_shards};
+use crate::run::shard::ShardError;
 use crate::stats::chi2::sidak;
 use clap::Args;
 use std::path::PathBuf;
@@ -32,6 +33,16 @@ pub struct MergeArgs {
     pub output: OutputArgs,
 }
 
+/// `e` with the command that writes what it says is missing.
+fn with_advice(e: ShardError) -> ShardError {
+    let advice = match &e {
+        ShardError::NoneIn { dir } => format!("write them with `lobes run SCENE --shard I/N --out {}`", dir.display()),
+        ShardError::Missing { .. } => "run the missing `lobes run SCENE --shard I/N` and pass its output folder to `lobes merge` too".into(),
+        ShardError::Bad(_) => return e,
+    };
+    ShardError::Bad(format!("{e}; {advice}"))
+}
+
 /// `lobes merge DIR... --out DIR`.
 pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     // as `lobes run`: an existing --out is locked first, and bad shards replace its summary
@@ -39,7 +50,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     let (shards, merged) = match read_shards(&args.dirs).and_then(|shards| merge(&shards).map(|m| (shards, m))) {
         Ok(found) => found,
         Err(e) => {
-            let e = anyhow::Error::from(e);
+            let e = anyhow::Error::from(with_advice(e));
             if let Some(folder) = &existing {
                 super::run::record_error(folder, args.significance, &e);
             }

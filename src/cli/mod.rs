@@ -444,7 +444,7 @@ mod tests {
 
     #[test]
     fn bad_shards_are_bad_input() {
-        let err = anyhow::Error::from(ShardError("case 'c': samples 3..6 are missing".into())).context("lobes merge");
+        let err = anyhow::Error::from(ShardError::Missing { case: "c".into(), from: 3, to: 6 }).context("lobes merge");
         assert_eq!(exit_code(&err), EXIT_USAGE);
         assert_eq!(exit_code(&usage("x")), EXIT_USAGE);
         assert_eq!(exit_code(&anyhow::anyhow!("disk full")), EXIT_TOOL_FAILURE);

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 /// named directly, each once, sorted.
 pub fn find_shards(dirs: &[PathBuf]) -> Result<Vec<PathBuf>, ShardError> {
     let list = |d: &Path| -> Result<Vec<PathBuf>, ShardError> {
-        let entries = std::fs::read_dir(d).map_err(|e| ShardError(format!("cannot read folder {}: {e}", d.display())))?;
+        let entries = std::fs::read_dir(d).map_err(|e| ShardError::Bad(format!("cannot read folder {}: {e}", d.display())))?;
         Ok(entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
     };
     let mut found = Vec::new();
@@ -30,11 +30,7 @@ pub fn find_shards(dirs: &[PathBuf]) -> Result<Vec<PathBuf>, ShardError> {
             }
         }
         if here.is_empty() {
-            return Err(ShardError(format!(
-                "{}: no shard files (<case>/shard-I-of-N.json) found; write them with `lobes run SCENE --shard I/N --out {}`",
-                dir.display(),
-                dir.display()
-            )));
+            return Err(ShardError::NoneIn { dir: dir.clone() });
         }
         found.extend(here);
     }
@@ -56,19 +52,14 @@ pub fn check_tiling<'a>(case: &str, samples: u64, shards: &[&'a ShardOnDisk]) ->
     sorted.sort_by_key(|s| (s.file.first, s.file.end));
     let mut at = 0u64;
     let mut last: Option<&ShardOnDisk> = None;
-    let missing = |from: u64, to: u64| {
-        ShardError(format!(
-            "case '{case}': samples {from}..{to} are missing (no shard covers them); run the missing \
-             `lobes run SCENE --shard I/N` and pass its output folder to `lobes merge` too"
-        ))
-    };
+    let missing = |from: u64, to: u64| ShardError::Missing { case: case.to_string(), from, to };
     for s in &sorted {
         if s.file.first > at {
             return Err(missing(at, s.file.first));
         }
         if s.file.first < at {
             let prev = last.expect("a shard before");
-            return Err(ShardError(format!(
+            return Err(ShardError::Bad(format!(
                 "case '{case}': shards overlap: {} covers samples {}..{} and {} covers {}..{}; pass each shard once",
                 prev.path.display(),
                 prev.file.first,
@@ -161,9 +152,9 @@ fn joined(values: impl Iterator<Item = String>) -> String {
 /// to a case of it (name, seed, samples, bins), that each case's ranges tile it exactly, and
 /// that a weighted case's shards carry weighted sums.
 pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
-    let first = shards.first().ok_or_else(|| ShardError("no shard files to merge".into()))?;
+    let first = shards.first().ok_or_else(|| ShardError::Bad("no shard files to merge".into()))?;
     if let Some(other) = shards.iter().find(|s| s.file.scene != first.file.scene) {
-        return Err(ShardError(format!(
+        return Err(ShardError::Bad(format!(
             "shards come from different scenes: {} ({}, {}) and {} ({}, {}); merge the shards of one scene at a time",
             first.path.display(),
             first.file.scene_name,
@@ -174,19 +165,19 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
         )));
     }
     let scene = Scene::parse(&first.file.scene_name, &first.file.scene)
-        .map_err(|e| ShardError(format!("{}: the scene stored in the shard does not parse: {e}", first.path.display())))?;
+        .map_err(|e| ShardError::Bad(format!("{}: the scene stored in the shard does not parse: {e}", first.path.display())))?;
     if let Some(user) = scene.user_cases.first() {
         // `lobes run --shard` refuses such scenes, so no shard of one is ever written
-        return Err(ShardError(format!("{}: case '{}' is a WGSL sampler, which is never sharded; run it with `lobes run`", first.path.display(), user.name)));
+        return Err(ShardError::Bad(format!("{}: case '{}' is a WGSL sampler, which is never sharded; run it with `lobes run`", first.path.display(), user.name)));
     }
     let mut by_case: BTreeMap<&str, Vec<&ShardOnDisk>> = BTreeMap::new();
     for s in shards {
         let f = &s.file;
         let Some(case) = scene.cases.iter().find(|c| c.name == f.case) else {
-            return Err(ShardError(format!("{}: case '{}' is not in the scene", s.path.display(), f.case)));
+            return Err(ShardError::Bad(format!("{}: case '{}' is not in the scene", s.path.display(), f.case)));
         };
         if f.seed != case.seed || f.samples != case.samples || f.counts.len() != case.job.bins() {
-            return Err(ShardError(format!(
+            return Err(ShardError::Bad(format!(
                 "{}: case '{}' has seed {}, {} samples and {} bins, but the scene says seed {}, {} samples, {} bins",
                 s.path.display(),
                 f.case,
@@ -199,7 +190,7 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
             )));
         }
         if case.effects.is_some() && f.weighted.is_none() {
-            return Err(ShardError(format!(
+            return Err(ShardError::Bad(format!(
                 "{}: case '{}' is weighted in the scene but this shard has no weighted sums; run the shard again with this lobes",
                 s.path.display(),
                 case.name
@@ -217,7 +208,7 @@ pub fn merge(shards: &[ShardOnDisk]) -> Result<Merged, ShardError> {
         for p in rest {
             let part = p.file.sampled();
             if !adds_within_64_bits(&sum, &part) {
-                return Err(ShardError(format!(
+                return Err(ShardError::Bad(format!(
                     "case '{}': adding {} makes a count or sum exceed 2^64 − 1 (a damaged or edited file); run its shard again",
                     case.name,
                     p.path.display()

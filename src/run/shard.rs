@@ -44,10 +44,20 @@ pub const SHARD_VERSION: u32 = 5;
 pub const LOBES_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Bad shards: a file that is not a readable shard of this lobes, or shards that do not add up
-/// to one scene. Bad input: the CLI exits with its usage code.
+/// to one scene. Bad input: the CLI exits with its usage code, and adds the command that writes
+/// what is missing.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("{0}")]
-pub struct ShardError(pub String);
+pub enum ShardError {
+    /// A folder given holds no shard file.
+    #[error("{}: no shard files (<case>/shard-I-of-N.json) found", dir.display())]
+    NoneIn { dir: std::path::PathBuf },
+    /// No shard covers samples `from .. to` of a case.
+    #[error("case '{case}': samples {from}..{to} are missing (no shard covers them)")]
+    Missing { case: String, from: u64, to: u64 },
+    /// Any other: an unreadable file, shards of different scenes, overlaps…
+    #[error("{0}")]
+    Bad(String),
+}
 
 /// Shard `index` of `count` (0-based: `0 ≤ index < count`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -265,7 +275,7 @@ impl ShardFile {
 
     /// Parses and checks a shard file's text; `path` names it in errors.
     pub fn parse(path: &Path, text: &str) -> Result<ShardFile, ShardError> {
-        let bad = |what: String| ShardError(format!("{}: {what}", path.display()));
+        let bad = |what: String| ShardError::Bad(format!("{}: {what}", path.display()));
         let header: Header = serde_json::from_str(text).map_err(|e| bad(format!("not a lobes shard file (invalid JSON: {e})")))?;
         if header.format.as_deref() != Some(SHARD_FORMAT) {
             return Err(bad(format!("not a lobes shard file (no \"format\": \"{SHARD_FORMAT}\")")));
@@ -319,13 +329,8 @@ impl ShardFile {
 
     /// Reads and checks a shard file.
     pub fn read(path: &Path) -> Result<ShardFile, ShardError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ShardError(format!("{}: cannot read: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| ShardError::Bad(format!("{}: cannot read: {e}", path.display())))?;
         Self::parse(path, &text)
-    }
-
-    /// The scene it belongs to.
-    pub fn scene_source(&self) -> SceneSource {
-        SceneSource { name: self.scene_name.clone(), text: self.scene.clone() }
     }
 
     /// Its results, to add up with the other shards of the case.
