@@ -162,11 +162,6 @@ impl Composition {
         }
         Ok(out)
     }
-
-    /// Whether anything beyond the contract's plain files is asked for.
-    pub fn is_plain(&self) -> bool {
-        *self == Self::default()
-    }
 }
 
 /// A package's name: an identifier, not `package` (the sampler's own root), given once. The

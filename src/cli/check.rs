@@ -52,12 +52,12 @@ pub struct CheckArgs {
     /// unit, with its #includes) or one SPIR-V module (.spv).
     #[arg(required = true, value_name = "FILE.wgsl")]
     pub files: Vec<PathBuf>,
-    /// The sampling function: fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>,
+    /// The sampling function: `fn(wi: vec3<f32>, u: vec4<f32>, params: array<vec4<f32>, 4>) -> vec4<f32>`,
     /// or a WGSL call expression over wi, u, params, p0 … p15 and rng returning vec4 (d, pdf) or
     /// vec3 (d), e.g. 'sample_ggx_vndf(wi, p0, rng)'.
     #[arg(long, value_name = "NAME|EXPR")]
     pub sample: String,
-    /// The density: fn(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32, or a call
+    /// The density: `fn(wi: vec3<f32>, d: vec3<f32>, params: array<vec4<f32>, 4>) -> f32`, or a call
     /// expression over wi, d, params, p0 … p15 and rng, e.g. 'ggx_vndf_pdf(wi, d, p0)'.
     #[arg(long, value_name = "NAME|EXPR")]
     pub pdf: String,
@@ -84,12 +84,12 @@ pub struct CheckArgs {
     /// A renderer's texture the sampler reads (repeatable): a Radiance .hdr, an OpenEXR .exr
     /// (scanline; NONE, RLE, ZIPS or ZIP) or a .png image (its stored values: 8-bit v is v/255,
     /// no sRGB decoding) bound as the files' NAME:
-    /// texture_2d<f32> (rgba32float, for textureLoad or a --sampler).
+    /// `texture_2d<f32>` (rgba32float, for textureLoad or a --sampler).
     #[arg(long, value_name = "NAME=FILE")]
     pub texture: Vec<String>,
     /// A renderer's table the sampler reads (repeatable): a .npy array of float32, uint32 or int32,
-    /// or raw little-endian 32-bit words (.bin, .raw), bound as the files' var<storage, read>
-    /// NAME: array<f32> (or u32, i32).
+    /// or raw little-endian 32-bit words (.bin, .raw), bound as the files'
+    /// `var<storage, read> NAME: array<f32>` (or u32, i32).
     #[arg(long, value_name = "NAME=FILE")]
     pub buffer: Vec<String>,
     /// A renderer's sampler the sampler reads (repeatable): bound as the files' NAME: sampler
@@ -145,7 +145,7 @@ pub struct CheckArgs {
     #[arg(long, value_name = "solid-angle|projected|area", default_value = "solid-angle")]
     pub measure: Measure,
     /// With --measure area: the light's unit normal at the sampled point p, a WGSL expression
-    /// over p, params and p0 … p15 (e.g. 'vec3<f32>(0.0, 0.0, -1.0)' for a light facing down).
+    /// over p, params and p0 … p15 (e.g. `'vec3<f32>(0.0, 0.0, -1.0)'` for a light facing down).
     #[arg(long, value_name = "EXPR")]
     pub normal: Option<String>,
     /// The sampler's tangent frame: z-up, or y-up (normal +y; --incident-theta from +y, φ from +x
