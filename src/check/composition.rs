@@ -1,7 +1,7 @@
 //! How a user's sampler is composed and called: the settings beyond the contract's three
 //! functions ([`Composition`], [`Draw`], [`SampleReturns`]), the dialect of its files
 //! ([`Dialect`]; `dialect::sniff` tells it), and the composed code that lobes' glue calls
-//! ([`UserCode`]). The vocabulary that `modules` (which composes), `dialect` (the front ends) and
+//! (`UserCode`). The vocabulary that `modules` (which composes), `dialect` (the front ends) and
 //! `gpu` (the glue) share.
 
 use super::compose::Source;

@@ -208,7 +208,7 @@ pub type MapPass<'a> = dyn Fn(&[[f32; 4]]) -> Result<Vec<[f32; 4]>, super::Check
 
 /// Whether the sample map jumps along u.x or u.y: on the lines through the first [`JUMP_LINES`]
 /// of `probes` (u with a valid sample) along each axis, the largest step of d over
-/// [`JUMP_NODES`] nodes, refined twice around its largest sub-step; `map` evaluates the sampler
+/// `JUMP_NODES` nodes, refined twice around its largest sub-step; `map` evaluates the sampler
 /// at uniforms (the check's map pass). A smooth map's largest sub-step shrinks with the step; a
 /// jump's stays.
 pub fn find_jump(probes: &[[f32; 4]], domain: Domain, map: &MapPass) -> Result<Option<Jump>, super::CheckError> {

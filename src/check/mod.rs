@@ -138,7 +138,7 @@ impl UserSampler {
 
 
 
-    /// The conventions must fit the domain and each other, and the code [`Self::validate_code`].
+    /// The conventions must fit the domain and each other, and the code `Self::validate_code`.
     pub fn validate(&self) -> Result<(), CheckError> {
         self.conventions.validate(self.domain)?;
         self.light_measure()?;
@@ -208,7 +208,7 @@ pub fn histograms(gpu: &Gpu, sampler: &UserSampler, settings: &Settings, runs: &
         .collect()
 }
 
-/// Runs every check of `sampler` on `gpu`: measures once ([`judge::measure`]), then judges.
+/// Runs every check of `sampler` on `gpu`: measures once (`judge::measure`), then judges.
 pub fn check(gpu: &Gpu, sampler: &UserSampler, settings: &Settings) -> Result<Report, CheckError> {
     let started = std::time::Instant::now();
     settings.validate()?;

@@ -1,6 +1,6 @@
 //! A user's sampler as it is in its repository, composed the way the renderer composes it into
 //! the WGSL that lobes' glue (`glue::glue`) calls: the front end of the files' dialect
-//! ([`super::dialect`]) composes them, and the trees composed are kept ([`compose_user`]).
+//! ([`super::dialect`]) composes them, and the trees composed are kept (`compose_user`).
 //!
 //! A composed tree becomes one WGSL text: the naga module of the tree and the glue, compacted to
 //! what the glue's calls reach (so a module's bind groups, ray queries or other entry points need

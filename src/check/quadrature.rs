@@ -104,7 +104,7 @@ pub const HIDDEN_SIGMA: f64 = 5.0;
 
 impl Integrals {
     /// `Err` with what is wrong where a bin's error estimate is beyond [`MAX_QUADRATURE_SIGMA`] of
-    /// its count's standard deviation at `samples` (after the retries of [`integrate`]): expected
+    /// its count's standard deviation at `samples` (after the retries of `integrate`): expected
     /// counts that uncertain give no verdict, neither a pass nor a fail.
     ///
     /// ```

@@ -25,7 +25,7 @@ pub struct RunArgs {
     /// scenes/all-lobes.toml (every lobe and method).
     pub scene: Option<PathBuf>,
     /// Run only the cases whose names match NAME, a pattern such as 'ggx-*' (* any text, ? one
-    /// character, [ab] one of them; ignoring case); repeat it for more.
+    /// character, `[ab]` one of them; ignoring case); repeat it for more.
     #[arg(long = "case", value_name = "NAME", conflicts_with = "shard")]
     pub cases: Vec<String>,
     /// Samples of every case, in place of the scene's.

@@ -74,7 +74,7 @@ pub enum Scatter {
     #[default]
     Reflect,
     /// Reflects and refracts it as a rough dielectric whose lower medium has relative index
-    /// `eta` ([`RoughDielectric`](crate::reference::dielectric::RoughDielectric)).
+    /// `eta` ([`RoughDielectric`]).
     Dielectric { eta: f64 },
 }
 

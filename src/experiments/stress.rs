@@ -183,7 +183,7 @@ pub fn dielectric_cases() -> Vec<StressCase> {
 /// and exactly 1 (callers only).
 const EDGES: [f64; 5] = [0.0, 1.0 / 16_777_216.0, 0.5, 1.0 - 1.0 / 16_777_216.0, 1.0];
 
-/// The uniforms tried: every pair of [`EDGES`] and 64 pairs from the RNG.
+/// The uniforms tried: every pair of `EDGES` and 64 pairs from the RNG.
 pub fn uniforms() -> Vec<[f64; 2]> {
     let mut u: Vec<[f64; 2]> = EDGES.iter().flat_map(|&a| EDGES.iter().map(move |&b| [a, b])).collect();
     u.extend((0..64).map(|i| {
@@ -193,7 +193,7 @@ pub fn uniforms() -> Vec<[f64; 2]> {
     u
 }
 
-/// A dielectric's uniforms: every pair of [`EDGES`] with u.z at 0, ½, 1 − 2⁻²⁴ and 1; 64 triples
+/// A dielectric's uniforms: every pair of `EDGES` with u.z at 0, ½, 1 − 2⁻²⁴ and 1; 64 triples
 /// from the RNG; and 32 pairs from the RNG with u.z at the event threshold, the f32 value of the
 /// f64 F(ωi·h) and its two f32 neighbours (within [0, 1]). Every value is an f32, so the GPU
 /// reads the uniforms the CPU uses.

@@ -101,7 +101,7 @@ pub struct OutFolder {
 }
 
 impl OutFolder {
-    /// Creates `path` if missing and locks it; see [`OutFolder::lock`].
+    /// Creates `path` if missing and locks it; see `OutFolder::lock`.
     pub fn claim(path: &Path, access: Access, wait: bool) -> Result<OutFolder, FolderError> {
         if path.exists() && !path.is_dir() {
             return Err(not_a_folder(path));

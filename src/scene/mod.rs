@@ -31,7 +31,7 @@
 //! ```
 //!
 //! Any key with one number or name sweeps when given an array (`alpha = [0.1, 0.3]`,
-//! `method = ["ndf", "vndf"]`), and several such keys make their product ([`sweep`]).
+//! `method = ["ndf", "vndf"]`), and several such keys make their product (`sweep`).
 //!
 //! Every value is read as a TOML value first and checked here, so a wrong type, a value out
 //! of range, NaN or infinity, an unknown name or a key that does not apply to the case's lobe

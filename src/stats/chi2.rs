@@ -38,8 +38,8 @@ pub struct Chi2 {
 /// adjustment for the family.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 pub struct FamilyTest {
-    /// The test ([`Test::name`]): "64 × 128" (a grid of rows × cols cells), "cos θ", "φ", "y" or
-    /// "x" (a marginal).
+    /// The test: "64 × 128" (a grid of rows × cols cells), "cos θ", "φ", "y" or "x" (a
+    /// marginal).
     pub test: String,
     pub rows: u32,
     pub cols: u32,
@@ -149,7 +149,7 @@ pub fn test(observed: &[u64], expected: &[f64], significance: f64) -> Chi2 {
 }
 
 /// The test of a sampler's histogram, the one `lobes run`, `lobes merge` and `lobes check` judge
-/// by: Pearson's [`test`] over the bins and the invalid-sample cells together, where a histogram
+/// by: Pearson's [`test()`] over the bins and the invalid-sample cells together, where a histogram
 /// with no sample in any bin is [`Untested::NoValidSample`] (it never passes) and one whose
 /// cells pool into one is [`Untested::OneCell`].
 ///

@@ -43,7 +43,7 @@ impl SphereGrid {
 
     /// The column of a direction whose components across the axis are (x, y): ⌊(φ+π)/2π ·
     /// cols⌋ with φ = atan2(y, x), φ = π wrapped to column 0, φ = 0 at x = y = 0, exact on the
-    /// axes' edges ([`Self::axis_exact_column`]).
+    /// axes' edges (`Self::axis_exact_column`).
     pub fn column_of(&self, x: f64, y: f64) -> u32 {
         let t = if x == 0.0 && y == 0.0 { 0.5 } else { (y.atan2(x) + PI) / (2.0 * PI) };
         let mut col = (t.max(0.0) * self.cols as f64) as u32;

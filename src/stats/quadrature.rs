@@ -635,7 +635,7 @@ fn sphere_parts() -> Vec<Part> {
     parts
 }
 
-/// ∫ f(d) dω over the unit sphere by `f`'s rules, from [`sphere_parts`].
+/// ∫ f(d) dω over the unit sphere by `f`'s rules, from `sphere_parts`.
 pub fn sphere_integral<E>(f: &dyn Integrand<E>) -> Result<SphereIntegral, E> {
     let i = refine(f, sphere_parts(), 1, &SPHERE_SETTINGS)?;
     Ok(SphereIntegral { value: i.pdf[0], error_estimate: i.linear[0], unconverged_parts: i.unconverged[0], bad_parts: i.bad_parts, parts: i.parts })

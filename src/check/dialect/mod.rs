@@ -1,25 +1,25 @@
-//! The front ends of `lobes check`, one module per dialect, each a [`FrontEnd`]: how its files
+//! The front ends of `lobes check`, one module per dialect, each a `FrontEnd`: how its files
 //! are told apart ([`sniff`]), composed into the WGSL that lobes' glue calls, and how a call
 //! expression (`--sample`, `--pdf`, `--eval`) names their functions.
 //!
-//! - plain WGSL ([`wgsl`]): the files, in order, as they are;
-//! - naga_oil ([`naga_oil`]): `#define_import_path`, `#import`, `#ifdef` shader defs, composed by
-//!   naga_oil's `Composer` over the modules under the shader roots ([`roots`]);
-//! - WESL ([`wesl`]): `import package::a::b;`, `@if` features, composed by the `wesl` crate
-//!   (feature "wesl") with lobes' resolver ([`wesl_resolver`]) and conditional blocks
+//! - plain WGSL (`wgsl`): the files, in order, as they are;
+//! - naga_oil (`naga_oil`): `#define_import_path`, `#import`, `#ifdef` shader defs, composed by
+//!   naga_oil's `Composer` over the modules under the shader roots (`roots`);
+//! - WESL (`wesl`): `import package::a::b;`, `@if` features, composed by the `wesl` crate
+//!   (feature "wesl") with lobes' resolver (`wesl_resolver`) and conditional blocks
 //!   ([`wesl_blocks`]);
 //! - GLSL ([`glsl`]): naga's GLSL front end (Vulkan GLSL 440–460), after lobes' `#include`
 //!   expansion, with errors at the user's file and line;
 //! - SPIR-V ([`spirv`]): naga's SPIR-V front end, functions named by their debug names (`OpName`).
 //!
-//! GLSL and SPIR-V are translated to WGSL by naga ([`translate`]); where WGSL cannot spell a
+//! GLSL and SPIR-V are translated to WGSL by naga (`translate`); where WGSL cannot spell a
 //! function's name (a WGSL reserved word such as `saturate`, an overloaded GLSL function), the
 //! names written are recorded as origins, so that `--rand` and call expressions name the
 //! functions as the user's file does. Composing a tree is slow ([`stage`] says what is being
 //! composed); `super::modules` keeps the trees composed and calls the front ends.
 //!
-//! A new dialect is a variant of [`Dialect`], a module here with its [`FrontEnd`], its arm in
-//! [`Dialect::front_end`] and its place in [`SNIFFED`].
+//! A new dialect is a variant of [`Dialect`], a module here with its `FrontEnd`, its arm in
+//! `Dialect::front_end` and its place in [`SNIFFED`].
 
 pub(super) mod front_end;
 mod gl_uniforms;

@@ -1,6 +1,6 @@
 //! A SPIR-V module (`.spv`, from glslc, glslangValidator, `dxc -spirv`, `slangc -target spirv`)
 //! through naga's SPIR-V front end (`spv-in`), translated to WGSL when the file is read
-//! ([`read`]); its functions are named by their debug names (`OpName`), a glslang name's
+//! (`read`); its functions are named by their debug names (`OpName`), a glslang name's
 //! signature (`sample_ggx(vf3;f1;`) dropped. A module without debug names (compiled with `-g0`
 //! or stripped) has no names to call.
 

@@ -85,7 +85,7 @@ impl Counting {
     /// Slabs for `threads` host threads within the limits: as many workgroups of
     /// [`SLAB_WORKGROUP`] as balance over the threads, fewer where the slabs would pass
     /// [`SLAB_BUDGET_BYTES`], the storage binding limit or the dispatch grid; None where fewer
-    /// than [`MIN_SLAB_GROUPS`] would fit.
+    /// than `MIN_SLAB_GROUPS` would fit.
     pub fn slabs(limits: &wgpu::Limits, tile_bins: u32, threads: u32) -> Option<Counting> {
         let slab_bytes = tile_bins.max(1) as u64 * 4;
         let bytes = SLAB_BUDGET_BYTES.min(limits.max_storage_buffer_binding_size).min(limits.max_buffer_size);

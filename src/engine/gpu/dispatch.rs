@@ -65,7 +65,7 @@ impl Gpu {
     }
 
     /// `source` validated by naga (errors name `what`) and made a shader module, within the
-    /// bounds ([`Gpu::bounded`]).
+    /// bounds (`Gpu::bounded`).
     pub fn module(&self, what: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
         super::library::validate_module(what, source)?;
         self.module_unvalidated(what, source)
@@ -80,7 +80,7 @@ impl Gpu {
     }
 
     /// The compute pipeline of `entry` in `module`; `layout` None: derived from the module.
-    /// The driver compiles the shader here, within the bounds ([`Gpu::bounded`]).
+    /// The driver compiles the shader here, within the bounds (`Gpu::bounded`).
     pub fn pipeline(
         &self,
         module: &wgpu::ShaderModule,

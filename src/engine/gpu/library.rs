@@ -31,7 +31,7 @@
 //! import it, drops aliases, and naga_oil then rejects the name as one that "requires
 //! substitution"), so it cannot be imported either. For naga_oil's check alone each file is
 //! therefore read with `Real` spelled as the precision's type (`f32 ` or `f64 `, four columns
-//! like `Real`, so positions stay the file's) and the `alias` line blanked ([`for_naga_oil`]).
+//! like `Real`, so positions stay the file's) and the `alias` line blanked (`for_naga_oil`).
 //! Every file that uses `Real` says `#import lobes::math::Real`: that is the dependency which
 //! brings the alias along in the plain WGSL (and to a renderer's naga_oil, `lobes::embed`), while
 //! for lobes' own naga_oil check, which sees `Real` spelled out, the import is one it does not use.
