@@ -19,7 +19,7 @@ use lobes::check::report::NormalizationFigures;
 use lobes::check::{Settings, UserSampler, check};
 use lobes::embed::Module;
 use lobes::engine::gpu::Gpu;
-use lobes::check::light::{LightDraw, draws};
+use lobes::check::light::{LightDraw, LightPasses};
 use lobes::reference::light::registry::{LIGHTS, LightParams, LightSpec, by_name};
 
 fn gpu() -> Gpu {
@@ -211,8 +211,8 @@ fn broken_lights_fail_by_the_checks_that_should_catch_them() {
 }
 
 /// The light's WGSL sample and pdf(sample) at each u, on the GPU.
-fn wgsl_samples(gpu: &Gpu, spec: &LightSpec, params: &LightParams, us: &[[f64; 2]]) -> Vec<LightDraw> {
-    draws(gpu, spec, params, us).unwrap_or_else(|e| panic!("{}: {e}", spec.name))
+fn wgsl_samples(passes: &LightPasses, spec: &LightSpec, params: &LightParams, us: &[[f64; 2]]) -> Vec<LightDraw> {
+    passes.draws(params, us).unwrap_or_else(|e| panic!("{}: {e}", spec.name))
 }
 
 /// The geometry as the GPU received it (rounded to f32).
@@ -226,9 +226,10 @@ fn wgsl_samples_equal_the_f64_twins() {
     for spec in &LIGHTS {
         let us: Vec<[f64; 2]> = (0..24 * 24).map(|k| [(k / 24) as f64 + 0.5, (k % 24) as f64 + 0.5].map(|x| x / 24.0)).collect();
         let (mut worst_d, mut worst_pdf, mut worst_fn) = (0f64, 0f64, 0f64);
+        let passes = LightPasses::new(&gpu, spec).unwrap_or_else(|e| panic!("{}: {e}", spec.name));
         for (omega, elevation) in SIZES {
             let p = in_f32(&spec.sized(omega, elevation));
-            for (u, s) in us.iter().zip(wgsl_samples(&gpu, spec, &p, &us)) {
+            for (u, s) in us.iter().zip(wgsl_samples(&passes, spec, &p, &us)) {
                 let want = (spec.sample_f64)(&p, *u);
                 // the direction's error in units of the light's angular radius, sqrt(Ω/π)
                 let radius = (1.0 / (std::f64::consts::PI * (spec.pdf_f64)(&p, want.d).max(1e-300))).sqrt().min(1.0);

@@ -234,6 +234,7 @@ fn broken_dielectrics_are_caught() {
 /// 1 − cos θmax is taken as 1 − sqrt(1 − sin²) (no stable form) is inconsistent at 10⁻⁶ sr.
 #[test]
 fn every_light_is_stable_at_its_hard_cases() {
+    use lobes::check::light::LightPasses;
     use lobes::experiments::light_stress::{light_cases, run_all_lights, run_light_case};
     let e = engine();
     let rows = run_all_lights(Some(&e.gpu)).unwrap();
@@ -250,7 +251,7 @@ fn every_light_is_stable_at_its_hard_cases() {
     let naive = "select(0.0, 1.0 / (2.0 * 3.14159265 * (1.0 - sqrt(1.0 - params[0].w * params[0].w / dot(params[0].xyz, params[0].xyz)))), sphere_light_pdf(params[0].xyz, params[0].w, d) > 0.0)";
     let broken = Box::leak(Box::new(lobes::reference::light::registry::LightSpec { pdf: naive, ..*case.light }));
     case.light = broken;
-    let rows = run_light_case(&case, Some(&e.gpu)).unwrap();
+    let rows = run_light_case(&case, Some(&LightPasses::new(&e.gpu, case.light).unwrap())).unwrap();
     let gpu = rows.iter().find(|r| r.kernel == "gpu f32").unwrap();
     assert!(!gpu.passed && gpu.inconsistent + gpu.bad_values > gpu.interior / 2, "{gpu:?}");
 }

@@ -65,18 +65,28 @@ pub struct LightDraw {
     pub pdf_at_d: f64,
 }
 
-/// The light's WGSL (its library module, f32) with geometry `params` at each u, on `gpu`, by the
-/// passes `lobes check` runs on it: the sample map (`lobes_map`), then the pdf at the drawn
-/// directions (`lobes_conditioning`).
-pub fn draws(gpu: &Gpu, spec: &LightSpec, params: &LightParams, us: &[[f64; 2]]) -> Result<Vec<LightDraw>, CheckError> {
-    let passes = Passes::new(gpu, &UserSampler::light(spec))?;
-    let mut user = [[0f32; 4]; 4];
-    for (i, x) in params.iter().enumerate() {
-        user[i / 4][i % 4] = *x as f32;
+/// `lobes check`'s passes over a light's WGSL (its library module, f32), composed once for any
+/// number of draws.
+pub struct LightPasses<'g> {
+    passes: Passes<'g>,
+}
+
+impl<'g> LightPasses<'g> {
+    pub fn new(gpu: &'g Gpu, spec: &LightSpec) -> Result<Self, CheckError> {
+        Ok(Self { passes: Passes::new(gpu, &UserSampler::light(spec))? })
     }
-    let p = Params { user, ..bytemuck::Zeroable::zeroed() };
-    let drawn = passes.map(&p, &us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0, 0.0]).collect::<Vec<_>>())?;
-    let at = passes.conditioning(&p, &drawn.iter().map(|s| [s[0], s[1], s[2]]).collect::<Vec<_>>())?;
-    let f64s = |s: &[f32; 4]| s.map(f64::from);
-    Ok(drawn.iter().zip(&at).map(|(s, a)| LightDraw { d: glam::DVec3::from_slice(&f64s(s)[..3]), pdf: s[3] as f64, pdf_at_d: a[0] as f64 }).collect())
+
+    /// The draws with geometry `params` at each u: the sample map (`lobes_map`), then the pdf at
+    /// the drawn directions (`lobes_conditioning`).
+    pub fn draws(&self, params: &LightParams, us: &[[f64; 2]]) -> Result<Vec<LightDraw>, CheckError> {
+        let mut user = [[0f32; 4]; 4];
+        for (i, x) in params.iter().enumerate() {
+            user[i / 4][i % 4] = *x as f32;
+        }
+        let p = Params { user, ..bytemuck::Zeroable::zeroed() };
+        let drawn = self.passes.map(&p, &us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0, 0.0]).collect::<Vec<_>>())?;
+        let at = self.passes.conditioning(&p, &drawn.iter().map(|s| [s[0], s[1], s[2]]).collect::<Vec<_>>())?;
+        let d = |s: &[f32; 4]| glam::DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
+        Ok(drawn.iter().zip(&at).map(|(s, a)| LightDraw { d: d(s), pdf: s[3] as f64, pdf_at_d: a[0] as f64 }).collect())
+    }
 }

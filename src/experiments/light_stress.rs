@@ -3,7 +3,8 @@
 //! a sliver triangle of near-zero and of zero area, a rectangle and a disk seen edge-on and
 //! nearly so, a shading point inside the sphere and on its surface — drawn at the stress
 //! uniforms ([`super::stress::uniforms`]: 0, 1 and their neighbours) on the GPU in f32 (the
-//! library's WGSL through `lobes check`'s passes, [`draws`]) and on the CPU in f64 (the twins).
+//! library's WGSL through `lobes check`'s passes, [`LightPasses`]) and on the CPU in f64 (the
+//! twins).
 //!
 //! Per sample: no NaN or infinity in d or the pdf, no negative pdf, d a unit vector where the
 //! pdf is positive; a non-degenerate light's every sample valid; and the pdf function at the
@@ -13,7 +14,7 @@
 
 use super::stress::{UNIT_BOUND_F32, UNIT_BOUND_F64, uniforms};
 use crate::check::CheckError;
-use crate::check::light::draws;
+use crate::check::light::LightPasses;
 use crate::engine::gpu::Gpu;
 use crate::reference::light::registry::{LIGHTS, LightParams, LightSpec, by_name};
 use glam::DVec3;
@@ -124,8 +125,9 @@ fn verdict(case: &LightCase, mut row: LightRow, unit_bound: f64) -> LightRow {
     row
 }
 
-/// The case's rows: the f64 twin on the CPU, and the WGSL on `gpu` if given.
-pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRow>, CheckError> {
+/// The case's rows: the f64 twin on the CPU, and the WGSL through `passes` (of `case.light`) if
+/// given.
+pub fn run_light_case(case: &LightCase, passes: Option<&LightPasses>) -> Result<Vec<LightRow>, CheckError> {
     let us = uniforms();
     // the last 64 of the stress uniforms are the RNG's, away from 0 and 1
     let interior = |i: usize| i + 64 >= us.len();
@@ -136,9 +138,9 @@ pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRo
         judge(&mut cpu, (s.d, s.pdf, (case.light.pdf_f64)(&case.params, s.d)), interior(i));
     }
     let mut rows = vec![verdict(case, cpu, UNIT_BOUND_F64)];
-    if let Some(gpu) = gpu {
+    if let Some(passes) = passes {
         let mut row = new("gpu f32");
-        for (i, s) in draws(gpu, case.light, &case.params, &us)?.into_iter().enumerate() {
+        for (i, s) in passes.draws(&case.params, &us)?.into_iter().enumerate() {
             judge(&mut row, (s.d, s.pdf, s.pdf_at_d), interior(i));
         }
         rows.push(verdict(case, row, UNIT_BOUND_F32));
@@ -148,9 +150,12 @@ pub fn run_light_case(case: &LightCase, gpu: Option<&Gpu>) -> Result<Vec<LightRo
 
 /// Every case of [`light_cases`].
 pub fn run_all_lights(gpu: Option<&Gpu>) -> Result<Vec<LightRow>, CheckError> {
+    // each light's passes composed once, for all of its cases
+    let passes = gpu.map(|gpu| LIGHTS.iter().map(|l| Ok((l.name, LightPasses::new(gpu, l)?))).collect::<Result<Vec<_>, CheckError>>()).transpose()?;
     let mut rows = Vec::new();
     for case in light_cases() {
-        rows.extend(run_light_case(&case, gpu)?);
+        let of_light = passes.as_ref().and_then(|p| p.iter().find(|(name, _)| *name == case.light.name)).map(|(_, p)| p);
+        rows.extend(run_light_case(&case, of_light)?);
     }
     Ok(rows)
 }
