@@ -44,12 +44,14 @@ def main():
                 t0 = time.perf_counter()
                 p = subprocess.run(command(binary, scene, extra, os.path.join(wd, name)), capture_output=True)
                 dt = time.perf_counter() - t0
-                if p.returncode != 0:
+                # exit 1 is a finished run or check with a failed verdict (a broken sampler's)
+                if p.returncode not in (0, 1):
                     sys.exit(f"{name}: exit {p.returncode}\n{p.stderr.decode()}")
                 if r > 0:
                     times[name].append(dt)
-                    if scene == "check" and json.loads(p.stdout).get("gpu_seconds") is not None:
-                        gpu[name].append(json.loads(p.stdout)["gpu_seconds"])
+                    seconds = json.loads(p.stdout).get("gpu_seconds") if scene == "check" else None
+                    if seconds is not None:
+                        gpu[name].append(seconds)
     first = statistics.median(times[builds[0][0]])
     print(f"load average {os.getloadavg()[0]:.1f}")
     for n, v in times.items():

@@ -797,14 +797,10 @@ pub const CONDITIONING_ULPS: f64 = 4.0;
 /// the grid.
 pub(super) fn params_of(sampler: &UserSampler, settings: &Settings) -> Params {
     let (rows, cols) = settings.grid(&sampler.domain);
-    let mut user = [[0f32; 4]; 4];
-    for (i, p) in settings.params.iter().enumerate() {
-        user[i / 4][i % 4] = *p as f32;
-    }
     let wi = super::incident(settings.incident_theta, settings.incident_phi);
     let bounds = sampler.domain.uniform_bounds();
     Params {
-        user,
+        user: Params::user_numbers(&settings.params),
         wi: [wi[0], wi[1], wi[2], 0.0],
         bounds,
         seed: split(settings.seed),

@@ -79,11 +79,7 @@ impl<'g> LightPasses<'g> {
     /// The draws with geometry `params` at each u: the sample map (`lobes_map`), then the pdf at
     /// the drawn directions (`lobes_conditioning`).
     pub fn draws(&self, params: &LightParams, us: &[[f64; 2]]) -> Result<Vec<LightDraw>, CheckError> {
-        let mut user = [[0f32; 4]; 4];
-        for (i, x) in params.iter().enumerate() {
-            user[i / 4][i % 4] = *x as f32;
-        }
-        let p = Params { user, ..bytemuck::Zeroable::zeroed() };
+        let p = Params { user: Params::user_numbers(params), ..bytemuck::Zeroable::zeroed() };
         let drawn = self.passes.map(&p, &us.iter().map(|u| [u[0] as f32, u[1] as f32, 0.0, 0.0]).collect::<Vec<_>>())?;
         let at = self.passes.conditioning(&p, &drawn.iter().map(|s| [s[0], s[1], s[2]]).collect::<Vec<_>>())?;
         let d = |s: &[f32; 4]| glam::DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);

@@ -645,11 +645,7 @@ impl<'g> WgslIntegrand<'g> {
         if params.len() > MAX_PARAMS {
             return Err(CheckError::Input(format!("{} params given, at most {MAX_PARAMS} fit `params: array<vec4<f32>, 4>`", params.len())));
         }
-        let mut p: Params = bytemuck::Zeroable::zeroed();
-        for (i, v) in params.iter().enumerate() {
-            p.user[i / 4][i % 4] = *v as f32;
-        }
-        p.wi = [wi.x as f32, wi.y as f32, wi.z as f32, 0.0];
+        let p = Params { user: Params::user_numbers(params), wi: [wi.x as f32, wi.y as f32, wi.z as f32, 0.0], ..bytemuck::Zeroable::zeroed() };
         sphere_integral::<CheckError>(&(&self.passes, &p))
     }
 }

@@ -66,6 +66,16 @@ impl Params {
         p
     }
 
+    /// A user's sampler's numbers (at most 16) as the WGSL reads them, `params[i / 4][i % 4]`,
+    /// rounded to f32 and zero-padded.
+    pub fn user_numbers(numbers: &[f64]) -> [[f32; 4]; 4] {
+        let mut user = [[0f32; 4]; 4];
+        for (i, x) in numbers.iter().enumerate() {
+            user[i / 4][i % 4] = *x as f32;
+        }
+        user
+    }
+
     /// As `self`, counting the tile of bins from `first` on.
     pub fn tile(self, first: u32) -> Self {
         Self { tile_first: first, ..self }
